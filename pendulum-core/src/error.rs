@@ -1,0 +1,87 @@
+//! The one error type of the crate: every variant names the bad value and where it is.
+
+/// Everything that can go wrong when building a chain or evaluating a model.
+///
+/// Link numbers (`link`) are 1-based, as in the seed document (link 1 hangs from the
+/// pivot); indices into vectors (`index`) are 0-based, as in Rust.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A chain was asked for with no links.
+    #[error("a chain needs at least one link, got 0")]
+    NoLinks,
+    /// A vector has the wrong number of entries.
+    #[error("{what} has {got} entries, expected {expected}")]
+    LengthMismatch {
+        /// Which vector (`"masses"`, `"q"`, `"torque"`, ...).
+        what: &'static str,
+        /// The length the chain or model needs.
+        expected: usize,
+        /// The length that was given.
+        got: usize,
+    },
+    /// A mass is zero, negative, infinite or NaN.
+    #[error("mass of link {link} must be finite and positive, got {value}")]
+    InvalidMass {
+        /// 1-based link number.
+        link: usize,
+        /// The offending value, kg.
+        value: f64,
+    },
+    /// A length is zero, negative, infinite or NaN.
+    #[error("length of link {link} must be finite and positive, got {value}")]
+    InvalidLength {
+        /// 1-based link number.
+        link: usize,
+        /// The offending value, m.
+        value: f64,
+    },
+    /// Gravity is negative, infinite or NaN.
+    #[error("gravity g must be finite and non-negative, got {value}")]
+    InvalidGravity {
+        /// The offending value, m/s².
+        value: f64,
+    },
+    /// A damping coefficient is negative, infinite or NaN.
+    #[error("damping of link {link} must be finite and non-negative, got {value}")]
+    InvalidDamping {
+        /// 1-based link number.
+        link: usize,
+        /// The offending value, N·m·s.
+        value: f64,
+    },
+    /// A state or input entry is infinite or NaN.
+    #[error("{what}[{index}] must be finite, got {value}")]
+    NonFinite {
+        /// Which vector (`"q"`, `"qd"`, `"torque"`, `"pivot_acceleration"`).
+        what: &'static str,
+        /// 0-based index into that vector.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A link of a spatial (θ, φ) model points straight down or up, where φ is undefined
+    /// and the mass matrix is singular.
+    #[error(
+        "link {link} sits at the spherical-angle singularity: theta = {theta} rad \
+         (|sin theta| = {sin_theta:e} < {tolerance:e}); the (theta, phi) coordinates cannot \
+         give its phi acceleration there"
+    )]
+    SingularAngle {
+        /// 1-based link number.
+        link: usize,
+        /// The link's polar angle θ, rad.
+        theta: f64,
+        /// |sin θ|.
+        sin_theta: f64,
+        /// The threshold below which |sin θ| counts as singular.
+        tolerance: f64,
+    },
+    /// The mass matrix failed to factor as symmetric positive definite (only possible
+    /// through round-off in extreme parameter ranges).
+    #[error("the mass matrix is not numerically positive definite at this state")]
+    NotPositiveDefinite,
+}
+
+/// The crate's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

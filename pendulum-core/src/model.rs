@@ -1,0 +1,201 @@
+//! The trait every chain model implements, generated fixed-N and generic dynamic-N alike.
+
+use nalgebra::{DefaultAllocator, Dim, DimName, OMatrix, OVector, allocator::Allocator};
+
+use crate::{Chain, Error, Result};
+
+/// The allocator bounds a [`Model`] needs, in one name.
+///
+/// Write `DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>` once in a generic
+/// function instead of four `Allocator` bounds.
+pub trait ModelAlloc<L: Dim, D: Dim, S: DimName>:
+    Allocator<L> + Allocator<D> + Allocator<D, D> + Allocator<S>
+{
+}
+
+impl<L: Dim, D: Dim, S: DimName, A> ModelAlloc<L, D, S> for A where
+    A: Allocator<L> + Allocator<D> + Allocator<D, D> + Allocator<S>
+{
+}
+
+/// What acts on the chain from outside at one instant.
+///
+/// `torque` holds the generalized forces `σ` conjugate to each coordinate (N·m; eq 26),
+/// `pivot_acceleration` the pivot's acceleration `p̈` (m/s²) in the model's space
+/// (2 components planar, 3 spatial). A driven pivot enters the equations only through
+/// `p̈` (DESIGN.md).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inputs<D: Dim, S: DimName>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    /// Generalized torques `σ`, one per coordinate, N·m.
+    pub torque: OVector<f64, D>,
+    /// Pivot acceleration `p̈`, m/s².
+    pub pivot_acceleration: OVector<f64, S>,
+}
+
+impl<D: Dim, S: DimName> Inputs<D, S>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    /// No torque, pivot at rest.
+    pub fn zeros(dof: D) -> Self {
+        Self {
+            torque: OVector::zeros_generic(dof, nalgebra::U1),
+            pivot_acceleration: OVector::zeros_generic(S::name(), nalgebra::U1),
+        }
+    }
+}
+
+/// An n-link chain's equations of motion in generalized coordinates `q`:
+///
+/// ```text
+/// M(q) q̈ + c(q, q̇) + k(q) + d(q, p̈) = Q(q, q̇, σ)
+/// ```
+///
+/// with `M` the mass matrix, `c` the terms quadratic in the rates, `k = ∂U/∂q` the
+/// gravity terms, `d` the terms of the pivot acceleration and `Q` the non-conservative
+/// generalized forces (torques and damping). This is the sympy reference's form
+/// (`reference/README.md`); in the document's planar notation (eq 25)
+/// `C = M`, `S θ̇² = −c`, `h = k`, `f = Q`.
+///
+/// Building blocks write into `&mut` outputs and assume the vectors have
+/// [`dof`](Model::dof) entries (fixed-size models enforce it by type; dynamic ones
+/// panic like nalgebra on a mismatch). [`accelerations`](Model::accelerations) is the
+/// checked entry point: it validates sizes and finiteness and returns errors.
+pub trait Model
+where
+    DefaultAllocator: ModelAlloc<Self::Links, Self::Dof, Self::Space>,
+{
+    /// Number of links as a dimension (`Const<N>` or `Dyn`).
+    type Links: Dim;
+    /// Number of generalized coordinates (`n` planar, `2n` spatial).
+    type Dof: Dim;
+    /// The pivot's space: `U2` planar (x, y), `U3` spatial (x, y, z).
+    type Space: DimName;
+
+    /// The chain's parameters.
+    fn chain(&self) -> &Chain<Self::Links>;
+
+    /// Number of generalized coordinates as a dimension.
+    fn dof(&self) -> Self::Dof;
+
+    /// Mass matrix `M(q)` (kg·m²), symmetric; positive definite away from singularities.
+    fn mass_matrix(&self, q: &OVector<f64, Self::Dof>, out: &mut OMatrix<f64, Self::Dof, Self::Dof>);
+
+    /// Velocity terms `c(q, q̇)` (N·m), homogeneous quadratic in `q̇`: Coriolis and
+    /// centrifugal terms as they stand on the left-hand side.
+    fn velocity_terms(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    );
+
+    /// Gravity terms `k(q) = ∂U/∂q` (N·m).
+    fn gravity_terms(&self, q: &OVector<f64, Self::Dof>, out: &mut OVector<f64, Self::Dof>);
+
+    /// Pivot terms `d(q, p̈) = Σ_k m_k (∂r_k/∂q)ᵀ p̈` (N·m), linear in the pivot
+    /// acceleration `p̈` (m/s²).
+    fn pivot_terms(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        pivot_acceleration: &OVector<f64, Self::Space>,
+        out: &mut OVector<f64, Self::Dof>,
+    );
+
+    /// Non-conservative generalized forces `Q = σ − ∂D/∂q̇` (N·m): torques `σ` and the
+    /// damping of the Rayleigh function `D = ½ Σ λ_i |u̇_i|²` (`u_i` link i's unit
+    /// direction). Planar this is eq 26, `Q_i = σ_i − λ_i θ̇_i`.
+    fn generalized_forces(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        torque: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    );
+
+    /// Kinetic energy `T` (J) relative to the pivot (pivot at rest).
+    fn kinetic_energy(&self, q: &OVector<f64, Self::Dof>, qd: &OVector<f64, Self::Dof>) -> f64;
+
+    /// Potential energy `U = Σ m_i g (height of mass i above the pivot)` (J).
+    fn potential_energy(&self, q: &OVector<f64, Self::Dof>) -> f64;
+
+    /// Errors when the coordinates themselves are unusable at `q` (the spatial model's
+    /// `sin θ_i = 0`). Planar models have no such states.
+    fn check_configuration(&self, _q: &OVector<f64, Self::Dof>) -> Result<()> {
+        Ok(())
+    }
+
+    /// Accelerations `q̈ = M⁻¹ (Q − c − k − d)` (rad/s²), by a symmetric
+    /// positive-definite (Cholesky) solve.
+    ///
+    /// Errors: [`Error::LengthMismatch`] or [`Error::NonFinite`] for bad inputs,
+    /// [`Error::SingularAngle`] at a coordinate singularity,
+    /// [`Error::NotPositiveDefinite`] if the factorisation fails.
+    fn accelerations(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        inputs: &Inputs<Self::Dof, Self::Space>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) -> Result<()> {
+        check_inputs(self.dof().value(), q, qd, inputs)?;
+        self.check_configuration(q)?;
+        let dof = self.dof();
+        let mut mass = OMatrix::<f64, Self::Dof, Self::Dof>::zeros_generic(dof, dof);
+        self.mass_matrix(q, &mut mass);
+        let mut tmp = OVector::<f64, Self::Dof>::zeros_generic(dof, nalgebra::U1);
+        self.generalized_forces(q, qd, &inputs.torque, out);
+        self.velocity_terms(q, qd, &mut tmp);
+        *out -= &tmp;
+        self.gravity_terms(q, &mut tmp);
+        *out -= &tmp;
+        self.pivot_terms(q, &inputs.pivot_acceleration, &mut tmp);
+        *out -= &tmp;
+        let cholesky = nalgebra::Cholesky::new(mass).ok_or(Error::NotPositiveDefinite)?;
+        cholesky.solve_mut(out);
+        if out.iter().all(|a| a.is_finite()) { Ok(()) } else { Err(Error::NotPositiveDefinite) }
+    }
+
+    /// Total mechanical energy `H = T + U` (J) relative to the pivot.
+    fn energy(&self, q: &OVector<f64, Self::Dof>, qd: &OVector<f64, Self::Dof>) -> f64 {
+        self.kinetic_energy(q, qd) + self.potential_energy(q)
+    }
+
+    /// No torque and a pivot at rest, sized for this model.
+    fn zero_inputs(&self) -> Inputs<Self::Dof, Self::Space> {
+        Inputs::zeros(self.dof())
+    }
+}
+
+/// Checks that `q`, `q̇` and the inputs have `dof` entries and are finite.
+///
+/// Called by every model's [`Model::accelerations`], generated ones included.
+pub fn check_inputs<D: Dim, S: DimName>(
+    dof: usize,
+    q: &OVector<f64, D>,
+    qd: &OVector<f64, D>,
+    inputs: &Inputs<D, S>,
+) -> Result<()>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    let vectors: [(&'static str, &[f64]); 4] = [
+        ("q", q.as_slice()),
+        ("qd", qd.as_slice()),
+        ("torque", inputs.torque.as_slice()),
+        ("pivot_acceleration", inputs.pivot_acceleration.as_slice()),
+    ];
+    for (what, v) in vectors {
+        let expected = if what == "pivot_acceleration" { S::dim() } else { dof };
+        if v.len() != expected {
+            return Err(Error::LengthMismatch { what, expected, got: v.len() });
+        }
+        if let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(Error::NonFinite { what, index, value });
+        }
+    }
+    Ok(())
+}

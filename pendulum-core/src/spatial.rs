@@ -1,0 +1,306 @@
+//! The generic spatial chain in spherical angles (θ, φ): the document's eq 30, as derived.
+
+use nalgebra::{
+    DefaultAllocator, Dim, DimMul, DimProd, Dyn, OMatrix, OVector, U2, U3, Vector3, allocator::Allocator,
+};
+
+use crate::{Chain, Error, Model, Result};
+
+/// Below this `|sin θ_i|` a spatial (θ, φ) model refuses to compute accelerations.
+///
+/// The φ rows of the mass matrix scale with `sin θ_i`, so its condition number grows like
+/// `1 / sin² θ_i`: at `1e-6` about twelve of sixteen digits are already gone.
+pub const SINGULARITY_TOLERANCE: f64 = 1e-6;
+
+/// [`Error::SingularAngle`] if `|sin θ|` of link `link` (1-based) is below
+/// [`SINGULARITY_TOLERANCE`].
+pub fn check_polar_angle(link: usize, theta: f64) -> Result<()> {
+    let sin_theta = theta.sin().abs();
+    if sin_theta < SINGULARITY_TOLERANCE {
+        Err(Error::SingularAngle { link, theta, sin_theta, tolerance: SINGULARITY_TOLERANCE })
+    } else {
+        Ok(())
+    }
+}
+
+/// A spatial chain in spherical angles: `θ_i` from the −z axis, `φ_i` the azimuth from
+/// +x (eqs 27–29), for any number of links `L`.
+///
+/// Coordinates are ordered as the document's block form (eq 30):
+/// `q = (θ_1, …, θ_n, φ_1, …, φ_n)`. With link direction `u_i = (sin θ_i cos φ_i,
+/// sin θ_i sin φ_i, −cos θ_i)` and `W_ij = M_max(i,j) l_i l_j`, the kinetic energy is
+/// `T = ½ Σ_ij W_ij u̇_i·u̇_j`, so with `J_a = ∂u/∂q_a`:
+/// - mass matrix `M_ab = W_ij J_a·J_b` — the blocks A11, A12, A21, A22 of eqs 31–34;
+/// - velocity terms `c_a = Σ_j W_ij J_a·ü_j|_{q̈=0}`, where `ü_j|_{q̈=0} = −u_j θ̇_j² +
+///   ∂²u_j/∂φ_j² φ̇_j² + 2 ∂²u_j/∂θ_j∂φ_j θ̇_j φ̇_j`; eqs 35–39 print some of these
+///   wrongly (`reference/ERRATA.md`);
+/// - gravity `k_θi = M_i g l_i sin θ_i` (eq 40), `k_φi = 0`;
+/// - pivot `d_a = M_i l_i J_a·p̈`;
+/// - forces `Q_θi = σ_θi − λ_i θ̇_i`, `Q_φi = σ_φi − λ_i sin²θ_i φ̇_i` (Rayleigh
+///   `D = ½ Σ λ_i |u̇_i|²`, the 3D analogue of eq 26).
+///
+/// These coordinates are singular where `sin θ_i = 0` (a link straight down, where a
+/// chain rests): [`Model::accelerations`] then returns [`Error::SingularAngle`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spatial<L: Dim = Dyn>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    chain: Chain<L>,
+}
+
+impl<L: Dim> Spatial<L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    /// The spatial model of `chain`.
+    pub fn new(chain: Chain<L>) -> Self {
+        Self { chain }
+    }
+
+    fn weight(&self, i: usize, j: usize) -> f64 {
+        let c = &self.chain;
+        c.tail_masses()[i.max(j)] * c.lengths()[i] * c.lengths()[j]
+    }
+}
+
+impl<L: Dim> From<Chain<L>> for Spatial<L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    fn from(chain: Chain<L>) -> Self {
+        Self::new(chain)
+    }
+}
+
+/// The geometry of one link's direction at angles (θ, φ).
+struct Frame {
+    /// `∂u/∂θ`.
+    d_theta: Vector3<f64>,
+    /// `∂u/∂φ`.
+    d_phi: Vector3<f64>,
+    /// `∂²u/∂θ² = −u`.
+    d_theta2: Vector3<f64>,
+    /// `∂²u/∂φ²`.
+    d_phi2: Vector3<f64>,
+    /// `∂²u/∂θ∂φ`.
+    d_theta_phi: Vector3<f64>,
+}
+
+impl Frame {
+    fn new(theta: f64, phi: f64) -> Self {
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        Self {
+            d_theta: Vector3::new(ct * cp, ct * sp, st),
+            d_phi: Vector3::new(-st * sp, st * cp, 0.0),
+            d_theta2: Vector3::new(-st * cp, -st * sp, ct),
+            d_phi2: Vector3::new(-st * cp, -st * sp, 0.0),
+            d_theta_phi: Vector3::new(-ct * sp, ct * cp, 0.0),
+        }
+    }
+
+    /// `u̇ = ∂u/∂θ θ̇ + ∂u/∂φ φ̇`.
+    fn velocity(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
+        self.d_theta * theta_dot + self.d_phi * phi_dot
+    }
+
+    /// `ü` at `q̈ = 0`: the part of the acceleration quadratic in the rates.
+    fn centripetal(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
+        self.d_theta2 * (theta_dot * theta_dot)
+            + self.d_phi2 * (phi_dot * phi_dot)
+            + self.d_theta_phi * (2.0 * theta_dot * phi_dot)
+    }
+}
+
+impl<L> Spatial<L>
+where
+    L: Dim + DimMul<U2>,
+    DefaultAllocator: Allocator<L> + Allocator<DimProd<L, U2>>,
+{
+    fn frames(&self, q: &OVector<f64, DimProd<L, U2>>) -> Vec<Frame> {
+        let n = self.chain.links();
+        (0..n).map(|i| Frame::new(q[i], q[n + i])).collect()
+    }
+}
+
+impl<L> Model for Spatial<L>
+where
+    L: Dim + DimMul<U2>,
+    DefaultAllocator:
+        Allocator<L> + Allocator<DimProd<L, U2>> + Allocator<DimProd<L, U2>, DimProd<L, U2>> + Allocator<U3>,
+{
+    type Links = L;
+    type Dof = DimProd<L, U2>;
+    type Space = U3;
+
+    fn chain(&self) -> &Chain<L> {
+        &self.chain
+    }
+
+    fn dof(&self) -> Self::Dof {
+        self.chain.link_dim().mul(U2)
+    }
+
+    fn mass_matrix(&self, q: &OVector<f64, Self::Dof>, out: &mut OMatrix<f64, Self::Dof, Self::Dof>) {
+        let n = self.chain.links();
+        let f = self.frames(q);
+        for i in 0..n {
+            for j in 0..n {
+                let w = self.weight(i, j);
+                out[(i, j)] = w * f[i].d_theta.dot(&f[j].d_theta);
+                out[(i, n + j)] = w * f[i].d_theta.dot(&f[j].d_phi);
+                out[(n + i, j)] = w * f[i].d_phi.dot(&f[j].d_theta);
+                out[(n + i, n + j)] = w * f[i].d_phi.dot(&f[j].d_phi);
+            }
+        }
+    }
+
+    fn velocity_terms(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        let n = self.chain.links();
+        let f = self.frames(q);
+        let acc: Vec<Vector3<f64>> = (0..n).map(|j| f[j].centripetal(qd[j], qd[n + j])).collect();
+        for i in 0..n {
+            let (mut ct, mut cp) = (0.0, 0.0);
+            for (j, a) in acc.iter().enumerate() {
+                let w = self.weight(i, j);
+                ct += w * f[i].d_theta.dot(a);
+                cp += w * f[i].d_phi.dot(a);
+            }
+            out[i] = ct;
+            out[n + i] = cp;
+        }
+    }
+
+    fn gravity_terms(&self, q: &OVector<f64, Self::Dof>, out: &mut OVector<f64, Self::Dof>) {
+        let c = &self.chain;
+        let n = c.links();
+        for i in 0..n {
+            out[i] = c.tail_masses()[i] * c.gravity() * c.lengths()[i] * q[i].sin();
+            out[n + i] = 0.0;
+        }
+    }
+
+    fn pivot_terms(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        a: &OVector<f64, U3>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        let c = &self.chain;
+        let n = c.links();
+        let a = Vector3::new(a[0], a[1], a[2]);
+        for (i, f) in self.frames(q).iter().enumerate() {
+            let ml = c.tail_masses()[i] * c.lengths()[i];
+            out[i] = ml * f.d_theta.dot(&a);
+            out[n + i] = ml * f.d_phi.dot(&a);
+        }
+    }
+
+    fn generalized_forces(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        torque: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        let c = &self.chain;
+        let n = c.links();
+        for i in 0..n {
+            let s = q[i].sin();
+            out[i] = torque[i] - c.damping()[i] * qd[i];
+            out[n + i] = torque[n + i] - c.damping()[i] * s * s * qd[n + i];
+        }
+    }
+
+    /// `T = ½ Σ_k m_k |v_k|²` with `v_k = Σ_{j≤k} l_j u̇_j` (eq 48 as derived).
+    fn kinetic_energy(&self, q: &OVector<f64, Self::Dof>, qd: &OVector<f64, Self::Dof>) -> f64 {
+        let c = &self.chain;
+        let n = c.links();
+        let mut v = Vector3::zeros();
+        let mut t = 0.0;
+        for (k, f) in self.frames(q).iter().enumerate() {
+            v += f.velocity(qd[k], qd[n + k]) * c.lengths()[k];
+            t += 0.5 * c.masses()[k] * v.norm_squared();
+        }
+        t
+    }
+
+    /// `U = −Σ_i M_i g l_i cos θ_i` (eq 12, unchanged in 3D).
+    fn potential_energy(&self, q: &OVector<f64, Self::Dof>) -> f64 {
+        let c = &self.chain;
+        -(0..c.links()).map(|i| c.tail_masses()[i] * c.gravity() * c.lengths()[i] * q[i].cos()).sum::<f64>()
+    }
+
+    fn check_configuration(&self, q: &OVector<f64, Self::Dof>) -> Result<()> {
+        for i in 0..self.chain.links() {
+            check_polar_angle(i + 1, q[i])?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use nalgebra::DVector;
+
+    fn single(theta: f64, phi: f64, theta_dot: f64, phi_dot: f64) -> Result<DVector<f64>> {
+        let model = Spatial::new(Chain::<Dyn>::new(&[1.5], &[0.8], 9.81).unwrap());
+        let q = DVector::from_vec(vec![theta, phi]);
+        let qd = DVector::from_vec(vec![theta_dot, phi_dot]);
+        let mut a = DVector::zeros(2);
+        model.accelerations(&q, &qd, &model.zero_inputs(), &mut a).map(|()| a)
+    }
+
+    #[test]
+    fn spherical_pendulum_matches_its_textbook_equations() {
+        // θ̈ = sinθ cosθ φ̇² − (g/l) sinθ,  φ̈ = −2 cotθ θ̇ φ̇.
+        let (th, ph, thd, phd) = (0.9, 2.0, 0.7, -1.3);
+        let a = single(th, ph, thd, phd).unwrap();
+        assert_relative_eq!(
+            a[0],
+            th.sin() * th.cos() * phd * phd - 9.81 / 0.8 * th.sin(),
+            max_relative = 1e-13
+        );
+        assert_relative_eq!(a[1], -2.0 * thd * phd / th.tan(), max_relative = 1e-13);
+    }
+
+    #[test]
+    fn fixed_size_generic_agrees_with_dynamic() {
+        use nalgebra::{Const, SVector};
+        let masses = [1.0, 0.3, 2.0];
+        let lengths = [0.5, 1.0, 0.7];
+        let fixed = Spatial::new(Chain::<Const<3>>::new(&masses, &lengths, 9.81).unwrap());
+        let dynamic = Spatial::new(Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap());
+        let q = [0.4, 1.0, 2.5, 0.1, -2.0, 3.0];
+        let qd = [1.0, -0.5, 0.3, 2.0, 0.7, -1.1];
+        let mut af = SVector::<f64, 6>::zeros();
+        let mut ad = DVector::zeros(6);
+        fixed.accelerations(&SVector::from(q), &SVector::from(qd), &fixed.zero_inputs(), &mut af).unwrap();
+        dynamic
+            .accelerations(
+                &DVector::from_row_slice(&q),
+                &DVector::from_row_slice(&qd),
+                &dynamic.zero_inputs(),
+                &mut ad,
+            )
+            .unwrap();
+        assert_relative_eq!(af.as_slice(), ad.as_slice(), max_relative = 1e-14);
+    }
+
+    #[test]
+    fn hanging_straight_down_is_a_singular_angle_error() {
+        for theta in [0.0, 1e-9, std::f64::consts::PI] {
+            let err = single(theta, 0.3, 0.0, 0.0).unwrap_err();
+            assert!(matches!(err, Error::SingularAngle { link: 1, .. }), "{err}");
+        }
+        assert!(single(1e-3, 0.3, 0.0, 0.0).is_ok());
+    }
+}

@@ -1,0 +1,1 @@
+//! Physics-level integration tests live in `tests/`; this library is empty.

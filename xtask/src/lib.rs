@@ -1,0 +1,23 @@
+//! Project tasks behind `cargo xtask`: the sympy reference, `verify`, benchmarks.
+//!
+//! One module per task or concern; `main.rs` is a flat match on subcommands.
+
+pub mod case;
+pub mod document;
+pub mod expr;
+pub mod models;
+pub mod regen;
+pub mod sample;
+pub mod verify;
+
+use std::path::PathBuf;
+
+/// The workspace root (the parent of this crate's directory).
+pub fn workspace_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace root").to_path_buf()
+}
+
+/// Where the committed reference case files live.
+pub fn cases_dir() -> PathBuf {
+    workspace_root().join("reference").join("cases")
+}
