@@ -81,6 +81,36 @@ pub enum Error {
     /// through round-off in extreme parameter ranges).
     #[error("the mass matrix is not numerically positive definite at this state")]
     NotPositiveDefinite,
+    /// The implicit stage equations of an integrator step did not converge: the Newton
+    /// iterations (simplified, then full) diverged, stalled above round-off, or ran out of
+    /// iterations. The state is left as it was before the step.
+    #[error(
+        "the stage equations of the step from t = {t} s with h = {h} s did not converge \
+         after {iterations} Newton iterations; try a smaller step"
+    )]
+    StageSolveFailed {
+        /// Time at the start of the step, s.
+        t: f64,
+        /// The step size, s.
+        h: f64,
+        /// Newton iterations spent on the step, over all attempts.
+        iterations: usize,
+    },
+    /// An integrator step produced an infinite or NaN state. The state is left as it was
+    /// before the step.
+    #[error("the step from t = {t} s with h = {h} s produced a non-finite state")]
+    NonFiniteState {
+        /// Time at the start of the step, s.
+        t: f64,
+        /// The step size, s.
+        h: f64,
+    },
+    /// An integrator was asked for a step of size zero, infinite or NaN.
+    #[error("step size h must be finite and non-zero, got {h}")]
+    InvalidStepSize {
+        /// The offending value, s.
+        h: f64,
+    },
 }
 
 /// The crate's result type.

@@ -11,12 +11,15 @@
 
 mod chain;
 mod error;
+mod first_order;
+pub mod integrate;
 mod model;
 mod planar;
 mod spatial;
 
 pub use chain::Chain;
 pub use error::{Error, Result};
+pub use first_order::{FirstOrder, InputsAt};
 pub use model::{Inputs, Model, ModelAlloc, check_inputs};
 pub use planar::Planar;
 pub use spatial::{SINGULARITY_TOLERANCE, Spatial, check_polar_angle};

@@ -1,1 +1,58 @@
+//! `model!`: fixed-N chain models as straight-line code, implementing
+//! `pendulum_core::Model` with the same results as the generic `Planar` and `Spatial`.
+//!
+//! ```
+//! use pendulum_core::{Chain, Model};
+//!
+//! pendulum_macros::model! {
+//!     /// An unrolled triple pendulum.
+//!     pub struct Planar3 { kind: planar, links: 3 }
+//!     pub(crate) struct Spatial2 { kind: spatial, links: 2 }
+//! }
+//!
+//! let model = Planar3::new(Chain::uniform(3, 1.0, 0.5, 9.81)?);
+//! let q = nalgebra::Vector3::new(0.3, -0.2, 1.0);
+//! let mut qdd = nalgebra::Vector3::zeros();
+//! model.accelerations(&q, &nalgebra::Vector3::zeros(), &model.zero_inputs(), &mut qdd)?;
+//! # Ok::<(), pendulum_core::Error>(())
+//! ```
+//!
+//! See [`model!`] for the syntax and what it generates; `expanded/` holds the formatted
+//! expansion for a few `n`, kept current by a unit test.
+//!
+//! Inside: `parse` reads the input, `plan` describes what to emit as plain data,
+//! `codegen` turns the plan into tokens.
+
+mod codegen;
+mod parse;
+mod plan;
+
 use proc_macro::TokenStream;
+
+/// Generates one fixed-N chain model per item
+/// `#[attrs] vis struct Name { kind: planar|spatial, links: N }`.
+///
+/// - `kind: planar`: coordinates `q = (θ_1 … θ_n)`, `Dof = Const<n>`, `Space = U2`;
+///   `kind: spatial`: `q = (θ_1 … θ_n, φ_1 … φ_n)`, `Dof = Const<2n>`, `Space = U3`.
+/// - `links`: an integer literal from 1 to 16.
+///
+/// Each item becomes `vis struct Name { chain: Chain<Const<n>> }` (the attributes and doc
+/// comments pass through; `Debug`, `Clone` and `PartialEq` are derived) with
+/// `vis fn new(chain) -> Self`, `From<Chain<Const<n>>>` and an impl of
+/// `pendulum_core::Model` that gives the same results as `pendulum_core::Planar` /
+/// `pendulum_core::Spatial`, to round-off. Every method is straight-line code: each
+/// angle's sine and cosine computed once, angle differences from the angle-sum
+/// identities, tail masses and `W_ij = M_max(i,j) l_i l_j` as named temporaries, no loops
+/// and no allocation. `accelerations` checks its inputs (`check_inputs`, and for spatial
+/// models `check_polar_angle` on every link), then solves `M q̈ = Q − c − k − d` by an
+/// unrolled Cholesky factorisation, returning `Error::NotPositiveDefinite` if a pivot is
+/// not positive or the result is not finite.
+///
+/// Mistakes in the input are compile errors pointing at the offending token, all
+/// reported at once.
+#[proc_macro]
+pub fn model(input: TokenStream) -> TokenStream {
+    syn::parse::<parse::Input>(input)
+        .map_or_else(|e| e.to_compile_error(), |input| codegen::expand(&input))
+        .into()
+}

@@ -1,0 +1,182 @@
+//! The adapter that turns a chain [`Model`] into a first-order [`System`]
+//! `x' = f(t, x)` with `x = (q, q̇)`, for the integrators.
+
+use std::borrow::Cow;
+
+use nalgebra::{DefaultAllocator, Dim, DimMul, DimName, DimProd, OVector, U1, U2, allocator::Allocator};
+
+use crate::integrate::{System, SystemAlloc};
+use crate::{Inputs, Model, ModelAlloc, Result};
+
+/// The inputs (torques, pivot acceleration) acting at time `t`: the seam for a
+/// time-dependent drive.
+///
+/// Constant [`Inputs`] implement it (borrowed, no copy), and so does any closure
+/// `Fn(f64) -> Inputs` (`t` in s).
+pub trait InputsAt<D: Dim, S: DimName>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    /// The inputs at time `t` (s).
+    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>>;
+}
+
+impl<D: Dim, S: DimName> InputsAt<D, S> for Inputs<D, S>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    fn inputs_at(&self, _t: f64) -> Cow<'_, Inputs<D, S>> {
+        Cow::Borrowed(self)
+    }
+}
+
+impl<D: Dim, S: DimName, F: Fn(f64) -> Inputs<D, S>> InputsAt<D, S> for F
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>> {
+        Cow::Owned(self(t))
+    }
+}
+
+/// A chain model as the first-order system
+/// ```text
+/// x = (q, q̇),   x' = (q̇, q̈(q, q̇, inputs(t)))
+/// ```
+/// of dimension `2·dof` (`DimProd<M::Dof, U2>`: `Const<2N>` for fixed-size models, `Dyn`
+/// otherwise), with `q̈` from [`Model::accelerations`] (the document's eqs 51–52 for the
+/// double pendulum). `I` supplies the inputs at each time ([`InputsAt`]);
+/// [`new`](FirstOrder::new) uses none (no torque, pivot at rest).
+///
+/// The Jacobian is the finite-difference default of [`System::jacobian`].
+#[derive(Debug, Clone)]
+pub struct FirstOrder<M, I> {
+    model: M,
+    inputs: I,
+}
+
+impl<M: Model> FirstOrder<M, Inputs<M::Dof, M::Space>>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    /// The free chain: no torque, pivot at rest.
+    pub fn new(model: M) -> Self {
+        let inputs = model.zero_inputs();
+        Self { model, inputs }
+    }
+}
+
+impl<M: Model, I> FirstOrder<M, I>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
+{
+    /// The chain driven by `inputs` (constant [`Inputs`] or a closure of time).
+    pub fn with_inputs(model: M, inputs: I) -> Self {
+        Self { model, inputs }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// The inputs.
+    pub fn inputs(&self) -> &I {
+        &self.inputs
+    }
+
+    /// The state `x = (q, q̇)` (rad, rad/s).
+    pub fn state(
+        &self,
+        q: &OVector<f64, M::Dof>,
+        qd: &OVector<f64, M::Dof>,
+    ) -> OVector<f64, DimProd<M::Dof, U2>> {
+        let dim = self.model.dof().mul(U2);
+        OVector::from_iterator_generic(dim, U1, q.iter().chain(qd.iter()).copied())
+    }
+
+    /// Splits a state into `(q, q̇)`.
+    pub fn split(
+        &self,
+        x: &OVector<f64, DimProd<M::Dof, U2>>,
+    ) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>) {
+        let dof = self.model.dof();
+        let n = dof.value();
+        let q = OVector::from_iterator_generic(dof, U1, x.iter().take(n).copied());
+        let qd = OVector::from_iterator_generic(dof, U1, x.iter().skip(n).take(n).copied());
+        (q, qd)
+    }
+
+    /// Total mechanical energy `H = T + U` (J) of a state, relative to the pivot.
+    pub fn energy(&self, x: &OVector<f64, DimProd<M::Dof, U2>>) -> f64 {
+        let (q, qd) = self.split(x);
+        self.model.energy(&q, &qd)
+    }
+}
+
+impl<M: Model, I: InputsAt<M::Dof, M::Space>> System for FirstOrder<M, I>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<DimProd<M::Dof, U2>>,
+{
+    type Dim = DimProd<M::Dof, U2>;
+
+    fn dim(&self) -> Self::Dim {
+        self.model.dof().mul(U2)
+    }
+
+    /// `(q̇, q̈)`; errors of [`Model::accelerations`] pass through.
+    fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()> {
+        let (q, qd) = self.split(x);
+        let mut qdd = OVector::zeros_generic(self.model.dof(), U1);
+        self.model.accelerations(&q, &qd, &self.inputs.inputs_at(t), &mut qdd)?;
+        let n = qd.len();
+        for i in 0..n {
+            out[i] = qd[i];
+            out[n + i] = qdd[i];
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Const, DVector, Dyn, Vector2, Vector4};
+
+    use super::*;
+    use crate::{Chain, Planar};
+
+    #[test]
+    fn rhs_is_velocity_then_acceleration() {
+        let chain = Chain::<Const<2>>::new(&[1.0, 2.0], &[0.5, 1.5], 9.81).unwrap();
+        let model = Planar::new(chain);
+        let system = FirstOrder::new(model.clone());
+        let (q, qd) = (Vector2::new(0.3, -1.1), Vector2::new(2.0, 0.4));
+        let x: Vector4<f64> = system.state(&q, &qd);
+        let mut f = Vector4::zeros();
+        system.rhs(0.0, &x, &mut f).unwrap();
+        let mut qdd = Vector2::zeros();
+        model.accelerations(&q, &qd, &model.zero_inputs(), &mut qdd).unwrap();
+        assert_eq!(f, Vector4::new(qd[0], qd[1], qdd[0], qdd[1]));
+        assert_eq!(system.split(&x), (q, qd));
+    }
+
+    #[test]
+    fn a_closure_drives_the_inputs() {
+        let chain = Chain::<Dyn>::uniform(1, 1.0, 1.0, 0.0).unwrap();
+        let model = Planar::new(chain);
+        // σ(t) = t: the hanging pendulum without gravity accelerates as θ̈ = σ / (m l²).
+        let drive = |t: f64| {
+            let mut inputs = Inputs::<Dyn, U2>::zeros(Dyn(1));
+            inputs.torque[0] = t;
+            inputs
+        };
+        let system = FirstOrder::with_inputs(model, drive);
+        let x = DVector::from_vec(vec![0.0, 0.0]);
+        let mut f = DVector::zeros(2);
+        system.rhs(2.5, &x, &mut f).unwrap();
+        assert_eq!(f.as_slice(), &[0.0, 2.5]);
+        assert_eq!(system.dim(), Dyn(2));
+    }
+}

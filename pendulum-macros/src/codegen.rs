@@ -1,0 +1,534 @@
+//! Tokens from a [`Plan`]: the struct, its constructor and its `pendulum_core::Model` impl,
+//! as straight-line code (one `let` per symbol, in the plan's order).
+
+use std::collections::BTreeSet;
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::parse::{Input, ModelDef};
+use crate::plan::{Angle, Expr, Kind, Plan, Sym, Trig};
+
+/// Everything `model!` emits for its input.
+pub fn expand(input: &Input) -> TokenStream {
+    input.models.iter().map(model).collect()
+}
+
+fn ident(sym: Sym) -> Ident {
+    Ident::new(&sym.name(), Span::call_site())
+}
+
+fn index(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// `name` if the generated body uses it, `_name` otherwise (no unused-variable warnings).
+fn param(name: &str, used: bool) -> Ident {
+    if used { format_ident!("{name}") } else { format_ident!("_{name}") }
+}
+
+/// `a · b · c` with the term's constant in front when it is not ±1; the sign is the caller's.
+fn product(coef: f64, factors: &[Sym]) -> TokenStream {
+    let mut parts = factors.iter().map(|&s| {
+        let s = ident(s);
+        quote!(#s)
+    });
+    let magnitude = coef.abs();
+    let first = if magnitude == 1.0 {
+        parts.next().unwrap_or_else(|| quote!(1.0))
+    } else {
+        let lit = Literal::f64_unsuffixed(magnitude);
+        quote!(#lit)
+    };
+    parts.fold(first, |acc, p| quote!(#acc * #p))
+}
+
+fn expr(e: &Expr) -> TokenStream {
+    let mut terms = e.terms.iter();
+    let Some(first) = terms.next() else { return quote!(0.0) };
+    let p = product(first.coef, &first.factors);
+    let start = if first.coef < 0.0 { quote!(-#p) } else { p };
+    terms.fold(start, |acc, t| {
+        let p = product(t.coef, &t.factors);
+        if t.coef < 0.0 { quote!(#acc - #p) } else { quote!(#acc + #p) }
+    })
+}
+
+/// The `let` statements that compute `syms` (a sorted closure) from the chain and the
+/// arguments `q`, `qd`, `torque`, `pivot_acceleration`.
+fn lets(plan: &Plan, syms: &[Sym]) -> TokenStream {
+    let has = |f: fn(&Sym) -> bool| syms.iter().any(f);
+    let mut out = TokenStream::new();
+    // Each chain vector is borrowed once, each entry read once.
+    if has(|s| matches!(s, Sym::Mass(_))) {
+        out.extend(quote!(let masses = self.chain.masses();));
+    }
+    if has(|s| matches!(s, Sym::Tail(_))) {
+        out.extend(quote!(let tail_masses = self.chain.tail_masses();));
+    }
+    if has(|s| matches!(s, Sym::Length(_))) {
+        out.extend(quote!(let lengths = self.chain.lengths();));
+    }
+    if has(|s| matches!(s, Sym::Damping(_))) {
+        out.extend(quote!(let damping = self.chain.damping();));
+    }
+    let set: BTreeSet<Sym> = syms.iter().copied().collect();
+    for &sym in syms {
+        let name = ident(sym);
+        let stmt = match sym {
+            Sym::Gravity => quote!(let #name = self.chain.gravity();),
+            Sym::Mass(i) => vector_entry(&name, "masses", i),
+            Sym::Tail(i) => vector_entry(&name, "tail_masses", i),
+            Sym::Length(i) => vector_entry(&name, "lengths", i),
+            Sym::Damping(i) => vector_entry(&name, "damping", i),
+            Sym::Trig(angle, trig) => trig_let(plan, &set, angle, trig),
+            Sym::Rate(angle) => vector_entry(&name, "qd", plan.index(angle)),
+            Sym::Torque(angle) => vector_entry(&name, "torque", plan.index(angle)),
+            Sym::Pivot(axis) => vector_entry(&name, "pivot_acceleration", axis),
+            _ => {
+                let value = expr(&plan.definition(sym).expect("computed symbols have a definition"));
+                quote!(let #name = #value;)
+            }
+        };
+        out.extend(stmt);
+    }
+    out
+}
+
+fn vector_entry(name: &Ident, vector: &str, i: usize) -> TokenStream {
+    let vector = format_ident!("{vector}");
+    let i = index(i);
+    quote!(let #name = #vector[#i];)
+}
+
+/// `let (s, c) = q[i].sin_cos();` when both are needed (emitted with the sine), else the
+/// one that is.
+fn trig_let(plan: &Plan, set: &BTreeSet<Sym>, angle: Angle, trig: Trig) -> TokenStream {
+    let i = index(plan.index(angle));
+    let (sin, cos) = (Sym::Trig(angle, Trig::Sin), Sym::Trig(angle, Trig::Cos));
+    let both = set.contains(&sin) && set.contains(&cos);
+    let (s, c) = (ident(sin), ident(cos));
+    match (trig, both) {
+        (Trig::Sin, true) => quote!(let (#s, #c) = q[#i].sin_cos();),
+        (Trig::Cos, true) => TokenStream::new(),
+        (Trig::Sin, false) => quote!(let #s = q[#i].sin();),
+        (Trig::Cos, false) => quote!(let #c = q[#i].cos();),
+    }
+}
+
+/// A method body's computations: the lets for every symbol the outputs need.
+struct Body {
+    lets: TokenStream,
+    uses: BTreeSet<Sym>,
+}
+
+impl Body {
+    fn new<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
+        let roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
+        let syms = plan.closure(roots);
+        Body { lets: lets(plan, &syms), uses: syms.into_iter().collect() }
+    }
+
+    fn uses(&self, f: fn(&Sym) -> bool) -> bool {
+        self.uses.iter().any(f)
+    }
+
+    fn q(&self) -> Ident {
+        param("q", self.uses(|s| matches!(s, Sym::Trig(..))))
+    }
+
+    fn qd(&self) -> Ident {
+        param("qd", self.uses(|s| matches!(s, Sym::Rate(_))))
+    }
+}
+
+/// `out[a] = …;` for each coordinate: the symbol's definition inline, `0.0` where it is
+/// identically zero.
+fn vector_outputs(plan: &Plan, sym: fn(usize) -> Sym) -> (Body, TokenStream) {
+    let exprs: Vec<Expr> = plan
+        .per_coordinate(sym)
+        .into_iter()
+        .map(|s| s.and_then(|s| plan.definition(s)).unwrap_or_default())
+        .collect();
+    let body = Body::new(plan, &exprs);
+    let assigns = exprs.iter().enumerate().map(|(a, e)| {
+        let (a, value) = (index(a), expr(e));
+        quote!(out[#a] = #value;)
+    });
+    (body, quote!(#(#assigns)*))
+}
+
+fn model(def: &ModelDef) -> TokenStream {
+    let plan = Plan::new(def.kind, def.links);
+    let ModelDef { attrs, vis, ident: name, .. } = def;
+    let n = index(plan.links);
+    let dof = index(plan.dof());
+    let space = match plan.kind {
+        Kind::Planar => quote!(U2),
+        Kind::Spatial => quote!(U3),
+    };
+    let space_dim = index(plan.space());
+    let vector = quote!(SVector<f64, #dof>);
+    let matrix = quote!(SMatrix<f64, #dof, #dof>);
+
+    // A `#[cfg]` on the struct must also remove its impls.
+    let cfgs = attrs.iter().filter(|a| a.path().is_ident("cfg"));
+    let mut doc = Vec::new();
+    if attrs.iter().any(|a| a.path().is_ident("doc")) {
+        doc.push(String::new());
+    }
+    doc.push(match plan.kind {
+        Kind::Planar => format!(
+            " A planar chain of {n} links in straight-line code, generated by `pendulum_macros::model!`: \
+             coordinates `q = (θ_1 … θ_{n})` from the downward vertical, rad."
+        ),
+        Kind::Spatial => format!(
+            " A spatial chain of {n} links in straight-line code, generated by `pendulum_macros::model!`: \
+             coordinates `q = (θ_1 … θ_{n}, φ_1 … φ_{n})`, θ from −z and φ the azimuth from +x, rad."
+        ),
+    });
+
+    // mass_matrix
+    let entries: Vec<Expr> = (0..plan.dof())
+        .flat_map(|r| (0..=r).filter_map(move |c| plan.mass_entry(r, c)))
+        .map(Expr::of)
+        .collect();
+    let mass = Body::new(&plan, &entries);
+    let mass_q = mass.q();
+    let mass_lets = &mass.lets;
+    let mass_assigns = (0..plan.dof()).flat_map(|r| (0..plan.dof()).map(move |c| (r, c))).map(|(r, c)| {
+        let value = plan.mass_entry(r, c).map_or_else(|| quote!(0.0), |s| expr(&Expr::of(s)));
+        let (r, c) = (index(r), index(c));
+        quote!(out[(#r, #c)] = #value;)
+    });
+
+    let (velocity, velocity_assigns) = vector_outputs(&plan, Sym::VelocityTerm);
+    let (velocity_q, velocity_qd, velocity_lets) = (velocity.q(), velocity.qd(), &velocity.lets);
+    let (gravity, gravity_assigns) = vector_outputs(&plan, Sym::GravityTerm);
+    let (gravity_q, gravity_lets) = (gravity.q(), &gravity.lets);
+    let (pivot, pivot_assigns) = vector_outputs(&plan, Sym::PivotTerm);
+    let (pivot_q, pivot_lets) = (pivot.q(), &pivot.lets);
+    let (forces, forces_assigns) = vector_outputs(&plan, Sym::Force);
+    let (forces_q, forces_qd, forces_lets) = (forces.q(), forces.qd(), &forces.lets);
+
+    let kinetic_expr = plan.kinetic_energy();
+    let kinetic = Body::new(&plan, [&kinetic_expr]);
+    let (kinetic_q, kinetic_qd, kinetic_lets) = (kinetic.q(), kinetic.qd(), &kinetic.lets);
+    let kinetic_value = expr(&kinetic_expr);
+    let potential_expr = plan.potential_energy();
+    let potential = Body::new(&plan, [&potential_expr]);
+    let (potential_q, potential_lets) = (potential.q(), &potential.lets);
+    let potential_value = expr(&potential_expr);
+
+    let check_polar = plan.singular_links().into_iter().map(|(link, i)| {
+        let (link, i) = (index(link), index(i));
+        quote!(::pendulum_core::check_polar_angle(#link, q[#i])?;)
+    });
+    let check_polar: Vec<TokenStream> = check_polar.collect();
+    let check_configuration = (!check_polar.is_empty()).then(|| {
+        quote! {
+            fn check_configuration(&self, q: &#vector) -> Result<()> {
+                #(#check_polar)*
+                Ok(())
+            }
+        }
+    });
+    let accelerations = accelerations(&plan, &check_polar);
+
+    quote! {
+        #(#attrs)*
+        #(#[doc = #doc])*
+        #[derive(::core::fmt::Debug, ::core::clone::Clone, ::core::cmp::PartialEq)]
+        #vis struct #name {
+            chain: ::pendulum_core::Chain<::pendulum_core::__private::nalgebra::Const<#n>>,
+        }
+
+        #(#cfgs)*
+        const _: () = {
+            use ::core::primitive::f64;
+            use ::core::result::Result::{Err, Ok};
+            use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, #space};
+            use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+
+            impl #name {
+                /// The model of `chain`.
+                #vis fn new(chain: Chain<Const<#n>>) -> Self {
+                    Self { chain }
+                }
+            }
+
+            #[automatically_derived]
+            impl ::core::convert::From<Chain<Const<#n>>> for #name {
+                fn from(chain: Chain<Const<#n>>) -> Self {
+                    Self::new(chain)
+                }
+            }
+
+            // `mul_add` would be a slow libm call on targets without FMA, and would round
+            // differently from the generic models.
+            #[automatically_derived]
+            #[allow(clippy::suboptimal_flops)]
+            impl Model for #name {
+                type Links = Const<#n>;
+                type Dof = Const<#dof>;
+                type Space = #space;
+
+                fn chain(&self) -> &Chain<Const<#n>> {
+                    &self.chain
+                }
+
+                fn dof(&self) -> Const<#dof> {
+                    Const::<#dof>
+                }
+
+                fn mass_matrix(&self, #mass_q: &#vector, out: &mut #matrix) {
+                    #mass_lets
+                    #(#mass_assigns)*
+                }
+
+                fn velocity_terms(&self, #velocity_q: &#vector, #velocity_qd: &#vector, out: &mut #vector) {
+                    #velocity_lets
+                    #velocity_assigns
+                }
+
+                fn gravity_terms(&self, #gravity_q: &#vector, out: &mut #vector) {
+                    #gravity_lets
+                    #gravity_assigns
+                }
+
+                fn pivot_terms(&self, #pivot_q: &#vector, pivot_acceleration: &SVector<f64, #space_dim>, out: &mut #vector) {
+                    #pivot_lets
+                    #pivot_assigns
+                }
+
+                fn generalized_forces(
+                    &self,
+                    #forces_q: &#vector,
+                    #forces_qd: &#vector,
+                    torque: &#vector,
+                    out: &mut #vector,
+                ) {
+                    #forces_lets
+                    #forces_assigns
+                }
+
+                fn kinetic_energy(&self, #kinetic_q: &#vector, #kinetic_qd: &#vector) -> f64 {
+                    #kinetic_lets
+                    #kinetic_value
+                }
+
+                fn potential_energy(&self, #potential_q: &#vector) -> f64 {
+                    #potential_lets
+                    #potential_value
+                }
+
+                #check_configuration
+
+                #accelerations
+            }
+        };
+    }
+}
+
+/// `a - p·q - …` (or `-p·q - …` when `a` is zero); `None` when everything is zero.
+fn minus_products(first: Option<&Ident>, products: &[(Ident, Ident)]) -> Option<TokenStream> {
+    let mut products = products.iter().map(|(p, q)| quote!(#p * #q));
+    let start = match first {
+        Some(a) => quote!(#a),
+        None => {
+            let p = products.next()?;
+            quote!(-#p)
+        }
+    };
+    Some(products.fold(start, |acc, p| quote!(#acc - #p)))
+}
+
+/// `(sum) * inv` (no parentheses around a single name).
+fn scaled(sum: TokenStream, is_single: bool, inv: &Ident) -> TokenStream {
+    if is_single { quote!(#sum * #inv) } else { quote!((#sum) * #inv) }
+}
+
+/// `accelerations`: checks, `M` and `Q − c − k − d` as lets, an unrolled Cholesky
+/// factorisation `M = L Lᵀ` (column by column; entries known to be zero are skipped) and
+/// forward and back substitution.
+fn accelerations(plan: &Plan, check_polar: &[TokenStream]) -> TokenStream {
+    let d = plan.dof();
+    let dof = index(d);
+    let space = match plan.kind {
+        Kind::Planar => quote!(U2),
+        Kind::Spatial => quote!(U3),
+    };
+    let mut roots: Vec<Expr> =
+        (0..d).flat_map(|r| (0..=r).filter_map(move |c| plan.mass_entry(r, c))).map(Expr::of).collect();
+    roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
+    let body = Body::new(plan, &roots);
+    let lets = &body.lets;
+    let torque = body.uses(|s| matches!(s, Sym::Torque(_))).then(|| quote!(let torque = &inputs.torque;));
+    let pivot = body
+        .uses(|s| matches!(s, Sym::Pivot(_)))
+        .then(|| quote!(let pivot_acceleration = &inputs.pivot_acceleration;));
+
+    let entry = |r: usize, c: usize| plan.mass_entry(r, c).map(ident);
+    let fac_name = |i: usize, j: usize| format_ident!("fac{i}_{j}");
+    let inv = |j: usize| format_ident!("inv{j}");
+    // fac[i][j] = L_ij (i > j), `None` where it is known to be zero.
+    let mut fac: Vec<Vec<Option<Ident>>> = vec![vec![None; d]; d];
+    let mut factor = TokenStream::new();
+    for j in 0..d {
+        let products: Vec<(Ident, Ident)> =
+            (0..j).filter_map(|k| fac[j][k].clone().map(|f| (f.clone(), f))).collect();
+        let diagonal = entry(j, j).expect("the diagonal of M is never identically zero");
+        let value = minus_products(Some(&diagonal), &products).expect("non-empty");
+        let (piv, inv_j) = (format_ident!("piv{j}"), inv(j));
+        factor.extend(quote! {
+            let #piv = #value;
+            if #piv.is_nan() || #piv <= 0.0 {
+                return Err(Error::NotPositiveDefinite);
+            }
+            let #inv_j = 1.0 / #piv.sqrt();
+        });
+        for i in j + 1..d {
+            let products: Vec<(Ident, Ident)> =
+                (0..j).filter_map(|k| Some((fac[i][k].clone()?, fac[j][k].clone()?))).collect();
+            let a = entry(i, j);
+            let single = a.is_some() && products.is_empty();
+            if let Some(sum) = minus_products(a.as_ref(), &products) {
+                let name = fac_name(i, j);
+                let value = scaled(sum, single, &inv_j);
+                factor.extend(quote!(let #name = #value;));
+                fac[i][j] = Some(name);
+            }
+        }
+    }
+    let y = |i: usize| format_ident!("y{i}");
+    let x = |i: usize| format_ident!("x{i}");
+    let mut solve = TokenStream::new();
+    // L y = r
+    for (i, row) in fac.iter().enumerate() {
+        let products: Vec<(Ident, Ident)> =
+            row[..i].iter().enumerate().filter_map(|(k, f)| Some((f.clone()?, y(k)))).collect();
+        let r = ident(Sym::Rhs(i));
+        let sum = minus_products(Some(&r), &products).expect("non-empty");
+        let (yi, value) = (y(i), scaled(sum, products.is_empty(), &inv(i)));
+        solve.extend(quote!(let #yi = #value;));
+    }
+    // Lᵀ x = y
+    for i in (0..d).rev() {
+        let products: Vec<(Ident, Ident)> =
+            (i + 1..d).filter_map(|k| Some((fac[k][i].clone()?, x(k)))).collect();
+        let yi = y(i);
+        let sum = minus_products(Some(&yi), &products).expect("non-empty");
+        let (xi, value) = (x(i), scaled(sum, products.is_empty(), &inv(i)));
+        solve.extend(quote!(let #xi = #value;));
+    }
+    let xs: Vec<Ident> = (0..d).map(x).collect();
+    let indices = (0..d).map(index);
+    quote! {
+        fn accelerations(
+            &self,
+            q: &SVector<f64, #dof>,
+            qd: &SVector<f64, #dof>,
+            inputs: &Inputs<Const<#dof>, #space>,
+            out: &mut SVector<f64, #dof>,
+        ) -> Result<()> {
+            ::pendulum_core::check_inputs(#dof, q, qd, inputs)?;
+            #(#check_polar)*
+            #torque
+            #pivot
+            #lets
+            #factor
+            #solve
+            if #(!#xs.is_finite())||* {
+                return Err(Error::NotPositiveDefinite);
+            }
+            #(out[#indices] = #xs;)*
+            Ok(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Write;
+    use std::path::Path;
+    use std::process::{Command, Stdio};
+
+    use super::*;
+
+    /// Expansions committed under `pendulum-macros/expanded/` so reviewers read diffs of
+    /// real generated code.
+    const EXPANSIONS: [(&str, &str); 2] = [
+        ("planar3.rs", "pub struct Planar3 { kind: planar, links: 3 }"),
+        ("spatial2.rs", "pub struct Spatial2 { kind: spatial, links: 2 }"),
+    ];
+
+    fn rustfmt(code: &str) -> String {
+        let rustfmt = std::env::var("RUSTFMT").unwrap_or_else(|_| "rustfmt".into());
+        let mut child = Command::new(&rustfmt)
+            .args(["--edition", "2024", "--config", "max_width=110,use_small_heuristics=Max"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot run `{rustfmt}` to format the expansions: {e}"));
+        child.stdin.take().unwrap().write_all(code.as_bytes()).unwrap();
+        let output = child.wait_with_output().unwrap();
+        assert!(output.status.success(), "rustfmt failed on the expansion");
+        String::from_utf8(output.stdout).unwrap()
+    }
+
+    /// Writes the expansions (`write`) or checks that the committed ones are current.
+    fn generate(write: bool) {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("expanded");
+        for (file, item) in EXPANSIONS {
+            let input: Input = syn::parse_str(item).unwrap();
+            let header = format!(
+                "// The expansion of `pendulum_macros::model! {{ {item} }}`, formatted.\n\
+                 // Written by `UPDATE_EXPANSIONS=1 cargo test -p pendulum-macros --lib`; do not edit.\n\n"
+            );
+            let text = header + &rustfmt(&expand(&input).to_string());
+            let path = dir.join(file);
+            if write {
+                std::fs::create_dir_all(&dir).unwrap();
+                std::fs::write(&path, text).unwrap();
+            } else {
+                let committed = std::fs::read_to_string(&path).unwrap_or_default();
+                assert!(
+                    committed == text,
+                    "{} is stale: run `UPDATE_EXPANSIONS=1 cargo test -p pendulum-macros --lib` \
+                     and review the diff",
+                    path.display()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn committed_expansions_are_current() {
+        generate(std::env::var_os("UPDATE_EXPANSIONS").is_some());
+    }
+
+    fn idents(tokens: TokenStream, out: &mut Vec<String>) {
+        for token in tokens {
+            match token {
+                proc_macro2::TokenTree::Ident(i) => out.push(i.to_string()),
+                proc_macro2::TokenTree::Group(g) => idents(g.stream(), out),
+                _ => {}
+            }
+        }
+    }
+
+    #[test]
+    fn expansion_has_no_loops_and_one_sin_cos_per_angle() {
+        let input: Input = syn::parse_str("struct S3 { kind: spatial, links: 3 }").unwrap();
+        let tokens = expand(&input);
+        let mut words = Vec::new();
+        idents(tokens.clone(), &mut words);
+        for word in ["in", "while", "loop", "Vec", "vec", "Box", "iter", "collect"] {
+            assert!(!words.iter().any(|w| w == word), "the expansion contains `{word}`");
+        }
+        let code = tokens.to_string();
+        // mass_matrix, velocity_terms, pivot_terms, kinetic_energy, accelerations: 6 angles each.
+        assert_eq!(code.matches("sin_cos").count(), 5 * 6);
+        assert_eq!(code.matches("check_polar_angle").count(), 2 * 3);
+    }
+}

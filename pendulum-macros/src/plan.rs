@@ -1,0 +1,651 @@
+//! What to emit for one model, as plain data: every quantity is a named symbol whose
+//! definition is a sum of signed products of earlier symbols; no tokens.
+//!
+//! The formulas are those of `pendulum_core::Planar` and `pendulum_core::Spatial`, with
+//! every dot product and angle difference written out in the sines and cosines of single
+//! angles:
+//!
+//! - `cos(a − b) = cos a cos b + sin a sin b`, `sin(a − b) = sin a cos b − cos a sin b`;
+//! - spatial, with `J_θi = ∂u_i/∂θ_i`, `J_φi = ∂u_i/∂φ_i` and `Δ = φ_i − φ_j`:
+//!   `J_θi·J_θj = cθi cθj cos Δ + sθi sθj`, `J_φi·J_θj = −sθi cθj sin Δ`,
+//!   `J_φi·J_φj = sθi sθj cos Δ`, and for the velocity terms
+//!   `J_θi·u_j = cθi sθj cos Δ − sθi cθj`, `J_θi·∂²u_j/∂φ_j² = −cθi sθj cos Δ`,
+//!   `J_θi·∂²u_j/∂θ_j∂φ_j = cθi cθj sin Δ`, `J_φi·u_j = −sθi sθj sin Δ`,
+//!   `J_φi·∂²u_j/∂φ_j² = sθi sθj sin Δ`, `J_φi·∂²u_j/∂θ_j∂φ_j = sθi cθj cos Δ`.
+//!
+//! Indices are 0-based throughout (link `i` here is link `i + 1` of the document);
+//! generalized coordinates are `θ_0 … θ_{n−1}` (planar) or
+//! `θ_0 … θ_{n−1}, φ_0 … φ_{n−1}` (spatial), as in `pendulum_core`.
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+use self::Angle::{Phi, Theta};
+use self::Trig::{Cos, Sin};
+
+/// Which chain model to generate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Planar: `q = (θ_1 … θ_n)`, pivot acceleration in (x, y).
+    Planar,
+    /// Spatial: `q = (θ_1 … θ_n, φ_1 … φ_n)`, pivot acceleration in (x, y, z).
+    Spatial,
+}
+
+/// An angle of the chain: the polar angle θ or the azimuth φ of link `i` (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Angle {
+    /// `θ_i`.
+    Theta(usize),
+    /// `φ_i` (spatial only).
+    Phi(usize),
+}
+
+impl Angle {
+    fn link(self) -> usize {
+        match self {
+            Angle::Theta(i) | Angle::Phi(i) => i,
+        }
+    }
+
+    /// The same kind of angle on another link.
+    fn with_link(self, j: usize) -> Angle {
+        match self {
+            Angle::Theta(_) => Angle::Theta(j),
+            Angle::Phi(_) => Angle::Phi(j),
+        }
+    }
+
+    fn tag(self) -> &'static str {
+        match self {
+            Angle::Theta(_) => "th",
+            Angle::Phi(_) => "ph",
+        }
+    }
+}
+
+/// Sine or cosine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Trig {
+    /// `sin`.
+    Sin,
+    /// `cos`.
+    Cos,
+}
+
+/// A named quantity of the generated code: one `let` statement each.
+///
+/// The variant order is the dependency order: a definition only refers to symbols that
+/// sort before it, so emitting a set of symbols sorted is a valid statement order (and a
+/// deterministic one). The first group are inputs read from the chain or the arguments;
+/// the rest have a [`Plan::definition`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Sym {
+    /// `g`, m/s².
+    Gravity,
+    /// Point mass `m_i`, kg.
+    Mass(usize),
+    /// Tail mass `M_i = Σ_{k ≥ i} m_k`, kg.
+    Tail(usize),
+    /// Length `l_i`, m.
+    Length(usize),
+    /// Damping `λ_i`, N·m·s.
+    Damping(usize),
+    /// Sine or cosine of one angle, from `q`.
+    Trig(Angle, Trig),
+    /// The rate of one angle, from `q̇`.
+    Rate(Angle),
+    /// The torque conjugate to one angle.
+    Torque(Angle),
+    /// Pivot acceleration component (0 = x, 1 = y, 2 = z), m/s².
+    Pivot(usize),
+    /// `cos(a − b)` for two angles of the same kind, `a` on the lower link.
+    CosDiff(Angle, Angle),
+    /// `sin(a − b)` for two angles of the same kind, `a` on the lower link.
+    SinDiff(Angle, Angle),
+    /// `W_ij = M_max(i,j) l_i l_j` with `i ≤ j`, kg·m².
+    Weight(usize, usize),
+    /// Component `axis` of the velocity of mass `k` relative to the pivot, m/s.
+    Velocity(usize, usize),
+    /// Mass-matrix entry `M_rc` with `r ≥ c` (generalized-coordinate indices).
+    MassEntry(usize, usize),
+    /// Velocity term `c_a`.
+    VelocityTerm(usize),
+    /// Gravity term `k_a`.
+    GravityTerm(usize),
+    /// Pivot term `d_a`.
+    PivotTerm(usize),
+    /// Generalized force `Q_a`.
+    Force(usize),
+    /// Right-hand side `Q_a − c_a − k_a − d_a` of `M q̈ = …`.
+    Rhs(usize),
+}
+
+impl Sym {
+    /// Whether the symbol is read from the chain or an argument rather than computed.
+    pub fn is_input(self) -> bool {
+        self < Sym::CosDiff(Angle::Theta(0), Angle::Theta(0))
+    }
+
+    /// The symbol's variable name in the generated code.
+    ///
+    /// Links are 0-based; `st0`/`ct0` are sin/cos of θ_0, `sp0`/`cp0` of φ_0, `cth0_2` is
+    /// `cos(θ_0 − θ_2)`, `sph1_3` is `sin(φ_1 − φ_3)`, `w0_2` is `W_02`, `a2_0` is the
+    /// mass-matrix entry (2, 0), `c`, `k`, `d`, `f`, `r` the velocity, gravity and pivot
+    /// terms, the forces and the right-hand side by coordinate index.
+    pub fn name(self) -> String {
+        match self {
+            Sym::Gravity => "g".into(),
+            Sym::Mass(i) => format!("m{i}"),
+            Sym::Tail(i) => format!("mt{i}"),
+            Sym::Length(i) => format!("l{i}"),
+            Sym::Damping(i) => format!("lam{i}"),
+            Sym::Trig(a, t) => {
+                let f = match t {
+                    Trig::Sin => 's',
+                    Trig::Cos => 'c',
+                };
+                let x = match a {
+                    Angle::Theta(_) => 't',
+                    Angle::Phi(_) => 'p',
+                };
+                format!("{f}{x}{}", a.link())
+            }
+            Sym::Rate(a) => format!("d{}{}", a.tag(), a.link()),
+            Sym::Torque(a) => format!("tau_{}{}", a.tag(), a.link()),
+            Sym::Pivot(axis) => ["ax", "ay", "az"][axis].into(),
+            Sym::CosDiff(a, b) => format!("c{}{}_{}", a.tag(), a.link(), b.link()),
+            Sym::SinDiff(a, b) => format!("s{}{}_{}", a.tag(), a.link(), b.link()),
+            Sym::Weight(i, j) => format!("w{i}_{j}"),
+            Sym::Velocity(k, axis) => format!("v{}{k}", ['x', 'y', 'z'][axis]),
+            Sym::MassEntry(r, c) => format!("a{r}_{c}"),
+            Sym::VelocityTerm(a) => format!("c{a}"),
+            Sym::GravityTerm(a) => format!("k{a}"),
+            Sym::PivotTerm(a) => format!("d{a}"),
+            Sym::Force(a) => format!("f{a}"),
+            Sym::Rhs(a) => format!("r{a}"),
+        }
+    }
+}
+
+impl fmt::Display for Sym {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// `coef · Π factors`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Term {
+    /// A small constant: ±1, ±2 or ½.
+    pub coef: f64,
+    /// The symbols multiplied, in order; a symbol may repeat (a square).
+    pub factors: Vec<Sym>,
+}
+
+/// A sum of terms; the empty sum is zero.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Expr {
+    /// The terms, added in order.
+    pub terms: Vec<Term>,
+}
+
+impl Expr {
+    /// The expression that is just `sym`.
+    pub fn of(sym: Sym) -> Self {
+        let mut e = Expr::default();
+        e.add(1.0, &[sym]);
+        e
+    }
+
+    /// Appends `coef · Π factors`.
+    fn add(&mut self, coef: f64, factors: &[Sym]) -> &mut Self {
+        self.terms.push(Term { coef, factors: factors.to_vec() });
+        self
+    }
+
+    /// Appends `coef · Π factors` with `signed`, a factor with a sign of its own, second.
+    fn add_signed(&mut self, coef: f64, signed: (f64, Sym), factors: &[Sym]) -> &mut Self {
+        let mut all = factors.to_vec();
+        all.insert(1.min(all.len()), signed.1);
+        self.add(coef * signed.0, &all)
+    }
+
+    /// Whether this is the empty sum.
+    pub fn is_zero(&self) -> bool {
+        self.terms.is_empty()
+    }
+
+    /// Every symbol the expression mentions.
+    pub fn symbols(&self) -> impl Iterator<Item = Sym> + '_ {
+        self.terms.iter().flat_map(|t| t.factors.iter().copied())
+    }
+}
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.terms.is_empty() {
+            return f.write_str("0");
+        }
+        for (k, t) in self.terms.iter().enumerate() {
+            let sign = if t.coef < 0.0 { "-" } else { "+" };
+            match (k, sign) {
+                (0, "+") => {}
+                (0, _) => f.write_str("-")?,
+                _ => write!(f, " {sign} ")?,
+            }
+            let mut parts: Vec<String> = Vec::new();
+            if t.coef.abs() != 1.0 {
+                parts.push(format!("{}", t.coef.abs()));
+            }
+            parts.extend(t.factors.iter().map(|s| s.name()));
+            f.write_str(&parts.join("*"))?;
+        }
+        Ok(())
+    }
+}
+
+/// What to emit for one model: its kind and number of links, and the definition of every
+/// symbol and method output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Plan {
+    /// Planar or spatial.
+    pub kind: Kind,
+    /// Number of links `n`.
+    pub links: usize,
+}
+
+fn sin(a: Angle) -> Sym {
+    Sym::Trig(a, Sin)
+}
+
+fn cos(a: Angle) -> Sym {
+    Sym::Trig(a, Cos)
+}
+
+/// `cos(a − b)` as a symbol (`cos` is even, so the order of the links does not matter).
+fn cos_diff(a: Angle, b: Angle) -> Sym {
+    if a.link() <= b.link() { Sym::CosDiff(a, b) } else { Sym::CosDiff(b, a) }
+}
+
+/// `sin(a − b)` as a sign and a symbol (`sin(b − a) = −sin(a − b)`).
+fn sin_diff(a: Angle, b: Angle) -> (f64, Sym) {
+    if a.link() <= b.link() { (1.0, Sym::SinDiff(a, b)) } else { (-1.0, Sym::SinDiff(b, a)) }
+}
+
+fn weight(i: usize, j: usize) -> Sym {
+    Sym::Weight(i.min(j), i.max(j))
+}
+
+impl Plan {
+    /// The plan for `links` links of `kind`.
+    pub fn new(kind: Kind, links: usize) -> Self {
+        Self { kind, links }
+    }
+
+    /// Number of generalized coordinates: `n` planar, `2n` spatial.
+    pub fn dof(&self) -> usize {
+        match self.kind {
+            Kind::Planar => self.links,
+            Kind::Spatial => 2 * self.links,
+        }
+    }
+
+    /// Number of pivot-acceleration components: 2 planar, 3 spatial.
+    pub fn space(&self) -> usize {
+        match self.kind {
+            Kind::Planar => 2,
+            Kind::Spatial => 3,
+        }
+    }
+
+    /// The angle that is generalized coordinate `a`.
+    pub fn angle(&self, a: usize) -> Angle {
+        if a < self.links { Theta(a) } else { Phi(a - self.links) }
+    }
+
+    /// The index of `angle` in `q`.
+    pub fn index(&self, angle: Angle) -> usize {
+        match angle {
+            Theta(i) => i,
+            Phi(i) => self.links + i,
+        }
+    }
+
+    /// The definition of a computed symbol; `None` for inputs.
+    pub fn definition(&self, sym: Sym) -> Option<Expr> {
+        let mut e = Expr::default();
+        match sym {
+            _ if sym.is_input() => return None,
+            Sym::CosDiff(a, b) => {
+                e.add(1.0, &[cos(a), cos(b)]).add(1.0, &[sin(a), sin(b)]);
+            }
+            Sym::SinDiff(a, b) => {
+                e.add(1.0, &[sin(a), cos(b)]).add(-1.0, &[cos(a), sin(b)]);
+            }
+            Sym::Weight(i, j) => {
+                e.add(1.0, &[Sym::Tail(j), Sym::Length(i), Sym::Length(j)]);
+            }
+            Sym::Velocity(k, axis) => {
+                if k > 0 {
+                    e.add(1.0, &[Sym::Velocity(k - 1, axis)]);
+                }
+                let (l, th, ph) = (Sym::Length(k), Theta(k), Phi(k));
+                let (dth, dph) = (Sym::Rate(th), Sym::Rate(ph));
+                match (self.kind, axis) {
+                    // u̇ = (cθ θ̇, sθ θ̇)
+                    (Kind::Planar, 0) => e.add(1.0, &[l, cos(th), dth]),
+                    (Kind::Planar, _) => e.add(1.0, &[l, sin(th), dth]),
+                    // u̇ = (cθ cφ θ̇ − sθ sφ φ̇, cθ sφ θ̇ + sθ cφ φ̇, sθ θ̇)
+                    (Kind::Spatial, 0) => {
+                        e.add(1.0, &[l, cos(th), cos(ph), dth]).add(-1.0, &[l, sin(th), sin(ph), dph])
+                    }
+                    (Kind::Spatial, 1) => {
+                        e.add(1.0, &[l, cos(th), sin(ph), dth]).add(1.0, &[l, sin(th), cos(ph), dph])
+                    }
+                    (Kind::Spatial, _) => e.add(1.0, &[l, sin(th), dth]),
+                };
+            }
+            Sym::MassEntry(r, c) => self.mass_entry_expr(r, c, &mut e),
+            Sym::VelocityTerm(a) => self.velocity_term_expr(a, &mut e),
+            Sym::GravityTerm(a) => {
+                if let Theta(i) = self.angle(a) {
+                    e.add(1.0, &[Sym::Tail(i), Sym::Gravity, Sym::Length(i), sin(Theta(i))]);
+                }
+            }
+            Sym::PivotTerm(a) => {
+                let i = self.angle(a).link();
+                let ml = [Sym::Tail(i), Sym::Length(i)];
+                let (th, ph) = (Theta(i), Phi(i));
+                let (ax, ay, az) = (Sym::Pivot(0), Sym::Pivot(1), Sym::Pivot(2));
+                match (self.kind, self.angle(a)) {
+                    // d_i = M_i l_i (p̈_x cθ + p̈_y sθ)
+                    (Kind::Planar, _) => {
+                        e.add(1.0, &[ml[0], ml[1], ax, cos(th)]).add(1.0, &[ml[0], ml[1], ay, sin(th)]);
+                    }
+                    // d_θi = M_i l_i J_θi·p̈
+                    (Kind::Spatial, Theta(_)) => {
+                        e.add(1.0, &[ml[0], ml[1], ax, cos(th), cos(ph)])
+                            .add(1.0, &[ml[0], ml[1], ay, cos(th), sin(ph)])
+                            .add(1.0, &[ml[0], ml[1], az, sin(th)]);
+                    }
+                    // d_φi = M_i l_i J_φi·p̈
+                    (Kind::Spatial, Phi(_)) => {
+                        e.add(1.0, &[ml[0], ml[1], ay, sin(th), cos(ph)])
+                            .add(-1.0, &[ml[0], ml[1], ax, sin(th), sin(ph)]);
+                    }
+                }
+            }
+            Sym::Force(a) => {
+                let angle = self.angle(a);
+                let i = angle.link();
+                e.add(1.0, &[Sym::Torque(angle)]);
+                match angle {
+                    // Q_θi = σ_θi − λ_i θ̇_i
+                    Theta(_) => e.add(-1.0, &[Sym::Damping(i), Sym::Rate(angle)]),
+                    // Q_φi = σ_φi − λ_i sin²θ_i φ̇_i
+                    Phi(_) => e.add(-1.0, &[Sym::Damping(i), sin(Theta(i)), sin(Theta(i)), Sym::Rate(angle)]),
+                };
+            }
+            Sym::Rhs(a) => {
+                e.add(1.0, &[Sym::Force(a)]);
+                for term in [Sym::VelocityTerm(a), Sym::GravityTerm(a), Sym::PivotTerm(a)] {
+                    if !self.is_zero(term) {
+                        e.add(-1.0, &[term]);
+                    }
+                }
+            }
+            _ => unreachable!("{sym:?} is an input"),
+        }
+        Some(e)
+    }
+
+    /// Whether a computed symbol is identically zero (it is then never emitted).
+    pub fn is_zero(&self, sym: Sym) -> bool {
+        self.definition(sym).is_some_and(|e| e.is_zero())
+    }
+
+    /// `M_rc` (`r ≥ c`), symmetric: `M_ab = W_ij J_a·J_b` with `a` on link `i`, `b` on `j`
+    /// (`i ≥ j` in the θθ and φφ blocks, whose products are written lower link first).
+    fn mass_entry_expr(&self, r: usize, c: usize, e: &mut Expr) {
+        let (a, b) = (self.angle(r), self.angle(c));
+        let (i, j) = (a.link(), b.link());
+        let w = weight(i, j);
+        match (self.kind, a, b) {
+            // C_ij = W_ij cos(θ_i − θ_j) (eq 22)
+            (Kind::Planar, ..) if i == j => e.add(1.0, &[w]),
+            (Kind::Planar, ..) => e.add(1.0, &[w, cos_diff(a, b)]),
+            // J_θi·J_θj = cθi cθj cos(φ_i − φ_j) + sθi sθj; |J_θi|² = 1
+            (Kind::Spatial, Theta(_), Theta(_)) if i == j => e.add(1.0, &[w]),
+            (Kind::Spatial, Theta(_), Theta(_)) => e
+                .add(1.0, &[w, cos(Theta(j)), cos(Theta(i)), cos_diff(Phi(j), Phi(i))])
+                .add(1.0, &[w, sin(Theta(j)), sin(Theta(i))]),
+            // J_φi·J_θj = −sθi cθj sin(φ_i − φ_j); zero for i = j
+            (Kind::Spatial, Phi(_), Theta(_)) if i == j => e,
+            (Kind::Spatial, Phi(_), Theta(_)) => {
+                e.add_signed(-1.0, sin_diff(Phi(i), Phi(j)), &[w, sin(Theta(i)), cos(Theta(j))])
+            }
+            // J_φi·J_φj = sθi sθj cos(φ_i − φ_j)
+            (Kind::Spatial, Phi(_), Phi(_)) if i == j => e.add(1.0, &[w, sin(Theta(i)), sin(Theta(i))]),
+            (Kind::Spatial, Phi(_), Phi(_)) => {
+                e.add(1.0, &[w, sin(Theta(j)), sin(Theta(i)), cos_diff(Phi(j), Phi(i))])
+            }
+            (Kind::Spatial, Theta(_), Phi(_)) => unreachable!("M_rc is only asked for r ≥ c"),
+        };
+    }
+
+    /// `c_a = Σ_j W_ij J_a·ü_j|_{q̈=0}` (`a` on link `i`); planar `Σ_j W_ij sin(θ_i − θ_j) θ̇_j²`.
+    fn velocity_term_expr(&self, a: usize, e: &mut Expr) {
+        let angle = self.angle(a);
+        let i = angle.link();
+        let (sti, cti) = (sin(Theta(i)), cos(Theta(i)));
+        for j in 0..self.links {
+            let w = weight(i, j);
+            let (stj, ctj) = (sin(Theta(j)), cos(Theta(j)));
+            let (dth, dph) = (Sym::Rate(Theta(j)), Sym::Rate(Phi(j)));
+            match (self.kind, angle) {
+                (Kind::Planar, _) if i == j => {}
+                (Kind::Planar, _) => {
+                    e.add_signed(1.0, sin_diff(angle, angle.with_link(j)), &[w, dth, dth]);
+                }
+                // The j = i term: sθ cθ θ̇² − cθ sθ (θ̇² + φ̇²) = −sθ cθ φ̇².
+                (Kind::Spatial, Theta(_)) if i == j => {
+                    e.add(-1.0, &[w, sti, cti, dph, dph]);
+                }
+                // W_ij [sθi cθj θ̇j² − cθi sθj cos Δ (θ̇j² + φ̇j²) + 2 cθi cθj sin Δ θ̇j φ̇j]
+                (Kind::Spatial, Theta(_)) => {
+                    let cd = cos_diff(Phi(i), Phi(j));
+                    let sd = sin_diff(Phi(i), Phi(j));
+                    e.add(1.0, &[w, sti, ctj, dth, dth])
+                        .add(-1.0, &[w, cti, stj, cd, dth, dth])
+                        .add(-1.0, &[w, cti, stj, cd, dph, dph])
+                        .add_signed(2.0, sd, &[w, cti, ctj, dth, dph]);
+                }
+                // The j = i term: 2 sθ cθ θ̇ φ̇.
+                (Kind::Spatial, Phi(_)) if i == j => {
+                    e.add(2.0, &[w, sti, cti, dth, dph]);
+                }
+                // W_ij [sθi sθj sin Δ (θ̇j² + φ̇j²) + 2 sθi cθj cos Δ θ̇j φ̇j]
+                (Kind::Spatial, Phi(_)) => {
+                    let cd = cos_diff(Phi(i), Phi(j));
+                    let sd = sin_diff(Phi(i), Phi(j));
+                    e.add_signed(1.0, sd, &[w, sti, stj, dth, dth])
+                        .add_signed(1.0, sd, &[w, sti, stj, dph, dph])
+                        .add(2.0, &[w, sti, ctj, cd, dth, dph]);
+                }
+            }
+        }
+    }
+
+    /// The symbol of `M_rc` (either triangle), `None` where the entry is identically zero.
+    pub fn mass_entry(&self, r: usize, c: usize) -> Option<Sym> {
+        let sym = Sym::MassEntry(r.max(c), r.min(c));
+        (!self.is_zero(sym)).then_some(sym)
+    }
+
+    /// Kinetic energy `T = ½ Σ_k m_k |v_k|²`, `v_k = Σ_{j ≤ k} l_j u̇_j`.
+    pub fn kinetic_energy(&self) -> Expr {
+        let mut e = Expr::default();
+        for k in 0..self.links {
+            for axis in 0..self.space() {
+                let v = Sym::Velocity(k, axis);
+                e.add(0.5, &[Sym::Mass(k), v, v]);
+            }
+        }
+        e
+    }
+
+    /// Potential energy `U = −Σ_i M_i g l_i cos θ_i` (eq 12).
+    pub fn potential_energy(&self) -> Expr {
+        let mut e = Expr::default();
+        for i in 0..self.links {
+            e.add(-1.0, &[Sym::Tail(i), Sym::Gravity, Sym::Length(i), cos(Theta(i))]);
+        }
+        e
+    }
+
+    /// One output per coordinate: `sym(a)` or `None` where it is identically zero.
+    pub fn per_coordinate(&self, sym: fn(usize) -> Sym) -> Vec<Option<Sym>> {
+        (0..self.dof()).map(|a| Some(sym(a)).filter(|&s| !self.is_zero(s))).collect()
+    }
+
+    /// Links whose polar angle must be checked for the `sin θ = 0` singularity (1-based,
+    /// as `pendulum_core::check_polar_angle` takes them) with the index of θ in `q`.
+    pub fn singular_links(&self) -> Vec<(usize, usize)> {
+        match self.kind {
+            Kind::Planar => Vec::new(),
+            Kind::Spatial => (0..self.links).map(|i| (i + 1, i)).collect(),
+        }
+    }
+
+    /// `roots` and everything they depend on, sorted into a valid statement order.
+    pub fn closure(&self, roots: impl IntoIterator<Item = Sym>) -> Vec<Sym> {
+        let mut done = BTreeSet::new();
+        let mut todo: Vec<Sym> = roots.into_iter().collect();
+        while let Some(sym) = todo.pop() {
+            if done.insert(sym)
+                && let Some(def) = self.definition(sym)
+            {
+                todo.extend(def.symbols());
+            }
+        }
+        done.into_iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inputs_of(plan: &Plan, sym: Sym) -> Vec<Sym> {
+        plan.closure([sym]).into_iter().filter(|s| s.is_input()).collect()
+    }
+
+    #[test]
+    fn planar_mass_entry_0_2_uses_tail_mass_2_and_angles_0_and_2() {
+        let plan = Plan::new(Kind::Planar, 3);
+        let entry = plan.mass_entry(0, 2).unwrap();
+        assert_eq!(entry, Sym::MassEntry(2, 0));
+        assert_eq!(plan.mass_entry(2, 0), Some(entry));
+        assert_eq!(plan.definition(entry).unwrap().to_string(), "w0_2*cth0_2");
+        assert_eq!(plan.definition(Sym::Weight(0, 2)).unwrap().to_string(), "mt2*l0*l2");
+        assert_eq!(
+            plan.definition(Sym::CosDiff(Theta(0), Theta(2))).unwrap().to_string(),
+            "ct0*ct2 + st0*st2"
+        );
+        assert_eq!(
+            inputs_of(&plan, entry),
+            [
+                Sym::Tail(2),
+                Sym::Length(0),
+                Sym::Length(2),
+                Sym::Trig(Theta(0), Sin),
+                Sym::Trig(Theta(0), Cos),
+                Sym::Trig(Theta(2), Sin),
+                Sym::Trig(Theta(2), Cos),
+            ]
+        );
+    }
+
+    #[test]
+    fn planar_diagonal_is_the_weight_alone() {
+        let plan = Plan::new(Kind::Planar, 3);
+        assert_eq!(plan.definition(Sym::MassEntry(1, 1)).unwrap().to_string(), "w1_1");
+        assert_eq!(plan.definition(Sym::Weight(1, 1)).unwrap().to_string(), "mt1*l1*l1");
+    }
+
+    #[test]
+    fn planar_velocity_term_has_one_term_per_other_link_with_the_sign_of_the_difference() {
+        let plan = Plan::new(Kind::Planar, 3);
+        let c1 = plan.definition(Sym::VelocityTerm(1)).unwrap();
+        // sin(θ1 − θ0) = −sin(θ0 − θ1)
+        assert_eq!(c1.to_string(), "-w0_1*sth0_1*dth0*dth0 + w1_2*sth1_2*dth2*dth2");
+        assert_eq!(plan.per_coordinate(Sym::VelocityTerm), [0, 1, 2].map(|a| Some(Sym::VelocityTerm(a))));
+        assert_eq!(Plan::new(Kind::Planar, 1).per_coordinate(Sym::VelocityTerm), [None]);
+    }
+
+    #[test]
+    fn spatial_zero_entries_are_known() {
+        let plan = Plan::new(Kind::Spatial, 2);
+        // J_φi·J_θi = 0, gravity has no φ component.
+        assert_eq!(plan.mass_entry(2, 0), None);
+        assert_eq!(plan.mass_entry(1, 3), None);
+        assert!(plan.mass_entry(2, 1).is_some());
+        assert_eq!(
+            plan.per_coordinate(Sym::GravityTerm),
+            [Some(Sym::GravityTerm(0)), Some(Sym::GravityTerm(1)), None, None]
+        );
+        assert_eq!(plan.definition(Sym::Rhs(3)).unwrap().to_string(), "f3 - c3 - d3");
+    }
+
+    #[test]
+    fn spatial_cross_entry_is_minus_sin_theta_cos_theta_sin_phi_difference() {
+        let plan = Plan::new(Kind::Spatial, 2);
+        // Row φ_1 (index 3), column θ_0: −W_01 sθ1 cθ0 sin(φ1 − φ0) = +W_01 sθ1 cθ0 sin(φ0 − φ1).
+        assert_eq!(plan.definition(Sym::MassEntry(3, 0)).unwrap().to_string(), "w0_1*sph0_1*st1*ct0");
+        // Row φ_0 (index 2), column θ_1: −W_01 sθ0 cθ1 sin(φ0 − φ1).
+        assert_eq!(plan.definition(Sym::MassEntry(2, 1)).unwrap().to_string(), "-w0_1*sph0_1*st0*ct1");
+        assert_eq!(plan.definition(Sym::MassEntry(3, 3)).unwrap().to_string(), "w1_1*st1*st1");
+    }
+
+    #[test]
+    fn every_definition_refers_only_to_earlier_symbols() {
+        for plan in (1..=4).flat_map(|n| [Plan::new(Kind::Planar, n), Plan::new(Kind::Spatial, n)]) {
+            let roots = (0..plan.dof()).flat_map(|a| (0..=a).map(move |b| Sym::MassEntry(a, b)));
+            let roots = roots.chain((0..plan.dof()).map(Sym::Rhs));
+            let roots = roots.chain(plan.kinetic_energy().symbols().collect::<Vec<_>>());
+            for sym in plan.closure(roots) {
+                for dep in plan.definition(sym).unwrap_or_default().symbols() {
+                    assert!(dep < sym, "{plan:?}: {sym} uses {dep}, which sorts after it");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn closure_is_sorted_inputs_first_and_mentions_only_what_is_needed() {
+        let plan = Plan::new(Kind::Planar, 2);
+        let all = plan.closure(plan.potential_energy().symbols().collect::<Vec<_>>());
+        let names: Vec<String> = all.iter().map(|s| s.name()).collect();
+        assert_eq!(names, ["g", "mt0", "mt1", "l0", "l1", "ct0", "ct1"]);
+    }
+
+    #[test]
+    fn names_are_distinct() {
+        let plan = Plan::new(Kind::Spatial, 12);
+        let roots = (0..plan.dof()).flat_map(|a| (0..=a).map(move |b| Sym::MassEntry(a, b)));
+        let roots = roots.chain((0..plan.dof()).map(Sym::Rhs));
+        let roots = roots.chain(plan.kinetic_energy().symbols().collect::<Vec<_>>());
+        let all = plan.closure(roots);
+        let names: BTreeSet<String> = all.iter().map(|s| s.name()).collect();
+        assert_eq!(names.len(), all.len());
+    }
+
+    #[test]
+    fn input_symbols_are_exactly_the_first_group() {
+        assert!(Sym::Pivot(2).is_input());
+        assert!(Sym::Trig(Phi(15), Cos).is_input());
+        assert!(!Sym::CosDiff(Theta(0), Theta(1)).is_input());
+        assert!(!Sym::Weight(0, 0).is_input());
+    }
+}

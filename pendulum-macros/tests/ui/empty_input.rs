@@ -1,0 +1,3 @@
+pendulum_macros::model! {}
+
+fn main() {}

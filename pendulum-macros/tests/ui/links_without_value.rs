@@ -1,0 +1,5 @@
+pendulum_macros::model! {
+    pub struct Nothing { kind: planar, links: }
+}
+
+fn main() {}

@@ -1,0 +1,5 @@
+pendulum_macros::model! {
+    pub struct Planar3 { kind: planar }
+}
+
+fn main() {}

@@ -1,0 +1,5 @@
+pendulum_macros::model! {
+    pub struct Circle { kind: circular, links: 2 }
+}
+
+fn main() {}

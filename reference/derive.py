@@ -1,0 +1,505 @@
+#!/usr/bin/env python3
+"""Symbolic reference for the N-link pendulum, derived from first principles.
+
+For each case (planar n = 1..8, spatial n = 1..5) this script
+
+1. writes the positions of the point masses as functions of time, with a moving
+   pivot p(t) (sympy dynamicsymbols),
+2. forms the kinetic energy T = 1/2 sum m_k |r_k'|^2, the potential energy
+   U = sum m_k g (height of mass k) and L = T - U,
+3. forms the Rayleigh dissipation D = 1/2 sum lam_i |u_i'|^2 with u_i' the rate of
+   the unit link direction, u_i' = (r_i' - r_{i-1}')/l_i (r_0 = p), and the
+   generalized forces Q_a = sig_a - dD/dqdot_a,
+4. forms the Euler-Lagrange residual E_a = d/dt(dL/dqdot_a) - dL/dq_a - Q_a, taking
+   the time derivative with .diff(t) and only then replacing the derivatives by
+   plain symbols,
+5. splits E = M qdd + c + k + d - Q (mass matrix, velocity terms, gravity terms,
+   pivot terms, generalized forces), checks a list of identities (see `check_case`)
+   and writes one JSON file per case (format: reference/README.md).
+
+Nothing here is taken from the seed document's printed formulas or from the Rust code.
+
+Usage: python3 reference/derive.py [--out DIR] [--cases planar_n3,spatial_n2,...]
+"""
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import sympy
+from sympy import Add, Integer, Mul, Pow, Rational, Symbol, cos, sin
+from sympy.physics.vector import dynamicsymbols
+
+SYMPY_VERSION = "1.14.0"
+FORMAT = "pendulum-reference/1"
+EQUATION = "mass_matrix * qdd + velocity_terms + gravity_terms + pivot_terms = generalized_forces"
+PLANAR_LINKS = range(1, 9)
+SPATIAL_LINKS = range(1, 6)
+
+t = dynamicsymbols._t  # the time symbol the dynamicsymbols depend on
+
+
+class DerivationError(Exception):
+    """An identity that must hold did not."""
+
+
+def require(condition, message):
+    if not condition:
+        raise DerivationError(message)
+
+
+def real(name):
+    return Symbol(name, real=True)
+
+
+def positive(name):
+    return Symbol(name, positive=True)
+
+
+# ---------------------------------------------------------------------------
+# Trigonometric canonical form.
+#
+# After the angles are replaced by plain symbols, every expression is a polynomial
+# in sin(q_i), cos(q_i) and the other symbols (lengths appear with negative powers
+# only in intermediate steps). We replace sin(q_i) -> S_i, cos(q_i) -> C_i, expand,
+# and reduce modulo C_i^2 = 1 - S_i^2, so that C_i appears at most linearly in every
+# monomial. This normal form is unique, so an identity holds iff the difference of
+# both sides reduces to 0: equality checks below are exact, not numerical.
+# ---------------------------------------------------------------------------
+
+
+class Trig:
+    """sin/cos of the angle symbols as plain symbols, and the reduction C^2 = 1 - S^2."""
+
+    def __init__(self, angles):
+        self.angles = list(angles)
+        self.S = {q: real("sin_" + q.name) for q in self.angles}
+        self.C = {q: real("cos_" + q.name) for q in self.angles}
+        self.to_poly = {}
+        for q in self.angles:
+            self.to_poly[sin(q)] = self.S[q]
+            self.to_poly[cos(q)] = self.C[q]
+        self.c_to_s = {self.C[q]: self.S[q] for q in self.angles}
+        # printer: plain symbol -> (function name, angle name)
+        self.names = {}
+        for q in self.angles:
+            self.names[self.S[q]] = ("sin", q.name)
+            self.names[self.C[q]] = ("cos", q.name)
+
+    def poly(self, expr):
+        """Replace sin/cos of angles by symbols and reduce to the normal form."""
+        expr = expr.xreplace(self.to_poly)
+        require(
+            not any(q in expr.free_symbols for q in self.angles),
+            "an angle appears outside sin/cos: " + str(expr)[:200],
+        )
+        return self.reduce(expr)
+
+    def reduce(self, expr):
+        expr = sympy.expand(expr)
+        kept = []
+        changed = []
+        for term in Add.make_args(expr):
+            powers = term.as_powers_dict()
+            high = [(c, int(powers[c])) for c in self.c_to_s if powers.get(c, 0) >= 2]
+            if not high:
+                kept.append(term)
+                continue
+            new = term
+            for c, e in high:
+                s = self.c_to_s[c]
+                new = new / c**e * c ** (e % 2) * (1 - s**2) ** (e // 2)
+            changed.append(sympy.expand(new))
+        return Add(*kept, *changed)
+
+
+# ---------------------------------------------------------------------------
+# Printer: sympy expression -> JSON expression tree (grammar: reference/README.md)
+# ---------------------------------------------------------------------------
+
+
+class Printer:
+    def __init__(self, trig, allowed):
+        self.trig = trig
+        self.allowed = set(allowed)
+
+    def __call__(self, expr):
+        return self.tree(expr)
+
+    def sorted_args(self, args):
+        return sorted(args, key=sympy.default_sort_key)
+
+    def tree(self, e):
+        if isinstance(e, Integer):
+            return int(e)
+        if isinstance(e, Rational):
+            require(e.q > 1, "bad rational " + str(e))
+            return ["/", int(e.p), int(e.q)]
+        if isinstance(e, Symbol):
+            if e in self.trig.names:
+                fn, name = self.trig.names[e]
+                return [fn, name]
+            require(e.name in self.allowed, "symbol %s is not listed under 'symbols'" % e.name)
+            return e.name
+        if isinstance(e, Add):
+            return ["+"] + [self.tree(a) for a in self.sorted_args(e.args)]
+        if isinstance(e, Mul):
+            return ["*"] + [self.tree(a) for a in self.sorted_args(e.args)]
+        if isinstance(e, Pow):
+            require(isinstance(e.exp, Integer), "non-integer power: " + str(e))
+            return ["^", self.tree(e.base), int(e.exp)]
+        if isinstance(e, (sympy.sin, sympy.cos)):
+            return [type(e).__name__, self.tree(e.args[0])]
+        raise DerivationError(
+            "cannot serialize sympy node %s (%s)" % (type(e).__name__, str(e)[:200])
+        )
+
+
+# ---------------------------------------------------------------------------
+# Models
+# ---------------------------------------------------------------------------
+
+
+class Case:
+    """Symbols and kinematics of one case; q are dynamicsymbols (functions of t)."""
+
+    def __init__(self, kind, n):
+        self.kind = kind
+        self.n = n
+        self.name = "%s_n%d" % (kind, n)
+        idx = range(1, n + 1)
+        self.m = [positive("m%d" % i) for i in idx]
+        self.l = [positive("l%d" % i) for i in idx]
+        self.g = positive("g")
+        self.lam = [real("lam%d" % i) for i in idx]
+        axes = ["x", "y"] if kind == "planar" else ["x", "y", "z"]
+        self.axes = axes
+        # pivot as functions of time, and the plain symbols its derivatives become
+        self.p_fun = [dynamicsymbols("p" + a) for a in axes]
+        self.p_sym = [real("p" + a) for a in axes]
+        self.v_sym = [real("v" + a) for a in axes]
+        self.a_sym = [real("a" + a) for a in axes]
+
+        if kind == "planar":
+            names = ["th%d" % i for i in idx]
+            self.sig_names = ["sig%d" % i for i in idx]
+        else:
+            names = ["th%d" % i for i in idx] + ["ph%d" % i for i in idx]
+            self.sig_names = ["sigth%d" % i for i in idx] + ["sigph%d" % i for i in idx]
+        self.q_fun = [dynamicsymbols(nm) for nm in names]
+        self.q = [real(nm) for nm in names]
+        self.qd = [real("d" + nm) for nm in names]
+        self.qdd = [real("dd" + nm) for nm in names]
+        self.sig = [real(nm) for nm in self.sig_names]
+        self.dof = len(self.q)
+
+        # link unit directions u_i(t)
+        if kind == "planar":
+            self.u = [sympy.Matrix([sin(th), -cos(th)]) for th in self.q_fun]
+        else:
+            th, ph = self.q_fun[:n], self.q_fun[n:]
+            self.u = [
+                sympy.Matrix([sin(th[i]) * cos(ph[i]), sin(th[i]) * sin(ph[i]), -cos(th[i])])
+                for i in range(n)
+            ]
+        p = sympy.Matrix(self.p_fun)
+        self.r = []  # r_0 = p, r_k = p + sum_{j<=k} l_j u_j
+        acc = p
+        self.r.append(acc)
+        for k in range(n):
+            acc = acc + self.l[k] * self.u[k]
+            self.r.append(acc)
+
+        self.trig = Trig(self.q)
+
+        # substitution of time functions by plain symbols, highest derivative first
+        # (xreplace matches top-down, so Derivative(q(t), (t, 2)) is replaced whole)
+        self.to_symbols = {}
+        for f, s, v, a in zip(self.p_fun, self.p_sym, self.v_sym, self.a_sym):
+            self.to_symbols[f.diff(t, 2)] = a
+            self.to_symbols[f.diff(t)] = v
+            self.to_symbols[f] = s
+        for f, s, v, a in zip(self.q_fun, self.q, self.qd, self.qdd):
+            self.to_symbols[f.diff(t, 2)] = a
+            self.to_symbols[f.diff(t)] = v
+            self.to_symbols[f] = s
+
+    def symbolize(self, expr):
+        expr = expr.xreplace(self.to_symbols)
+        require(
+            not expr.atoms(sympy.Derivative) and not expr.atoms(sympy.core.function.AppliedUndef),
+            "a time function survived the substitution in " + self.name,
+        )
+        require(t not in expr.free_symbols, "t survived in " + self.name)
+        return self.trig.poly(expr)
+
+    def height(self, r):
+        return r[1] if self.kind == "planar" else r[2]
+
+
+def derive(case):
+    """Returns a dict of normal-form sympy expressions for the case."""
+    n, dof = case.n, case.dof
+    rdot = [r.diff(t) for r in case.r]
+    T = Rational(1, 2) * sum(case.m[k] * rdot[k + 1].dot(rdot[k + 1]) for k in range(n))
+    U = sum(case.m[k] * case.g * case.height(case.r[k + 1]) for k in range(n))
+    L = sympy.expand(T - U)
+
+    # Rayleigh dissipation from the link direction rates computed from the positions
+    D = 0
+    for i in range(n):
+        udot = (rdot[i + 1] - rdot[i]) / case.l[i]
+        D += Rational(1, 2) * case.lam[i] * sympy.expand(udot.dot(udot))
+
+    E_L = []  # d/dt dL/dqdot - dL/dq
+    Q = []
+    for a in range(dof):
+        qf = case.q_fun[a]
+        qfd = qf.diff(t)
+        dL_dqd = L.diff(qfd)
+        dL_dq = L.diff(qf)
+        E_L.append(case.symbolize(dL_dqd.diff(t) - dL_dq))
+        Q.append(case.symbolize(case.sig[a] - D.diff(qfd)))
+
+    # energies with the pivot fixed at the origin and at rest
+    at_rest = {f: 0 for f in case.p_fun}
+    T0 = case.symbolize(T.subs(at_rest).doit())
+    U0 = case.symbolize(U.subs(at_rest))
+
+    # split E_L term by term (the normal form is expanded and unique)
+    qdd, qd, acc = set(case.qdd), set(case.qd), set(case.a_sym)
+    M = [[[] for _ in range(dof)] for _ in range(dof)]
+    c = [[] for _ in range(dof)]
+    k = [[] for _ in range(dof)]
+    d = [[] for _ in range(dof)]
+    forbidden = set(case.p_sym) | set(case.v_sym)
+    for a in range(dof):
+        leftover = E_L[a].free_symbols & forbidden
+        require(
+            not leftover,
+            "%s: pivot position/velocity did not cancel in E_%d: %s" % (case.name, a, sorted(map(str, leftover))),
+        )
+        for term in Add.make_args(E_L[a]):
+            pw = term.as_powers_dict()
+            n_qdd = sum(pw.get(s, 0) for s in qdd)
+            n_qd = sum(pw.get(s, 0) for s in qd)
+            n_acc = sum(pw.get(s, 0) for s in acc)
+            if n_qdd:
+                require(n_qdd == 1 and n_qd == 0 and n_acc == 0, "%s: E not linear in qdd: %s" % (case.name, term))
+                b = next(i for i, s in enumerate(case.qdd) if pw.get(s, 0))
+                M[a][b].append(term / case.qdd[b])
+            elif n_acc:
+                require(n_acc == 1 and n_qd == 0, "%s: pivot term not linear in a: %s" % (case.name, term))
+                d[a].append(term)
+            elif n_qd:
+                require(n_qd == 2, "%s: velocity term not quadratic in rates: %s" % (case.name, term))
+                c[a].append(term)
+            else:
+                k[a].append(term)
+    M = [[Add(*e) for e in row] for row in M]
+    c = [Add(*e) for e in c]
+    k = [Add(*e) for e in k]
+    d = [Add(*e) for e in d]
+    out = dict(M=M, c=c, k=k, d=d, Q=Q, T=T0, U=U0, E_L=E_L)
+    check_case(case, out)
+    return out
+
+
+def check_case(case, r):
+    """Identities the derivation must satisfy; any failure aborts the run."""
+    n, dof, trig = case.n, case.dof, case.trig
+    M, c, k, d, Q, T0, U0, E_L = (r[x] for x in ("M", "c", "k", "d", "Q", "T", "U", "E_L"))
+    zero_rates = {s: 0 for s in case.qd}
+    scale = Symbol("_scale")
+
+    # the split is complete: E_L = M qdd + c + k + d
+    for a in range(dof):
+        recon = sum(M[a][b] * case.qdd[b] for b in range(dof)) + c[a] + k[a] + d[a]
+        require(trig.reduce(recon - E_L[a]) == 0, "%s: split of E_%d incomplete" % (case.name, a))
+
+    # mass matrix: symmetric, free of rates, accelerations, pivot, torques, damping
+    state = set(case.qd) | set(case.qdd) | set(case.a_sym) | set(case.sig) | set(case.lam)
+    for a in range(dof):
+        require(M[a][a] != 0, "%s: M[%d][%d] = 0" % (case.name, a, a))
+        for b in range(dof):
+            require(trig.reduce(M[a][b] - M[b][a]) == 0, "%s: M not symmetric at (%d,%d)" % (case.name, a, b))
+            require(not (M[a][b].free_symbols & state), "%s: M[%d][%d] depends on rates/forces" % (case.name, a, b))
+
+    # T (pivot at rest) = 1/2 qd^T M qd
+    quad = sum(M[a][b] * case.qd[a] * case.qd[b] for a in range(dof) for b in range(dof)) / 2
+    require(trig.reduce(quad - T0) == 0, "%s: T != qd^T M qd / 2" % case.name)
+
+    # velocity terms: vanish at rest and homogeneous of degree 2 in the rates
+    for a in range(dof):
+        require(c[a].xreplace(zero_rates) == 0, "%s: c_%d does not vanish at qd = 0" % (case.name, a))
+        scaled = c[a].xreplace({s: scale * s for s in case.qd})
+        require(
+            sympy.expand(scaled - scale**2 * c[a]) == 0, "%s: c_%d is not homogeneous of degree 2" % (case.name, a)
+        )
+        require(not (c[a].free_symbols & (set(case.a_sym) | set(case.qdd))), "%s: c_%d bad symbols" % (case.name, a))
+
+    # gravity terms = dU/dq, U computed separately from the heights (pivot at origin)
+    U_sep = 0
+    pos = sympy.zeros(len(case.axes), 1)
+    for i in range(n):
+        pos = pos + case.l[i] * case.u[i]
+        U_sep += case.m[i] * case.g * case.height(pos)
+    U_sep = case.symbolize(U_sep)
+    require(trig.reduce(U_sep - U0) == 0, "%s: stored U differs from the separate U" % case.name)
+    U_plain = U_sep.xreplace({v: k_ for k_, v in trig.to_poly.items()})
+    for a in range(dof):
+        dU = trig.poly(U_plain.diff(case.q[a]))
+        require(trig.reduce(dU - k[a]) == 0, "%s: gravity term %d != dU/dq" % (case.name, a))
+
+    # pivot terms: linear in the pivot acceleration, no rates
+    for a in range(dof):
+        lin = sum(d[a].diff(s) * s for s in case.a_sym)
+        require(trig.reduce(lin - d[a]) == 0, "%s: d_%d not linear in a" % (case.name, a))
+        for s in case.a_sym:
+            require(d[a].diff(s, 2) == 0, "%s: d_%d not linear in %s" % (case.name, a, s))
+        require(not (d[a].free_symbols & set(case.qd)), "%s: d_%d depends on rates" % (case.name, a))
+
+    # equivalence principle: in the pivot's frame the drive is an inertial force
+    # -m a, i.e. the potential U_a = sum m_k a . (r_k - p), and d = dU_a/dq
+    U_acc = 0
+    pos = sympy.zeros(len(case.axes), 1)
+    for i in range(n):
+        pos = pos + case.l[i] * case.u[i]
+        U_acc += case.m[i] * sum(a_ * x for a_, x in zip(case.a_sym, pos))
+    U_acc = case.symbolize(U_acc).xreplace({v: k_ for k_, v in trig.to_poly.items()})
+    for a in range(dof):
+        dUa = trig.poly(U_acc.diff(case.q[a]))
+        require(trig.reduce(dUa - d[a]) == 0, "%s: pivot term %d != d(m a.r)/dq" % (case.name, a))
+
+    # generalized forces: the Rayleigh dissipation gives the expected forms
+    for a in range(dof):
+        i = a % n
+        if case.kind == "planar" or a < n:
+            expect = case.sig[a] - case.lam[i] * case.qd[a]
+        else:
+            expect = case.sig[a] - case.lam[i] * trig.S[case.q[i]] ** 2 * case.qd[a]
+        require(trig.reduce(Q[a] - expect) == 0, "%s: Q_%d = %s unexpected" % (case.name, a, Q[a]))
+        require(not (Q[a].free_symbols & (set(case.p_sym) | set(case.v_sym) | set(case.a_sym))),
+                "%s: Q_%d depends on the pivot" % (case.name, a))
+
+
+# ---------------------------------------------------------------------------
+# Output
+# ---------------------------------------------------------------------------
+
+
+def compact(tree):
+    return json.dumps(tree, separators=(",", ":"))
+
+
+def render(case, r):
+    n = case.n
+    symbols = [
+        ("coordinates", [s.name for s in case.q]),
+        ("rates", [s.name for s in case.qd]),
+        ("masses", [s.name for s in case.m]),
+        ("lengths", [s.name for s in case.l]),
+        ("gravity", case.g.name),
+        ("damping", [s.name for s in case.lam]),
+        ("torques", case.sig_names),
+        ("pivot_acceleration", [s.name for s in case.a_sym]),
+    ]
+    allowed = []
+    for _, v in symbols:
+        allowed += v if isinstance(v, list) else [v]
+    pr = Printer(case.trig, allowed)
+
+    lines = ["{"]
+    header = [
+        ("format", FORMAT),
+        ("case", case.name),
+        ("kind", case.kind),
+        ("links", n),
+        ("sympy_version", sympy.__version__),
+        ("equation", EQUATION),
+    ]
+    for key, v in header:
+        lines.append(" %s: %s," % (json.dumps(key), json.dumps(v)))
+    lines.append(' "symbols": {')
+    for i, (key, v) in enumerate(symbols):
+        sep = "," if i + 1 < len(symbols) else ""
+        lines.append("  %s: %s%s" % (json.dumps(key), compact(v), sep))
+    lines.append(" },")
+
+    def vector(key, exprs, last=False):
+        lines.append(" %s: [" % json.dumps(key))
+        for i, e in enumerate(exprs):
+            lines.append("  " + compact(pr(e)) + ("," if i + 1 < len(exprs) else ""))
+        lines.append(" ]" + ("" if last else ","))
+
+    lines.append(' "mass_matrix": [')
+    for a, row in enumerate(r["M"]):
+        lines.append("  [")
+        for b, e in enumerate(row):
+            lines.append("   " + compact(pr(e)) + ("," if b + 1 < len(row) else ""))
+        lines.append("  ]" + ("," if a + 1 < len(r["M"]) else ""))
+    lines.append(" ],")
+    vector("velocity_terms", r["c"])
+    vector("gravity_terms", r["k"])
+    vector("pivot_terms", r["d"])
+    vector("generalized_forces", r["Q"])
+    lines.append(' "kinetic_energy": %s,' % compact(pr(r["T"])))
+    lines.append(' "potential_energy": %s' % compact(pr(r["U"])))
+    lines.append("}")
+    text = "\n".join(lines) + "\n"
+    json.loads(text)  # well-formed
+    return text
+
+
+def all_cases():
+    return [("planar", n) for n in PLANAR_LINKS] + [("spatial", n) for n in SPATIAL_LINKS]
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    default_out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "cases")
+    ap.add_argument("--out", default=default_out, help="output directory (default: reference/cases)")
+    ap.add_argument("--cases", default=None, help="comma-separated subset, e.g. planar_n3,spatial_n2")
+    ap.add_argument("--quiet", action="store_true", help="no per-case progress on stderr")
+    args = ap.parse_args(argv)
+
+    if sympy.__version__ != SYMPY_VERSION:
+        sys.exit(
+            "derive.py: sympy %s found, %s required (pip install -r reference/requirements.txt)"
+            % (sympy.__version__, SYMPY_VERSION)
+        )
+
+    cases = all_cases()
+    if args.cases:
+        wanted = args.cases.split(",")
+        known = {"%s_n%d" % c for c in cases}
+        unknown = [w for w in wanted if w not in known]
+        if unknown:
+            sys.exit("derive.py: unknown case(s): %s" % ", ".join(unknown))
+        cases = [c for c in cases if "%s_n%d" % c in wanted]
+
+    os.makedirs(args.out, exist_ok=True)
+    start = time.monotonic()
+    for kind, n in cases:
+        t0 = time.monotonic()
+        case = Case(kind, n)
+        try:
+            text = render(case, derive(case))
+        except DerivationError as e:
+            sys.exit("derive.py: check failed: %s" % e)
+        path = os.path.join(args.out, case.name + ".json")
+        with open(path, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+        if not args.quiet:
+            print(
+                "%-12s %9d bytes  %6.2f s" % (case.name, len(text.encode()), time.monotonic() - t0),
+                file=sys.stderr,
+            )
+    if not args.quiet:
+        print("total %.2f s" % (time.monotonic() - start), file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
