@@ -134,6 +134,12 @@ where
     pub fn gravity(&self) -> f64 {
         self.gravity
     }
+
+    /// The coupling weight `W_ij = M_max(i,j) l_i l_j` (kg·m², 0-based `i`, `j`) that
+    /// multiplies every entry of the mass matrix and the velocity terms (eqs 22, 31–39).
+    pub fn weight(&self, i: usize, j: usize) -> f64 {
+        self.tail_masses[i.max(j)] * self.lengths[i] * self.lengths[j]
+    }
 }
 
 #[cfg(test)]

@@ -32,12 +32,6 @@ where
     pub fn new(chain: Chain<L>) -> Self {
         Self { chain }
     }
-
-    /// `W_ij = M_max(i,j) l_i l_j`, kg·m².
-    fn weight(&self, i: usize, j: usize) -> f64 {
-        let c = &self.chain;
-        c.tail_masses()[i.max(j)] * c.lengths()[i] * c.lengths()[j]
-    }
 }
 
 impl<L: Dim> From<Chain<L>> for Planar<L>
@@ -68,9 +62,9 @@ where
     fn mass_matrix(&self, q: &OVector<f64, L>, out: &mut OMatrix<f64, L, L>) {
         let n = self.chain.links();
         for i in 0..n {
-            out[(i, i)] = self.weight(i, i);
+            out[(i, i)] = self.chain.weight(i, i);
             for j in 0..i {
-                let v = self.weight(i, j) * (q[i] - q[j]).cos();
+                let v = self.chain.weight(i, j) * (q[i] - q[j]).cos();
                 out[(i, j)] = v;
                 out[(j, i)] = v;
             }
@@ -80,7 +74,7 @@ where
     fn velocity_terms(&self, q: &OVector<f64, L>, qd: &OVector<f64, L>, out: &mut OVector<f64, L>) {
         let n = self.chain.links();
         for i in 0..n {
-            out[i] = (0..n).map(|j| self.weight(i, j) * (q[i] - q[j]).sin() * qd[j] * qd[j]).sum();
+            out[i] = (0..n).map(|j| self.chain.weight(i, j) * (q[i] - q[j]).sin() * qd[j] * qd[j]).sum();
         }
     }
 
@@ -117,9 +111,9 @@ where
         let n = self.chain.links();
         let mut t = 0.0;
         for i in 0..n {
-            t += 0.5 * self.weight(i, i) * qd[i] * qd[i];
+            t += 0.5 * self.chain.weight(i, i) * qd[i] * qd[i];
             for j in 0..i {
-                t += self.weight(i, j) * (q[i] - q[j]).cos() * qd[i] * qd[j];
+                t += self.chain.weight(i, j) * (q[i] - q[j]).cos() * qd[i] * qd[j];
             }
         }
         t

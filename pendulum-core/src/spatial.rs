@@ -57,11 +57,6 @@ where
     pub fn new(chain: Chain<L>) -> Self {
         Self { chain }
     }
-
-    fn weight(&self, i: usize, j: usize) -> f64 {
-        let c = &self.chain;
-        c.tail_masses()[i.max(j)] * c.lengths()[i] * c.lengths()[j]
-    }
 }
 
 impl<L: Dim> From<Chain<L>> for Spatial<L>
@@ -147,7 +142,7 @@ where
         let f = self.frames(q);
         for i in 0..n {
             for j in 0..n {
-                let w = self.weight(i, j);
+                let w = self.chain.weight(i, j);
                 out[(i, j)] = w * f[i].d_theta.dot(&f[j].d_theta);
                 out[(i, n + j)] = w * f[i].d_theta.dot(&f[j].d_phi);
                 out[(n + i, j)] = w * f[i].d_phi.dot(&f[j].d_theta);
@@ -168,7 +163,7 @@ where
         for i in 0..n {
             let (mut ct, mut cp) = (0.0, 0.0);
             for (j, a) in acc.iter().enumerate() {
-                let w = self.weight(i, j);
+                let w = self.chain.weight(i, j);
                 ct += w * f[i].d_theta.dot(a);
                 cp += w * f[i].d_phi.dot(a);
             }
