@@ -67,11 +67,20 @@ pub const DEFAULT_STATES: usize = 200;
 /// Default seed: "pendulum" in ASCII.
 pub const DEFAULT_SEED: u64 = 0x7065_6e64_756c_756d;
 
+/// Parses `--states`: a positive count.
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("must be at least 1: a verify of no states would prove nothing".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{e}")),
+    }
+}
+
 /// Options of `cargo xtask verify`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Options {
-    /// Random states per case.
-    #[arg(long, default_value_t = DEFAULT_STATES)]
+    /// Random states per case (at least 1: a verify of no states would prove nothing).
+    #[arg(long, default_value_t = DEFAULT_STATES, value_parser = at_least_one)]
     pub states: usize,
     /// Seed of the random states; state k of a case depends only on the seed and k.
     #[arg(long, default_value_t = DEFAULT_SEED)]
