@@ -2,6 +2,7 @@
 //!
 //! One module per task or concern; `main.rs` is a flat match on subcommands.
 
+pub mod bench;
 pub mod case;
 pub mod document;
 pub mod expr;
