@@ -111,6 +111,39 @@ pub enum Error {
         /// The offending value, s.
         h: f64,
     },
+    /// A pivot drive parameter is out of range (non-finite, negative amplitude or radius,
+    /// zero direction).
+    #[error("drive {what} must be {requirement}, got {value}")]
+    InvalidDrive {
+        /// Which parameter (`"amplitude"`, `"angular frequency"`, `"phase"`, `"radius"`,
+        /// `"direction norm"`).
+        what: &'static str,
+        /// What it must be (`"finite"`, `"finite and non-negative"`, ...).
+        requirement: &'static str,
+        /// The offending value (for a direction, its Euclidean norm).
+        value: f64,
+    },
+    /// A trajectory run was asked for with a bad end time or sampling.
+    #[error("trajectory {what} must be {requirement}, got {value}")]
+    InvalidRun {
+        /// Which parameter (`"end time"`, `"step size"`, `"sampling interval"`).
+        what: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A step of a trajectory run failed; `source` is the integrator's or the system's
+    /// error. The state is left at time `t`, the start of the failed step.
+    #[error("step {step} of the run, from t = {t} s, failed: {source}")]
+    StepFailed {
+        /// Time at the start of the failed step, s.
+        t: f64,
+        /// 0-based number of the failed step in the run.
+        step: u64,
+        /// What went wrong.
+        source: Box<Error>,
+    },
 }
 
 /// The crate's result type.

@@ -12,7 +12,8 @@ use crate::{Inputs, Model, ModelAlloc, Result};
 /// time-dependent drive.
 ///
 /// Constant [`Inputs`] implement it (borrowed, no copy), and so does any closure
-/// `Fn(f64) -> Inputs` (`t` in s).
+/// `Fn(f64) -> Inputs` (`t` in s) and [`Driven`](crate::Driven), a pivot
+/// [`Drive`](crate::Drive) with torques of time.
 pub trait InputsAt<D: Dim, S: DimName>
 where
     DefaultAllocator: Allocator<D> + Allocator<S>,

@@ -5,19 +5,38 @@
 //! - [`Model`]: the equations of motion `M(q) q̈ + c + k + d = Q`, implemented by the
 //!   generic [`Planar`] and [`Spatial`] models here and by the unrolled fixed-N models
 //!   `pendulum-macros` generates.
+//! - [`Canonical`]: a model as the first-order system in canonical variables `(q, p)`,
+//!   `p = M(q) q̇`, where Gauss–Legendre methods are symplectic (`docs/integrators.md`).
+//! - [`Drive`] ([`Fixed`], [`Harmonic`], [`Circle`], [`FnDrive`]) and [`TorqueAt`]: a
+//!   prescribed pivot motion `p(t)` and torques `σ(t)`, combined by [`Driven`] into the
+//!   inputs of a [`FirstOrder`] system.
+//! - [`Accounted`]: the inertial-frame energy `H = T + U` of a driven chain with the work
+//!   of drive and torques and the damping losses integrated along the run.
+//! - [`trajectory::run`]: integrate from `t0` to `t1`, sampling every k steps, stopping
+//!   early on request.
 //!
 //! Equation numbers refer to the seed document (`shared/seed`); where it is wrong the
 //! code follows the sympy derivation and `reference/ERRATA.md` says so.
 
+mod canonical;
 mod chain;
+mod drive;
+mod energy;
 mod error;
 mod first_order;
 pub mod integrate;
 mod model;
 mod planar;
 mod spatial;
+pub mod trajectory;
 
+pub use canonical::{Canonical, KineticGradient};
 pub use chain::Chain;
+pub use drive::{Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, TorqueAt};
+pub use energy::{
+    Accounted, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum, pivot_momentum_rate,
+    powers,
+};
 pub use error::{Error, Result};
 pub use first_order::{FirstOrder, InputsAt};
 pub use model::{Inputs, Model, ModelAlloc, check_inputs};

@@ -1,0 +1,409 @@
+//! The canonical (Hamiltonian) form of a chain model, `x = (q, p)` with `p = M(q) q̇`,
+//! the variables in which Gauss–Legendre methods are symplectic.
+
+use nalgebra::{
+    Cholesky, DefaultAllocator, Dim, DimMul, DimName, DimProd, OMatrix, OVector, U1, U2, U3, Vector3,
+    allocator::Allocator,
+};
+
+use crate::integrate::{System, SystemAlloc};
+use crate::{Chain, Error, Inputs, InputsAt, Model, ModelAlloc, Planar, Result, Spatial, check_inputs};
+
+/// The gradient `∂T/∂q` of the kinetic energy at fixed rates `q̇` (N·m), the term the
+/// momentum equation of [`Canonical`] needs and the [`Model`] trait does not offer.
+///
+/// With `T = ½ q̇ᵀ M(q) q̇`, `∂T/∂q_k = ½ q̇ᵀ (∂M/∂q_k) q̇`. Lagrange's equations
+/// `d/dt (M q̇) − ∂T/∂q = Q − k − d` and the model's form `M q̈ + c + k + d = Q` give the
+/// identity `∂T/∂q = Ṁ q̇ − c`, but `Ṁ q̇` needs `∂M/∂q`, which the trait does not expose
+/// either; so the gradient is written here in closed form for the two kinds of chain
+/// (both in `W_ij = M_max(i,j) l_i l_j`, eq 10 tail masses):
+///
+/// - planar (`Space = U2`, `q = (θ_1 … θ_n)`, `T = ½ Σ_ij W_ij cos(θ_i − θ_j) θ̇_i θ̇_j`):
+///   `∂T/∂θ_k = −Σ_j W_kj sin(θ_k − θ_j) θ̇_k θ̇_j`;
+/// - spatial (`Space = U3`, `q = (θ_1 … θ_n, φ_1 … φ_n)`, `T = ½ Σ_ij W_ij u̇_i·u̇_j`):
+///   `∂T/∂q_a = (∂u̇_k/∂q_a) · Σ_j W_kj u̇_j` for `q_a` an angle of link `k`, with
+///   `∂u̇/∂θ = u_θθ θ̇ + u_θφ φ̇` and `∂u̇/∂φ = u_θφ θ̇ + u_φφ φ̇`.
+///
+/// The provided method picks the formula from `Self::Space` and the chain, so a model
+/// in these coordinates (the fixed-N models of `pendulum-macros` are) opts in with an
+/// empty `impl KineticGradient for MyModel {}`. A model in other coordinates must
+/// override [`kinetic_gradient`](KineticGradient::kinetic_gradient).
+pub trait KineticGradient: Model
+where
+    DefaultAllocator: ModelAlloc<Self::Links, Self::Dof, Self::Space>,
+{
+    /// Writes `∂T/∂q (q, q̇)` (N·m) into `out`.
+    ///
+    /// Panics if the model's `dof` is not `n` (planar) or `2n` (spatial) for its `n`
+    /// links, i.e. if the default is used for a model it does not describe.
+    fn kinetic_gradient(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        let weights = Weights::of(self.chain());
+        match Self::Space::dim() {
+            2 => planar_kinetic_gradient(&weights, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
+            3 => spatial_kinetic_gradient(&weights, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
+            d => panic!("no default kinetic gradient for a model in a space of dimension {d}"),
+        }
+    }
+}
+
+impl<L: Dim> KineticGradient for Planar<L> where
+    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2>
+{
+}
+
+impl<L> KineticGradient for Spatial<L>
+where
+    L: Dim + DimMul<U2>,
+    DefaultAllocator:
+        Allocator<L> + Allocator<DimProd<L, U2>> + Allocator<DimProd<L, U2>, DimProd<L, U2>> + Allocator<U3>,
+{
+}
+
+/// A chain's tail masses `M_d` (kg) and lengths `l_d` (m) as slices, which is all the
+/// kinetic energy depends on.
+struct Weights<'a> {
+    tail_masses: &'a [f64],
+    lengths: &'a [f64],
+}
+
+impl<'a> Weights<'a> {
+    fn of<L: Dim>(chain: &'a Chain<L>) -> Self
+    where
+        DefaultAllocator: Allocator<L>,
+    {
+        Self { tail_masses: chain.tail_masses().as_slice(), lengths: chain.lengths().as_slice() }
+    }
+
+    fn links(&self) -> usize {
+        self.lengths.len()
+    }
+
+    /// `W_ij = M_max(i,j) l_i l_j`, kg·m².
+    fn w(&self, i: usize, j: usize) -> f64 {
+        self.tail_masses[i.max(j)] * self.lengths[i] * self.lengths[j]
+    }
+}
+
+/// `∂T/∂θ_k = −Σ_j W_kj sin(θ_k − θ_j) θ̇_k θ̇_j` of the planar chain.
+fn planar_kinetic_gradient(weights: &Weights, q: &[f64], qd: &[f64], out: &mut [f64]) {
+    let n = weights.links();
+    assert_eq!(q.len(), n, "a planar chain of {n} links has {n} coordinates");
+    for k in 0..n {
+        let sum: f64 = (0..n).map(|j| weights.w(k, j) * (q[k] - q[j]).sin() * qd[j]).sum();
+        out[k] = -qd[k] * sum;
+    }
+}
+
+/// `∂T/∂θ_k = (u_θθ θ̇_k + u_θφ φ̇_k)·V_k`, `∂T/∂φ_k = (u_θφ θ̇_k + u_φφ φ̇_k)·V_k` with
+/// `V_k = Σ_j W_kj u̇_j`, of the spatial chain in `q = (θ_1 … θ_n, φ_1 … φ_n)`.
+fn spatial_kinetic_gradient(weights: &Weights, q: &[f64], qd: &[f64], out: &mut [f64]) {
+    let n = weights.links();
+    assert_eq!(q.len(), 2 * n, "a spatial chain of {n} links has {} coordinates", 2 * n);
+    // Per link: u̇, ∂u̇/∂θ, ∂u̇/∂φ.
+    let links: Vec<[Vector3<f64>; 3]> = (0..n)
+        .map(|k| {
+            let (st, ct) = q[k].sin_cos();
+            let (sp, cp) = q[n + k].sin_cos();
+            let (td, pd) = (qd[k], qd[n + k]);
+            let u_t = Vector3::new(ct * cp, ct * sp, st);
+            let u_p = Vector3::new(-st * sp, st * cp, 0.0);
+            let u_tt = Vector3::new(-st * cp, -st * sp, ct);
+            let u_pp = Vector3::new(-st * cp, -st * sp, 0.0);
+            let u_tp = Vector3::new(-ct * sp, ct * cp, 0.0);
+            [u_t * td + u_p * pd, u_tt * td + u_tp * pd, u_tp * td + u_pp * pd]
+        })
+        .collect();
+    for k in 0..n {
+        let v = (0..n).fold(Vector3::zeros(), |v, j| v + links[j][0] * weights.w(k, j));
+        out[k] = links[k][1].dot(&v);
+        out[n + k] = links[k][2].dot(&v);
+    }
+}
+
+/// Coordinates and rates (or momenta), one vector each.
+type Pair<D> = (OVector<f64, D>, OVector<f64, D>);
+
+/// A chain model as the first-order system in canonical variables
+/// ```text
+/// x = (q, p),   p = M(q) q̇,
+/// q̇ = M(q)⁻¹ p,
+/// ṗ = ∂T/∂q|_q̇ − k(q) + Q(q, q̇, σ) − d(q, p̈)
+/// ```
+/// of dimension `2·dof`. Without torque, damping and drive these are Hamilton's equations
+/// of `H(q, p) = ½ pᵀ M(q)⁻¹ p + U(q)` (the document's section 1.1 `H = T + U`,
+/// `∂H/∂q|_p = −∂T/∂q|_q̇ + ∂U/∂q`), for which Gauss–Legendre methods are symplectic; in
+/// the velocity form [`FirstOrder`](crate::FirstOrder) (`x = (q, q̇)`) they are not. The
+/// momentum equation is Lagrange's `d/dt(∂T/∂q̇) − ∂T/∂q = Q − k − d`, so both forms
+/// describe the same motion; `docs/integrators.md` compares them on long runs.
+///
+/// `q̇` comes from a Cholesky solve with `M(q)`; `∂T/∂q` from [`KineticGradient`]. The
+/// Jacobian is the finite-difference default of [`System::jacobian`].
+#[derive(Debug, Clone)]
+pub struct Canonical<M, I> {
+    model: M,
+    inputs: I,
+}
+
+impl<M: Model> Canonical<M, Inputs<M::Dof, M::Space>>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    /// The free chain: no torque, pivot at rest.
+    pub fn new(model: M) -> Self {
+        let inputs = model.zero_inputs();
+        Self { model, inputs }
+    }
+}
+
+impl<M: KineticGradient, I> Canonical<M, I>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
+{
+    /// The chain driven by `inputs` (constant [`Inputs`] or a closure of time).
+    pub fn with_inputs(model: M, inputs: I) -> Self {
+        Self { model, inputs }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// The inputs.
+    pub fn inputs(&self) -> &I {
+        &self.inputs
+    }
+
+    /// The state `x = (q, p)` (rad, kg·m²/s).
+    pub fn state(
+        &self,
+        q: &OVector<f64, M::Dof>,
+        p: &OVector<f64, M::Dof>,
+    ) -> OVector<f64, DimProd<M::Dof, U2>> {
+        let dim = self.model.dof().mul(U2);
+        OVector::from_iterator_generic(dim, U1, q.iter().chain(p.iter()).copied())
+    }
+
+    /// Splits a state into `(q, p)`.
+    pub fn split(
+        &self,
+        x: &OVector<f64, DimProd<M::Dof, U2>>,
+    ) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>) {
+        let dof = self.model.dof();
+        let n = dof.value();
+        let q = OVector::from_iterator_generic(dof, U1, x.iter().take(n).copied());
+        let p = OVector::from_iterator_generic(dof, U1, x.iter().skip(n).take(n).copied());
+        (q, p)
+    }
+
+    /// The momenta `p = M(q) q̇` (kg·m²/s) of rates `q̇` (rad/s).
+    pub fn momenta(&self, q: &OVector<f64, M::Dof>, qd: &OVector<f64, M::Dof>) -> OVector<f64, M::Dof> {
+        let dof = self.model.dof();
+        let mut mass = OMatrix::<f64, M::Dof, M::Dof>::zeros_generic(dof, dof);
+        self.model.mass_matrix(q, &mut mass);
+        mass * qd
+    }
+
+    /// The canonical state of `(q, q̇)`: `x = (q, M(q) q̇)`.
+    pub fn from_velocities(
+        &self,
+        q: &OVector<f64, M::Dof>,
+        qd: &OVector<f64, M::Dof>,
+    ) -> OVector<f64, DimProd<M::Dof, U2>> {
+        self.state(q, &self.momenta(q, qd))
+    }
+
+    /// The rates `q̇ = M(q)⁻¹ p` (rad/s) of momenta `p`.
+    ///
+    /// Errors: [`Error::SingularAngle`] at a coordinate singularity,
+    /// [`Error::NotPositiveDefinite`] if the mass matrix does not factor.
+    pub fn velocities(
+        &self,
+        q: &OVector<f64, M::Dof>,
+        p: &OVector<f64, M::Dof>,
+    ) -> Result<OVector<f64, M::Dof>> {
+        self.model.check_configuration(q)?;
+        let dof = self.model.dof();
+        let mut mass = OMatrix::<f64, M::Dof, M::Dof>::zeros_generic(dof, dof);
+        self.model.mass_matrix(q, &mut mass);
+        let cholesky = Cholesky::new(mass).ok_or(Error::NotPositiveDefinite)?;
+        let qd = cholesky.solve(p);
+        if qd.iter().all(|v| v.is_finite()) { Ok(qd) } else { Err(Error::NotPositiveDefinite) }
+    }
+
+    /// The velocity-form state `(q, q̇)` of a canonical state (errors of
+    /// [`velocities`](Self::velocities)).
+    pub fn to_velocities(&self, x: &OVector<f64, DimProd<M::Dof, U2>>) -> Result<Pair<M::Dof>> {
+        let (q, p) = self.split(x);
+        let qd = self.velocities(&q, &p)?;
+        Ok((q, qd))
+    }
+
+    /// The Hamiltonian `H(q, p) = ½ pᵀ M(q)⁻¹ p + U(q) = T + U` (J), relative to the pivot,
+    /// evaluated as [`Model::energy`] of `(q, M⁻¹ p)` so that it is the same function of
+    /// the motion as [`FirstOrder::energy`](crate::FirstOrder::energy).
+    pub fn energy(&self, x: &OVector<f64, DimProd<M::Dof, U2>>) -> Result<f64> {
+        let (q, qd) = self.to_velocities(x)?;
+        Ok(self.model.energy(&q, &qd))
+    }
+}
+
+impl<M: KineticGradient, I: InputsAt<M::Dof, M::Space>> System for Canonical<M, I>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<DimProd<M::Dof, U2>>,
+{
+    type Dim = DimProd<M::Dof, U2>;
+
+    fn dim(&self) -> Self::Dim {
+        self.model.dof().mul(U2)
+    }
+
+    /// `(M⁻¹ p, ∂T/∂q − k + Q − d)`. Errors: [`Error::NonFinite`] (`"q"`, `"p"` or an
+    /// input), [`Error::SingularAngle`], [`Error::NotPositiveDefinite`].
+    fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()> {
+        let (q, p) = self.split(x);
+        let inputs = self.inputs.inputs_at(t);
+        check_inputs(self.model.dof().value(), &q, &p, &inputs).map_err(|e| match e {
+            Error::NonFinite { what: "qd", index, value } => Error::NonFinite { what: "p", index, value },
+            Error::LengthMismatch { what: "qd", expected, got } => {
+                Error::LengthMismatch { what: "p", expected, got }
+            }
+            other => other,
+        })?;
+        let qd = self.velocities(&q, &p)?;
+        let dof = self.model.dof();
+        let mut pd = OVector::<f64, M::Dof>::zeros_generic(dof, U1);
+        let mut tmp = OVector::<f64, M::Dof>::zeros_generic(dof, U1);
+        self.model.kinetic_gradient(&q, &qd, &mut pd);
+        self.model.generalized_forces(&q, &qd, &inputs.torque, &mut tmp);
+        pd += &tmp;
+        self.model.gravity_terms(&q, &mut tmp);
+        pd -= &tmp;
+        self.model.pivot_terms(&q, &inputs.pivot_acceleration, &mut tmp);
+        pd -= &tmp;
+        let n = dof.value();
+        for i in 0..n {
+            out[i] = qd[i];
+            out[n + i] = pd[i];
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Const, DVector, Dyn, SVector, Vector2};
+
+    use super::*;
+    use crate::FirstOrder;
+
+    /// Central difference of `T` in each coordinate, step `1e-5`: error ~1e-10 · scale.
+    fn numeric_gradient<M: Model>(model: &M, q: &OVector<f64, M::Dof>, qd: &OVector<f64, M::Dof>) -> Vec<f64>
+    where
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    {
+        let h = 1e-5;
+        (0..q.len())
+            .map(|k| {
+                let (mut plus, mut minus) = (q.clone(), q.clone());
+                plus[k] += h;
+                minus[k] -= h;
+                (model.kinetic_energy(&plus, qd) - model.kinetic_energy(&minus, qd)) / (2.0 * h)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn planar_gradient_matches_a_finite_difference_of_the_kinetic_energy() {
+        let model =
+            Planar::new(Chain::<Dyn>::new(&[1.0, 0.3, 2.0, 0.7], &[0.5, 1.0, 0.7, 1.3], 9.81).unwrap());
+        let q = DVector::from_vec(vec![0.4, -1.0, 2.5, 0.1]);
+        let qd = DVector::from_vec(vec![1.0, -0.5, 2.3, -1.7]);
+        let mut got = DVector::zeros(4);
+        model.kinetic_gradient(&q, &qd, &mut got);
+        let expected = numeric_gradient(&model, &q, &qd);
+        for (g, e) in got.iter().zip(&expected) {
+            assert!((g - e).abs() < 1e-8, "{got} vs {expected:?}");
+        }
+    }
+
+    #[test]
+    fn spatial_gradient_matches_a_finite_difference_of_the_kinetic_energy() {
+        let model = Spatial::new(Chain::<Const<3>>::new(&[1.0, 0.3, 2.0], &[0.5, 1.0, 0.7], 9.81).unwrap());
+        let q = SVector::<f64, 6>::from([0.4, 1.0, 2.5, 0.1, -2.0, 3.0]);
+        let qd = SVector::<f64, 6>::from([1.0, -0.5, 0.3, 2.0, 0.7, -1.1]);
+        let mut got = SVector::<f64, 6>::zeros();
+        model.kinetic_gradient(&q, &qd, &mut got);
+        let expected = numeric_gradient(&model, &q, &qd);
+        for (g, e) in got.iter().zip(&expected) {
+            assert!((g - e).abs() < 1e-8, "{got} vs {expected:?}");
+        }
+    }
+
+    /// `ṗ = d/dt (M q̇)` along the motion: `M q̈ + Ṁ q̇`, with `Ṁ q̇` a finite difference of
+    /// `M` along `q̇`; checks the whole momentum equation including damping and drive.
+    #[test]
+    fn momentum_rate_is_the_time_derivative_of_m_qdot() {
+        let chain = Chain::<Dyn>::new(&[1.0, 2.0, 0.5], &[0.8, 0.6, 1.1], 9.81).unwrap();
+        let model = Spatial::new(chain.with_damping(&[0.1, 0.2, 0.3]).unwrap());
+        let mut inputs = model.zero_inputs();
+        inputs.torque.copy_from_slice(&[0.3, -0.2, 0.1, 0.5, 0.0, -0.4]);
+        inputs.pivot_acceleration.copy_from_slice(&[1.0, -2.0, 0.5]);
+        let q = DVector::from_vec(vec![0.7, 1.9, 2.2, 0.3, -1.0, 2.0]);
+        let qd = DVector::from_vec(vec![0.5, -1.2, 0.8, 1.5, 0.2, -0.9]);
+        let system = Canonical::with_inputs(model.clone(), inputs.clone());
+        let x = system.from_velocities(&q, &qd);
+        let mut f = DVector::zeros(12);
+        system.rhs(0.0, &x, &mut f).unwrap();
+        let mut qdd = DVector::zeros(6);
+        model.accelerations(&q, &qd, &inputs, &mut qdd).unwrap();
+        let h = 1e-6;
+        let (mut mp, mut mm) = (DMatrixOf::zeros(6, 6), DMatrixOf::zeros(6, 6));
+        model.mass_matrix(&(&q + &qd * h), &mut mp);
+        model.mass_matrix(&(&q - &qd * h), &mut mm);
+        let mut mass = DMatrixOf::zeros(6, 6);
+        model.mass_matrix(&q, &mut mass);
+        let expected = &mass * &qdd + (mp - mm) / (2.0 * h) * &qd;
+        for i in 0..6 {
+            assert!((f[i] - qd[i]).abs() < 1e-13, "q̇[{i}]: {} vs {}", f[i], qd[i]);
+            assert!((f[6 + i] - expected[i]).abs() < 1e-7, "ṗ[{i}]: {} vs {}", f[6 + i], expected[i]);
+        }
+    }
+
+    type DMatrixOf = nalgebra::DMatrix<f64>;
+
+    #[test]
+    fn conversions_round_trip_and_energy_matches_the_velocity_form() {
+        let model = Planar::new(Chain::<Const<2>>::new(&[1.0, 2.0], &[0.5, 1.5], 9.81).unwrap());
+        let system = Canonical::new(model.clone());
+        let velocity_form = FirstOrder::new(model);
+        let (q, qd) = (Vector2::new(0.3, -1.1), Vector2::new(2.0, 0.4));
+        let x = system.from_velocities(&q, &qd);
+        let (q2, qd2) = system.to_velocities(&x).unwrap();
+        assert_eq!(q2, q);
+        assert!((qd2 - qd).amax() < 1e-14);
+        let e = velocity_form.energy(&velocity_form.state(&q, &qd));
+        assert!((system.energy(&x).unwrap() - e).abs() < 1e-13 * e.abs());
+        // H = ½ p·q̇ + U.
+        let (_, p) = system.split(&x);
+        let h = 0.5 * p.dot(&qd) + system.model().potential_energy(&q);
+        assert!((h - e).abs() < 1e-13 * e.abs());
+    }
+
+    #[test]
+    fn singular_spatial_state_and_nan_momenta_are_errors() {
+        let system = Canonical::new(Spatial::new(Chain::<Dyn>::uniform(1, 1.0, 1.0, 9.81).unwrap()));
+        let mut f = DVector::zeros(4);
+        let x = DVector::from_vec(vec![0.0, 0.3, 0.0, 0.0]);
+        assert!(matches!(system.rhs(0.0, &x, &mut f), Err(Error::SingularAngle { link: 1, .. })));
+        let x = DVector::from_vec(vec![1.0, 0.3, f64::NAN, 0.0]);
+        assert!(matches!(system.rhs(0.0, &x, &mut f), Err(Error::NonFinite { what: "p", index: 0, .. })));
+    }
+}

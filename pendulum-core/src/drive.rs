@@ -1,0 +1,463 @@
+//! Prescribed pivot motion `p(t)` and time-dependent torques `σ(t)`: the inputs of a
+//! driven chain, plugged into [`FirstOrder`](crate::FirstOrder) through [`Driven`].
+//!
+//! A driven pivot enters the equations of motion only through its acceleration `p̈(t)`
+//! (in the pivot's frame it acts as the time-dependent gravity `g⃗ − p̈(t)`, DESIGN.md);
+//! the energy accounting ([`Accounted`](crate::Accounted)) also needs `p(t)` and `ṗ(t)`.
+//! Vectors live in the model's space: `(x, y)` with y up for planar models, `(x, y, z)`
+//! with z up for spatial ones.
+
+use std::borrow::Cow;
+
+use nalgebra::{DefaultAllocator, Dim, DimName, OVector, U1, U3, Vector3, allocator::Allocator};
+
+use crate::{Error, Inputs, InputsAt, Result};
+
+/// A prescribed pivot motion: position `p(t)` (m), velocity `ṗ(t)` (m/s) and acceleration
+/// `p̈(t)` (m/s²) in the model's space `S` (`U2` planar, `U3` spatial).
+///
+/// The three must be consistent (`ṗ = dp/dt`, `p̈ = dṗ/dt`) for the energy balance of
+/// [`Accounted`](crate::Accounted) to close; the dynamics use `p̈` only. The built-in
+/// drives are [`Fixed`], [`Harmonic`], [`Circle`] (spatial) and [`FnDrive`] (closures);
+/// implement the trait for any other motion. `&D` and `Box<D>` (also `Box<dyn Drive<S>>`,
+/// to choose a drive at run time) are drives when `D` is.
+pub trait Drive<S: DimName>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// Pivot position `p(t)`, m.
+    fn position(&self, t: f64) -> OVector<f64, S>;
+    /// Pivot velocity `ṗ(t)`, m/s.
+    fn velocity(&self, t: f64) -> OVector<f64, S>;
+    /// Pivot acceleration `p̈(t)`, m/s².
+    fn acceleration(&self, t: f64) -> OVector<f64, S>;
+}
+
+impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for &D
+where
+    DefaultAllocator: Allocator<S>,
+{
+    fn position(&self, t: f64) -> OVector<f64, S> {
+        (**self).position(t)
+    }
+    fn velocity(&self, t: f64) -> OVector<f64, S> {
+        (**self).velocity(t)
+    }
+    fn acceleration(&self, t: f64) -> OVector<f64, S> {
+        (**self).acceleration(t)
+    }
+}
+
+impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for Box<D>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    fn position(&self, t: f64) -> OVector<f64, S> {
+        (**self).position(t)
+    }
+    fn velocity(&self, t: f64) -> OVector<f64, S> {
+        (**self).velocity(t)
+    }
+    fn acceleration(&self, t: f64) -> OVector<f64, S> {
+        (**self).acceleration(t)
+    }
+}
+
+/// The pivot at rest at the origin: `p = ṗ = p̈ = 0`. A drive in any space.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Fixed;
+
+impl<S: DimName> Drive<S> for Fixed
+where
+    DefaultAllocator: Allocator<S>,
+{
+    fn position(&self, _t: f64) -> OVector<f64, S> {
+        OVector::zeros()
+    }
+    fn velocity(&self, _t: f64) -> OVector<f64, S> {
+        OVector::zeros()
+    }
+    fn acceleration(&self, _t: f64) -> OVector<f64, S> {
+        OVector::zeros()
+    }
+}
+
+/// `InvalidDrive` unless `value` is finite (and `≥ 0` when `non_negative`).
+fn check_parameter(what: &'static str, value: f64, non_negative: bool) -> Result<f64> {
+    if !value.is_finite() {
+        return Err(Error::InvalidDrive { what, requirement: "finite", value });
+    }
+    if non_negative && value < 0.0 {
+        return Err(Error::InvalidDrive { what, requirement: "finite and non-negative", value });
+    }
+    Ok(value)
+}
+
+/// Harmonic oscillation of the pivot along a fixed direction `d̂`:
+/// ```text
+/// p(t) = A sin(ωt + φ) d̂,   ṗ(t) = A ω cos(ωt + φ) d̂,   p̈(t) = −A ω² sin(ωt + φ) d̂
+/// ```
+/// with amplitude `A ≥ 0` (m), angular frequency `ω ≥ 0` (rad/s) and phase `φ` (rad).
+/// Kapitza's pendulum is the vertical case, [`Harmonic::vertical`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Harmonic<S: DimName>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    direction: OVector<f64, S>,
+    amplitude: f64,
+    angular_frequency: f64,
+    phase: f64,
+}
+
+impl<S: DimName> Harmonic<S>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// Oscillation along `direction` (normalized here; any non-zero finite length),
+    /// amplitude `A` (m), angular frequency `ω` (rad/s), phase `φ` (rad).
+    ///
+    /// Errors: [`Error::InvalidDrive`] naming the value when the direction is zero or
+    /// not finite (`what = "direction norm"`), `A` or `ω` is negative or not finite, or
+    /// `φ` is not finite.
+    pub fn new(
+        direction: OVector<f64, S>,
+        amplitude: f64,
+        angular_frequency: f64,
+        phase: f64,
+    ) -> Result<Self> {
+        let norm = direction.norm();
+        if !(norm.is_finite() && norm > 0.0) {
+            let requirement = "finite and positive";
+            return Err(Error::InvalidDrive { what: "direction norm", requirement, value: norm });
+        }
+        Ok(Self {
+            direction: direction / norm,
+            amplitude: check_parameter("amplitude", amplitude, true)?,
+            angular_frequency: check_parameter("angular frequency", angular_frequency, true)?,
+            phase: check_parameter("phase", phase, false)?,
+        })
+    }
+
+    /// Oscillation along the vertical (the last axis: y planar, z spatial), the drive of
+    /// Kapitza's pendulum. Errors as [`new`](Harmonic::new).
+    pub fn vertical(amplitude: f64, angular_frequency: f64, phase: f64) -> Result<Self> {
+        let mut up = OVector::<f64, S>::zeros();
+        up[S::dim() - 1] = 1.0;
+        Self::new(up, amplitude, angular_frequency, phase)
+    }
+
+    /// The unit direction `d̂`.
+    pub fn direction(&self) -> &OVector<f64, S> {
+        &self.direction
+    }
+
+    /// Amplitude `A`, m.
+    pub fn amplitude(&self) -> f64 {
+        self.amplitude
+    }
+
+    /// Angular frequency `ω`, rad/s.
+    pub fn angular_frequency(&self) -> f64 {
+        self.angular_frequency
+    }
+
+    /// Phase `φ`, rad.
+    pub fn phase(&self) -> f64 {
+        self.phase
+    }
+}
+
+impl<S: DimName> Drive<S> for Harmonic<S>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    fn position(&self, t: f64) -> OVector<f64, S> {
+        let arg = self.angular_frequency * t + self.phase;
+        &self.direction * (self.amplitude * arg.sin())
+    }
+    fn velocity(&self, t: f64) -> OVector<f64, S> {
+        let arg = self.angular_frequency * t + self.phase;
+        &self.direction * (self.amplitude * self.angular_frequency * arg.cos())
+    }
+    fn acceleration(&self, t: f64) -> OVector<f64, S> {
+        let (w, arg) = (self.angular_frequency, self.angular_frequency * t + self.phase);
+        &self.direction * (-self.amplitude * w * w * arg.sin())
+    }
+}
+
+/// The pivot moving on a horizontal circle (the x–y plane, z up) about the origin,
+/// counter-clockwise seen from above for `ω > 0`:
+/// ```text
+/// p(t) = R (cos ωt, sin ωt, 0),   ṗ(t) = R ω (−sin ωt, cos ωt, 0),
+/// p̈(t) = −R ω² (cos ωt, sin ωt, 0)
+/// ```
+/// with radius `R ≥ 0` (m) and angular frequency `ω` (rad/s, either sign). Spatial
+/// models only.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    radius: f64,
+    angular_frequency: f64,
+}
+
+impl Circle {
+    /// A circle of radius `R` (m) traversed at `ω` (rad/s).
+    ///
+    /// Errors: [`Error::InvalidDrive`] when `R` is negative or not finite or `ω` is not
+    /// finite.
+    pub fn new(radius: f64, angular_frequency: f64) -> Result<Self> {
+        Ok(Self {
+            radius: check_parameter("radius", radius, true)?,
+            angular_frequency: check_parameter("angular frequency", angular_frequency, false)?,
+        })
+    }
+
+    /// Radius `R`, m.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Angular frequency `ω`, rad/s.
+    pub fn angular_frequency(&self) -> f64 {
+        self.angular_frequency
+    }
+}
+
+impl Drive<U3> for Circle {
+    fn position(&self, t: f64) -> Vector3<f64> {
+        let (s, c) = (self.angular_frequency * t).sin_cos();
+        Vector3::new(c, s, 0.0) * self.radius
+    }
+    fn velocity(&self, t: f64) -> Vector3<f64> {
+        let (s, c) = (self.angular_frequency * t).sin_cos();
+        Vector3::new(-s, c, 0.0) * (self.radius * self.angular_frequency)
+    }
+    fn acceleration(&self, t: f64) -> Vector3<f64> {
+        let w = self.angular_frequency;
+        let (s, c) = (w * t).sin_cos();
+        Vector3::new(c, s, 0.0) * (-self.radius * w * w)
+    }
+}
+
+/// A user-supplied pivot motion: three closures of time `t` (s) giving `p(t)` (m),
+/// `ṗ(t)` (m/s) and `p̈(t)` (m/s²).
+///
+/// Their consistency is the caller's responsibility (only `p̈` moves the chain; the
+/// energy balance needs all three).
+#[derive(Clone, Copy)]
+pub struct FnDrive<P, V, A> {
+    position: P,
+    velocity: V,
+    acceleration: A,
+}
+
+impl<P, V, A> FnDrive<P, V, A> {
+    /// The drive `(p, ṗ, p̈)` from three closures.
+    pub fn new(position: P, velocity: V, acceleration: A) -> Self {
+        Self { position, velocity, acceleration }
+    }
+}
+
+impl<P, V, A> std::fmt::Debug for FnDrive<P, V, A> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("FnDrive { .. }")
+    }
+}
+
+impl<S: DimName, P, V, A> Drive<S> for FnDrive<P, V, A>
+where
+    DefaultAllocator: Allocator<S>,
+    P: Fn(f64) -> OVector<f64, S>,
+    V: Fn(f64) -> OVector<f64, S>,
+    A: Fn(f64) -> OVector<f64, S>,
+{
+    fn position(&self, t: f64) -> OVector<f64, S> {
+        (self.position)(t)
+    }
+    fn velocity(&self, t: f64) -> OVector<f64, S> {
+        (self.velocity)(t)
+    }
+    fn acceleration(&self, t: f64) -> OVector<f64, S> {
+        (self.acceleration)(t)
+    }
+}
+
+/// Generalized torques as a function of time: `σ(t)` (N·m), one per coordinate of a
+/// model with `D` coordinates (eq 26's `σ_d`; the spatial model's `σ_θi, σ_φi`).
+///
+/// [`ConstantTorque`] is the constant case; any closure `Fn(f64) -> OVector<f64, D>` is
+/// a torque of time.
+pub trait TorqueAt<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// `σ(t)`, N·m.
+    fn torque_at(&self, t: f64) -> Cow<'_, OVector<f64, D>>;
+}
+
+/// A constant torque vector `σ` (N·m).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstantTorque<D: Dim>(pub OVector<f64, D>)
+where
+    DefaultAllocator: Allocator<D>;
+
+impl<D: Dim> ConstantTorque<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// No torque on any of the `dof` coordinates (use `model.dof()`).
+    pub fn zeros(dof: D) -> Self {
+        Self(OVector::zeros_generic(dof, U1))
+    }
+}
+
+impl<D: Dim> TorqueAt<D> for ConstantTorque<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    fn torque_at(&self, _t: f64) -> Cow<'_, OVector<f64, D>> {
+        Cow::Borrowed(&self.0)
+    }
+}
+
+impl<D: Dim, F: Fn(f64) -> OVector<f64, D>> TorqueAt<D> for F
+where
+    DefaultAllocator: Allocator<D>,
+{
+    fn torque_at(&self, t: f64) -> Cow<'_, OVector<f64, D>> {
+        Cow::Owned(self(t))
+    }
+}
+
+/// A driven pivot and time-dependent torques together: the [`InputsAt`] of a driven
+/// chain, `inputs(t) = (σ(t), p̈(t))`.
+///
+/// ```
+/// use nalgebra::{DVector, Dyn, U2};
+/// use pendulum_core::integrate::{Integrator, Rk4, State};
+/// use pendulum_core::{Chain, ConstantTorque, Driven, FirstOrder, Harmonic, Planar};
+///
+/// let model = Planar::new(Chain::<Dyn>::uniform(1, 1.0, 0.2, 9.81).unwrap());
+/// let drive = Harmonic::<U2>::vertical(0.01, 400.0, 0.0).unwrap();
+/// let system = FirstOrder::with_inputs(model, Driven::new(drive, ConstantTorque::zeros(Dyn(1))));
+/// let mut state = State::new(0.0, system.state(&DVector::from_vec(vec![3.0]), &DVector::zeros(1)));
+/// Rk4::new(&system).integrate(&system, &mut state, 0.1, 400).unwrap();
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Driven<Dr, T> {
+    drive: Dr,
+    torque: T,
+}
+
+impl<Dr, T> Driven<Dr, T> {
+    /// The pivot motion `drive` with the torques `torque`.
+    pub fn new(drive: Dr, torque: T) -> Self {
+        Self { drive, torque }
+    }
+
+    /// The pivot motion.
+    pub fn drive(&self) -> &Dr {
+        &self.drive
+    }
+
+    /// The torques.
+    pub fn torque(&self) -> &T {
+        &self.torque
+    }
+}
+
+impl<D: Dim, S: DimName, Dr: Drive<S>, T: TorqueAt<D>> InputsAt<D, S> for Driven<Dr, T>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>> {
+        Cow::Owned(Inputs {
+            torque: self.torque.torque_at(t).into_owned(),
+            pivot_acceleration: self.drive.acceleration(t),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{DVector, Dyn, U2, Vector2};
+
+    use super::*;
+
+    /// Central differences of p and ṗ match ṗ and p̈.
+    fn assert_consistent<S: DimName, D: Drive<S>>(drive: &D)
+    where
+        DefaultAllocator: Allocator<S>,
+    {
+        let eps = 1e-5;
+        for t in [0.0, 0.3, 1.7] {
+            let dp = (drive.position(t + eps) - drive.position(t - eps)) / (2.0 * eps);
+            let dv = (drive.velocity(t + eps) - drive.velocity(t - eps)) / (2.0 * eps);
+            let (v, a) = (drive.velocity(t), drive.acceleration(t));
+            assert!((&dp - &v).norm() < 1e-7 * (1.0 + v.norm()), "ṗ {v} vs {dp}");
+            assert!((&dv - &a).norm() < 1e-7 * (1.0 + a.norm()), "p̈ {a} vs {dv}");
+        }
+    }
+
+    #[test]
+    fn built_in_drives_are_consistent() {
+        assert_consistent::<U2, _>(&Harmonic::new(Vector2::new(3.0, 4.0), 0.2, 5.0, 0.4).unwrap());
+        assert_consistent(&Harmonic::new(Vector3::new(1.0, -1.0, 2.0), 0.1, 7.0, -1.0).unwrap());
+        assert_consistent(&Circle::new(0.3, -4.0).unwrap());
+        assert_consistent::<U3, _>(&Fixed);
+    }
+
+    #[test]
+    fn harmonic_normalizes_its_direction() {
+        let h = Harmonic::new(Vector2::new(3.0, 4.0), 2.0, 1.0, std::f64::consts::FRAC_PI_2).unwrap();
+        assert_eq!(h.direction(), &Vector2::new(0.6, 0.8));
+        assert!((h.position(0.0) - Vector2::new(1.2, 1.6)).norm() < 1e-15);
+        assert_eq!(Harmonic::<U3>::vertical(1.0, 1.0, 0.0).unwrap().direction(), &Vector3::z());
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        let err = Harmonic::new(Vector2::zeros(), 1.0, 1.0, 0.0).unwrap_err();
+        assert!(matches!(err, Error::InvalidDrive { what: "direction norm", .. }), "{err}");
+        let err = Harmonic::new(Vector2::new(f64::NAN, 1.0), 1.0, 1.0, 0.0).unwrap_err();
+        assert!(matches!(err, Error::InvalidDrive { what: "direction norm", .. }), "{err}");
+        assert_eq!(
+            Harmonic::new(Vector2::x(), -0.5, 1.0, 0.0),
+            Err(Error::InvalidDrive {
+                what: "amplitude",
+                requirement: "finite and non-negative",
+                value: -0.5
+            })
+        );
+        assert!(matches!(
+            Harmonic::new(Vector2::x(), 0.5, f64::INFINITY, 0.0),
+            Err(Error::InvalidDrive { what: "angular frequency", .. })
+        ));
+        assert!(matches!(
+            Harmonic::new(Vector2::x(), 0.5, 1.0, f64::NAN),
+            Err(Error::InvalidDrive { what: "phase", .. })
+        ));
+        let err = Circle::new(-1.0, 2.0).unwrap_err();
+        assert_eq!(err.to_string(), "drive radius must be finite and non-negative, got -1");
+        assert!(matches!(
+            Circle::new(1.0, f64::NAN),
+            Err(Error::InvalidDrive { what: "angular frequency", .. })
+        ));
+    }
+
+    #[test]
+    fn driven_inputs_carry_the_torque_and_the_pivot_acceleration() {
+        let drive = FnDrive::new(
+            |t: f64| Vector2::new(t * t, 0.0),
+            |t: f64| Vector2::new(2.0 * t, 0.0),
+            |_t: f64| Vector2::new(2.0, 0.0),
+        );
+        let torque = |t: f64| DVector::from_vec(vec![t, -t]);
+        let driven = Driven::new(drive, torque);
+        let inputs: Cow<'_, Inputs<Dyn, U2>> = driven.inputs_at(1.5);
+        assert_eq!(inputs.torque.as_slice(), &[1.5, -1.5]);
+        assert_eq!(inputs.pivot_acceleration, Vector2::new(2.0, 0.0));
+        let boxed: Box<dyn Drive<U2>> = Box::new(Fixed);
+        assert_eq!(boxed.velocity(3.0), Vector2::zeros());
+    }
+}
