@@ -186,8 +186,7 @@ where
         q: &OVector<f64, M::Dof>,
         p: &OVector<f64, M::Dof>,
     ) -> OVector<f64, DimProd<M::Dof, U2>> {
-        let dim = self.model.dof().mul(U2);
-        OVector::from_iterator_generic(dim, U1, q.iter().chain(p.iter()).copied())
+        crate::first_order::stack(self.model.dof(), q, p)
     }
 
     /// Splits a state into `(q, p)`.
@@ -195,11 +194,7 @@ where
         &self,
         x: &OVector<f64, DimProd<M::Dof, U2>>,
     ) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>) {
-        let dof = self.model.dof();
-        let n = dof.value();
-        let q = OVector::from_iterator_generic(dof, U1, x.iter().take(n).copied());
-        let p = OVector::from_iterator_generic(dof, U1, x.iter().skip(n).take(n).copied());
-        (q, p)
+        crate::first_order::unstack(self.model.dof(), x)
     }
 
     /// The momenta `p = M(q) q̇` (kg·m²/s) of rates `q̇` (rad/s).

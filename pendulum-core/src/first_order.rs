@@ -93,8 +93,7 @@ where
         q: &OVector<f64, M::Dof>,
         qd: &OVector<f64, M::Dof>,
     ) -> OVector<f64, DimProd<M::Dof, U2>> {
-        let dim = self.model.dof().mul(U2);
-        OVector::from_iterator_generic(dim, U1, q.iter().chain(qd.iter()).copied())
+        stack(self.model.dof(), q, qd)
     }
 
     /// Splits a state into `(q, q̇)`.
@@ -102,11 +101,7 @@ where
         &self,
         x: &OVector<f64, DimProd<M::Dof, U2>>,
     ) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>) {
-        let dof = self.model.dof();
-        let n = dof.value();
-        let q = OVector::from_iterator_generic(dof, U1, x.iter().take(n).copied());
-        let qd = OVector::from_iterator_generic(dof, U1, x.iter().skip(n).take(n).copied());
-        (q, qd)
+        unstack(self.model.dof(), x)
     }
 
     /// Total mechanical energy `H = T + U` (J) of a state, relative to the pivot.
@@ -114,6 +109,33 @@ where
         let (q, qd) = self.split(x);
         self.model.energy(&q, &qd)
     }
+}
+
+/// The state `x = (q, r)` of a chain with `dof` coordinates, `r` being the rates `q̇`
+/// ([`FirstOrder`]) or the momenta `p` ([`Canonical`](crate::Canonical)).
+pub(crate) fn stack<D: Dim + DimMul<U2>>(
+    dof: D,
+    q: &OVector<f64, D>,
+    r: &OVector<f64, D>,
+) -> OVector<f64, DimProd<D, U2>>
+where
+    DefaultAllocator: Allocator<D> + Allocator<DimProd<D, U2>>,
+{
+    OVector::from_iterator_generic(dof.mul(U2), U1, q.iter().chain(r.iter()).copied())
+}
+
+/// Splits `x = (q, r)` back into `q` and `r`: the inverse of [`stack`].
+pub(crate) fn unstack<D: Dim + DimMul<U2>>(
+    dof: D,
+    x: &OVector<f64, DimProd<D, U2>>,
+) -> (OVector<f64, D>, OVector<f64, D>)
+where
+    DefaultAllocator: Allocator<D> + Allocator<DimProd<D, U2>>,
+{
+    let n = dof.value();
+    let q = OVector::from_iterator_generic(dof, U1, x.iter().take(n).copied());
+    let r = OVector::from_iterator_generic(dof, U1, x.iter().skip(n).take(n).copied());
+    (q, r)
 }
 
 impl<M: Model, I: InputsAt<M::Dof, M::Space>> System for FirstOrder<M, I>
