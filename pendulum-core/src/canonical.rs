@@ -7,6 +7,7 @@ use nalgebra::{
 };
 
 use crate::integrate::{System, SystemAlloc};
+use crate::spatial::Frame;
 use crate::{Chain, Error, Inputs, InputsAt, Model, ModelAlloc, Planar, Result, Spatial, check_inputs};
 
 /// The gradient `∂T/∂q` of the kinetic energy at fixed rates `q̇` (N·m), the term the
@@ -42,10 +43,10 @@ where
         qd: &OVector<f64, Self::Dof>,
         out: &mut OVector<f64, Self::Dof>,
     ) {
-        let weights = Weights::of(self.chain());
+        let chain = self.chain();
         match Self::Space::dim() {
-            2 => planar_kinetic_gradient(&weights, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
-            3 => spatial_kinetic_gradient(&weights, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
+            2 => planar_kinetic_gradient(chain, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
+            3 => spatial_kinetic_gradient(chain, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
             d => panic!("no default kinetic gradient for a model in a space of dimension {d}"),
         }
     }
@@ -64,64 +65,34 @@ where
 {
 }
 
-/// A chain's tail masses `M_d` (kg) and lengths `l_d` (m) as slices, which is all the
-/// kinetic energy depends on.
-struct Weights<'a> {
-    tail_masses: &'a [f64],
-    lengths: &'a [f64],
-}
-
-impl<'a> Weights<'a> {
-    fn of<L: Dim>(chain: &'a Chain<L>) -> Self
-    where
-        DefaultAllocator: Allocator<L>,
-    {
-        Self { tail_masses: chain.tail_masses().as_slice(), lengths: chain.lengths().as_slice() }
-    }
-
-    fn links(&self) -> usize {
-        self.lengths.len()
-    }
-
-    /// `W_ij = M_max(i,j) l_i l_j`, kg·m².
-    fn w(&self, i: usize, j: usize) -> f64 {
-        self.tail_masses[i.max(j)] * self.lengths[i] * self.lengths[j]
-    }
-}
-
 /// `∂T/∂θ_k = −Σ_j W_kj sin(θ_k − θ_j) θ̇_k θ̇_j` of the planar chain.
-fn planar_kinetic_gradient(weights: &Weights, q: &[f64], qd: &[f64], out: &mut [f64]) {
-    let n = weights.links();
+fn planar_kinetic_gradient<L: Dim>(chain: &Chain<L>, q: &[f64], qd: &[f64], out: &mut [f64])
+where
+    DefaultAllocator: Allocator<L>,
+{
+    let n = chain.links();
     assert_eq!(q.len(), n, "a planar chain of {n} links has {n} coordinates");
     for k in 0..n {
-        let sum: f64 = (0..n).map(|j| weights.w(k, j) * (q[k] - q[j]).sin() * qd[j]).sum();
+        let sum: f64 = (0..n).map(|j| chain.weight(k, j) * (q[k] - q[j]).sin() * qd[j]).sum();
         out[k] = -qd[k] * sum;
     }
 }
 
-/// `∂T/∂θ_k = (u_θθ θ̇_k + u_θφ φ̇_k)·V_k`, `∂T/∂φ_k = (u_θφ θ̇_k + u_φφ φ̇_k)·V_k` with
-/// `V_k = Σ_j W_kj u̇_j`, of the spatial chain in `q = (θ_1 … θ_n, φ_1 … φ_n)`.
-fn spatial_kinetic_gradient(weights: &Weights, q: &[f64], qd: &[f64], out: &mut [f64]) {
-    let n = weights.links();
+/// `∂T/∂θ_k = ∂u̇_k/∂θ_k · V_k`, `∂T/∂φ_k = ∂u̇_k/∂φ_k · V_k` with `V_k = Σ_j W_kj u̇_j`, of
+/// the spatial chain in `q = (θ_1 … θ_n, φ_1 … φ_n)`.
+fn spatial_kinetic_gradient<L: Dim>(chain: &Chain<L>, q: &[f64], qd: &[f64], out: &mut [f64])
+where
+    DefaultAllocator: Allocator<L>,
+{
+    let n = chain.links();
     assert_eq!(q.len(), 2 * n, "a spatial chain of {n} links has {} coordinates", 2 * n);
-    // Per link: u̇, ∂u̇/∂θ, ∂u̇/∂φ.
-    let links: Vec<[Vector3<f64>; 3]> = (0..n)
-        .map(|k| {
-            let (st, ct) = q[k].sin_cos();
-            let (sp, cp) = q[n + k].sin_cos();
-            let (td, pd) = (qd[k], qd[n + k]);
-            let u_t = Vector3::new(ct * cp, ct * sp, st);
-            let u_p = Vector3::new(-st * sp, st * cp, 0.0);
-            let u_tt = Vector3::new(-st * cp, -st * sp, ct);
-            let u_pp = Vector3::new(-st * cp, -st * sp, 0.0);
-            let u_tp = Vector3::new(-ct * sp, ct * cp, 0.0);
-            [u_t * td + u_p * pd, u_tt * td + u_tp * pd, u_tp * td + u_pp * pd]
-        })
-        .collect();
-    for k in 0..n {
-        let v = (0..n).fold(Vector3::zeros(), |v, j| v + links[j][0] * weights.w(k, j));
-        out[k] = links[k][1].dot(&v);
-        out[n + k] = links[k][2].dot(&v);
+    let frames: Vec<Frame> = (0..n).map(|k| Frame::new(q[k], q[n + k])).collect();
+    let velocities: Vec<Vector3<f64>> = (0..n).map(|k| frames[k].velocity(qd[k], qd[n + k])).collect();
+    for (k, frame) in frames.iter().enumerate() {
+        let v = (0..n).fold(Vector3::new(0.0, 0.0, 0.0), |v, j| v + velocities[j] * chain.weight(k, j));
+        let (d_theta, d_phi) = frame.velocity_gradient(qd[k], qd[n + k]);
+        out[k] = d_theta.dot(&v);
+        out[n + k] = d_phi.dot(&v);
     }
 }
 

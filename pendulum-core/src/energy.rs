@@ -18,6 +18,7 @@
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, Vector3};
 
 use crate::integrate::System;
+use crate::spatial::Frame;
 use crate::{Drive, Driven, Inputs, InputsAt, Model, ModelAlloc, Result, TorqueAt};
 
 /// `P = Σ_k m_k ρ̇_k = Σ_i M_i l_i u̇_i` (kg·m/s): the chain's momentum relative to the
@@ -81,20 +82,8 @@ where
         3 => {
             let mut sum = Vector3::zeros();
             for i in 0..n {
-                let (st, ct) = q[i].sin_cos();
-                let (sp, cp) = q[n + i].sin_cos();
-                let (td, pd) = (qd[i], qd[n + i]);
-                let d_theta = Vector3::new(ct * cp, ct * sp, st);
-                let d_phi = Vector3::new(-st * sp, st * cp, 0.0);
-                let d_theta2 = Vector3::new(-st * cp, -st * sp, ct);
-                let d_phi2 = Vector3::new(-st * cp, -st * sp, 0.0);
-                let d_theta_phi = Vector3::new(-ct * sp, ct * cp, 0.0);
-                let acc = d_theta * qdd[i]
-                    + d_phi * qdd[n + i]
-                    + d_theta2 * (td * td)
-                    + d_phi2 * (pd * pd)
-                    + d_theta_phi * (2.0 * td * pd);
-                sum += acc * weight(i);
+                let frame = Frame::new(q[i], q[n + i]);
+                sum += frame.acceleration(qd[i], qd[n + i], qdd[i], qdd[n + i]) * weight(i);
             }
             for j in 0..3 {
                 rate[j] = sum[j];
@@ -303,11 +292,23 @@ where
 
     /// The [`Powers`] at `(t, x)`. Errors of [`Model::accelerations`] pass through.
     pub fn powers(&self, t: f64, x: &DVector<f64>) -> Result<Powers> {
+        self.evaluate(t, x).map(|(.., powers)| powers)
+    }
+
+    /// `(q̇, q̈, powers)` at `(t, x)`: what [`System::rhs`] and [`powers`](Self::powers)
+    /// both need.
+    #[allow(clippy::type_complexity)] // The tuple is the plainest reading.
+    fn evaluate(
+        &self,
+        t: f64,
+        x: &DVector<f64>,
+    ) -> Result<(OVector<f64, M::Dof>, OVector<f64, M::Dof>, Powers)> {
         let (q, qd, _) = self.split(x);
         let inputs = self.inputs.inputs_at(t);
         let mut qdd = OVector::zeros_generic(self.model.dof(), U1);
         self.model.accelerations(&q, &qd, &inputs, &mut qdd)?;
-        Ok(powers(&self.model, &q, &qd, &qdd, &inputs, &self.inputs.drive().velocity(t)))
+        let powers = powers(&self.model, &q, &qd, &qdd, &inputs, &self.inputs.drive().velocity(t));
+        Ok((qd, qdd, powers))
     }
 
     /// The energy balance from `(t0, x0)` to `(t, x)` (see [`Balance`]).
@@ -349,11 +350,7 @@ where
     /// `(q̇, q̈, P_drive, P_torque, P_damping)`; errors of [`Model::accelerations`] pass
     /// through.
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
-        let (q, qd, _) = self.split(x);
-        let inputs = self.inputs.inputs_at(t);
-        let mut qdd = OVector::zeros_generic(self.model.dof(), U1);
-        self.model.accelerations(&q, &qd, &inputs, &mut qdd)?;
-        let p = powers(&self.model, &q, &qd, &qdd, &inputs, &self.inputs.drive().velocity(t));
+        let (qd, qdd, p) = self.evaluate(t, x)?;
         let n = qd.len();
         for i in 0..n {
             out[i] = qd[i];

@@ -68,22 +68,24 @@ where
     }
 }
 
-/// The geometry of one link's direction at angles (θ, φ).
-struct Frame {
+/// The geometry of one link's direction `u = (sin θ cos φ, sin θ sin φ, −cos θ)` at
+/// angles (θ, φ): its first and second partial derivatives. The one place the spatial
+/// model, the canonical form ([`crate::Canonical`]) and the energy ledger get them from.
+pub(crate) struct Frame {
     /// `∂u/∂θ`.
-    d_theta: Vector3<f64>,
+    pub(crate) d_theta: Vector3<f64>,
     /// `∂u/∂φ`.
-    d_phi: Vector3<f64>,
+    pub(crate) d_phi: Vector3<f64>,
     /// `∂²u/∂θ² = −u`.
-    d_theta2: Vector3<f64>,
+    pub(crate) d_theta2: Vector3<f64>,
     /// `∂²u/∂φ²`.
-    d_phi2: Vector3<f64>,
+    pub(crate) d_phi2: Vector3<f64>,
     /// `∂²u/∂θ∂φ`.
-    d_theta_phi: Vector3<f64>,
+    pub(crate) d_theta_phi: Vector3<f64>,
 }
 
 impl Frame {
-    fn new(theta: f64, phi: f64) -> Self {
+    pub(crate) fn new(theta: f64, phi: f64) -> Self {
         let (st, ct) = theta.sin_cos();
         let (sp, cp) = phi.sin_cos();
         Self {
@@ -96,15 +98,35 @@ impl Frame {
     }
 
     /// `u̇ = ∂u/∂θ θ̇ + ∂u/∂φ φ̇`.
-    fn velocity(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
+    pub(crate) fn velocity(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
         self.d_theta * theta_dot + self.d_phi * phi_dot
     }
 
     /// `ü` at `q̈ = 0`: the part of the acceleration quadratic in the rates.
-    fn centripetal(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
+    pub(crate) fn centripetal(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
         self.d_theta2 * (theta_dot * theta_dot)
             + self.d_phi2 * (phi_dot * phi_dot)
             + self.d_theta_phi * (2.0 * theta_dot * phi_dot)
+    }
+
+    /// `ü = ∂u/∂θ θ̈ + ∂u/∂φ φ̈ +` [`centripetal`](Self::centripetal).
+    pub(crate) fn acceleration(
+        &self,
+        theta_dot: f64,
+        phi_dot: f64,
+        theta_ddot: f64,
+        phi_ddot: f64,
+    ) -> Vector3<f64> {
+        self.d_theta * theta_ddot + self.d_phi * phi_ddot + self.centripetal(theta_dot, phi_dot)
+    }
+
+    /// `∂u̇/∂θ = ∂²u/∂θ² θ̇ + ∂²u/∂θ∂φ φ̇` and `∂u̇/∂φ = ∂²u/∂θ∂φ θ̇ + ∂²u/∂φ² φ̇`: how the
+    /// link's velocity changes with its angles at fixed rates.
+    pub(crate) fn velocity_gradient(&self, theta_dot: f64, phi_dot: f64) -> (Vector3<f64>, Vector3<f64>) {
+        (
+            self.d_theta2 * theta_dot + self.d_theta_phi * phi_dot,
+            self.d_theta_phi * theta_dot + self.d_phi2 * phi_dot,
+        )
     }
 }
 
