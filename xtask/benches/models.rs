@@ -9,8 +9,9 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OVector, U1};
-use pendulum_core::{Chain, Model, ModelAlloc, Planar, Spatial};
-use xtask::models::{Planar1, Planar2, Planar3, Planar4, Planar8, Spatial1, Spatial2, Spatial4};
+use pendulum_core::{Model, ModelAlloc, Planar, Spatial};
+use xtask::case::Params;
+use xtask::models::{Planar1, Planar2, Planar3, Planar4, Planar8, Spatial1, Spatial2, Spatial4, chain};
 
 /// A fixed, non-singular state: angles spread over (0.3, 2.8) so that no sin θ vanishes.
 fn state<M: Model>(model: &M) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>)
@@ -43,44 +44,50 @@ fn bench_one<M: Model>(
     });
 }
 
-fn chain<L: nalgebra::Dim>(n: usize) -> Chain<L>
-where
-    DefaultAllocator: nalgebra::allocator::Allocator<L>,
-{
-    let masses: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
-    let lengths: Vec<f64> = (0..n).map(|i| 0.5 + 0.05 * i as f64).collect();
-    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&vec![0.01; n])).expect("valid chain")
+/// The benchmarked chain's parameters: `n` links of slowly growing masses and lengths.
+fn params(n: usize) -> Params {
+    Params {
+        masses: (0..n).map(|i| 1.0 + 0.1 * i as f64).collect(),
+        lengths: (0..n).map(|i| 0.5 + 0.05 * i as f64).collect(),
+        gravity: 9.81,
+        damping: vec![0.01; n],
+    }
 }
 
-macro_rules! planar {
-    ($group:expr, $n:literal, $generated:ident) => {
-        bench_one($group, "generated", $n, &$generated::new(chain::<Const<$n>>($n)));
-        bench_one($group, "generic_fixed", $n, &Planar::new(chain::<Const<$n>>($n)));
-        bench_one($group, "generic_dyn", $n, &Planar::new(chain::<Dyn>($n)));
-    };
-}
-
-macro_rules! spatial {
-    ($group:expr, $n:literal, $generated:ident) => {
-        bench_one($group, "generated", $n, &$generated::new(chain::<Const<$n>>($n)));
-        bench_one($group, "generic_fixed", $n, &Spatial::new(chain::<Const<$n>>($n)));
-        bench_one($group, "generic_dyn", $n, &Spatial::new(chain::<Dyn>($n)));
+/// The generated model of `n` links and the generic one (`Planar` or `Spatial`) with
+/// `L = Const<n>` and `L = Dyn`.
+macro_rules! bench_models {
+    ($group:expr, $n:literal, $generated:ident, $generic:ident) => {
+        let params = params($n);
+        bench_one(
+            $group,
+            "generated",
+            $n,
+            &$generated::new(chain::<Const<$n>>(&params).expect("valid chain")),
+        );
+        bench_one(
+            $group,
+            "generic_fixed",
+            $n,
+            &$generic::new(chain::<Const<$n>>(&params).expect("valid chain")),
+        );
+        bench_one($group, "generic_dyn", $n, &$generic::new(chain::<Dyn>(&params).expect("valid chain")));
     };
 }
 
 fn accelerations(c: &mut Criterion) {
     let mut group = c.benchmark_group("planar_accelerations");
-    planar!(&mut group, 1, Planar1);
-    planar!(&mut group, 2, Planar2);
-    planar!(&mut group, 3, Planar3);
-    planar!(&mut group, 4, Planar4);
-    planar!(&mut group, 8, Planar8);
+    bench_models!(&mut group, 1, Planar1, Planar);
+    bench_models!(&mut group, 2, Planar2, Planar);
+    bench_models!(&mut group, 3, Planar3, Planar);
+    bench_models!(&mut group, 4, Planar4, Planar);
+    bench_models!(&mut group, 8, Planar8, Planar);
     group.finish();
 
     let mut group = c.benchmark_group("spatial_accelerations");
-    spatial!(&mut group, 1, Spatial1);
-    spatial!(&mut group, 2, Spatial2);
-    spatial!(&mut group, 4, Spatial4);
+    bench_models!(&mut group, 1, Spatial1, Spatial);
+    bench_models!(&mut group, 2, Spatial2, Spatial);
+    bench_models!(&mut group, 4, Spatial4, Spatial);
     group.finish();
 }
 

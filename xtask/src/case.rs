@@ -15,10 +15,14 @@ use anyhow::{Context, Result, anyhow, bail, ensure};
 use nalgebra::{DMatrix, DVector};
 use serde_json::{Map, Value};
 
-use crate::expr::{Expr, Symbols};
+use crate::expr::{Expr, Scaled, Symbols};
 
 /// The format string every case file must carry.
 pub const FORMAT: &str = "pendulum-reference/1";
+
+/// The equation every case file must state, in its sign convention.
+pub const EQUATION: &str =
+    "mass_matrix * qdd + velocity_terms + gravity_terms + pivot_terms = generalized_forces";
 
 /// Planar or spatial chain.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -87,8 +91,8 @@ pub struct Point {
     pub pivot_acceleration: Vec<f64>,
 }
 
-/// Every quantity of a case evaluated at one state (or, from [`Case::scales`], the
-/// absolute scale of each entry).
+/// Every quantity of a case evaluated at one state (or, from
+/// [`Case::evaluate_with_scales`], the absolute scale of each entry).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Evaluated {
     /// `M(q)`, dof × dof.
@@ -139,11 +143,6 @@ pub struct Case {
     pub links: usize,
     /// The file it was loaded from.
     pub path: PathBuf,
-    /// The sympy version that derived it.
-    pub sympy_version: String,
-    /// The equation, as the file states it.
-    pub equation: String,
-    symbols: Symbols,
     layout: Layout,
     /// Row-major, dof × dof.
     mass_matrix: Vec<Expr>,
@@ -194,8 +193,11 @@ impl Case {
             .filter(|&n| n >= 1)
             .ok_or_else(|| anyhow!("{at}: \"links\" must be a positive integer"))?
             as usize;
-        let sympy_version = string("sympy_version").with_context(|| at.clone())?;
+        // The deriving sympy version is informational (`cargo xtask reference --check`
+        // is what ties the files to sympy), but must be there.
+        string("sympy_version").with_context(|| at.clone())?;
         let equation = string("equation").with_context(|| at.clone())?;
+        ensure!(equation == EQUATION, "{at}: the equation is {equation:?}, expected {EQUATION:?}");
         let dof = kind.dof(links);
 
         let (symbols, layout) = symbol_table(get("symbols")?, kind, links, &at)?;
@@ -226,9 +228,6 @@ impl Case {
             kind,
             links,
             path: path.to_owned(),
-            sympy_version,
-            equation,
-            symbols,
             layout,
         })
     }
@@ -238,17 +237,9 @@ impl Case {
         self.kind.dof(self.links)
     }
 
-    /// The case's symbol table (names in slot order: coordinates, rates, masses,
-    /// lengths, gravity, damping, torques, pivot acceleration).
-    pub fn symbols(&self) -> &Symbols {
-        &self.symbols
-    }
-
-    /// Total number of expression nodes in the case.
-    pub fn size(&self) -> usize {
-        self.exprs().map(Expr::size).sum()
-    }
-
+    /// Every expression, in the order [`Case::assemble`] takes their results:
+    /// mass matrix (row-major), velocity, gravity and pivot terms, generalized forces,
+    /// kinetic and potential energy.
     fn exprs(&self) -> impl Iterator<Item = &Expr> {
         self.mass_matrix
             .iter()
@@ -288,19 +279,23 @@ impl Case {
         slots
     }
 
-    /// Applies `f` (value or scale of one expression) to every quantity.
-    fn map(&self, params: &Params, point: &Point, f: impl Fn(&Expr, &[f64]) -> f64) -> Evaluated {
-        let slots = self.slots(params, point);
+    /// The quantities from one number per expression, in [`Case::exprs`] order.
+    fn assemble(&self, mut numbers: impl Iterator<Item = f64>) -> Evaluated {
         let dof = self.dof();
-        let vector = |exprs: &[Expr]| DVector::from_iterator(dof, exprs.iter().map(|e| f(e, &slots)));
+        let mass_matrix = DMatrix::from_row_iterator(dof, dof, numbers.by_ref().take(dof * dof));
+        let mut vector = || DVector::from_iterator(dof, numbers.by_ref().take(dof));
+        let (velocity_terms, gravity_terms, pivot_terms, generalized_forces) =
+            (vector(), vector(), vector(), vector());
+        let mut scalar = || numbers.next().expect("one number per expression");
+        let (kinetic_energy, potential_energy) = (scalar(), scalar());
         Evaluated {
-            mass_matrix: DMatrix::from_row_iterator(dof, dof, self.mass_matrix.iter().map(|e| f(e, &slots))),
-            velocity_terms: vector(&self.velocity_terms),
-            gravity_terms: vector(&self.gravity_terms),
-            pivot_terms: vector(&self.pivot_terms),
-            generalized_forces: vector(&self.generalized_forces),
-            kinetic_energy: f(&self.kinetic_energy, &slots),
-            potential_energy: f(&self.potential_energy, &slots),
+            mass_matrix,
+            velocity_terms,
+            gravity_terms,
+            pivot_terms,
+            generalized_forces,
+            kinetic_energy,
+            potential_energy,
         }
     }
 
@@ -308,13 +303,19 @@ impl Case {
     ///
     /// Panics if a vector of `params` or `point` has the wrong length for the case.
     pub fn evaluate(&self, params: &Params, point: &Point) -> Evaluated {
-        self.map(params, point, Expr::eval)
+        let slots = self.slots(params, point);
+        self.assemble(self.exprs().map(|e| e.eval(&slots)))
     }
 
-    /// The absolute scale ([`Expr::scale`]) of every entry at `params` and `point`: the
-    /// size of its round-off, against which implementations are compared.
-    pub fn scales(&self, params: &Params, point: &Point) -> Evaluated {
-        self.map(params, point, Expr::scale)
+    /// Every quantity of the case at `params` and `point`, and the absolute scale
+    /// ([`Scaled`]) of every entry: the size of its round-off, against which
+    /// implementations are compared. Walks each expression once.
+    ///
+    /// Panics if a vector of `params` or `point` has the wrong length for the case.
+    pub fn evaluate_with_scales(&self, params: &Params, point: &Point) -> (Evaluated, Evaluated) {
+        let slots = self.slots(params, point);
+        let both: Vec<Scaled> = self.exprs().map(|e| e.eval_with_scale(&slots)).collect();
+        (self.assemble(both.iter().map(|x| x.v)), self.assemble(both.iter().map(|x| x.s)))
     }
 
     /// The accelerations `q̈` solving `M q̈ = Q − c − k − d` (by LU with partial pivoting;
@@ -451,8 +452,9 @@ mod tests {
         let expected = (0.7 + 0.3 * 1.2 - m * g * l * s - m * l * (1.5 * c - 2.0 * s)) / (m * l * l);
         assert!((a[0] - expected).abs() < 1e-13, "{a} vs {expected}");
         // Scales: Q = σ − λ θ̇ has scale |σ| + |λ θ̇|.
-        let s = case.scales(&p, &x);
+        let (values, s) = case.evaluate_with_scales(&p, &x);
         assert!((s.generalized_forces[0] - (0.7 + 0.36)).abs() < 1e-14);
+        assert_eq!(values, e);
     }
 
     #[test]
@@ -547,6 +549,10 @@ mod tests {
                 "kinetic_energy: \"^\" needs an integer exponent",
             ),
             (Box::new(|v| v["sympy_version"] = json!(1)), "\"sympy_version\" must be a string"),
+            (
+                Box::new(|v| v["equation"] = json!("mass_matrix * qdd = generalized_forces")),
+                "case planar_n1: the equation is \"mass_matrix * qdd = generalized_forces\", expected",
+            ),
         ];
         for (edit, expected) in cases {
             let message = load_error(edit);

@@ -1,11 +1,13 @@
 //! Expressions of the sympy reference (`reference/README.md`): parsing JSON trees with
-//! clear errors, evaluation, and the absolute-scale evaluation used for relative error.
+//! clear errors, evaluation, and the absolute scale ([`Scaled`]) used for relative error.
 //!
 //! Grammar (JSON): an integer is a constant; a string is a symbol; `["+", e, ...]` and
 //! `["*", e, ...]` are sums and products; `["^", e, k]` an integer power (k may be
 //! negative); `["/", p, q]` the rational constant p/q; `["sin", e]`, `["cos", e]`.
 
 use std::collections::HashMap;
+use std::iter::Sum;
+use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use anyhow::{Result, anyhow, bail};
 use serde_json::Value;
@@ -96,71 +98,145 @@ impl Expr {
         }
     }
 
-    /// The absolute scale of the expression: the natural size of its round-off.
+    /// The value and the absolute [scale](Scaled) of the expression, in one pass.
     ///
-    /// The tree is evaluated with every constant and symbol replaced by its absolute
-    /// value and every sum by the sum of its terms' scales, so cancellation does not
-    /// shrink it: evaluating the expression in floating point (in any reasonable order)
-    /// errs by a few units of round-off times this scale, times the number of
-    /// operations. It is never below the magnitude of the value. The non-polynomial
-    /// nodes use first-order error propagation:
-    /// - `sin e`: `|sin v|` when `e` is a symbol or constant (an exact input, so only
-    ///   the sine's own rounding), else `|sin v| + |cos v|·S(e)` (`v` the value of `e`,
-    ///   `S(e)` its scale): the argument's absolute error, of order `S(e)` units of
-    ///   round-off, passes through with slope `cos v`; `cos e` likewise;
-    /// - `e^k`, `k < 0`: `S(e)^|k| / |v|^(2|k|)`, the error of `1/e^|k|` when `e^|k|`
-    ///   errs by its scale (equal to `|v^k|` when `e` has no cancellation).
-    pub fn scale(&self, slots: &[f64]) -> f64 {
-        self.eval_with_scale(slots).1
-    }
-
-    /// The value and the [scale](Expr::scale) together, in one pass.
-    pub fn eval_with_scale(&self, slots: &[f64]) -> (f64, f64) {
+    /// The tree is evaluated in [`Scaled`] arithmetic: every constant and symbol is an
+    /// exact input ([`Scaled::exact`]), sums, products and powers are those of
+    /// [`Scaled`]. The value is exactly that of [`Expr::eval`] (up to the sign of a zero).
+    pub fn eval_with_scale(&self, slots: &[f64]) -> Scaled {
         match self {
-            Expr::Const(c) => (*c, c.abs()),
-            Expr::Symbol(i) => (slots[*i], slots[*i].abs()),
-            Expr::Sum(terms) => terms.iter().fold((0.0, 0.0), |(v, s), t| {
-                let (tv, ts) = t.eval_with_scale(slots);
-                (v + tv, s + ts)
-            }),
-            Expr::Product(factors) => factors.iter().fold((1.0, 1.0), |(v, s), f| {
-                let (fv, fs) = f.eval_with_scale(slots);
-                (v * fv, s * fs)
-            }),
-            Expr::Power(base, k) => {
-                let (v, s) = base.eval_with_scale(slots);
-                let scale = if *k >= 0 { s.powi(*k) } else { s.powi(-k) / v.abs().powi(-2 * k) };
-                (v.powi(*k), scale)
+            Expr::Const(c) => Scaled::exact(*c),
+            Expr::Symbol(i) => Scaled::exact(slots[*i]),
+            Expr::Sum(terms) => terms.iter().map(|t| t.eval_with_scale(slots)).sum(),
+            Expr::Product(factors) => {
+                factors.iter().fold(Scaled::exact(1.0), |p, f| p * f.eval_with_scale(slots))
             }
-            Expr::Sin(arg) => {
-                let (v, s) = arg.eval_with_scale(slots);
-                let (sin, cos) = v.sin_cos();
-                (sin, sin.abs() + cos.abs() * arg.argument_error(s))
-            }
-            Expr::Cos(arg) => {
-                let (v, s) = arg.eval_with_scale(slots);
-                let (sin, cos) = v.sin_cos();
-                (cos, cos.abs() + sin.abs() * arg.argument_error(s))
-            }
+            Expr::Power(base, k) => base.eval_with_scale(slots).powi(*k),
+            Expr::Sin(arg) => arg.eval_with_scale(slots).sin(),
+            Expr::Cos(arg) => arg.eval_with_scale(slots).cos(),
         }
     }
+}
 
-    /// The absolute error scale of this expression as an argument of `sin`/`cos`, given
-    /// its scale: none for a leaf (inputs are exact), its scale otherwise.
-    fn argument_error(&self, scale: f64) -> f64 {
-        match self {
-            Expr::Const(_) | Expr::Symbol(_) => 0.0,
-            _ => scale,
-        }
+/// A value `v` with its absolute round-off scale `s ≥ |v|`: the natural size of its
+/// round-off, the one scale rule of `verify` (for the reference, [`Expr::eval_with_scale`])
+/// and of the document check (for the printed formulas, `crate::document`).
+///
+/// The scale is the value computed with every input replaced by its absolute value and
+/// every sum by the sum of its terms' scales, so cancellation does not shrink it:
+/// computing the value in floating point (in any reasonable order) errs by a few units
+/// of round-off times this scale, times the number of operations. The non-polynomial
+/// operations use first-order error propagation:
+/// - `sin e`: `|sin v|` when `e` is an exact input ([`Scaled::exact`], or its
+///   negation), so only the sine's own rounding; else `|sin v| + |cos v|·S(e)` (`v` the
+///   value of `e`, `S(e)` its scale): the argument's absolute error, of order `S(e)`
+///   units of round-off, passes through with slope `cos v`; `cos e` likewise;
+/// - `e^k`, `k < 0`: `S(e)^|k| / |v|^(2|k|)`, the error of `1/e^|k|` when `e^|k|` errs
+///   by its scale (equal to `|v^k|` when `e` has no cancellation);
+/// - `a / b`: `(S(a) + |a/b|·S(b)) / |b|`, likewise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scaled {
+    /// The value.
+    pub v: f64,
+    /// Its absolute scale.
+    pub s: f64,
+    /// Whether `v` is an exact input (no round-off of its own).
+    exact: bool,
+}
+
+impl Scaled {
+    /// An exact input: its own scale, no round-off.
+    pub fn exact(v: f64) -> Scaled {
+        Scaled { v, s: v.abs(), exact: true }
     }
 
-    /// Number of nodes in the tree.
-    pub fn size(&self) -> usize {
-        1 + match self {
-            Expr::Const(_) | Expr::Symbol(_) => 0,
-            Expr::Sum(items) | Expr::Product(items) => items.iter().map(Expr::size).sum(),
-            Expr::Power(e, _) | Expr::Sin(e) | Expr::Cos(e) => e.size(),
-        }
+    /// A value computed elsewhere with scale `s` (raised to `|v|` if below).
+    pub fn with_scale(v: f64, s: f64) -> Scaled {
+        Scaled { v, s: s.abs().max(v.abs()), exact: false }
+    }
+
+    /// An exact zero.
+    pub fn zero() -> Scaled {
+        Scaled::exact(0.0)
+    }
+
+    /// The absolute error scale of this value as an argument of `sin`/`cos`: none for an
+    /// exact input, its scale otherwise.
+    fn argument_error(self) -> f64 {
+        if self.exact { 0.0 } else { self.s }
+    }
+
+    /// `sin v`.
+    pub fn sin(self) -> Scaled {
+        let (sin, cos) = self.v.sin_cos();
+        Scaled { v: sin, s: sin.abs() + cos.abs() * self.argument_error(), exact: false }
+    }
+
+    /// `cos v`.
+    pub fn cos(self) -> Scaled {
+        let (sin, cos) = self.v.sin_cos();
+        Scaled { v: cos, s: cos.abs() + sin.abs() * self.argument_error(), exact: false }
+    }
+
+    /// `v^k`.
+    pub fn powi(self, k: i32) -> Scaled {
+        let s = if k >= 0 { self.s.powi(k) } else { self.s.powi(-k) / self.v.abs().powi(-2 * k) };
+        Scaled { v: self.v.powi(k), s, exact: false }
+    }
+
+    /// `v²`.
+    pub fn sq(self) -> Scaled {
+        self * self
+    }
+}
+
+impl Add for Scaled {
+    type Output = Scaled;
+    fn add(self, o: Scaled) -> Scaled {
+        Scaled { v: self.v + o.v, s: self.s + o.s, exact: false }
+    }
+}
+
+impl Sub for Scaled {
+    type Output = Scaled;
+    fn sub(self, o: Scaled) -> Scaled {
+        Scaled { v: self.v - o.v, s: self.s + o.s, exact: false }
+    }
+}
+
+impl Mul for Scaled {
+    type Output = Scaled;
+    fn mul(self, o: Scaled) -> Scaled {
+        Scaled { v: self.v * o.v, s: self.s * o.s, exact: false }
+    }
+}
+
+impl Mul<Scaled> for f64 {
+    type Output = Scaled;
+    fn mul(self, o: Scaled) -> Scaled {
+        Scaled { v: self * o.v, s: self.abs() * o.s, exact: false }
+    }
+}
+
+impl Div for Scaled {
+    type Output = Scaled;
+    fn div(self, o: Scaled) -> Scaled {
+        let v = self.v / o.v;
+        Scaled { v, s: (self.s + v.abs() * o.s) / o.v.abs(), exact: false }
+    }
+}
+
+impl Neg for Scaled {
+    type Output = Scaled;
+    /// Negation is exact: an exact input stays one.
+    fn neg(self) -> Scaled {
+        Scaled { v: -self.v, ..self }
+    }
+}
+
+impl Sum for Scaled {
+    fn sum<I: Iterator<Item = Scaled>>(iter: I) -> Scaled {
+        iter.fold(Scaled::zero(), |a, b| a + b)
     }
 }
 
@@ -277,7 +353,6 @@ mod tests {
                 Expr::Sin(Box::new(Expr::Symbol(2))),
             ])
         );
-        assert_eq!(e.size(), 10);
         assert_eq!(parse_ok(json!(["cos", 0])), Expr::Cos(Box::new(Expr::Const(0.0))));
     }
 
@@ -290,28 +365,76 @@ mod tests {
         assert_eq!(e.eval(&SLOTS), 3.0 * (-1.0f64).powi(3) * 1.0f64.cos());
     }
 
+    /// Value and scale of `value` parsed at [`SLOTS`].
+    fn scaled(value: Value) -> (f64, f64) {
+        let Scaled { v, s, .. } = parse_ok(value).eval_with_scale(&SLOTS);
+        (v, s)
+    }
+
     #[test]
     fn scale_ignores_cancellation() {
         // x + y = −1, but its scale is |x| + |y| = 5.
-        let e = parse_ok(json!(["+", "x", "y"]));
-        assert_eq!(e.eval_with_scale(&SLOTS), (-1.0, 5.0));
+        assert_eq!(scaled(json!(["+", "x", "y"])), (-1.0, 5.0));
         // −x·y·(−1/2) = −3; products keep magnitudes.
-        let e = parse_ok(json!(["*", -1, "x", "y", ["/", -1, 2]]));
-        assert_eq!(e.eval_with_scale(&SLOTS), (-3.0, 3.0));
+        assert_eq!(scaled(json!(["*", -1, "x", "y", ["/", -1, 2]])), (-3.0, 3.0));
         // (x + y)² = 1 with scale 25; (x + y)⁻¹ = −1 with scale 5 / 1.
-        assert_eq!(parse_ok(json!(["^", ["+", "x", "y"], 2])).eval_with_scale(&SLOTS), (1.0, 25.0));
-        assert_eq!(parse_ok(json!(["^", ["+", "x", "y"], -1])).eval_with_scale(&SLOTS), (-1.0, 5.0));
+        assert_eq!(scaled(json!(["^", ["+", "x", "y"], 2])), (1.0, 25.0));
+        assert_eq!(scaled(json!(["^", ["+", "x", "y"], -1])), (-1.0, 5.0));
         // Without cancellation the scale is the magnitude.
-        assert_eq!(parse_ok(json!(["^", "y", -2])).eval_with_scale(&SLOTS), (1.0 / 9.0, 1.0 / 9.0));
+        assert_eq!(scaled(json!(["^", "y", -2])), (1.0 / 9.0, 1.0 / 9.0));
         // sin(x + y): value sin(−1), scale |sin 1| + |cos 1|·5.
-        let (v, s) = parse_ok(json!(["sin", ["+", "x", "y"]])).eval_with_scale(&SLOTS);
-        assert_eq!(v, (-1.0f64).sin());
-        assert_eq!(s, 1.0f64.sin() + 1.0f64.cos() * 5.0);
+        assert_eq!(
+            scaled(json!(["sin", ["+", "x", "y"]])),
+            ((-1.0f64).sin(), 1.0f64.sin() + 1.0f64.cos() * 5.0)
+        );
         // cos θ of an exact input: only its own rounding.
-        let (v, s) = parse_ok(json!(["cos", "th1"])).eval_with_scale(&SLOTS);
-        assert_eq!((v, s), (0.5f64.cos(), 0.5f64.cos()));
-        let (v, s) = parse_ok(json!(["sin", ["*", -1, "th1"]])).eval_with_scale(&SLOTS);
-        assert_eq!((v, s), (-(0.5f64.sin()), 0.5f64.sin() + 0.5f64.cos() * 0.5));
+        assert_eq!(scaled(json!(["cos", "th1"])), (0.5f64.cos(), 0.5f64.cos()));
+        assert_eq!(
+            scaled(json!(["sin", ["*", -1, "th1"]])),
+            (-(0.5f64.sin()), 0.5f64.sin() + 0.5f64.cos() * 0.5)
+        );
+    }
+
+    #[test]
+    fn values_are_those_of_eval() {
+        for value in [
+            json!(["+", 1, "x", ["*", ["/", -1, 2], "y"], ["^", "x", -2], ["sin", "th1"]]),
+            json!(["*", 3, ["^", ["+", "x", "y"], 3], ["cos", ["*", 2, "th1"]]]),
+            json!(["sin", ["+", "x", ["cos", ["+", "y", "th1"]]]]),
+        ] {
+            let e = parse_ok(value);
+            assert_eq!(e.eval_with_scale(&SLOTS).v, e.eval(&SLOTS));
+        }
+    }
+
+    /// The document check's formulas, in [`Scaled`] arithmetic, follow the rule of the
+    /// reference's expression trees: the same formula has the same value and scale.
+    #[test]
+    fn arithmetic_follows_the_expression_rule() {
+        let [x, y, th] = SLOTS.map(Scaled::exact);
+        let pairs = [
+            (x + y, json!(["+", "x", "y"])),
+            (x - y, json!(["+", "x", ["*", -1, "y"]])),
+            (x * y * th, json!(["*", "x", "y", "th1"])),
+            (-2.0 * th, json!(["*", -2, "th1"])),
+            (x.powi(-2), json!(["^", "x", -2])),
+            ((x + y).powi(-1), json!(["^", ["+", "x", "y"], -1])),
+            (th.sin(), json!(["sin", "th1"])),
+            (th.cos() * x.sin(), json!(["*", ["cos", "th1"], ["sin", "x"]])),
+            ((x + y).sin(), json!(["sin", ["+", "x", "y"]])),
+            ((x * th).cos().sq(), json!(["^", ["cos", ["*", "x", "th1"]], 2])),
+            ([x, y, th].into_iter().sum::<Scaled>(), json!(["+", "x", "y", "th1"])),
+        ];
+        for (computed, value) in pairs {
+            let (v, s) = scaled(value.clone());
+            assert_eq!((computed.v, computed.s), (v, s), "{value}");
+        }
+        // Negation is exact: sin(−θ) of an input is only the sine's rounding.
+        assert_eq!((-th).sin().s, 0.5f64.sin());
+        // A quotient errs by both operands' scales.
+        let q = (x + y) / th;
+        assert_eq!((q.v, q.s), (-2.0, (5.0 + 2.0 * 0.5) / 0.5));
+        assert_eq!(Scaled::with_scale(-3.0, 1.0), Scaled { v: -3.0, s: 3.0, exact: false });
     }
 
     #[test]

@@ -106,23 +106,3 @@ pub fn with_generated<V: ModelVisitor>(
         Spatial 5 => Spatial5,
     }
 }
-
-/// Whether [`with_generated`] has a model of `kind` with `links` links.
-pub fn has_generated(kind: Kind, links: usize) -> bool {
-    struct Probe;
-    impl ModelVisitor for Probe {
-        type Output = ();
-        fn visit<M: Model>(self, _: &M)
-        where
-            DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
-        {
-        }
-    }
-    let params = Params {
-        masses: vec![1.0; links],
-        lengths: vec![1.0; links],
-        gravity: 1.0,
-        damping: vec![0.0; links],
-    };
-    matches!(with_generated(kind, links, &params, Probe), Ok(Some(())))
-}

@@ -88,10 +88,17 @@ pub fn rng(seed: u64, index: usize) -> ChaCha8Rng {
 /// Parameters and point number `index` of a run with `seed` for an `n`-link `kind`
 /// chain: `params` then `point` drawn from [`rng(seed, index)`](rng).
 pub fn state(seed: u64, kind: Kind, n: usize, index: usize) -> (Params, Point) {
+    let (params, point, _) = state_with_rng(seed, kind, n, index);
+    (params, point)
+}
+
+/// [`state`], and the generator after it, for drawing more values that belong to the
+/// same state.
+pub fn state_with_rng(seed: u64, kind: Kind, n: usize, index: usize) -> (Params, Point, ChaCha8Rng) {
     let mut rng = rng(seed, index);
     let params = params(&mut rng, n);
     let point = point(&mut rng, kind, n);
-    (params, point)
+    (params, point, rng)
 }
 
 #[cfg(test)]
@@ -103,6 +110,15 @@ mod tests {
         assert_eq!(state(7, Kind::Spatial, 3, 5), state(7, Kind::Spatial, 3, 5));
         assert_ne!(state(7, Kind::Spatial, 3, 5), state(7, Kind::Spatial, 3, 6));
         assert_ne!(state(7, Kind::Planar, 3, 5), state(8, Kind::Planar, 3, 5));
+        // The generator continues where the state left off.
+        let (params, point, mut rest) = state_with_rng(7, Kind::Spatial, 3, 5);
+        assert_eq!((params.clone(), point.clone()), state(7, Kind::Spatial, 3, 5));
+        let mut again = rng(7, 5);
+        assert_eq!(
+            (super::params(&mut again, 3), super::point(&mut again, Kind::Spatial, 3)),
+            (params, point)
+        );
+        assert_eq!(rest.random::<u64>(), again.random::<u64>());
     }
 
     #[test]
