@@ -15,7 +15,13 @@ pub const SINGULARITY_TOLERANCE: f64 = 1e-6;
 /// [`Error::SingularAngle`] if `|sin θ|` of link `link` (1-based) is below
 /// [`SINGULARITY_TOLERANCE`].
 pub fn check_polar_angle(link: usize, theta: f64) -> Result<()> {
-    let sin_theta = theta.sin().abs();
+    check_polar_sin(link, theta, theta.sin())
+}
+
+/// [`check_polar_angle`] for a caller that already has `sin_theta = theta.sin()`, so the
+/// sine is computed once (the code `pendulum-macros` generates).
+pub fn check_polar_sin(link: usize, theta: f64, sin_theta: f64) -> Result<()> {
+    let sin_theta = sin_theta.abs();
     if sin_theta < SINGULARITY_TOLERANCE {
         Err(Error::SingularAngle { link, theta, sin_theta, tolerance: SINGULARITY_TOLERANCE })
     } else {

@@ -200,6 +200,41 @@ const _: () = {
             let ct2 = q[2].cos();
             -mt0 * g * l0 * ct0 - mt1 * g * l1 * ct1 - mt2 * g * l2 * ct2
         }
+        fn energy(&self, q: &SVector<f64, 3>, qd: &SVector<f64, 3>) -> f64 {
+            let masses = self.chain.masses();
+            let tail_masses = self.chain.tail_masses();
+            let lengths = self.chain.lengths();
+            let g = self.chain.gravity();
+            let m0 = masses[0];
+            let m1 = masses[1];
+            let m2 = masses[2];
+            let mt0 = tail_masses[0];
+            let mt1 = tail_masses[1];
+            let mt2 = tail_masses[2];
+            let l0 = lengths[0];
+            let l1 = lengths[1];
+            let l2 = lengths[2];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dth2 = qd[2];
+            let vx0 = l0 * ct0 * dth0;
+            let vy0 = l0 * st0 * dth0;
+            let vx1 = vx0 + l1 * ct1 * dth1;
+            let vy1 = vy0 + l1 * st1 * dth1;
+            let vx2 = vx1 + l2 * ct2 * dth2;
+            let vy2 = vy1 + l2 * st2 * dth2;
+            let kinetic = 0.5 * m0 * vx0 * vx0
+                + 0.5 * m0 * vy0 * vy0
+                + 0.5 * m1 * vx1 * vx1
+                + 0.5 * m1 * vy1 * vy1
+                + 0.5 * m2 * vx2 * vx2
+                + 0.5 * m2 * vy2 * vy2;
+            let potential = -mt0 * g * l0 * ct0 - mt1 * g * l1 * ct1 - mt2 * g * l2 * ct2;
+            kinetic + potential
+        }
         fn accelerations(
             &self,
             q: &SVector<f64, 3>,

@@ -149,8 +149,8 @@ const _: () = {
             let az = pivot_acceleration[2];
             out[0] = mt0 * l0 * ax * ct0 * cp0 + mt0 * l0 * ay * ct0 * sp0 + mt0 * l0 * az * st0;
             out[1] = mt1 * l1 * ax * ct1 * cp1 + mt1 * l1 * ay * ct1 * sp1 + mt1 * l1 * az * st1;
-            out[2] = mt0 * l0 * ay * st0 * cp0 - mt0 * l0 * ax * st0 * sp0;
-            out[3] = mt1 * l1 * ay * st1 * cp1 - mt1 * l1 * ax * st1 * sp1;
+            out[2] = -mt0 * l0 * ax * st0 * sp0 + mt0 * l0 * ay * st0 * cp0;
+            out[3] = -mt1 * l1 * ax * st1 * sp1 + mt1 * l1 * ay * st1 * cp1;
         }
         fn generalized_forces(
             &self,
@@ -217,9 +217,45 @@ const _: () = {
             let ct1 = q[1].cos();
             -mt0 * g * l0 * ct0 - mt1 * g * l1 * ct1
         }
+        fn energy(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> f64 {
+            let masses = self.chain.masses();
+            let tail_masses = self.chain.tail_masses();
+            let lengths = self.chain.lengths();
+            let g = self.chain.gravity();
+            let m0 = masses[0];
+            let m1 = masses[1];
+            let mt0 = tail_masses[0];
+            let mt1 = tail_masses[1];
+            let l0 = lengths[0];
+            let l1 = lengths[1];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (sp0, cp0) = q[2].sin_cos();
+            let (sp1, cp1) = q[3].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dph0 = qd[2];
+            let dph1 = qd[3];
+            let vx0 = l0 * ct0 * cp0 * dth0 - l0 * st0 * sp0 * dph0;
+            let vy0 = l0 * ct0 * sp0 * dth0 + l0 * st0 * cp0 * dph0;
+            let vz0 = l0 * st0 * dth0;
+            let vx1 = vx0 + l1 * ct1 * cp1 * dth1 - l1 * st1 * sp1 * dph1;
+            let vy1 = vy0 + l1 * ct1 * sp1 * dth1 + l1 * st1 * cp1 * dph1;
+            let vz1 = vz0 + l1 * st1 * dth1;
+            let kinetic = 0.5 * m0 * vx0 * vx0
+                + 0.5 * m0 * vy0 * vy0
+                + 0.5 * m0 * vz0 * vz0
+                + 0.5 * m1 * vx1 * vx1
+                + 0.5 * m1 * vy1 * vy1
+                + 0.5 * m1 * vz1 * vz1;
+            let potential = -mt0 * g * l0 * ct0 - mt1 * g * l1 * ct1;
+            kinetic + potential
+        }
         fn check_configuration(&self, q: &SVector<f64, 4>) -> Result<()> {
-            ::pendulum_core::check_polar_angle(1, q[0])?;
-            ::pendulum_core::check_polar_angle(2, q[1])?;
+            let st0 = q[0].sin();
+            let st1 = q[1].sin();
+            ::pendulum_core::check_polar_sin(1, q[0], st0)?;
+            ::pendulum_core::check_polar_sin(2, q[1], st1)?;
             Ok(())
         }
         fn accelerations(
@@ -230,8 +266,6 @@ const _: () = {
             out: &mut SVector<f64, 4>,
         ) -> Result<()> {
             ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-            ::pendulum_core::check_polar_angle(1, q[0])?;
-            ::pendulum_core::check_polar_angle(2, q[1])?;
             let torque = &inputs.torque;
             let pivot_acceleration = &inputs.pivot_acceleration;
             let tail_masses = self.chain.tail_masses();
@@ -246,6 +280,8 @@ const _: () = {
             let lam1 = damping[1];
             let (st0, ct0) = q[0].sin_cos();
             let (st1, ct1) = q[1].sin_cos();
+            ::pendulum_core::check_polar_sin(1, q[0], st0)?;
+            ::pendulum_core::check_polar_sin(2, q[1], st1)?;
             let (sp0, cp0) = q[2].sin_cos();
             let (sp1, cp1) = q[3].sin_cos();
             let dth0 = qd[0];
@@ -292,8 +328,8 @@ const _: () = {
             let k1 = mt1 * g * l1 * st1;
             let d0 = mt0 * l0 * ax * ct0 * cp0 + mt0 * l0 * ay * ct0 * sp0 + mt0 * l0 * az * st0;
             let d1 = mt1 * l1 * ax * ct1 * cp1 + mt1 * l1 * ay * ct1 * sp1 + mt1 * l1 * az * st1;
-            let d2 = mt0 * l0 * ay * st0 * cp0 - mt0 * l0 * ax * st0 * sp0;
-            let d3 = mt1 * l1 * ay * st1 * cp1 - mt1 * l1 * ax * st1 * sp1;
+            let d2 = -mt0 * l0 * ax * st0 * sp0 + mt0 * l0 * ay * st0 * cp0;
+            let d3 = -mt1 * l1 * ax * st1 * sp1 + mt1 * l1 * ay * st1 * cp1;
             let f0 = tau_th0 - lam0 * dth0;
             let f1 = tau_th1 - lam1 * dth1;
             let f2 = tau_ph0 - lam0 * st0 * st0 * dph0;

@@ -54,9 +54,30 @@ fn expr(e: &Expr) -> TokenStream {
     })
 }
 
+/// The pivot-acceleration type: `U2` planar, `U3` spatial.
+fn space(plan: &Plan) -> Ident {
+    format_ident!("U{}", plan.space())
+}
+
+/// `check_polar_sin(link, q[i], st_i)?;` for every link whose polar angle can be singular,
+/// and the sines `st_i` they need from the lets: the one place the checks are written, for
+/// `check_configuration` and `accelerations` alike.
+fn polar_checks(plan: &Plan) -> (Vec<Sym>, TokenStream) {
+    let mut sines = Vec::new();
+    let mut checks = TokenStream::new();
+    for (link, i) in plan.singular_links() {
+        let sin = Sym::Trig(plan.angle(i), Trig::Sin);
+        sines.push(sin);
+        let (link, i, sin) = (index(link), index(i), ident(sin));
+        checks.extend(quote!(::pendulum_core::check_polar_sin(#link, q[#i], #sin)?;));
+    }
+    (sines, checks)
+}
+
 /// The `let` statements that compute `syms` (a sorted closure) from the chain and the
-/// arguments `q`, `qd`, `torque`, `pivot_acceleration`.
-fn lets(plan: &Plan, syms: &[Sym]) -> TokenStream {
+/// arguments `q`, `qd`, `torque`, `pivot_acceleration`; `checks` go right after the lets
+/// of the polar angles' sines and cosines.
+fn lets(plan: &Plan, syms: &[Sym], checks: TokenStream) -> TokenStream {
     let has = |f: fn(&Sym) -> bool| syms.iter().any(f);
     let mut out = TokenStream::new();
     // Each chain vector is borrowed once, each entry read once.
@@ -73,7 +94,10 @@ fn lets(plan: &Plan, syms: &[Sym]) -> TokenStream {
         out.extend(quote!(let damping = self.chain.damping();));
     }
     let set: BTreeSet<Sym> = syms.iter().copied().collect();
-    for &sym in syms {
+    let last_polar = syms.iter().rposition(|s| matches!(s, Sym::Trig(Angle::Theta(_), _)));
+    assert!(checks.is_empty() || last_polar.is_some(), "the checks need the sines of the polar angles");
+    let mut checks = Some(checks);
+    for (k, &sym) in syms.iter().enumerate() {
         let name = ident(sym);
         let stmt = match sym {
             Sym::Gravity => quote!(let #name = self.chain.gravity();),
@@ -91,6 +115,9 @@ fn lets(plan: &Plan, syms: &[Sym]) -> TokenStream {
             }
         };
         out.extend(stmt);
+        if Some(k) == last_polar {
+            out.extend(checks.take());
+        }
     }
     out
 }
@@ -124,9 +151,24 @@ struct Body {
 
 impl Body {
     fn new<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
-        let roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
+        Self::build(plan, exprs, false)
+    }
+
+    /// [`Body::new`] that also runs the [`polar_checks`] as soon as their sines are known.
+    fn checked<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
+        Self::build(plan, exprs, true)
+    }
+
+    fn build<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, checked: bool) -> Self {
+        let mut roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
+        let mut checks = TokenStream::new();
+        if checked {
+            let sines;
+            (sines, checks) = polar_checks(plan);
+            roots.extend(sines);
+        }
         let syms = plan.closure(roots);
-        Body { lets: lets(plan, &syms), uses: syms.into_iter().collect() }
+        Body { lets: lets(plan, &syms, checks), uses: syms.into_iter().collect() }
     }
 
     fn uses(&self, f: fn(&Sym) -> bool) -> bool {
@@ -163,10 +205,7 @@ fn model(def: &ModelDef) -> TokenStream {
     let ModelDef { attrs, vis, ident: name, .. } = def;
     let n = index(plan.links);
     let dof = index(plan.dof());
-    let space = match plan.kind {
-        Kind::Planar => quote!(U2),
-        Kind::Spatial => quote!(U3),
-    };
+    let space = space(&plan);
     let space_dim = index(plan.space());
     let vector = quote!(SVector<f64, #dof>);
     let matrix = quote!(SMatrix<f64, #dof, #dof>);
@@ -189,10 +228,7 @@ fn model(def: &ModelDef) -> TokenStream {
     });
 
     // mass_matrix
-    let entries: Vec<Expr> = (0..plan.dof())
-        .flat_map(|r| (0..=r).filter_map(move |c| plan.mass_entry(r, c)))
-        .map(Expr::of)
-        .collect();
+    let entries: Vec<Expr> = plan.mass_entries().into_iter().map(Expr::of).collect();
     let mass = Body::new(&plan, &entries);
     let mass_q = mass.q();
     let mass_lets = &mass.lets;
@@ -219,21 +255,20 @@ fn model(def: &ModelDef) -> TokenStream {
     let potential = Body::new(&plan, [&potential_expr]);
     let (potential_q, potential_lets) = (potential.q(), &potential.lets);
     let potential_value = expr(&potential_expr);
+    // H = T + U from one set of lets, each sum as in its own method (the same rounding).
+    let energy = Body::new(&plan, [&kinetic_expr, &potential_expr]);
+    let (energy_q, energy_qd, energy_lets) = (energy.q(), energy.qd(), &energy.lets);
 
-    let check_polar = plan.singular_links().into_iter().map(|(link, i)| {
-        let (link, i) = (index(link), index(i));
-        quote!(::pendulum_core::check_polar_angle(#link, q[#i])?;)
-    });
-    let check_polar: Vec<TokenStream> = check_polar.collect();
-    let check_configuration = (!check_polar.is_empty()).then(|| {
+    let check_configuration = (!plan.singular_links().is_empty()).then(|| {
+        let checks = &Body::checked(&plan, []).lets;
         quote! {
             fn check_configuration(&self, q: &#vector) -> Result<()> {
-                #(#check_polar)*
+                #checks
                 Ok(())
             }
         }
     });
-    let accelerations = accelerations(&plan, &check_polar);
+    let accelerations = accelerations(&plan);
 
     quote! {
         #(#attrs)*
@@ -322,6 +357,13 @@ fn model(def: &ModelDef) -> TokenStream {
                     #potential_value
                 }
 
+                fn energy(&self, #energy_q: &#vector, #energy_qd: &#vector) -> f64 {
+                    #energy_lets
+                    let kinetic = #kinetic_value;
+                    let potential = #potential_value;
+                    kinetic + potential
+                }
+
                 #check_configuration
 
                 #accelerations
@@ -348,20 +390,16 @@ fn scaled(sum: TokenStream, is_single: bool, inv: &Ident) -> TokenStream {
     if is_single { quote!(#sum * #inv) } else { quote!((#sum) * #inv) }
 }
 
-/// `accelerations`: checks, `M` and `Q − c − k − d` as lets, an unrolled Cholesky
-/// factorisation `M = L Lᵀ` (column by column; entries known to be zero are skipped) and
-/// forward and back substitution.
-fn accelerations(plan: &Plan, check_polar: &[TokenStream]) -> TokenStream {
+/// `accelerations`: `M` and `Q − c − k − d` as lets with the polar-angle checks among them,
+/// an unrolled Cholesky factorisation `M = L Lᵀ` (column by column; entries known to be
+/// zero are skipped) and forward and back substitution.
+fn accelerations(plan: &Plan) -> TokenStream {
     let d = plan.dof();
     let dof = index(d);
-    let space = match plan.kind {
-        Kind::Planar => quote!(U2),
-        Kind::Spatial => quote!(U3),
-    };
-    let mut roots: Vec<Expr> =
-        (0..d).flat_map(|r| (0..=r).filter_map(move |c| plan.mass_entry(r, c))).map(Expr::of).collect();
+    let space = space(plan);
+    let mut roots: Vec<Expr> = plan.mass_entries().into_iter().map(Expr::of).collect();
     roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
-    let body = Body::new(plan, &roots);
+    let body = Body::checked(plan, &roots);
     let lets = &body.lets;
     let torque = body.uses(|s| matches!(s, Sym::Torque(_))).then(|| quote!(let torque = &inputs.torque;));
     let pivot = body
@@ -432,7 +470,6 @@ fn accelerations(plan: &Plan, check_polar: &[TokenStream]) -> TokenStream {
             out: &mut SVector<f64, #dof>,
         ) -> Result<()> {
             ::pendulum_core::check_inputs(#dof, q, qd, inputs)?;
-            #(#check_polar)*
             #torque
             #pivot
             #lets
@@ -449,9 +486,12 @@ fn accelerations(plan: &Plan, check_polar: &[TokenStream]) -> TokenStream {
 
 #[cfg(test)]
 mod tests {
+    use std::collections::BTreeMap;
     use std::io::Write;
     use std::path::Path;
     use std::process::{Command, Stdio};
+
+    use proc_macro2::{Delimiter, TokenTree};
 
     use super::*;
 
@@ -517,18 +557,217 @@ mod tests {
         }
     }
 
+    /// Every `fn name(…) … { body }` in `tokens`, at any depth, as (name, body).
+    fn methods(tokens: TokenStream, out: &mut Vec<(String, TokenStream)>) {
+        let tokens: Vec<TokenTree> = tokens.into_iter().collect();
+        let mut k = 0;
+        while k < tokens.len() {
+            match &tokens[k] {
+                TokenTree::Ident(i) if i == "fn" => {
+                    let name = tokens[k + 1].to_string();
+                    let (at, body) = tokens[k..]
+                        .iter()
+                        .enumerate()
+                        .find_map(|(j, t)| match t {
+                            TokenTree::Group(g) if g.delimiter() == Delimiter::Brace => Some((k + j, g)),
+                            _ => None,
+                        })
+                        .expect("a fn has a body");
+                    out.push((name, body.stream()));
+                    k = at + 1;
+                }
+                TokenTree::Group(g) => {
+                    methods(g.stream(), out);
+                    k += 1;
+                }
+                _ => k += 1,
+            }
+        }
+    }
+
+    /// `i` if `tokens` start with `q[i]`.
+    fn q_index(tokens: &[TokenTree]) -> Option<String> {
+        match tokens {
+            [TokenTree::Ident(q), TokenTree::Group(g), ..]
+                if q == "q" && g.delimiter() == Delimiter::Bracket =>
+            {
+                Some(g.stream().to_string())
+            }
+            _ => None,
+        }
+    }
+
+    /// What one method body does with the angles `q[i]`: the trig calls on each (`.sin()`,
+    /// `.cos()`, `.sin_cos()`, and `check_polar_angle(_, q[i])`, which takes the sine
+    /// itself), the names bound to each sine, and the `check_polar_sin(_, q[i], s)` calls.
+    #[derive(Default)]
+    struct AngleUses {
+        trig: Vec<(String, String)>,
+        sine: BTreeMap<String, String>,
+        checks: Vec<(String, String)>,
+    }
+
+    fn angle_uses(body: TokenStream, uses: &mut AngleUses) {
+        let tokens: Vec<TokenTree> = body.into_iter().collect();
+        for (k, token) in tokens.iter().enumerate() {
+            match token {
+                TokenTree::Group(g) => angle_uses(g.stream(), uses),
+                TokenTree::Ident(f) if f == "check_polar_angle" || f == "check_polar_sin" => {
+                    let Some(TokenTree::Group(args)) = tokens.get(k + 1) else { continue };
+                    let args: Vec<TokenTree> = args.stream().into_iter().collect();
+                    let args: Vec<&[TokenTree]> =
+                        args.split(|t| matches!(t, TokenTree::Punct(p) if p.as_char() == ',')).collect();
+                    let i = q_index(args[1]).expect("the checks take q[i]");
+                    if f == "check_polar_angle" {
+                        uses.trig.push((i, f.to_string()));
+                    } else {
+                        uses.checks.push((i, args[2].iter().map(ToString::to_string).collect()));
+                    }
+                }
+                TokenTree::Ident(_) => {
+                    let Some(i) = q_index(&tokens[k..]) else { continue };
+                    let Some(TokenTree::Ident(method)) = tokens.get(k + 3) else { continue };
+                    let method = method.to_string();
+                    if !["sin", "cos", "sin_cos"].contains(&method.as_str()) {
+                        continue;
+                    }
+                    // `let s = q[i].sin()` or `let (s, c) = q[i].sin_cos()`
+                    let bound = match (k.checked_sub(3).map(|p| &tokens[p..k]), method.as_str()) {
+                        (Some([TokenTree::Ident(l), TokenTree::Ident(s), TokenTree::Punct(eq)]), "sin")
+                            if l == "let" && eq.as_char() == '=' =>
+                        {
+                            Some(s.to_string())
+                        }
+                        (
+                            Some([TokenTree::Ident(l), TokenTree::Group(pair), TokenTree::Punct(eq)]),
+                            "sin_cos",
+                        ) if l == "let" && eq.as_char() == '=' => {
+                            pair.stream().into_iter().next().map(|s| s.to_string())
+                        }
+                        _ => None,
+                    };
+                    if let Some(s) = bound {
+                        uses.sine.insert(s, i.clone());
+                    }
+                    uses.trig.push((i, method));
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Per method of `tokens`: an angle with more than one trig call, or a
+    /// `check_polar_sin` given something other than its angle's sine from this method.
+    fn repeated_trig(tokens: TokenStream) -> Vec<String> {
+        let mut found = Vec::new();
+        let mut all = Vec::new();
+        methods(tokens, &mut all);
+        for (name, body) in all {
+            let mut uses = AngleUses::default();
+            angle_uses(body, &mut uses);
+            let mut per_angle: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+            for (i, call) in &uses.trig {
+                per_angle.entry(i).or_default().push(call);
+            }
+            for (i, calls) in per_angle.into_iter().filter(|(_, calls)| calls.len() > 1) {
+                found.push(format!("{name}: q[{i}] has {calls:?}"));
+            }
+            for (i, sine) in &uses.checks {
+                if uses.sine.get(sine) != Some(i) {
+                    found.push(format!("{name}: check_polar_sin of q[{i}] is given `{sine}`"));
+                }
+            }
+        }
+        found
+    }
+
+    fn expansion(item: &str) -> TokenStream {
+        expand(&syn::parse_str::<Input>(item).unwrap())
+    }
+
     #[test]
-    fn expansion_has_no_loops_and_one_sin_cos_per_angle() {
-        let input: Input = syn::parse_str("struct S3 { kind: spatial, links: 3 }").unwrap();
-        let tokens = expand(&input);
+    fn expansion_has_no_loops() {
         let mut words = Vec::new();
-        idents(tokens.clone(), &mut words);
+        idents(expansion("struct S3 { kind: spatial, links: 3 }"), &mut words);
         for word in ["in", "while", "loop", "Vec", "vec", "Box", "iter", "collect"] {
             assert!(!words.iter().any(|w| w == word), "the expansion contains `{word}`");
         }
-        let code = tokens.to_string();
-        // mass_matrix, velocity_terms, pivot_terms, kinetic_energy, accelerations: 6 angles each.
-        assert_eq!(code.matches("sin_cos").count(), 5 * 6);
-        assert_eq!(code.matches("check_polar_angle").count(), 2 * 3);
+    }
+
+    #[test]
+    fn every_method_takes_each_angles_sine_and_cosine_once() {
+        for kind in ["planar", "spatial"] {
+            for links in [1, 2, 3, 5] {
+                let tokens = expansion(&format!("struct S {{ kind: {kind}, links: {links} }}"));
+                let found = repeated_trig(tokens.clone());
+                assert!(found.is_empty(), "{kind} {links}: {found:#?}");
+                // The spatial checks: every link's, in both methods that make them.
+                let mut all = Vec::new();
+                methods(tokens, &mut all);
+                for (name, body) in all {
+                    let mut uses = AngleUses::default();
+                    angle_uses(body, &mut uses);
+                    let checked: Vec<String> = uses.checks.into_iter().map(|(i, _)| i).collect();
+                    let want: Vec<String> = match (kind, name.as_str()) {
+                        ("spatial", "check_configuration" | "accelerations") => {
+                            (0..links).map(|i| i.to_string()).collect()
+                        }
+                        _ => Vec::new(),
+                    };
+                    assert_eq!(checked, want, "{kind} {links}: {name}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn repeated_trig_finds_a_second_use_of_an_angle() {
+        let bad = [
+            // the sine twice: once in the check, once in the let
+            quote!(
+                fn a(q: V) {
+                    check_polar_angle(1, q[0])?;
+                    let (st0, ct0) = q[0].sin_cos();
+                }
+            ),
+            quote!(
+                fn b(q: V) {
+                    let st0 = q[0].sin();
+                    let (s, c) = q[0].sin_cos();
+                }
+            ),
+            quote!(
+                fn c(q: V) {
+                    let x = 1.0 + q[1].cos() * q[1].cos();
+                }
+            ),
+            // the check given another angle's sine, or a sine from nowhere
+            quote!(
+                fn d(q: V) {
+                    let (st0, ct0) = q[0].sin_cos();
+                    let st1 = q[1].sin();
+                    check_polar_sin(1, q[0], st1)?;
+                }
+            ),
+            quote!(
+                fn e(q: V) {
+                    check_polar_sin(1, q[0], st0)?;
+                }
+            ),
+            quote!(
+                fn f(q: V) {
+                    let x = st0 * q[0].sin();
+                    check_polar_sin(1, q[0], st0)?;
+                }
+            ),
+        ];
+        for tokens in bad {
+            assert_eq!(repeated_trig(tokens.clone()).len(), 1, "{tokens}");
+        }
+        let good = quote! {
+            fn f(q: V) { let (st0, ct0) = q[0].sin_cos(); check_polar_sin(1, q[0], st0)?; let c1 = q[1].cos(); }
+            fn g(q: V) { let st0 = q[0].sin(); check_polar_sin(1, q[0], st0)?; let c1 = q[1].cos(); }
+        };
+        assert_eq!(repeated_trig(good), Vec::<String>::new());
     }
 }

@@ -43,10 +43,11 @@ use proc_macro::TokenStream;
 /// `pendulum_core::Spatial`, to round-off. Every method is straight-line code: each
 /// angle's sine and cosine computed once, angle differences from the angle-sum
 /// identities, tail masses and `W_ij = M_max(i,j) l_i l_j` as named temporaries, no loops
-/// and no allocation. `accelerations` checks its inputs (`check_inputs`, and for spatial
-/// models `check_polar_angle` on every link), then solves `M q̈ = Q − c − k − d` by an
-/// unrolled Cholesky factorisation, returning `Error::NotPositiveDefinite` if a pivot is
-/// not positive or the result is not finite.
+/// and no allocation; `energy` shares one set of temporaries between `T` and `U`.
+/// `accelerations` checks its inputs (`check_inputs`, and for spatial models
+/// `check_polar_sin` on every link, with the sines it computes anyway), then solves
+/// `M q̈ = Q − c − k − d` by an unrolled Cholesky factorisation, returning
+/// `Error::NotPositiveDefinite` if a pivot is not positive or the result is not finite.
 ///
 /// Mistakes in the input are compile errors pointing at the offending token, all
 /// reported at once.

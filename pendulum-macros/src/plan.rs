@@ -204,6 +204,15 @@ impl Expr {
         self
     }
 
+    /// Appends each term of `e` multiplied as `before · term · after`.
+    fn add_product(&mut self, before: &[Sym], e: &Expr, after: &[Sym]) -> &mut Self {
+        for t in &e.terms {
+            let factors: Vec<Sym> = [before, &t.factors, after].concat();
+            self.add(t.coef, &factors);
+        }
+        self
+    }
+
     /// Appends `coef · Π factors` with `signed`, a factor with a sign of its own, second.
     fn add_signed(&mut self, coef: f64, signed: (f64, Sym), factors: &[Sym]) -> &mut Self {
         let mut all = factors.to_vec();
@@ -326,25 +335,14 @@ impl Plan {
             Sym::Weight(i, j) => {
                 e.add(1.0, &[Sym::Tail(j), Sym::Length(i), Sym::Length(j)]);
             }
+            // v_k = v_{k−1} + l_k u̇_k, u̇_k = Σ_a J_a q̇_a over link k's angles.
             Sym::Velocity(k, axis) => {
                 if k > 0 {
                     e.add(1.0, &[Sym::Velocity(k - 1, axis)]);
                 }
-                let (l, th, ph) = (Sym::Length(k), Theta(k), Phi(k));
-                let (dth, dph) = (Sym::Rate(th), Sym::Rate(ph));
-                match (self.kind, axis) {
-                    // u̇ = (cθ θ̇, sθ θ̇)
-                    (Kind::Planar, 0) => e.add(1.0, &[l, cos(th), dth]),
-                    (Kind::Planar, _) => e.add(1.0, &[l, sin(th), dth]),
-                    // u̇ = (cθ cφ θ̇ − sθ sφ φ̇, cθ sφ θ̇ + sθ cφ φ̇, sθ θ̇)
-                    (Kind::Spatial, 0) => {
-                        e.add(1.0, &[l, cos(th), cos(ph), dth]).add(-1.0, &[l, sin(th), sin(ph), dph])
-                    }
-                    (Kind::Spatial, 1) => {
-                        e.add(1.0, &[l, cos(th), sin(ph), dth]).add(1.0, &[l, sin(th), cos(ph), dph])
-                    }
-                    (Kind::Spatial, _) => e.add(1.0, &[l, sin(th), dth]),
-                };
+                for angle in self.link_angles(k) {
+                    e.add_product(&[Sym::Length(k)], &self.jacobian(angle, axis), &[Sym::Rate(angle)]);
+                }
             }
             Sym::MassEntry(r, c) => self.mass_entry_expr(r, c, &mut e),
             Sym::VelocityTerm(a) => self.velocity_term_expr(a, &mut e),
@@ -353,27 +351,13 @@ impl Plan {
                     e.add(1.0, &[Sym::Tail(i), Sym::Gravity, Sym::Length(i), sin(Theta(i))]);
                 }
             }
+            // d_a = M_i l_i J_a·p̈ (`a` on link `i`); planar d_i = M_i l_i (p̈_x cθ + p̈_y sθ).
             Sym::PivotTerm(a) => {
-                let i = self.angle(a).link();
-                let ml = [Sym::Tail(i), Sym::Length(i)];
-                let (th, ph) = (Theta(i), Phi(i));
-                let (ax, ay, az) = (Sym::Pivot(0), Sym::Pivot(1), Sym::Pivot(2));
-                match (self.kind, self.angle(a)) {
-                    // d_i = M_i l_i (p̈_x cθ + p̈_y sθ)
-                    (Kind::Planar, _) => {
-                        e.add(1.0, &[ml[0], ml[1], ax, cos(th)]).add(1.0, &[ml[0], ml[1], ay, sin(th)]);
-                    }
-                    // d_θi = M_i l_i J_θi·p̈
-                    (Kind::Spatial, Theta(_)) => {
-                        e.add(1.0, &[ml[0], ml[1], ax, cos(th), cos(ph)])
-                            .add(1.0, &[ml[0], ml[1], ay, cos(th), sin(ph)])
-                            .add(1.0, &[ml[0], ml[1], az, sin(th)]);
-                    }
-                    // d_φi = M_i l_i J_φi·p̈
-                    (Kind::Spatial, Phi(_)) => {
-                        e.add(1.0, &[ml[0], ml[1], ay, sin(th), cos(ph)])
-                            .add(-1.0, &[ml[0], ml[1], ax, sin(th), sin(ph)]);
-                    }
+                let angle = self.angle(a);
+                let i = angle.link();
+                for axis in 0..self.space() {
+                    let before = [Sym::Tail(i), Sym::Length(i), Sym::Pivot(axis)];
+                    e.add_product(&before, &self.jacobian(angle, axis), &[]);
                 }
             }
             Sym::Force(a) => {
@@ -412,11 +396,11 @@ impl Plan {
         let (i, j) = (a.link(), b.link());
         let w = weight(i, j);
         match (self.kind, a, b) {
+            // |J_θi|² = 1, planar and spatial (planar angles are all θ).
+            (_, Theta(_), Theta(_)) if i == j => e.add(1.0, &[w]),
             // C_ij = W_ij cos(θ_i − θ_j) (eq 22)
-            (Kind::Planar, ..) if i == j => e.add(1.0, &[w]),
             (Kind::Planar, ..) => e.add(1.0, &[w, cos_diff(a, b)]),
-            // J_θi·J_θj = cθi cθj cos(φ_i − φ_j) + sθi sθj; |J_θi|² = 1
-            (Kind::Spatial, Theta(_), Theta(_)) if i == j => e.add(1.0, &[w]),
+            // J_θi·J_θj = cθi cθj cos(φ_i − φ_j) + sθi sθj
             (Kind::Spatial, Theta(_), Theta(_)) => e
                 .add(1.0, &[w, cos(Theta(j)), cos(Theta(i)), cos_diff(Phi(j), Phi(i))])
                 .add(1.0, &[w, sin(Theta(j)), sin(Theta(i))]),
@@ -477,6 +461,41 @@ impl Plan {
         }
     }
 
+    /// The angles of link `k`: `θ_k`, and `φ_k` when spatial.
+    fn link_angles(&self, k: usize) -> Vec<Angle> {
+        match self.kind {
+            Kind::Planar => vec![Theta(k)],
+            Kind::Spatial => vec![Theta(k), Phi(k)],
+        }
+    }
+
+    /// Component `axis` of `J_a = ∂u_i/∂a`, the link direction's derivative by one of its
+    /// angles (empty where zero): planar `u = (sθ, −cθ)`, `J_θ = (cθ, sθ)`; spatial
+    /// `J_θ = (cθ cφ, cθ sφ, sθ)`, `J_φ = (−sθ sφ, sθ cφ, 0)`. One term at most, the
+    /// factors in the order above.
+    fn jacobian(&self, angle: Angle, axis: usize) -> Expr {
+        let i = angle.link();
+        let (th, ph) = (Theta(i), Phi(i));
+        let mut e = Expr::default();
+        match (self.kind, angle, axis) {
+            (Kind::Planar, _, 0) => e.add(1.0, &[cos(th)]),
+            (Kind::Planar, _, _) => e.add(1.0, &[sin(th)]),
+            (Kind::Spatial, Theta(_), 0) => e.add(1.0, &[cos(th), cos(ph)]),
+            (Kind::Spatial, Theta(_), 1) => e.add(1.0, &[cos(th), sin(ph)]),
+            (Kind::Spatial, Theta(_), _) => e.add(1.0, &[sin(th)]),
+            (Kind::Spatial, Phi(_), 0) => e.add(-1.0, &[sin(th), sin(ph)]),
+            (Kind::Spatial, Phi(_), 1) => e.add(1.0, &[sin(th), cos(ph)]),
+            (Kind::Spatial, Phi(_), _) => &mut e,
+        };
+        e
+    }
+
+    /// The symbols of the lower triangle of `M` (`r ≥ c`) that are not identically zero,
+    /// row by row: the mass-matrix entries a method computes.
+    pub fn mass_entries(&self) -> Vec<Sym> {
+        (0..self.dof()).flat_map(|r| (0..=r).filter_map(move |c| self.mass_entry(r, c))).collect()
+    }
+
     /// The symbol of `M_rc` (either triangle), `None` where the entry is identically zero.
     pub fn mass_entry(&self, r: usize, c: usize) -> Option<Sym> {
         let sym = Sym::MassEntry(r.max(c), r.min(c));
@@ -510,7 +529,7 @@ impl Plan {
     }
 
     /// Links whose polar angle must be checked for the `sin θ = 0` singularity (1-based,
-    /// as `pendulum_core::check_polar_angle` takes them) with the index of θ in `q`.
+    /// as `pendulum_core::check_polar_sin` takes them) with the index of θ in `q`.
     pub fn singular_links(&self) -> Vec<(usize, usize)> {
         match self.kind {
             Kind::Planar => Vec::new(),

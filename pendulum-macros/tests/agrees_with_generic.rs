@@ -211,6 +211,10 @@ where
         close("T", f.kinetic, g.kinetic, kinetic_scale, trial);
         close("U", f.potential, g.potential, potential_scale, trial);
         close("H", f.energy, g.energy, kinetic_scale + potential_scale, trial);
+        // The generated `energy` shares the lets of T and U and sums each as its own method
+        // does, so it is T + U to the bit.
+        let (sum, energy) = (f.kinetic + f.potential, f.energy);
+        assert_eq!(energy.to_bits(), sum.to_bits(), "{trial}: H = {energy:e}, T + U = {sum:e}");
         // The solve amplifies round-off by up to the condition number κ of M; both sides
         // are backward stable, so allow max(TOLERANCE, κ ε) of the largest |q̈|.
         let singular = g.mass.clone().singular_values();
