@@ -1,0 +1,225 @@
+//! The command line: `pendulum simulate | eval` and their options (clap derive).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use serde::{Deserialize, Serialize};
+
+use crate::spec::InitialSpec;
+
+/// Swing N-link pendulums: chains of point masses on massless rigid rods hung from a
+/// pivot that may be fixed or driven, in 2D or 3D.
+///
+/// SI units throughout, angles in radians. 2D: θ_i from the downward vertical, gravity
+/// along −y. 3D: θ_i from −z, φ_i azimuth from +x, gravity along −z.
+#[derive(Debug, Parser)]
+#[command(name = "pendulum", version, propagate_version = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Integrate a chain in time; write trajectory.csv, energy.csv, run.json, energy.png
+    /// and chain.gif into the output directory.
+    ///
+    /// Without options: a small demo (a triple pendulum released from tilted:1.0 for
+    /// 10 s) written to ./pendulum-run.
+    Simulate(Box<SimulateArgs>),
+    /// Evaluate one model at one state and print its terms as JSON: mass matrix M,
+    /// velocity terms c, gravity terms k, pivot terms d, generalized forces Q, the
+    /// accelerations q̈ = M⁻¹(Q − c − k − d), kinetic energy T and potential energy U
+    /// (equation M q̈ + c + k + d = Q, the sympy reference's form).
+    Eval(EvalArgs),
+}
+
+/// Space dimension of the chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+pub enum Dimension {
+    /// Planar chain, angles θ_i.
+    #[value(name = "2")]
+    #[serde(rename = "2")]
+    Two,
+    /// Spatial chain.
+    #[value(name = "3")]
+    #[serde(rename = "3")]
+    Three,
+}
+
+/// The pivot's motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DriveKind {
+    /// Pivot at rest at the origin.
+    Fixed,
+    /// p(t) = A sin(ωt + φ) d̂ along --direction (default vertical).
+    Harmonic,
+    /// p(t) = R (cos ωt, sin ωt, 0), a horizontal circle (3D only).
+    Circle,
+}
+
+/// The time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    /// Gauss–Legendre, 1 stage (implicit midpoint), order 2.
+    Gl1,
+    /// Gauss–Legendre, 2 stages, order 4.
+    Gl2,
+    /// Gauss–Legendre, 3 stages, order 6.
+    Gl3,
+    /// Classical explicit Runge–Kutta, order 4.
+    Rk4,
+}
+
+/// The plane a 3D chain is drawn in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum View {
+    /// Side view: x to the right, z up.
+    Xz,
+    /// Side view: y to the right, z up.
+    Yz,
+    /// Top view: x to the right, y up.
+    Xy,
+}
+
+/// Options of `pendulum simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Repeat the run recorded in this run.json exactly (only --out, --no-plots and
+    /// --quiet may be given with it).
+    #[arg(long, value_name = "RUN_JSON", conflicts_with = "Physics")]
+    pub from: Option<PathBuf>,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "pendulum-run")]
+    pub out: PathBuf,
+    /// Write only the CSV files and run.json, no energy.png or chain.gif.
+    #[arg(long)]
+    pub no_plots: bool,
+    /// No progress bar and no summary line.
+    #[arg(long)]
+    pub quiet: bool,
+    /// The chain, its drive and the run.
+    #[command(flatten)]
+    pub physics: Physics,
+}
+
+/// Everything that defines a run (recorded in run.json).
+#[derive(Debug, Args)]
+pub struct Physics {
+    /// Space dimension.
+    #[arg(long, value_enum, default_value = "2")]
+    pub dim: Dimension,
+    /// Number of links (default: the length of a --masses or --lengths list, else 3).
+    #[arg(long)]
+    pub n: Option<usize>,
+    /// Masses, kg: one value for every link, a comma list (one per link) or a file of
+    /// numbers.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    pub masses: String,
+    /// Rod lengths, m: one value, a comma list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0.5")]
+    pub lengths: String,
+    /// Gravitational acceleration g, m/s² (along −y in 2D, −z in 3D).
+    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
+    pub gravity: f64,
+    /// Damping λ_i, N·m·s: one value, a comma list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0")]
+    pub damping: String,
+    /// Constant torques σ_i on the angles θ_i, N·m (2D only): one value, a list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE")]
+    pub torque: Option<String>,
+    /// Pivot motion.
+    #[arg(long, value_enum, default_value = "fixed")]
+    pub drive: DriveKind,
+    /// Harmonic drive: amplitude A, m.
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
+    pub amplitude: f64,
+    /// Harmonic or circle drive: angular frequency ω, rad/s.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub omega: f64,
+    /// Harmonic drive: phase φ, rad.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub phase: f64,
+    /// Harmonic drive: direction of oscillation, 2 (2D) or 3 (3D) comma-separated
+    /// components (default: vertical).
+    #[arg(long, value_name = "X,Y[,Z]", allow_hyphen_values = true)]
+    pub direction: Option<String>,
+    /// Circle drive: radius R, m.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    pub radius: f64,
+    /// Time integrator.
+    #[arg(long, value_enum, default_value = "gl2")]
+    pub integrator: IntegratorKind,
+    /// Step size h, s (the run takes ⌈end / h⌉ equal steps).
+    #[arg(long, default_value_t = 0.005, allow_negative_numbers = true)]
+    pub step: f64,
+    /// End time, s (the run starts at t = 0).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub end: f64,
+    /// Initial state: hanging, horizontal, tilted:ANGLE (rad, every link, toward +x) or a
+    /// file of numbers: 2D θ_1..θ_n then θ̇_1..θ̇_n; 3D θ_1..θ_n, φ_1..φ_n,
+    /// θ̇_1..θ̇_n, φ̇_1..φ̇_n.
+    #[arg(long, value_name = "SPEC", default_value = "tilted:1.0")]
+    pub initial: InitialSpec,
+    /// 3D only: initial azimuthal rate φ̇ of every link, rad/s (a conical swing).
+    #[arg(long, allow_negative_numbers = true)]
+    pub spin: Option<f64>,
+    /// Write a sample every k steps.
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    pub every: usize,
+    /// 3D: the plane the animation shows.
+    #[arg(long, value_enum, default_value = "xz")]
+    pub view: View,
+    /// Most frames in the animation (samples are thinned to fit).
+    #[arg(long, default_value_t = 150)]
+    pub frames: usize,
+}
+
+/// Model kind of `pendulum eval`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// Planar chain, q = (θ_1..θ_n).
+    Planar,
+    /// Spatial chain in spherical angles, q = (θ_1..θ_n, φ_1..φ_n).
+    Spatial,
+}
+
+/// Options of `pendulum eval`.
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    /// The model.
+    #[arg(long, value_enum, default_value = "planar")]
+    pub model: ModelKind,
+    /// Number of links (default: the length of a --masses or --lengths list, else 2).
+    #[arg(long)]
+    pub n: Option<usize>,
+    /// Masses, kg: one value, a comma list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    pub masses: String,
+    /// Rod lengths, m: one value, a comma list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    pub lengths: String,
+    /// Gravitational acceleration g, m/s².
+    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
+    pub gravity: f64,
+    /// Damping λ_i, N·m·s: one value, a comma list or a file.
+    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0")]
+    pub damping: String,
+    /// Coordinates q, rad (planar θ_1..θ_n; spatial θ_1..θ_n, φ_1..φ_n), comma list.
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub q: String,
+    /// Rates q̇, rad/s, comma list (default: zeros).
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub qd: Option<String>,
+    /// Generalized torques σ, one per coordinate, N·m (default: zeros).
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub torque: Option<String>,
+    /// Pivot acceleration p̈, m/s²: 2 (planar) or 3 (spatial) components (default: 0).
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub pivot_acceleration: Option<String>,
+}

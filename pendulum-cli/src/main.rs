@@ -1,0 +1,69 @@
+//! `pendulum`: simulate N-link pendulums and write what a person wants to look at
+//! (trajectory and energy CSVs, run.json, an energy plot and an animation), or evaluate
+//! a model's terms as JSON.
+
+mod args;
+mod config;
+mod error;
+mod eval;
+mod models;
+mod plot;
+mod simulate;
+mod spec;
+
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+
+use clap::Parser;
+use clap::error::ErrorKind;
+
+use args::{Cli, Command};
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => match e.kind() {
+            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => e.exit(),
+            ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                let _ = e.print();
+                return ExitCode::from(2);
+            }
+            _ => {
+                // clap's message without its usage block and hints: one line.
+                let text = e.to_string();
+                let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid arguments");
+                eprintln!("{}", first.trim());
+                return ExitCode::from(2);
+            }
+        },
+    };
+    let result = match &cli.command {
+        Command::Simulate(args) => {
+            install_interrupt_handler();
+            // `pendulum simulate` alone: the demo.
+            let demo = std::env::args_os().len() == 2;
+            simulate::simulate(args, demo)
+        }
+        Command::Eval(args) => eval::eval(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+/// Ctrl-C once: the run stops at its next sample and writes valid files. Twice: exit at
+/// once (status 130).
+fn install_interrupt_handler() {
+    let installed = ctrlc::set_handler(|| {
+        if simulate::INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    if let Err(e) = installed {
+        eprintln!("pendulum: warning: Ctrl-C will end the run without writing files ({e})");
+    }
+}

@@ -1,0 +1,256 @@
+//! Which core model simulates which chain (one place to switch models), and the
+//! [`Simulation`] seam the run loop sees: a system, its initial state, and what one sample
+//! of it means (trajectory columns, positions, energy ledger).
+
+use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, Vector2, Vector3};
+use pendulum_core::integrate::System;
+use pendulum_core::{
+    Accounted, Chain, Circle, ConstantTorque, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc, Planar, Spatial,
+};
+
+use crate::args::Dimension;
+use crate::config::{DriveConfig, RunConfig};
+use crate::error::{CliError, CliResult};
+
+/// One sample of a run, in plain numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub t: f64,
+    /// The trajectory columns after `t` ([`Simulation::state_columns`]).
+    pub state: Vec<f64>,
+    /// Pivot position (m), z = 0 in 2D.
+    pub pivot: [f64; 3],
+    /// Mass positions in the inertial frame (m), mass 1 (nearest the pivot) first.
+    pub masses: Vec<[f64; 3]>,
+    /// Inertial-frame energy `H_in = T + U` with the pivot's motion included, J.
+    pub energy: f64,
+    /// Work of drive and torques and the damped energy since t = 0, J.
+    pub ledger: Ledger,
+}
+
+/// A chain set up to run: the integrators see [`system`](Simulation::system).
+pub trait Simulation {
+    /// The first-order system integrated.
+    type Sys: System<Dim = Dyn>;
+    /// The system.
+    fn system(&self) -> &Self::Sys;
+    /// The state at t = 0.
+    fn initial_state(&self) -> DVector<f64>;
+    /// Names of the trajectory's state columns (coordinates, then rates).
+    fn state_columns(&self) -> Vec<String>;
+    /// Reads a sample out of the state `x` at time `t`.
+    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample;
+}
+
+/// A chain model in angle coordinates with its drive, torques and energy ledger
+/// ([`Accounted`]): state `x = (q, q̇, W_drive, W_torque, E_damped)`.
+pub struct AngleSimulation<M: Model>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    system: Accounted<M, Box<dyn Drive<M::Space>>, ConstantTorque<M::Dof>>,
+    x0: DVector<f64>,
+}
+
+impl<M: Model<Links = Dyn, Dof = Dyn>> AngleSimulation<M>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    fn new(
+        model: M,
+        drive: Box<dyn Drive<M::Space>>,
+        torque: &[f64],
+        q: &[f64],
+        qd: &[f64],
+    ) -> CliResult<Self> {
+        let dof = model.dof();
+        let torque =
+            if torque.is_empty() { DVector::zeros(dof.0) } else { DVector::from_column_slice(torque) };
+        let (q, qd) = (DVector::from_column_slice(q), DVector::from_column_slice(qd));
+        model.check_configuration(&q).map_err(singular_start)?;
+        let system = Accounted::new(model, drive, ConstantTorque(torque));
+        let x0 = system.state(&q, &qd);
+        Ok(Self { system, x0 })
+    }
+}
+
+/// The error for a 3D start at the spherical-angle singularity.
+fn singular_start(e: pendulum_core::Error) -> CliError {
+    CliError::usage(format!(
+        "initial state: {e}. The 3D model in spherical angles cannot start with a link \
+         straight down or up; start tilted (--initial tilted:0.3) or from a file"
+    ))
+}
+
+impl<M: Model<Links = Dyn, Dof = Dyn>> Simulation for AngleSimulation<M>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    type Sys = Accounted<M, Box<dyn Drive<M::Space>>, ConstantTorque<Dyn>>;
+
+    fn system(&self) -> &Self::Sys {
+        &self.system
+    }
+
+    fn initial_state(&self) -> DVector<f64> {
+        self.x0.clone()
+    }
+
+    fn state_columns(&self) -> Vec<String> {
+        let n = self.system.model().chain().links();
+        let names: &[&str] = if M::Space::dim() == 2 { &["theta"] } else { &["theta", "phi"] };
+        let mut columns = Vec::new();
+        for prefix in ["", "d"] {
+            for name in names {
+                columns.extend((1..=n).map(|i| format!("{prefix}{name}{i}")));
+            }
+        }
+        columns
+    }
+
+    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
+        let (q, _, ledger) = self.system.split(x);
+        let drive = self.system.inputs().drive();
+        let pivot = to3(&drive.position(t));
+        let chain = self.system.model().chain();
+        let masses = if M::Space::dim() == 2 {
+            planar_positions(chain.lengths().as_slice(), q.as_slice(), pivot)
+        } else {
+            spatial_positions(chain.lengths().as_slice(), q.as_slice(), pivot)
+        };
+        let dof = q.len();
+        Sample {
+            t,
+            state: x.as_slice()[..2 * dof].to_vec(),
+            pivot,
+            masses,
+            energy: self.system.energy(t, x),
+            ledger,
+        }
+    }
+}
+
+/// A vector of the model's space as (x, y, z), z = 0 for a planar vector.
+fn to3<S: DimName>(v: &OVector<f64, S>) -> [f64; 3]
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    [v[0], v[1], if S::dim() > 2 { v[2] } else { 0.0 }]
+}
+
+/// Planar mass positions `r_k = p + Σ_{j≤k} l_j (sin θ_j, −cos θ_j)` (m).
+pub fn planar_positions(lengths: &[f64], theta: &[f64], pivot: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut r = pivot;
+    lengths
+        .iter()
+        .zip(theta)
+        .map(|(l, th)| {
+            let (s, c) = th.sin_cos();
+            r = [r[0] + l * s, r[1] - l * c, r[2]];
+            r
+        })
+        .collect()
+}
+
+/// Spatial mass positions `r_k = p + Σ_{j≤k} l_j (sin θ_j cos φ_j, sin θ_j sin φ_j,
+/// −cos θ_j)` (m), `q = (θ_1..θ_n, φ_1..φ_n)`.
+pub fn spatial_positions(lengths: &[f64], q: &[f64], pivot: [f64; 3]) -> Vec<[f64; 3]> {
+    let n = lengths.len();
+    let mut r = pivot;
+    (0..n)
+        .map(|i| {
+            let (st, ct) = q[i].sin_cos();
+            let (sp, cp) = q[n + i].sin_cos();
+            let l = lengths[i];
+            r = [r[0] + l * st * cp, r[1] + l * st * sp, r[2] - l * ct];
+            r
+        })
+        .collect()
+}
+
+/// The chain of a configuration, validated by the core.
+pub fn chain(config: &RunConfig) -> CliResult<Chain<Dyn>> {
+    Ok(Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?)
+}
+
+/// The planar model the command simulates with (the one place to change it).
+pub fn planar_model(chain: Chain<Dyn>) -> Planar<Dyn> {
+    Planar::new(chain)
+}
+
+/// The spatial model the command simulates with (the one place to change it).
+pub fn spatial_model(chain: Chain<Dyn>) -> Spatial<Dyn> {
+    Spatial::new(chain)
+}
+
+/// The planar drive of a configuration.
+fn drive2(config: &DriveConfig) -> CliResult<Box<dyn Drive<U2>>> {
+    Ok(match config {
+        DriveConfig::Fixed => Box::new(Fixed),
+        DriveConfig::Harmonic { direction, amplitude, omega, phase } => {
+            let d = Vector2::from_iterator(direction.iter().copied());
+            Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
+        }
+        DriveConfig::Circle { .. } => {
+            return Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only"));
+        }
+    })
+}
+
+/// The spatial drive of a configuration.
+fn drive3(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
+    Ok(match config {
+        DriveConfig::Fixed => Box::new(Fixed),
+        DriveConfig::Harmonic { direction, amplitude, omega, phase } => {
+            let d = Vector3::from_iterator(direction.iter().copied());
+            Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
+        }
+        DriveConfig::Circle { radius, omega } => Box::new(Circle::new(*radius, *omega)?),
+    })
+}
+
+/// The simulation of a configuration, one of the supported kinds.
+pub enum AnySimulation {
+    /// 2D, angles.
+    Planar(AngleSimulation<Planar<Dyn>>),
+    /// 3D, spherical angles.
+    Spatial(AngleSimulation<Spatial<Dyn>>),
+}
+
+/// Builds the simulation a configuration describes; errors name the bad parameter.
+pub fn build(config: &RunConfig) -> CliResult<AnySimulation> {
+    let chain = chain(config)?;
+    let (q, qd) = (&config.initial.coordinates, &config.initial.rates);
+    Ok(match config.dim {
+        Dimension::Two => AnySimulation::Planar(AngleSimulation::new(
+            planar_model(chain),
+            drive2(&config.drive)?,
+            &config.torque,
+            q,
+            qd,
+        )?),
+        Dimension::Three => AnySimulation::Spatial(AngleSimulation::new(
+            spatial_model(chain),
+            drive3(&config.drive)?,
+            &[],
+            q,
+            qd,
+        )?),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positions_follow_the_conventions() {
+        let r = planar_positions(&[1.0, 2.0], &[std::f64::consts::FRAC_PI_2, 0.0], [0.5, 0.0, 0.0]);
+        assert!((r[0][0] - 1.5).abs() < 1e-15 && r[0][1].abs() < 1e-15);
+        assert!((r[1][0] - 1.5).abs() < 1e-15 && (r[1][1] + 2.0).abs() < 1e-15);
+        let half = std::f64::consts::FRAC_PI_2;
+        let r = spatial_positions(&[1.0], &[half, half], [0.0; 3]);
+        assert!(r[0][0].abs() < 1e-15 && (r[0][1] - 1.0).abs() < 1e-15 && r[0][2].abs() < 1e-15);
+    }
+}

@@ -1,0 +1,290 @@
+//! `pendulum simulate`: the run loop, streaming the trajectory and energy CSVs, then the
+//! plots, run.json and the summary line.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nalgebra::{DefaultAllocator, Dyn, U1, U2, U3};
+use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, Rk4, State, System};
+use pendulum_core::trajectory;
+
+use crate::args::{Dimension, IntegratorKind, SimulateArgs};
+use crate::config::{Outcome, RunConfig, RunFile};
+use crate::error::{CliError, CliResult, io_failed};
+use crate::models::{AnySimulation, Sample, Simulation, build};
+use crate::plot::{self, Frame};
+
+/// Set by the Ctrl-C handler; the run stops at the next sample and writes its files.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Runs `pendulum simulate`.
+pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
+    let config = match &args.from {
+        Some(path) => RunFile::read(path)?.config,
+        None => RunConfig::from_args(&args.physics)?,
+    };
+    let simulation = build(&config)?;
+    std::fs::create_dir_all(&args.out).map_err(|e| io_failed("create the output directory", &args.out, e))?;
+    let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };
+    if demo && !args.quiet {
+        eprintln!(
+            "pendulum: no options given, running the demo (a triple pendulum released from 1 rad, 10 s); \
+             see `pendulum simulate --help`"
+        );
+    }
+    match &simulation {
+        AnySimulation::Planar(s) => execute(s, &config, &options),
+        AnySimulation::Spatial(s) => execute(s, &config, &options),
+    }
+}
+
+/// Where and what to write.
+struct Options {
+    out: PathBuf,
+    plots: bool,
+    quiet: bool,
+}
+
+/// The integrator of a configuration, boxed so the run loop is written once.
+fn integrator<'a, S: System<Dim = Dyn> + 'a>(kind: IntegratorKind, system: &S) -> Box<dyn Integrator<S> + 'a>
+where
+    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
+{
+    let options = GaussOptions::default();
+    match kind {
+        IntegratorKind::Gl1 => Box::new(GaussLegendre::<Dyn, U1>::new(system, options)),
+        IntegratorKind::Gl2 => Box::new(GaussLegendre::<Dyn, U2>::new(system, options)),
+        IntegratorKind::Gl3 => Box::new(GaussLegendre::<Dyn, U3>::new(system, options)),
+        IntegratorKind::Rk4 => Box::new(Rk4::new(system)),
+    }
+}
+
+/// A CSV file written through a buffer.
+struct Csv {
+    path: PathBuf,
+    writer: BufWriter<File>,
+}
+
+impl Csv {
+    fn create(path: PathBuf, header: &[String]) -> CliResult<Self> {
+        let file = File::create(&path).map_err(|e| io_failed("create", &path, e))?;
+        let mut csv = Self { path, writer: BufWriter::new(file) };
+        let line = header.join(",");
+        csv.line(&line)?;
+        Ok(csv)
+    }
+
+    fn line(&mut self, line: &str) -> CliResult<()> {
+        writeln!(self.writer, "{line}").map_err(|e| io_failed("write", &self.path, e))
+    }
+
+    fn row(&mut self, values: impl IntoIterator<Item = f64>) -> CliResult<()> {
+        let mut first = true;
+        for v in values {
+            let sep = if first { "" } else { "," };
+            first = false;
+            write!(self.writer, "{sep}{v:?}").map_err(|e| io_failed("write", &self.path, e))?;
+        }
+        writeln!(self.writer).map_err(|e| io_failed("write", &self.path, e))
+    }
+
+    fn finish(mut self) -> CliResult<()> {
+        self.writer.flush().map_err(|e| io_failed("flush", &self.path, e))?;
+        self.writer.get_ref().sync_all().map_err(|e| io_failed("sync", &self.path, e))
+    }
+}
+
+/// Columns of the trajectory: t, the simulation's state columns, the pivot and every
+/// mass (x, y in 2D; x, y, z in 3D).
+fn trajectory_header<S: Simulation>(simulation: &S, dim: Dimension, n: usize) -> Vec<String> {
+    let axes: &[&str] = if dim == Dimension::Two { &["x", "y"] } else { &["x", "y", "z"] };
+    let mut header = vec!["t".to_string()];
+    header.extend(simulation.state_columns());
+    header.extend(axes.iter().map(|a| format!("pivot_{a}")));
+    for i in 1..=n {
+        header.extend(axes.iter().map(|a| format!("{a}{i}")));
+    }
+    header
+}
+
+const ENERGY_HEADER: [&str; 6] = ["t", "energy", "drive_work", "torque_work", "damped", "balance_residual"];
+
+/// What the plots need from the samples, kept in memory while the CSVs stream out.
+#[derive(Default)]
+struct Kept {
+    times: Vec<f64>,
+    energy: Vec<f64>,
+    /// `H_in(0) + W_drive + W_torque − E_damped`: the energy the ledger predicts.
+    predicted: Vec<f64>,
+    tip: Vec<[f64; 3]>,
+    frames: Vec<Frame>,
+    /// The latest sample as a frame.
+    last: Option<Frame>,
+}
+
+/// Integrates, writes every output, prints the summary.
+fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options) -> CliResult<()>
+where
+    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
+{
+    let out = &options.out;
+    let n = config.links();
+    let mut run_file = RunFile::new(config.clone());
+    let run_json = out.join("run.json");
+    run_file.write_atomic(&run_json)?;
+
+    let (total_steps, _) = trajectory::plan(0.0, config.end, config.step)?;
+    let expected_samples = total_steps / config.every as u64 + 2;
+    let frame_stride = expected_samples.div_ceil(config.frames as u64).max(1);
+
+    let mut trajectory_csv =
+        Csv::create(out.join("trajectory.csv"), &trajectory_header(simulation, config.dim, n))?;
+    let header: Vec<String> = ENERGY_HEADER.iter().map(|s| s.to_string()).collect();
+    let mut energy_csv = Csv::create(out.join("energy.csv"), &header)?;
+
+    let dims = if config.dim == Dimension::Two { 2 } else { 3 };
+    let progress = progress_bar(total_steps, options.quiet);
+    let system = simulation.system();
+    let mut solver = integrator(config.integrator, system);
+    let mut state = State::new(0.0, simulation.initial_state());
+    let mut kept = Kept::default();
+    let mut write_error = None;
+    let mut initial_energy = None;
+    let mut sample_count: u64 = 0;
+    let result = trajectory::run(&mut *solver, system, &mut state, config.end, config.step, config.every, |t, x| {
+        let sample = simulation.sample(t, x);
+        let h0 = *initial_energy.get_or_insert(sample.energy);
+        if let Err(e) = write_sample(&mut trajectory_csv, &mut energy_csv, &sample, h0, dims) {
+            write_error = Some(e);
+            return ControlFlow::Break(());
+        }
+        keep(&mut kept, &sample, h0, sample_count.is_multiple_of(frame_stride));
+        sample_count += 1;
+        progress.set_position((t / config.end * total_steps as f64).round() as u64);
+        if INTERRUPTED.load(Ordering::SeqCst) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    });
+    progress.finish_and_clear();
+    // The last sample always goes into the animation.
+    if let Some(last) = kept.last.take()
+        && kept.frames.last().is_none_or(|f| f.t != last.t)
+    {
+        kept.frames.push(last);
+    }
+    trajectory_csv.finish()?;
+    energy_csv.finish()?;
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+
+    let (status, error, steps) = match &result {
+        Ok(s) if s.stopped_early => ("interrupted", None, s.steps),
+        Ok(s) => ("completed", None, s.steps),
+        Err(e) => ("failed", Some(e.to_string()), failed_steps(e)),
+    };
+    let mut images = Vec::new();
+    if options.plots && !kept.times.is_empty() {
+        let energy_png = out.join("energy.png");
+        plot::energy(&energy_png, &kept.times, &kept.energy, &kept.predicted, energy_scale(config))?;
+        let gif = out.join("chain.gif");
+        let delay_ms = frame_delay_ms(config, frame_stride);
+        plot::animation(&gif, &kept.frames, &kept.tip, &kept.times, config, delay_ms)?;
+        images.extend([energy_png, gif]);
+    }
+    run_file.outcome = Some(Outcome {
+        status: status.into(),
+        t: state.t(),
+        steps,
+        samples: sample_count,
+        error: error.clone(),
+    });
+    run_file.write_atomic(&run_json)?;
+
+    if !options.quiet {
+        let drift = kept
+            .energy
+            .iter()
+            .zip(&kept.predicted)
+            .map(|(h, p)| (h - p).abs())
+            .fold(0.0_f64, f64::max);
+        eprintln!(
+            "pendulum: {status}: {n} links, {dim}D, t = {t:.4} s in {steps} steps ({integrator:?}, h = {h} s); \
+             max |H − H0 − W| = {drift:.3e} J; {samples} samples; files in {dir}{images}",
+            dim = if config.dim == Dimension::Two { 2 } else { 3 },
+            t = state.t(),
+            integrator = config.integrator,
+            h = config.step,
+            samples = sample_count,
+            dir = out.display(),
+            images = if images.is_empty() { "" } else { " (trajectory.csv, energy.csv, run.json, energy.png, chain.gif)" },
+        );
+    }
+    match result {
+        Ok(_) => Ok(()),
+        Err(e) => Err(CliError::failed(format!("the run stopped at t = {} s: {e}; files hold what was computed", state.t()))),
+    }
+}
+
+/// The steps a failed run completed (the failed step's number).
+fn failed_steps(e: &pendulum_core::Error) -> u64 {
+    match e {
+        pendulum_core::Error::StepFailed { step, .. } => *step,
+        _ => 0,
+    }
+}
+
+/// A scale for the energy axis (J): the work gravity could do on the chain,
+/// `Σ_k m_k g (l_1 + … + l_k)`, or the total mass times 1 m²/s² without gravity.
+fn energy_scale(config: &RunConfig) -> f64 {
+    let mut reach = 0.0;
+    let mut scale = 0.0;
+    for (m, l) in config.masses.iter().zip(&config.lengths) {
+        reach += l;
+        scale += m * config.gravity.max(1.0) * reach;
+    }
+    scale
+}
+
+/// Delay between animation frames (ms): real time, at least 20 ms (GIF viewers ignore
+/// shorter delays).
+fn frame_delay_ms(config: &RunConfig, frame_stride: u64) -> u32 {
+    let frame_time = config.step * config.every as f64 * frame_stride as f64;
+    ((frame_time * 1000.0).round() as u32).max(20)
+}
+
+/// Writes one sample: a trajectory row (positions with `dims` components) and an
+/// energy row with the balance residual `H − H0 − (W_drive + W_torque − E_damped)`.
+fn write_sample(trajectory: &mut Csv, energy: &mut Csv, s: &Sample, h0: f64, dims: usize) -> CliResult<()> {
+    let positions = std::iter::once(&s.pivot).chain(&s.masses).flat_map(|r| r[..dims].iter().copied());
+    trajectory.row(std::iter::once(s.t).chain(s.state.iter().copied()).chain(positions))?;
+    let l = &s.ledger;
+    let residual = s.energy - h0 - l.net();
+    energy.row([s.t, s.energy, l.drive, l.torque, l.damped, residual])
+}
+
+fn keep(kept: &mut Kept, s: &Sample, h0: f64, frame: bool) {
+    kept.times.push(s.t);
+    kept.energy.push(s.energy);
+    kept.predicted.push(h0 + s.ledger.net());
+    kept.tip.push(*s.masses.last().expect("a chain has at least one mass"));
+    let current = Frame { t: s.t, pivot: s.pivot, masses: s.masses.clone() };
+    if frame {
+        kept.frames.push(current.clone());
+    }
+    kept.last = Some(current);
+}
+
+/// A progress bar for runs of 2000 steps or more, drawn only on a terminal.
+fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
+    if quiet || steps < 2000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}") {
+        bar.set_style(style);
+    }
+    bar
+}
