@@ -118,19 +118,19 @@ pub struct Physics {
     pub n: Option<usize>,
     /// Masses, kg: one value for every link, a comma list (one per link) or a file of
     /// numbers.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]
     pub masses: String,
     /// Rod lengths, m: one value, a comma list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0.5")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0.5")]
     pub lengths: String,
     /// Gravitational acceleration g, m/s² (along −y in 2D, −z in 3D).
     #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
     pub gravity: f64,
     /// Damping λ_i, N·m·s: one value, a comma list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0")]
     pub damping: String,
     /// Constant torques σ_i on the angles θ_i, N·m (2D only): one value, a list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE")]
     pub torque: Option<String>,
     /// Pivot motion.
     #[arg(long, value_enum, default_value = "fixed")]
@@ -199,16 +199,16 @@ pub struct EvalArgs {
     #[arg(long)]
     pub n: Option<usize>,
     /// Masses, kg: one value, a comma list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]
     pub masses: String,
     /// Rod lengths, m: one value, a comma list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]
     pub lengths: String,
     /// Gravitational acceleration g, m/s².
     #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
     pub gravity: f64,
     /// Damping λ_i, N·m·s: one value, a comma list or a file.
-    #[arg(long, value_name = "VALUE|LIST|FILE", default_value = "0")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0")]
     pub damping: String,
     /// Coordinates q, rad (planar θ_1..θ_n; spatial θ_1..θ_n, φ_1..φ_n), comma list.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]

@@ -29,10 +29,7 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
             _ => {
-                // clap's message without its usage block and hints: one line.
-                let text = e.to_string();
-                let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid arguments");
-                eprintln!("{}", first.trim());
+                eprintln!("{}", one_line(&e.to_string()));
                 return ExitCode::from(2);
             }
         },
@@ -53,6 +50,17 @@ fn main() -> ExitCode {
             e.exit_code()
         }
     }
+}
+
+/// clap's message on one line: the lines before its usage block, joined.
+fn one_line(text: &str) -> String {
+    let lines: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    if lines.is_empty() { "error: invalid arguments".into() } else { lines.join(" ") }
 }
 
 /// Ctrl-C once: the run stops at its next sample and writes valid files. Twice: exit at

@@ -1,0 +1,218 @@
+//! `pendulum simulate` driven as a user would: files written, their contents, physics
+//! visible in them, repeatability from run.json, interruption.
+
+mod common;
+
+use common::{Csv, run_in, run_json, scratch, stderr};
+
+#[test]
+fn the_demo_runs_without_options_and_says_where_its_files_went() {
+    let dir = scratch("demo");
+    let out = run_in(&dir, &["simulate"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(message.contains("demo"), "{message}");
+    assert!(message.contains("files in pendulum-run"), "{message}");
+    let run = dir.join("pendulum-run");
+    for file in ["trajectory.csv", "energy.csv", "run.json", "energy.png", "chain.gif"] {
+        let len = std::fs::metadata(run.join(file)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 100, "{file} missing or empty");
+    }
+    assert!(!run.join("run.json.tmp").exists());
+    let gif = std::fs::read(run.join("chain.gif")).unwrap();
+    assert_eq!(&gif[..6], b"GIF89a");
+    let png = std::fs::read(run.join("energy.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let json = run_json(&run);
+    assert_eq!(json["outcome"]["status"], "completed");
+    assert_eq!(json["version"], env!("CARGO_PKG_VERSION"));
+}
+
+#[test]
+fn a_conservative_run_keeps_its_energy_and_samples_every_k_steps() {
+    let dir = scratch("conservative");
+    let args = ["simulate", "--n", "2", "--initial", "horizontal", "--end", "2", "--step", "0.01", "--every", "5"];
+    let out = run_in(&dir, &[&args[..], &["--out", "run", "--no-plots"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let trajectory = Csv::read(&dir.join("run/trajectory.csv"));
+    let expected = ["t", "theta1", "theta2", "dtheta1", "dtheta2", "pivot_x", "pivot_y", "x1", "y1", "x2", "y2"];
+    assert_eq!(trajectory.header, expected);
+    // 200 steps sampled at 0, 5, ..., 200: 41 rows.
+    let t = trajectory.column("t");
+    assert_eq!(t.len(), 41);
+    assert!((t[1] - 0.05).abs() < 1e-12 && (t[40] - 2.0).abs() < 1e-12);
+    let energy = Csv::read(&dir.join("run/energy.csv"));
+    let h = energy.column("energy");
+    // Horizontal start at rest: H = −g (m1 + m2) l1 cos θ1 − ... = 0.
+    assert!(h[0].abs() < 1e-12, "H0 = {}", h[0]);
+    let drift = h.iter().map(|e| e.abs()).fold(0.0, f64::max);
+    assert!(drift < 1e-6, "energy drift {drift} J");
+    assert!(drift > 0.0, "the energy column should carry the integration's round-off");
+    assert!(energy.column("drive_work").iter().all(|&w| w == 0.0));
+    assert!(!dir.join("run/chain.gif").exists(), "--no-plots draws nothing");
+}
+
+#[test]
+fn positions_in_the_trajectory_match_the_angles() {
+    let dir = scratch("positions");
+    let args = ["simulate", "--masses", "1,2,0.5", "--lengths", "0.3,0.5,0.2", "--end", "0.5", "--out", "run"];
+    let out = run_in(&dir, &[&args[..], &["--no-plots", "--initial", "tilted:0.4"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let tr = Csv::read(&dir.join("run/trajectory.csv"));
+    let lengths = [0.3, 0.5, 0.2];
+    for row in 0..tr.rows.len() {
+        let (mut x, mut y) = (0.0, 0.0);
+        for (i, l) in lengths.iter().enumerate() {
+            let theta = tr.column(&format!("theta{}", i + 1))[row];
+            x += l * theta.sin();
+            y -= l * theta.cos();
+            assert!((tr.column(&format!("x{}", i + 1))[row] - x).abs() < 1e-12);
+            assert!((tr.column(&format!("y{}", i + 1))[row] - y).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn a_small_swing_has_the_period_of_the_simple_pendulum() {
+    // One link of l = 0.5 m from 0.05 rad: T = 2π √(l/g) (1 + θ0²/16) = 1.41857 s.
+    let dir = scratch("period");
+    let args = ["simulate", "--n", "1", "--initial", "tilted:0.05", "--end", "3", "--step", "0.002"];
+    let out = run_in(&dir, &[&args[..], &["--every", "1", "--out", "run", "--no-plots"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let tr = Csv::read(&dir.join("run/trajectory.csv"));
+    let (t, theta) = (tr.column("t"), tr.column("theta1"));
+    // Downward zero crossings of θ, interpolated.
+    let crossings: Vec<f64> = (1..t.len())
+        .filter(|&i| theta[i - 1] > 0.0 && theta[i] <= 0.0)
+        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * theta[i - 1] / (theta[i - 1] - theta[i]))
+        .collect();
+    assert!(crossings.len() >= 2, "{crossings:?}");
+    let period = crossings[1] - crossings[0];
+    let expected = 2.0 * std::f64::consts::PI * (0.5_f64 / 9.81).sqrt() * (1.0 + 0.05_f64.powi(2) / 16.0);
+    assert!((period - expected).abs() < 1e-4, "period {period} s, expected {expected} s");
+}
+
+#[test]
+fn from_run_json_repeats_the_run_exactly() {
+    let dir = scratch("repeat");
+    let args = [
+        "simulate", "--n", "3", "--masses", "1,0.5,2", "--damping", "0.05", "--torque", "0.1,0,-0.2", "--drive",
+        "harmonic", "--direction", "1,1", "--amplitude", "0.02", "--omega", "15", "--integrator", "gl3", "--end",
+        "0.6", "--step", "0.004", "--every", "3", "--out", "first", "--no-plots",
+    ];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = run_in(&dir, &["simulate", "--from", "first/run.json", "--out", "second", "--no-plots"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for file in ["trajectory.csv", "energy.csv"] {
+        let a = std::fs::read(dir.join("first").join(file)).unwrap();
+        let b = std::fs::read(dir.join("second").join(file)).unwrap();
+        assert!(a == b, "{file} differs between the run and its repetition");
+    }
+    let (a, b) = (run_json(&dir.join("first")), run_json(&dir.join("second")));
+    assert_eq!(a["config"], b["config"]);
+    assert_eq!(a["config"]["integrator"], "gl3");
+    assert_eq!(a["config"]["drive"]["kind"], "harmonic");
+}
+
+#[test]
+fn the_energy_ledger_closes_for_a_driven_damped_run() {
+    let dir = scratch("ledger");
+    let args = [
+        "simulate", "--n", "2", "--damping", "0.1", "--torque", "0.3", "--drive", "harmonic", "--amplitude", "0.05",
+        "--omega", "12", "--end", "2", "--step", "0.002", "--out", "run", "--no-plots",
+    ];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let e = Csv::read(&dir.join("run/energy.csv"));
+    let last = e.rows.len() - 1;
+    let (drive, torque, damped) = (e.column("drive_work")[last], e.column("torque_work")[last], e.column("damped")[last]);
+    assert!(drive.abs() > 1e-3 && torque.abs() > 1e-3 && damped > 1e-3, "{drive} {torque} {damped}");
+    let h = e.column("energy");
+    let change = h[last] - h[0];
+    let residual = e.column("balance_residual");
+    let worst = residual.iter().map(|r| r.abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-8 * (1.0 + change.abs()), "balance residual {worst} J, energy change {change} J");
+    assert!((change - (drive + torque - damped) - residual[last]).abs() < 1e-12);
+}
+
+#[test]
+fn a_spatial_chain_swings_on_a_circling_pivot() {
+    let dir = scratch("spatial");
+    let args = [
+        "simulate", "--dim", "3", "--n", "2", "--initial", "tilted:0.6", "--spin", "2", "--drive", "circle",
+        "--radius", "0.05", "--omega", "4", "--end", "1", "--step", "0.005", "--view", "xy", "--frames", "10",
+        "--out", "run",
+    ];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let tr = Csv::read(&dir.join("run/trajectory.csv"));
+    assert_eq!(&tr.header[1..5], ["theta1", "theta2", "phi1", "phi2"]);
+    assert!(tr.header.ends_with(&["x2".into(), "y2".into(), "z2".into()]));
+    let (px, py) = (tr.column("pivot_x"), tr.column("pivot_y"));
+    assert!(px.iter().zip(&py).all(|(x, y)| ((x * x + y * y).sqrt() - 0.05).abs() < 1e-12));
+    let residual = Csv::read(&dir.join("run/energy.csv")).column("balance_residual");
+    assert!(residual.iter().all(|r| r.abs() < 1e-7), "{residual:?}");
+    assert!(dir.join("run/chain.gif").exists());
+}
+
+#[test]
+fn a_3d_chain_cannot_start_hanging_in_spherical_angles() {
+    let dir = scratch("singular");
+    let out = run_in(&dir, &["simulate", "--dim", "3", "--initial", "hanging", "--out", "run"]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = stderr(&out);
+    assert!(message.contains("singularity") && message.contains("tilted"), "{message}");
+    assert_eq!(message.lines().count(), 1, "{message}");
+}
+
+#[test]
+fn an_initial_state_file_is_read() {
+    let dir = scratch("initial-file");
+    std::fs::write(dir.join("state.txt"), "# theta1 theta2\n0.1, -0.2\n# rates\n1.5 0\n").unwrap();
+    let args = ["simulate", "--n", "2", "--initial", "state.txt", "--end", "0.01", "--out", "run", "--no-plots"];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let row = &Csv::read(&dir.join("run/trajectory.csv")).rows[0];
+    assert_eq!(&row[..5], &[0.0, 0.1, -0.2, 1.5, 0.0]);
+    std::fs::write(dir.join("short.txt"), "0.1 0.2 0.3").unwrap();
+    let out = run_in(&dir, &["simulate", "--n", "2", "--initial", "short.txt", "--out", "run2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("holds 3 numbers, expected 4"), "{}", stderr(&out));
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_leaves_valid_files_for_what_was_computed() {
+    use std::time::{Duration, Instant};
+    let dir = scratch("interrupt");
+    // A run far longer than the test: only the interruption can end it in time.
+    let mut child = common::pendulum()
+        .args(["simulate", "--n", "3", "--end", "100000", "--step", "0.01", "--out", "run", "--frames", "20"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while std::fs::metadata(dir.join("run/energy.csv")).map(|m| m.len()).unwrap_or(0) < 10_000 {
+        assert!(start.elapsed() < Duration::from_secs(20), "the run never started writing");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let pid = child.id().to_string();
+    let killed = std::process::Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("interrupted"), "{}", stderr(&out));
+    let run = dir.join("run");
+    let json = run_json(&run);
+    assert_eq!(json["outcome"]["status"], "interrupted");
+    let t_end = json["outcome"]["t"].as_f64().unwrap();
+    assert!(t_end > 0.0 && t_end < 100000.0);
+    let trajectory = Csv::read(&run.join("trajectory.csv"));
+    let energy = Csv::read(&run.join("energy.csv"));
+    assert_eq!(trajectory.rows.len() as u64, json["outcome"]["samples"].as_u64().unwrap());
+    assert_eq!(energy.rows.len(), trajectory.rows.len());
+    assert!((trajectory.column("t").last().unwrap() - t_end).abs() < 1e-9);
+    assert!(std::fs::read(run.join("chain.gif")).unwrap().starts_with(b"GIF89a"));
+}
