@@ -109,8 +109,9 @@ where
         if x.len() != self.state_len() {
             return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: x.len() });
         }
-        if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFinite { what: "x", index, value });
+        // On the slice: nalgebra's strided iterator costs as much as the solve here.
+        if let Some(index) = x.as_slice().iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite { what: "x", index, value: x[index] });
         }
         Ok(())
     }
@@ -183,6 +184,20 @@ where
         Dr: Drive<S>,
     {
         self.check_state(x)?;
+        self.accelerations_of_valid(t, x, out, tensions)
+    }
+
+    /// [`accelerations`](Self::accelerations) for a state already checked.
+    fn accelerations_of_valid(
+        &self,
+        t: f64,
+        x: &DVector<f64>,
+        out: &mut [f64],
+        tensions: Option<&mut [f64]>,
+    ) -> Result<()>
+    where
+        Dr: Drive<S>,
+    {
         let n = self.links();
         if out.len() != S::DIM * n {
             return Err(Error::LengthMismatch { what: "out", expected: S::DIM * n, got: out.len() });
@@ -402,7 +417,7 @@ where
         self.check_state(x)?;
         let (velocity, acceleration) = out.as_mut_slice().split_at_mut(half);
         velocity.copy_from_slice(&x.as_slice()[half..]);
-        self.accelerations(t, x, acceleration, None)
+        self.accelerations_of_valid(t, x, acceleration, None)
     }
 }
 

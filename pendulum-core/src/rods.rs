@@ -196,7 +196,9 @@ impl Rods {
             for k in 0..S {
                 rhs += u[i][k] * (a[k] - free_above[k]);
             }
-            let diagonal = im + inverse_mass_above;
+            // |u_i|² is 1 on the constraint manifold; keeping it makes u_i·ü_i = −|u̇_i|²
+            // hold exactly also at the slightly non-unit directions inside an integrator step.
+            let diagonal = (im + inverse_mass_above) * dot(&u[i], &u[i]);
             // Off-diagonal entry between rods i−1 and i: −(u_{i−1}·u_i)/m_{i−1}.
             let off = if i == 0 { 0.0 } else { -dot(&u[i - 1], &u[i]) * inverse_mass_above };
             let factor = off * pivot_above;

@@ -102,7 +102,11 @@ where
                 t.copy_from_slice(s.tensions());
             }
         });
-        if out.iter().all(|a| a.is_finite()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
+        if out.as_slice().iter().all(|a| a.is_finite()) {
+            Ok(())
+        } else {
+            Err(crate::Error::NotPositiveDefinite)
+        }
     }
 }
 
