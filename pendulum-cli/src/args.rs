@@ -151,9 +151,12 @@ pub struct Physics {
     /// Circle drive: radius R, m.
     #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
     pub radius: f64,
-    /// Time integrator.
-    #[arg(long, value_enum, default_value = "gl2")]
-    pub integrator: IntegratorKind,
+    /// Time integrator [default: gl2 in 2D, rk4 in 3D]. 3D chains are integrated in unit
+    /// link directions with a projection onto the rod constraints after every step; there
+    /// the Gauss–Legendre stage solve can fail for 3D motion of longer chains (then use
+    /// rk4 or a smaller step).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorKind>,
     /// Step size h, s (the run takes ⌈end / h⌉ equal steps).
     #[arg(long, default_value_t = 0.005, allow_negative_numbers = true)]
     pub step: f64,

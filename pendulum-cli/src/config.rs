@@ -143,7 +143,10 @@ impl RunConfig {
             damping,
             torque,
             drive,
-            integrator: p.integrator,
+            integrator: p.integrator.unwrap_or(match p.dim {
+                Dimension::Two => IntegratorKind::Gl2,
+                Dimension::Three => IntegratorKind::Rk4,
+            }),
             step: p.step,
             end: p.end,
             every: p.every,
@@ -213,7 +216,9 @@ impl RunConfig {
             }
         }
         if matches!(self.drive, DriveConfig::Circle { .. }) && self.dim == Dimension::Two {
-            return Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only (--dim 3)"));
+            return Err(CliError::usage(
+                "--drive circle moves the pivot on a horizontal circle: 3D only (--dim 3)",
+            ));
         }
         Ok(())
     }
@@ -300,8 +305,9 @@ impl RunFile {
     pub fn read(path: &Path) -> CliResult<Self> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| CliError::usage(format!("--from: cannot read {}: {e}", path.display())))?;
-        let file: Self = serde_json::from_str(&text)
-            .map_err(|e| CliError::usage(format!("--from: {} is not a valid run.json: {e}", path.display())))?;
+        let file: Self = serde_json::from_str(&text).map_err(|e| {
+            CliError::usage(format!("--from: {} is not a valid run.json: {e}", path.display()))
+        })?;
         if file.program != "pendulum" {
             return Err(CliError::usage(format!(
                 "--from: {} was written by '{}', not pendulum",
@@ -319,7 +325,9 @@ impl RunFile {
         let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string_pretty(self).map_err(|e| CliError::failed(e.to_string()))?;
         let mut f = std::fs::File::create(&tmp).map_err(|e| io_failed("create", &tmp, e))?;
-        f.write_all(text.as_bytes()).and_then(|()| f.write_all(b"\n")).map_err(|e| io_failed("write", &tmp, e))?;
+        f.write_all(text.as_bytes())
+            .and_then(|()| f.write_all(b"\n"))
+            .map_err(|e| io_failed("write", &tmp, e))?;
         f.sync_all().map_err(|e| io_failed("sync", &tmp, e))?;
         std::fs::rename(&tmp, path).map_err(|e| io_failed("rename into", path, e))
     }

@@ -93,7 +93,10 @@ pub fn evaluate(args: &EvalArgs) -> CliResult<Evaluation> {
     };
     if q.len() != dof {
         let layout = if args.model == ModelKind::Planar { "θ_1..θ_n" } else { "θ_1..θ_n, φ_1..φ_n" };
-        return Err(CliError::usage(format!("--q: got {} values, expected {dof} ({layout}) for n = {n}", q.len())));
+        return Err(CliError::usage(format!(
+            "--q: got {} values, expected {dof} ({layout}) for n = {n}",
+            q.len()
+        )));
     }
     let qd = vector("--qd", &args.qd, dof)?;
     let torque = vector("--torque", &args.torque, dof)?;

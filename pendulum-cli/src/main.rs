@@ -6,6 +6,7 @@ mod args;
 mod config;
 mod error;
 mod eval;
+mod ledger;
 mod models;
 mod plot;
 mod simulate;

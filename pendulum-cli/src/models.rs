@@ -2,11 +2,15 @@
 //! [`Simulation`] seam the run loop sees: a system, its initial state, and what one sample
 //! of it means (trajectory columns, positions, energy ledger).
 
-use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, Vector2, Vector3};
-use pendulum_core::integrate::System;
+use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U1, U2, U3, Vector2, Vector3};
+use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System};
 use pendulum_core::{
-    Accounted, Chain, Circle, ConstantTorque, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc, Planar, Spatial,
+    Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc,
+    PlanarTension, Spatial,
 };
+
+use crate::args::IntegratorKind;
+use crate::ledger::LedgeredDirections;
 
 use crate::args::Dimension;
 use crate::config::{DriveConfig, RunConfig};
@@ -41,7 +45,44 @@ pub trait Simulation {
     fn state_columns(&self) -> Vec<String>;
     /// Reads a sample out of the state `x` at time `t`.
     fn sample(&self, t: f64, x: &DVector<f64>) -> Sample;
+    /// The integrator of this kind for the system (with a projection onto the
+    /// constraints where the system has them).
+    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_>;
 }
+
+/// The integrator of a kind for an unconstrained system.
+fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
+    kind: IntegratorKind,
+    system: &S,
+) -> Box<dyn Integrator<S> + 'a>
+where
+    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
+{
+    let options = GaussOptions::default();
+    match kind {
+        IntegratorKind::Gl1 => Box::new(GaussLegendre::<Dyn, U1>::new(system, options)),
+        IntegratorKind::Gl2 => Box::new(GaussLegendre::<Dyn, U2>::new(system, options)),
+        IntegratorKind::Gl3 => Box::new(GaussLegendre::<Dyn, U3>::new(system, options)),
+        IntegratorKind::Rk4 => Box::new(Rk4::new(system)),
+    }
+}
+
+/// The integrator of a kind followed by the system's projection after every step.
+fn projected_integrator<'a, S: pendulum_core::integrate::Constrained<Dim = Dyn> + 'a>(
+    kind: IntegratorKind,
+    system: &S,
+) -> Box<dyn Integrator<S> + 'a> {
+    let options = GaussOptions::default();
+    match kind {
+        IntegratorKind::Gl1 => Box::new(Projected::new(GaussLegendre::<Dyn, U1>::new(system, options))),
+        IntegratorKind::Gl2 => Box::new(Projected::new(GaussLegendre::<Dyn, U2>::new(system, options))),
+        IntegratorKind::Gl3 => Box::new(Projected::new(GaussLegendre::<Dyn, U3>::new(system, options))),
+        IntegratorKind::Rk4 => Box::new(Projected::new(Rk4::new(system))),
+    }
+}
+
+/// An angle model with a boxed pivot drive, constant torques and the energy ledger.
+type AccountedModel<M> = Accounted<M, Box<dyn Drive<<M as Model>::Space>>, ConstantTorque<<M as Model>::Dof>>;
 
 /// A chain model in angle coordinates with its drive, torques and energy ledger
 /// ([`Accounted`]): state `x = (q, q̇, W_drive, W_torque, E_damped)`.
@@ -49,7 +90,7 @@ pub struct AngleSimulation<M: Model>
 where
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
 {
-    system: Accounted<M, Box<dyn Drive<M::Space>>, ConstantTorque<M::Dof>>,
+    system: AccountedModel<M>,
     x0: DVector<f64>,
 }
 
@@ -87,7 +128,7 @@ impl<M: Model<Links = Dyn, Dof = Dyn>> Simulation for AngleSimulation<M>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
-    type Sys = Accounted<M, Box<dyn Drive<M::Space>>, ConstantTorque<Dyn>>;
+    type Sys = AccountedModel<M>;
 
     fn system(&self) -> &Self::Sys {
         &self.system
@@ -128,6 +169,65 @@ where
             energy: self.system.energy(t, x),
             ledger,
         }
+    }
+
+    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_> {
+        plain_integrator(kind, &self.system)
+    }
+}
+
+/// A chain in unit link directions ([`Directions`], no coordinate singularity) with its
+/// energy ledger ([`LedgeredDirections`]).
+pub struct DirectionsSimulation<S: DimName>
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    system: LedgeredDirections<S>,
+    x0: DVector<f64>,
+}
+
+impl<S: DimName> Simulation for DirectionsSimulation<S>
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    type Sys = LedgeredDirections<S>;
+
+    fn system(&self) -> &Self::Sys {
+        &self.system
+    }
+
+    fn initial_state(&self) -> DVector<f64> {
+        self.x0.clone()
+    }
+
+    fn state_columns(&self) -> Vec<String> {
+        let n = self.system.chain().links();
+        let axes = ["x", "y", "z"];
+        let mut columns = Vec::new();
+        for name in ["u", "w"] {
+            for i in 1..=n {
+                columns.extend(axes[..S::DIM].iter().map(|a| format!("{name}{i}_{a}")));
+            }
+        }
+        columns
+    }
+
+    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
+        let motion = self.system.motion(x);
+        let chain = self.system.chain();
+        let (drive, damped) = self.system.ledger(x);
+        Sample {
+            t,
+            state: motion.as_slice().to_vec(),
+            pivot: to3(&chain.drive().position(t)),
+            masses: chain.positions(t, &motion).iter().map(to3).collect(),
+            energy: chain.inertial_energy(t, &motion),
+            ledger: Ledger { drive, torque: 0.0, damped },
+        }
+    }
+
+    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_> {
+        projected_integrator(kind, &self.system)
     }
 }
 
@@ -174,14 +274,32 @@ pub fn chain(config: &RunConfig) -> CliResult<Chain<Dyn>> {
     Ok(Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?)
 }
 
-/// The planar model the command simulates with (the one place to change it).
-pub fn planar_model(chain: Chain<Dyn>) -> Planar<Dyn> {
-    Planar::new(chain)
+/// The planar model in angles (the one place to change it): O(n) accelerations by the
+/// rod tensions, everything else as the dense `Planar`.
+pub fn planar_model(chain: Chain<Dyn>) -> PlanarTension<Dyn> {
+    PlanarTension::new(chain)
 }
 
-/// The spatial model the command simulates with (the one place to change it).
+/// The spatial model in spherical angles (`pendulum eval`): singular where a link
+/// hangs straight down or up.
 pub fn spatial_model(chain: Chain<Dyn>) -> Spatial<Dyn> {
     Spatial::new(chain)
+}
+
+/// The 3D chain `pendulum simulate` integrates (the one place to change it): unit link
+/// directions, free of the spherical angles' singularity, started from spherical
+/// angles `q = (θ, φ)` and rates `q̇` (any angles, a hanging chain included).
+fn spatial_simulation(
+    chain: Chain<Dyn>,
+    drive: Box<dyn Drive<U3>>,
+    q: &[f64],
+    qd: &[f64],
+) -> CliResult<DirectionsSimulation<U3>> {
+    let directions = Directions::<U3>::new(chain).with_drive(drive);
+    let motion = directions.from_spherical(q, qd)?;
+    let system = LedgeredDirections::new(directions);
+    let x0 = system.state(&motion);
+    Ok(DirectionsSimulation { system, x0 })
 }
 
 /// The planar drive of a configuration.
@@ -213,9 +331,9 @@ fn drive3(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
 /// The simulation of a configuration, one of the supported kinds.
 pub enum AnySimulation {
     /// 2D, angles.
-    Planar(AngleSimulation<Planar<Dyn>>),
-    /// 3D, spherical angles.
-    Spatial(AngleSimulation<Spatial<Dyn>>),
+    Planar(AngleSimulation<PlanarTension<Dyn>>),
+    /// 3D, unit link directions.
+    Spatial(DirectionsSimulation<U3>),
 }
 
 /// Builds the simulation a configuration describes; errors name the bad parameter.
@@ -230,13 +348,7 @@ pub fn build(config: &RunConfig) -> CliResult<AnySimulation> {
             q,
             qd,
         )?),
-        Dimension::Three => AnySimulation::Spatial(AngleSimulation::new(
-            spatial_model(chain),
-            drive3(&config.drive)?,
-            &[],
-            q,
-            qd,
-        )?),
+        Dimension::Three => AnySimulation::Spatial(spatial_simulation(chain, drive3(&config.drive)?, q, qd)?),
     })
 }
 

@@ -72,7 +72,10 @@ pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], sca
         .draw()
         .map_err(|e| fail(&e))?;
     chart
-        .draw_series(LineSeries::new(times.iter().copied().zip(predicted.iter().copied()), RED.stroke_width(3)))
+        .draw_series(LineSeries::new(
+            times.iter().copied().zip(predicted.iter().copied()),
+            RED.stroke_width(3),
+        ))
         .map_err(|e| fail(&e))?
         .label("H0 + W_drive + W_torque − E_damped")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(3)));
@@ -131,7 +134,13 @@ pub fn animation(
     let root = BitMapBackend::gif(path, (size, size), delay_ms).map_err(|e| fail(&e))?.into_drawing_area();
     let r = extent(config);
     let n = config.links();
-    let dot = if n > 20 { 2 } else if n > 8 { 3 } else { 5 };
+    let dot = if n > 20 {
+        2
+    } else if n > 8 {
+        3
+    } else {
+        5
+    };
     let plane = match (dim, view) {
         (Dimension::Two, _) => "x-y plane",
         (Dimension::Three, View::Xz) => "x-z plane",
@@ -140,14 +149,19 @@ pub fn animation(
     };
     for frame in frames {
         root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let mut chart = ChartBuilder::on(&root).margin(8).build_cartesian_2d(-r..r, -r..r).map_err(|e| fail(&e))?;
+        let mut chart =
+            ChartBuilder::on(&root).margin(8).build_cartesian_2d(-r..r, -r..r).map_err(|e| fail(&e))?;
         let end = times.partition_point(|&t| t <= frame.t);
         let start = end.saturating_sub(300);
         let trace = tip[start..end].iter().map(|p| project(p, dim, view));
-        chart.draw_series(LineSeries::new(trace, RGBColor(255, 150, 40).stroke_width(2))).map_err(|e| fail(&e))?;
+        chart
+            .draw_series(LineSeries::new(trace, RGBColor(255, 150, 40).stroke_width(2)))
+            .map_err(|e| fail(&e))?;
         let points: Vec<(f64, f64)> =
             std::iter::once(&frame.pivot).chain(&frame.masses).map(|p| project(p, dim, view)).collect();
-        chart.draw_series(LineSeries::new(points.iter().copied(), BLACK.stroke_width(2))).map_err(|e| fail(&e))?;
+        chart
+            .draw_series(LineSeries::new(points.iter().copied(), BLACK.stroke_width(2)))
+            .map_err(|e| fail(&e))?;
         chart
             .draw_series(points[1..].iter().map(|&p| Circle::new(p, dot, BLUE.filled())))
             .map_err(|e| fail(&e))?;

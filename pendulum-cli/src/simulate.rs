@@ -8,11 +8,10 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use nalgebra::{DefaultAllocator, Dyn, U1, U2, U3};
-use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, Rk4, State, System};
+use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
-use crate::args::{Dimension, IntegratorKind, SimulateArgs};
+use crate::args::{Dimension, SimulateArgs};
 use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::models::{AnySimulation, Sample, Simulation, build};
@@ -47,20 +46,6 @@ struct Options {
     out: PathBuf,
     plots: bool,
     quiet: bool,
-}
-
-/// The integrator of a configuration, boxed so the run loop is written once.
-fn integrator<'a, S: System<Dim = Dyn> + 'a>(kind: IntegratorKind, system: &S) -> Box<dyn Integrator<S> + 'a>
-where
-    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
-{
-    let options = GaussOptions::default();
-    match kind {
-        IntegratorKind::Gl1 => Box::new(GaussLegendre::<Dyn, U1>::new(system, options)),
-        IntegratorKind::Gl2 => Box::new(GaussLegendre::<Dyn, U2>::new(system, options)),
-        IntegratorKind::Gl3 => Box::new(GaussLegendre::<Dyn, U3>::new(system, options)),
-        IntegratorKind::Rk4 => Box::new(Rk4::new(system)),
-    }
 }
 
 /// A CSV file written through a buffer.
@@ -127,10 +112,7 @@ struct Kept {
 }
 
 /// Integrates, writes every output, prints the summary.
-fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options) -> CliResult<()>
-where
-    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
-{
+fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options) -> CliResult<()> {
     let out = &options.out;
     let n = config.links();
     let mut run_file = RunFile::new(config.clone());
@@ -149,24 +131,29 @@ where
     let dims = if config.dim == Dimension::Two { 2 } else { 3 };
     let progress = progress_bar(total_steps, options.quiet);
     let system = simulation.system();
-    let mut solver = integrator(config.integrator, system);
+    let mut solver = simulation.integrator(config.integrator);
     let mut state = State::new(0.0, simulation.initial_state());
     let mut kept = Kept::default();
     let mut write_error = None;
     let mut initial_energy = None;
     let mut sample_count: u64 = 0;
-    let result = trajectory::run(&mut *solver, system, &mut state, config.end, config.step, config.every, |t, x| {
-        let sample = simulation.sample(t, x);
-        let h0 = *initial_energy.get_or_insert(sample.energy);
-        if let Err(e) = write_sample(&mut trajectory_csv, &mut energy_csv, &sample, h0, dims) {
-            write_error = Some(e);
-            return ControlFlow::Break(());
-        }
-        keep(&mut kept, &sample, h0, sample_count.is_multiple_of(frame_stride));
-        sample_count += 1;
-        progress.set_position((t / config.end * total_steps as f64).round() as u64);
-        if INTERRUPTED.load(Ordering::SeqCst) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
-    });
+    let result =
+        trajectory::run(&mut *solver, system, &mut state, config.end, config.step, config.every, |t, x| {
+            let sample = simulation.sample(t, x);
+            let h0 = *initial_energy.get_or_insert(sample.energy);
+            if let Err(e) = write_sample(&mut trajectory_csv, &mut energy_csv, &sample, h0, dims) {
+                write_error = Some(e);
+                return ControlFlow::Break(());
+            }
+            keep(&mut kept, &sample, h0, sample_count.is_multiple_of(frame_stride));
+            sample_count += 1;
+            progress.set_position((t / config.end * total_steps as f64).round() as u64);
+            if INTERRUPTED.load(Ordering::SeqCst) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
     progress.finish_and_clear();
     // The last sample always goes into the animation.
     if let Some(last) = kept.last.take()
@@ -204,12 +191,8 @@ where
     run_file.write_atomic(&run_json)?;
 
     if !options.quiet {
-        let drift = kept
-            .energy
-            .iter()
-            .zip(&kept.predicted)
-            .map(|(h, p)| (h - p).abs())
-            .fold(0.0_f64, f64::max);
+        let drift =
+            kept.energy.iter().zip(&kept.predicted).map(|(h, p)| (h - p).abs()).fold(0.0_f64, f64::max);
         eprintln!(
             "pendulum: {status}: {n} links, {dim}D, t = {t:.4} s in {steps} steps ({integrator:?}, h = {h} s); \
              max |H − H0 − W| = {drift:.3e} J; {samples} samples; files in {dir}{images}",
@@ -219,12 +202,19 @@ where
             h = config.step,
             samples = sample_count,
             dir = out.display(),
-            images = if images.is_empty() { "" } else { " (trajectory.csv, energy.csv, run.json, energy.png, chain.gif)" },
+            images = if images.is_empty() {
+                ""
+            } else {
+                " (trajectory.csv, energy.csv, run.json, energy.png, chain.gif)"
+            },
         );
     }
     match result {
         Ok(_) => Ok(()),
-        Err(e) => Err(CliError::failed(format!("the run stopped at t = {} s: {e}; files hold what was computed", state.t()))),
+        Err(e) => Err(CliError::failed(format!(
+            "the run stopped at t = {} s: {e}; files hold what was computed",
+            state.t()
+        ))),
     }
 }
 
@@ -283,7 +273,9 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}") {
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}")
+    {
         bar.set_style(style);
     }
     bar

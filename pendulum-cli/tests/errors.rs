@@ -25,9 +25,17 @@ fn assert_usage_error(name: &str, args: &[&str], needle: &str) {
 fn bad_chain_parameters_are_named() {
     assert_usage_error("n0", &["simulate", "--n", "0", "--out", "run"], "--n");
     assert_usage_error("mass", &["simulate", "--masses", "1,-2,1", "--out", "run"], "mass of link 2");
-    assert_usage_error("count", &["simulate", "--n", "3", "--lengths", "1,2", "--out", "run"], "2 values for 3 links");
+    assert_usage_error(
+        "count",
+        &["simulate", "--n", "3", "--lengths", "1,2", "--out", "run"],
+        "2 values for 3 links",
+    );
     assert_usage_error("entry", &["simulate", "--lengths", "1,abc", "--out", "run"], "'abc'");
-    assert_usage_error("file", &["simulate", "--masses", "letters.txt", "--out", "run"], "letters.txt line 1");
+    assert_usage_error(
+        "file",
+        &["simulate", "--masses", "letters.txt", "--out", "run"],
+        "letters.txt line 1",
+    );
     assert_usage_error("nofile", &["simulate", "--masses", "missing.txt", "--out", "run"], "missing.txt");
     assert_usage_error("empty", &["simulate", "--lengths", "empty.txt", "--out", "run"], "holds no numbers");
     assert_usage_error("gravity", &["simulate", "--gravity", "-9.8", "--out", "run"], "gravity");
@@ -51,12 +59,20 @@ fn bad_run_parameters_are_named() {
 #[test]
 fn bad_drives_and_combinations_are_named() {
     assert_usage_error("circle2d", &["simulate", "--drive", "circle", "--out", "run"], "3D only");
-    assert_usage_error("amplitude", &["simulate", "--drive", "harmonic", "--amplitude", "-1", "--out", "run"], "amplitude");
+    assert_usage_error(
+        "amplitude",
+        &["simulate", "--drive", "harmonic", "--amplitude", "-1", "--out", "run"],
+        "amplitude",
+    );
     let args = ["simulate", "--drive", "harmonic", "--direction", "0,0", "--out", "run"];
     assert_usage_error("direction", &args, "direction norm");
     let args = ["simulate", "--drive", "harmonic", "--direction", "1,0,0", "--out", "run"];
     assert_usage_error("direction3", &args, "3 components");
-    assert_usage_error("radius", &["simulate", "--dim", "3", "--drive", "circle", "--radius", "-1", "--out", "run"], "radius");
+    assert_usage_error(
+        "radius",
+        &["simulate", "--dim", "3", "--drive", "circle", "--radius", "-1", "--out", "run"],
+        "radius",
+    );
     assert_usage_error("torque3d", &["simulate", "--dim", "3", "--torque", "1", "--out", "run"], "2D only");
     assert_usage_error("spin2d", &["simulate", "--spin", "1", "--out", "run"], "--spin");
     assert_usage_error("from-and-n", &["simulate", "--from", "run.json", "--n", "3"], "--from");
@@ -64,8 +80,16 @@ fn bad_drives_and_combinations_are_named() {
 
 #[test]
 fn bad_run_files_are_named() {
-    assert_usage_error("from-missing", &["simulate", "--from", "nothere.json", "--out", "run"], "nothere.json");
-    assert_usage_error("from-bad", &["simulate", "--from", "bad.json", "--out", "run"], "not a valid run.json");
+    assert_usage_error(
+        "from-missing",
+        &["simulate", "--from", "nothere.json", "--out", "run"],
+        "nothere.json",
+    );
+    assert_usage_error(
+        "from-bad",
+        &["simulate", "--from", "bad.json", "--out", "run"],
+        "not a valid run.json",
+    );
     assert_usage_error("from-other", &["simulate", "--from", "other.json", "--out", "run"], "other.json");
 }
 
@@ -85,7 +109,11 @@ fn a_doctored_run_json_is_rejected() {
 
 #[test]
 fn bad_eval_arguments_are_named() {
-    assert_usage_error("eval-q", &["eval", "--model", "planar", "--n", "3", "--q", "0.1,0.2"], "--q: got 2 values");
+    assert_usage_error(
+        "eval-q",
+        &["eval", "--model", "planar", "--n", "3", "--q", "0.1,0.2"],
+        "--q: got 2 values",
+    );
     assert_usage_error("eval-noq", &["eval", "--model", "planar"], "--q");
     let args = ["eval", "--model", "spatial", "--q", "0,0.5,0,0"];
     assert_usage_error("eval-singular", &args, "singularity");
@@ -104,9 +132,31 @@ fn help_lists_every_command_and_option() {
     let out = run_in(&dir, &["simulate", "--help"]);
     let text = String::from_utf8_lossy(&out.stdout);
     for option in [
-        "--dim", "--n", "--masses", "--lengths", "--gravity", "--damping", "--torque", "--drive", "--amplitude",
-        "--omega", "--phase", "--direction", "--radius", "--integrator", "--step", "--end", "--initial", "--spin",
-        "--every", "--out", "--from", "--view", "--frames", "--no-plots", "--quiet",
+        "--dim",
+        "--n",
+        "--masses",
+        "--lengths",
+        "--gravity",
+        "--damping",
+        "--torque",
+        "--drive",
+        "--amplitude",
+        "--omega",
+        "--phase",
+        "--direction",
+        "--radius",
+        "--integrator",
+        "--step",
+        "--end",
+        "--initial",
+        "--spin",
+        "--every",
+        "--out",
+        "--from",
+        "--view",
+        "--frames",
+        "--no-plots",
+        "--quiet",
     ] {
         assert!(text.contains(option), "simulate --help lacks {option}");
     }

@@ -81,9 +81,25 @@ fn check_against_reference(case: &str, model: &str, p: &Point) {
 
     let dir = scratch(&format!("eval-{case}"));
     let args = [
-        "eval", "--model", model, "--masses", &list(&p.masses), "--lengths", &list(&p.lengths), "--gravity",
-        &format!("{:?}", p.gravity), "--damping", &list(&p.damping), "--q", &list(&p.q), "--qd", &list(&p.qd),
-        "--torque", &list(&p.torque), "--pivot-acceleration", &list(&p.pivot),
+        "eval",
+        "--model",
+        model,
+        "--masses",
+        &list(&p.masses),
+        "--lengths",
+        &list(&p.lengths),
+        "--gravity",
+        &format!("{:?}", p.gravity),
+        "--damping",
+        &list(&p.damping),
+        "--q",
+        &list(&p.q),
+        "--qd",
+        &list(&p.qd),
+        "--torque",
+        &list(&p.torque),
+        "--pivot-acceleration",
+        &list(&p.pivot),
     ];
     let out = run_in(&dir, &args);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -102,9 +118,12 @@ fn check_against_reference(case: &str, model: &str, p: &Point) {
         }
     }
     let mut rhs = DVector::zeros(dof);
-    for (key, sign) in
-        [("velocity_terms", -1.0), ("gravity_terms", -1.0), ("pivot_terms", -1.0), ("generalized_forces", 1.0)]
-    {
+    for (key, sign) in [
+        ("velocity_terms", -1.0),
+        ("gravity_terms", -1.0),
+        ("pivot_terms", -1.0),
+        ("generalized_forces", 1.0),
+    ] {
         let values = floats(&got[key]);
         assert_eq!(values.len(), dof, "{key}");
         for a in 0..dof {

@@ -47,7 +47,9 @@ impl Csv {
             .map(|(i, line)| {
                 let row: Vec<f64> = line
                     .split(',')
-                    .map(|v| v.parse().unwrap_or_else(|_| panic!("{} row {i}: bad value {v}", path.display())))
+                    .map(|v| {
+                        v.parse().unwrap_or_else(|_| panic!("{} row {i}: bad value {v}", path.display()))
+                    })
                     .collect();
                 assert_eq!(row.len(), header.len(), "{} row {i} has {} fields", path.display(), row.len());
                 row
