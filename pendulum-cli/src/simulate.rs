@@ -212,9 +212,23 @@ fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options)
     match result {
         Ok(_) => Ok(()),
         Err(e) => Err(CliError::failed(format!(
-            "the run stopped at t = {} s: {e}; files hold what was computed",
-            state.t()
+            "the run stopped at t = {} s: {e}{}; files hold what was computed",
+            state.t(),
+            stage_solve_hint(&e)
         ))),
+    }
+}
+
+/// Advice for a failed Gauss–Legendre stage solve, empty for other errors.
+fn stage_solve_hint(e: &pendulum_core::Error) -> &'static str {
+    match e {
+        pendulum_core::Error::StepFailed { source, .. }
+            if matches!(**source, pendulum_core::Error::StageSolveFailed { .. }) =>
+        {
+            " (the Gauss–Legendre stage solve is known to fail from exactly straight chains of more \
+             than about 5 links, such as horizontal or tilted starts; --integrator rk4 avoids it)"
+        }
+        _ => "",
     }
 }
 
