@@ -89,8 +89,8 @@ pub enum View {
 /// Options of `pendulum simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Repeat the run recorded in this run.json exactly (only --out, --no-plots and
-    /// --quiet may be given with it).
+    /// Repeat the run recorded in this run.json exactly (only --out, --no-plots, --quiet,
+    /// --view and --frames may be given with it).
     #[arg(long, value_name = "RUN_JSON", conflicts_with = "Physics")]
     pub from: Option<PathBuf>,
     /// Output directory (created if missing).
@@ -102,6 +102,12 @@ pub struct SimulateArgs {
     /// No progress bar and no summary line.
     #[arg(long)]
     pub quiet: bool,
+    /// 3D: the plane the animation shows [default: xz].
+    #[arg(long, value_enum)]
+    pub view: Option<View>,
+    /// Most frames in the animation (samples are thinned to fit) [default: 150].
+    #[arg(long)]
+    pub frames: Option<usize>,
     /// The chain, its drive and the run.
     #[command(flatten)]
     pub physics: Physics,
@@ -174,12 +180,6 @@ pub struct Physics {
     /// Write a sample every k steps.
     #[arg(long, value_name = "K", default_value_t = 4)]
     pub every: usize,
-    /// 3D: the plane the animation shows.
-    #[arg(long, value_enum, default_value = "xz")]
-    pub view: View,
-    /// Most frames in the animation (samples are thinned to fit).
-    #[arg(long, default_value_t = 150)]
-    pub frames: usize,
 }
 
 /// Model kind of `pendulum eval`.

@@ -90,7 +90,7 @@ impl RunConfig {
 
     /// Resolves the command line into a complete configuration, checking what the core
     /// does not check itself (counts, signs, combinations).
-    pub fn from_args(p: &Physics) -> CliResult<Self> {
+    pub fn from_args(p: &Physics, view: View, frames: usize) -> CliResult<Self> {
         let masses = per_link("--masses", &p.masses)?;
         let lengths = per_link("--lengths", &p.lengths)?;
         let n = match p.n {
@@ -151,8 +151,8 @@ impl RunConfig {
             end: p.end,
             every: p.every,
             initial,
-            view: p.view,
-            frames: p.frames,
+            view,
+            frames,
         };
         config.check()?;
         Ok(config)

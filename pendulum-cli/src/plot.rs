@@ -43,7 +43,8 @@ fn drawing_failed(path: &Path, e: impl std::fmt::Display) -> CliError {
 /// exact integration; for a conservative run both are the flat line `H_in(0)`.
 ///
 /// The vertical range covers the data and at least ±2 % of `scale` (J) around it, so
-/// round-off does not fill the plot; the caption gives the largest difference.
+/// round-off does not fill the plot, with room above the data for the legend; the
+/// caption gives the largest difference.
 pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], scale: f64) -> CliResult<()> {
     fonts();
     let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
@@ -62,7 +63,7 @@ pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], sca
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1, (mid - half)..(mid + half))
+        .build_cartesian_2d(t0..t1, (mid - half)..(mid + 1.6 * half))
         .map_err(|e| fail(&e))?;
     chart
         .configure_mesh()
@@ -86,7 +87,7 @@ pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], sca
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))

@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
-use crate::args::{Dimension, SimulateArgs};
+use crate::args::{Dimension, SimulateArgs, View};
 use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::models::{AnySimulation, Sample, Simulation, build};
@@ -22,10 +22,14 @@ pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Runs `pendulum simulate`.
 pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
-    let config = match &args.from {
+    let mut config = match &args.from {
         Some(path) => RunFile::read(path)?.config,
-        None => RunConfig::from_args(&args.physics)?,
+        None => RunConfig::from_args(&args.physics, View::Xz, 150)?,
     };
+    // Presentation only: may differ from the recorded run.
+    config.view = args.view.unwrap_or(config.view);
+    config.frames = args.frames.unwrap_or(config.frames);
+    config.check()?;
     let simulation = build(&config)?;
     std::fs::create_dir_all(&args.out).map_err(|e| io_failed("create the output directory", &args.out, e))?;
     let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };

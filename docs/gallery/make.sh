@@ -1,0 +1,35 @@
+#!/bin/sh
+# Regenerates the gallery images in docs/gallery with the `pendulum` command, exactly as
+# the README shows them. Run from anywhere: sh docs/gallery/make.sh
+set -eu
+root="$(cd "$(dirname "$0")/../.." && pwd)"
+cd "$root"
+cargo build --release -q -p pendulum-cli
+pendulum() { cargo run --release -q -p pendulum-cli -- "$@"; }
+runs="$(mktemp -d)"
+trap 'rm -rf "$runs"' EXIT
+gallery=docs/gallery
+
+# The demo: a triple pendulum released from 1 rad (chaotic), 10 s.
+pendulum simulate --out "$runs/triple" --frames 80 --quiet
+cp "$runs/triple/chain.gif" "$gallery/triple.gif"
+cp "$runs/triple/energy.png" "$gallery/triple-energy.png"
+
+# Kapitza's pendulum: released near the top, held upright by a fast vertical drive
+# (a²ω² = 16 m²/s² > 2gl = 3.9 m²/s²).
+pendulum simulate --n 1 --lengths 0.2 --initial tilted:2.9 --drive harmonic --amplitude 0.02 \
+    --omega 200 --step 0.0005 --end 4 --frames 80 --out "$runs/kapitza" --quiet
+cp "$runs/kapitza/chain.gif" "$gallery/kapitza.gif"
+cp "$runs/kapitza/energy.png" "$gallery/kapitza-energy.png"
+
+# A hanging 12-link chain whirled by its pivot on a horizontal circle (3D), side and top.
+pendulum simulate --dim 3 --n 12 --lengths 0.1 --initial hanging --drive circle --radius 0.08 \
+    --omega 5 --step 0.001 --end 10 --every 10 --frames 100 --out "$runs/whirl" --quiet
+cp "$runs/whirl/chain.gif" "$gallery/whirl-side.gif"
+pendulum simulate --from "$runs/whirl/run.json" --view xy --frames 100 --out "$runs/whirl-top" --quiet
+cp "$runs/whirl-top/chain.gif" "$gallery/whirl-top.gif"
+
+# A damped double pendulum: the energy falls by exactly the dissipated energy.
+pendulum simulate --n 2 --damping 0.05 --initial horizontal --end 20 --out "$runs/damped" --quiet
+cp "$runs/damped/energy.png" "$gallery/damped-energy.png"
+ls -l "$gallery"
