@@ -116,7 +116,7 @@ pub fn report(rows: &[RouteRow]) -> Result<()> {
             if ok { "ok" } else { "FAIL" }
         );
     }
-    if let Some(bad) = rows.iter().find(|r| !(r.error <= BOUND)) {
+    if let Some(bad) = rows.iter().find(|r| r.error.is_nan() || r.error > BOUND) {
         bail!(
             "verify failed: O(n) route {} on {} has backward error {:e} at state {} (bound {BOUND:e})",
             bad.route,
