@@ -4,7 +4,7 @@
 //! direction representation through the vertical, where the spherical angles fail.
 
 use nalgebra::{DVector, Dyn, U2, U3, Vector2, Vector3};
-use pendulum_core::integrate::{Constrained, Integrator, Projected, Rk4, State, System};
+use pendulum_core::integrate::{Constrained, Integrator, Projected, Rk4, State};
 use pendulum_core::{Chain, Directions, FnDrive, Model, Planar, PlanarTension, Spatial};
 use pendulum_tests::{random_chain, random_inputs, random_vector, rng};
 use rand::Rng;
