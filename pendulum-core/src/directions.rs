@@ -456,6 +456,11 @@ where
         Dyn(self.state_len())
     }
 
+    /// `x = (u, w)`, `u' = w`.
+    fn second_order(&self) -> Option<usize> {
+        Some(S::DIM * self.links())
+    }
+
     /// `x' = (w, ü(t, x))`: one O(n) tension solve.
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
         let half = S::DIM * self.links();
