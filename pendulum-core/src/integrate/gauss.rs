@@ -252,33 +252,9 @@ where
         Ok(())
     }
 
-    /// Continues the previous step's collocation polynomial `u(τ)` (degree `s`, `u(0) = 0`,
-    /// `u(c_i) = Z_i^prev`, `τ` in units of the previous step) to the new nodes:
-    /// `Z_j = u(1 + c_j h/h_prev) − u(1)`, error `O(h^{s+1})`.
+    /// Continues the previous step's collocation polynomial ([`extrapolate_stages`]).
     fn extrapolate(&mut self, ratio: f64) {
-        let c = S::TABLEAU.c;
-        let s = S::dim();
-        // Lagrange basis on the nodes (0, c_1, …, c_s); the node 0 carries the value 0.
-        let basis = |i: usize, tau: f64| {
-            let mut v = tau / c[i];
-            for m in (0..s).filter(|&m| m != i) {
-                v *= (tau - c[m]) / (c[i] - c[m]);
-            }
-            v
-        };
-        // weights[j][i] = ℓ_i(1 + c_j h/h_prev) − ℓ_i(1).
-        let mut weights = [[0.0; 3]; 3];
-        for (row, cj) in weights.iter_mut().zip(c).take(s) {
-            for (i, w) in row.iter_mut().enumerate().take(s) {
-                *w = basis(i, 1.0 + cj * ratio) - basis(i, 1.0);
-            }
-        }
-        self.k.copy_from(&self.z);
-        for (j, w) in weights.iter().enumerate().take(s) {
-            for r in 0..self.z.nrows() {
-                self.z[(r, j)] = (0..s).map(|i| self.k[(r, i)] * w[i]).sum();
-            }
-        }
+        extrapolate_stages::<D, S>(&mut self.z, &mut self.k, ratio);
     }
 
     fn evaluate_jacobian<Sys: System<Dim = D>>(
@@ -410,6 +386,42 @@ where
             previous_norm = norm;
         }
         Ok(None)
+    }
+}
+
+/// Continues a Gauss step's collocation polynomial `u(τ)` (degree `s`, `u(0) = 0`,
+/// `u(c_i) = Z_i^prev`, `τ` in units of the previous step) to the nodes of the next step,
+/// `h = ratio · h_prev`: `Z_j = u(1 + c_j ratio) − u(1)`, error `O(h^{s+1})`. `z` holds the
+/// previous increments on entry and the guess on return; `scratch` is overwritten.
+pub(super) fn extrapolate_stages<D: Dim, S: GaussStages>(
+    z: &mut OMatrix<f64, D, S>,
+    scratch: &mut OMatrix<f64, D, S>,
+    ratio: f64,
+) where
+    DefaultAllocator: Allocator<D, S>,
+{
+    let c = S::TABLEAU.c;
+    let s = S::dim();
+    // Lagrange basis on the nodes (0, c_1, …, c_s); the node 0 carries the value 0.
+    let basis = |i: usize, tau: f64| {
+        let mut v = tau / c[i];
+        for m in (0..s).filter(|&m| m != i) {
+            v *= (tau - c[m]) / (c[i] - c[m]);
+        }
+        v
+    };
+    // weights[j][i] = ℓ_i(1 + c_j h/h_prev) − ℓ_i(1).
+    let mut weights = [[0.0; 3]; 3];
+    for (row, cj) in weights.iter_mut().zip(c).take(s) {
+        for (i, w) in row.iter_mut().enumerate().take(s) {
+            *w = basis(i, 1.0 + cj * ratio) - basis(i, 1.0);
+        }
+    }
+    scratch.copy_from(z);
+    for (j, w) in weights.iter().enumerate().take(s) {
+        for r in 0..z.nrows() {
+            z[(r, j)] = (0..s).map(|i| scratch[(r, i)] * w[i]).sum();
+        }
     }
 }
 
