@@ -74,6 +74,17 @@ pub enum IntegratorKind {
     Rk4,
 }
 
+/// How an implicit Gauss–Legendre step solves its stage equations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StageSolver {
+    /// Fixed-point iteration: a few right-hand sides per sweep, no Jacobian; needs the
+    /// step to be shorter than the chain's fastest period.
+    FixedPoint,
+    /// Newton's method with a finite-difference Jacobian (cost grows as dim³).
+    Newton,
+}
+
 /// The plane a 3D chain is drawn in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -157,12 +168,13 @@ pub struct Physics {
     /// Circle drive: radius R, m.
     #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
     pub radius: f64,
-    /// Time integrator [default: gl2 in 2D, rk4 in 3D]. 3D chains are integrated in unit
-    /// link directions with a projection onto the rod constraints after every step; there
-    /// the Gauss–Legendre stage solve can fail for 3D motion of longer chains (then use
-    /// rk4 or a smaller step).
-    #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorKind>,
+    /// Time integrator. 3D chains are integrated in unit link directions with a
+    /// projection onto the rod constraints after every step.
+    #[arg(long, value_enum, default_value = "gl2")]
+    pub integrator: IntegratorKind,
+    /// Stage solve of the Gauss–Legendre integrators.
+    #[arg(long, value_enum, default_value = "fixed-point")]
+    pub solver: StageSolver,
     /// Step size h, s (the run takes ⌈end / h⌉ equal steps).
     #[arg(long, default_value_t = 0.005, allow_negative_numbers = true)]
     pub step: f64,

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::args::{Dimension, DriveKind, IntegratorKind, Physics, View};
+use crate::args::{Dimension, DriveKind, IntegratorKind, Physics, StageSolver, View};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::spec::{InitialSpec, expand, per_link, read_numbers};
 
@@ -68,6 +68,8 @@ pub struct RunConfig {
     pub drive: DriveConfig,
     /// Time integrator.
     pub integrator: IntegratorKind,
+    /// Stage solve of the Gauss–Legendre integrators (unused by rk4).
+    pub solver: StageSolver,
     /// Step size, s.
     pub step: f64,
     /// End time, s (start at 0).
@@ -143,10 +145,8 @@ impl RunConfig {
             damping,
             torque,
             drive,
-            integrator: p.integrator.unwrap_or(match p.dim {
-                Dimension::Two => IntegratorKind::Gl2,
-                Dimension::Three => IntegratorKind::Rk4,
-            }),
+            integrator: p.integrator,
+            solver: p.solver,
             step: p.step,
             end: p.end,
             every: p.every,

@@ -3,13 +3,16 @@
 //! of it means (trajectory columns, positions, energy ledger).
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U1, U2, U3, Vector2, Vector3};
-use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System};
+use pendulum_core::integrate::{
+    Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, State, Stats,
+    System,
+};
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc,
     PlanarTension, Spatial,
 };
 
-use crate::args::IntegratorKind;
+use crate::args::{IntegratorKind, StageSolver};
 use crate::ledger::LedgeredDirections;
 
 use crate::args::Dimension;
@@ -47,37 +50,63 @@ pub trait Simulation {
     fn sample(&self, t: f64, x: &DVector<f64>) -> Sample;
     /// The integrator of this kind for the system (with a projection onto the
     /// constraints where the system has them).
-    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_>;
+    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_>;
 }
 
-/// The integrator of a kind for an unconstrained system.
+/// Most sweeps of the fixed-point stage solve per step.
+const FIXED_POINT_SWEEPS: usize = 100;
+
+/// The integrator of a kind for an unconstrained system, Gauss–Legendre stages solved by
+/// `solver`.
 fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
     kind: IntegratorKind,
-    system: &S,
-) -> Box<dyn Integrator<S> + 'a>
-where
-    DefaultAllocator: GaussAlloc<Dyn, U1> + GaussAlloc<Dyn, U2> + GaussAlloc<Dyn, U3>,
-{
-    let options = GaussOptions::default();
-    match kind {
-        IntegratorKind::Gl1 => Box::new(GaussLegendre::<Dyn, U1>::new(system, options)),
-        IntegratorKind::Gl2 => Box::new(GaussLegendre::<Dyn, U2>::new(system, options)),
-        IntegratorKind::Gl3 => Box::new(GaussLegendre::<Dyn, U3>::new(system, options)),
-        IntegratorKind::Rk4 => Box::new(Rk4::new(system)),
-    }
-}
-
-/// The integrator of a kind followed by the system's projection after every step.
-fn projected_integrator<'a, S: pendulum_core::integrate::Constrained<Dim = Dyn> + 'a>(
-    kind: IntegratorKind,
+    solver: StageSolver,
     system: &S,
 ) -> Box<dyn Integrator<S> + 'a> {
     let options = GaussOptions::default();
-    match kind {
-        IntegratorKind::Gl1 => Box::new(Projected::new(GaussLegendre::<Dyn, U1>::new(system, options))),
-        IntegratorKind::Gl2 => Box::new(Projected::new(GaussLegendre::<Dyn, U2>::new(system, options))),
-        IntegratorKind::Gl3 => Box::new(Projected::new(GaussLegendre::<Dyn, U3>::new(system, options))),
-        IntegratorKind::Rk4 => Box::new(Projected::new(Rk4::new(system))),
+    match (kind, solver) {
+        (IntegratorKind::Gl1, StageSolver::Newton) => {
+            Box::new(GaussLegendre::<Dyn, U1>::new(system, options))
+        }
+        (IntegratorKind::Gl2, StageSolver::Newton) => {
+            Box::new(GaussLegendre::<Dyn, U2>::new(system, options))
+        }
+        (IntegratorKind::Gl3, StageSolver::Newton) => {
+            Box::new(GaussLegendre::<Dyn, U3>::new(system, options))
+        }
+        (IntegratorKind::Gl1, StageSolver::FixedPoint) => {
+            Box::new(GaussFixedPoint::<Dyn, U1>::new(system, FIXED_POINT_SWEEPS))
+        }
+        (IntegratorKind::Gl2, StageSolver::FixedPoint) => {
+            Box::new(GaussFixedPoint::<Dyn, U2>::new(system, FIXED_POINT_SWEEPS))
+        }
+        (IntegratorKind::Gl3, StageSolver::FixedPoint) => {
+            Box::new(GaussFixedPoint::<Dyn, U3>::new(system, FIXED_POINT_SWEEPS))
+        }
+        (IntegratorKind::Rk4, _) => Box::new(Rk4::new(system)),
+    }
+}
+
+/// [`plain_integrator`] followed by the system's projection after every step.
+fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
+    kind: IntegratorKind,
+    solver: StageSolver,
+    system: &S,
+) -> Box<dyn Integrator<S> + 'a> {
+    Box::new(Projected::new(Boxed(plain_integrator(kind, solver, system))))
+}
+
+/// A boxed integrator as an [`Integrator`] (the core implements the trait for concrete
+/// integrators, which [`Projected`] wraps).
+struct Boxed<'a, S: System<Dim = Dyn>>(Box<dyn Integrator<S> + 'a>);
+
+impl<S: System<Dim = Dyn>> Integrator<S> for Boxed<'_, S> {
+    fn step(&mut self, system: &S, state: &mut State<Dyn>, h: f64) -> pendulum_core::Result<()> {
+        self.0.step(system, state, h)
+    }
+
+    fn stats(&self) -> &Stats {
+        self.0.stats()
     }
 }
 
@@ -171,8 +200,8 @@ where
         }
     }
 
-    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_> {
-        plain_integrator(kind, &self.system)
+    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_> {
+        plain_integrator(kind, solver, &self.system)
     }
 }
 
@@ -226,8 +255,8 @@ where
         }
     }
 
-    fn integrator(&self, kind: IntegratorKind) -> Box<dyn Integrator<Self::Sys> + '_> {
-        projected_integrator(kind, &self.system)
+    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_> {
+        projected_integrator(kind, solver, &self.system)
     }
 }
 

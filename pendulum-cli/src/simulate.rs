@@ -135,7 +135,7 @@ fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options)
     let dims = if config.dim == Dimension::Two { 2 } else { 3 };
     let progress = progress_bar(total_steps, options.quiet);
     let system = simulation.system();
-    let mut solver = simulation.integrator(config.integrator);
+    let mut solver = simulation.integrator(config.integrator, config.solver);
     let mut state = State::new(0.0, simulation.initial_state());
     let mut kept = Kept::default();
     let mut write_error = None;
@@ -229,8 +229,9 @@ fn stage_solve_hint(e: &pendulum_core::Error) -> &'static str {
         pendulum_core::Error::StepFailed { source, .. }
             if matches!(**source, pendulum_core::Error::StageSolveFailed { .. }) =>
         {
-            " (the Gauss–Legendre stage solve is known to fail from exactly straight chains of more \
-             than about 5 links, such as horizontal or tilted starts; --integrator rk4 avoids it)"
+            " (Newton's stage solve is known to fail from exactly straight chains of more than \
+             about 5 links, such as horizontal or tilted starts; --solver fixed-point avoids it; \
+             the fixed-point solve needs a step shorter than the chain's fastest period)"
         }
         _ => "",
     }
