@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
-use crate::args::{Dimension, SimulateArgs, View};
+use crate::args::{Dimension, SimulateArgs, StageSolver, View};
 use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::models::{AnySimulation, Sample, Simulation, build};
@@ -218,22 +218,25 @@ fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options)
         Err(e) => Err(CliError::failed(format!(
             "the run stopped at t = {} s: {e}{}; files hold what was computed",
             state.t(),
-            stage_solve_hint(&e)
+            stage_solve_hint(&e, config.solver)
         ))),
     }
 }
 
 /// Advice for a failed Gauss–Legendre stage solve, empty for other errors.
-fn stage_solve_hint(e: &pendulum_core::Error) -> &'static str {
-    match e {
-        pendulum_core::Error::StepFailed { source, .. }
-            if matches!(**source, pendulum_core::Error::StageSolveFailed { .. }) =>
-        {
-            " (Newton's stage solve is known to fail from exactly straight chains of more than \
-             about 5 links, such as horizontal or tilted starts; --solver fixed-point avoids it; \
-             the fixed-point solve needs a step shorter than the chain's fastest period)"
+fn stage_solve_hint(e: &pendulum_core::Error, solver: StageSolver) -> &'static str {
+    let stage_failure = matches!(e, pendulum_core::Error::StepFailed { source, .. }
+        if matches!(**source, pendulum_core::Error::StageSolveFailed { .. }));
+    match (stage_failure, solver) {
+        (false, _) => "",
+        (true, StageSolver::FixedPoint) => {
+            " (the fixed-point stage solve converges only for steps shorter than about the \
+             chain's fastest period: use a smaller --step, --solver newton or --integrator rk4)"
         }
-        _ => "",
+        (true, StageSolver::Newton) => {
+            " (Newton's stage solve is known to fail from exactly straight chains of more than \
+             about 5 links, such as horizontal or tilted starts; --solver fixed-point avoids it)"
+        }
     }
 }
 

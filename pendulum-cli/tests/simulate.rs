@@ -343,3 +343,32 @@ fn ctrl_c_leaves_valid_files_for_what_was_computed() {
     assert!((trajectory.column("t").last().unwrap() - t_end).abs() < 1e-9);
     assert!(std::fs::read(run.join("chain.gif")).unwrap().starts_with(b"GIF89a"));
 }
+
+#[test]
+fn a_straight_chain_of_many_links_runs_with_the_defaults() {
+    // Regression: Newton's stage solve failed from exactly straight chains of > 5 links.
+    let dir = scratch("straight-many");
+    let args = ["simulate", "--n", "20", "--lengths", "0.05", "--initial", "tilted:1.0", "--end", "0.3"];
+    let out = run_in(&dir, &[&args[..], &["--step", "0.002", "--out", "run", "--no-plots"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let residual = Csv::read(&dir.join("run/energy.csv")).column("balance_residual");
+    let worst = residual.iter().map(|r| r.abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-6, "energy error {worst} J");
+}
+
+#[test]
+fn a_run_that_fails_exits_1_with_valid_files_and_says_why() {
+    // A step far longer than the fastest period of 30 links of 2 cm: the stage solve fails.
+    let dir = scratch("failed-run");
+    let args = ["simulate", "--n", "30", "--lengths", "0.02", "--end", "1", "--step", "0.05", "--out", "run"];
+    let out = run_in(&dir, &args);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(message.contains("smaller --step"), "{message}");
+    let json = run_json(&dir.join("run"));
+    assert_eq!(json["outcome"]["status"], "failed");
+    assert!(json["outcome"]["error"].as_str().unwrap().contains("did not converge"));
+    let trajectory = Csv::read(&dir.join("run/trajectory.csv"));
+    assert_eq!(trajectory.rows.len(), 1, "the initial state only");
+    assert!(std::fs::read(dir.join("run/chain.gif")).unwrap().starts_with(b"GIF89a"));
+}
