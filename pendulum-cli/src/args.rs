@@ -131,7 +131,7 @@ pub struct Physics {
     #[arg(long, value_enum, default_value = "2")]
     pub dim: Dimension,
     /// Number of links (default: the length of a --masses or --lengths list, else 3).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub n: Option<usize>,
     /// Masses, kg: one value for every link, a comma list (one per link) or a file of
     /// numbers.
@@ -190,7 +190,7 @@ pub struct Physics {
     #[arg(long, allow_negative_numbers = true)]
     pub spin: Option<f64>,
     /// Write a sample every k steps.
-    #[arg(long, value_name = "K", default_value_t = 4)]
+    #[arg(long, value_name = "K", default_value_t = 4, allow_negative_numbers = true)]
     pub every: usize,
 }
 
@@ -210,8 +210,8 @@ pub struct EvalArgs {
     /// The model.
     #[arg(long, value_enum, default_value = "planar")]
     pub model: ModelKind,
-    /// Number of links (default: the length of a --masses or --lengths list, else 2).
-    #[arg(long)]
+    /// Number of links (default: from the lengths of --q, --masses or --lengths).
+    #[arg(long, allow_negative_numbers = true)]
     pub n: Option<usize>,
     /// Masses, kg: one value, a comma list or a file.
     #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]

@@ -31,7 +31,9 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
     config.frames = args.frames.unwrap_or(config.frames);
     config.check()?;
     let simulation = build(&config)?;
-    std::fs::create_dir_all(&args.out).map_err(|e| io_failed("create the output directory", &args.out, e))?;
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+    })?;
     let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };
     if demo && !args.quiet {
         eprintln!(

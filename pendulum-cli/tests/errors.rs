@@ -54,6 +54,8 @@ fn bad_run_parameters_are_named() {
     assert_usage_error("initial", &["simulate", "--initial", "sideways", "--out", "run"], "sideways");
     assert_usage_error("tilted", &["simulate", "--initial", "tilted:x", "--out", "run"], "tilted angle 'x'");
     assert_usage_error("unknown", &["simulate", "--speed", "3"], "--speed");
+    assert_usage_error("negative-n", &["simulate", "--n", "-3", "--out", "run"], "'-3'");
+    assert_usage_error("out-is-file", &["simulate", "--out", "bad.json"], "--out");
 }
 
 #[test]
