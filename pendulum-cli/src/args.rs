@@ -26,6 +26,13 @@ pub enum Command {
     /// Integrate a chain in time; write trajectory.csv, energy.csv, run.json, energy.png
     /// and chain.gif into the output directory.
     ///
+    /// trajectory.csv: t, the state (2D: θ_i then θ̇_i; 3D: unit link directions u_i then
+    /// their rates w_i = u̇_i), the pivot and every mass (x, y[, z]), every k steps.
+    /// energy.csv: t, energy (inertial frame), drive_work, torque_work, damped,
+    /// balance_residual = energy − energy(0) − (drive_work + torque_work − damped).
+    /// run.json: every parameter and the version (repeat with --from). Ctrl-C stops the
+    /// run and writes valid files for what was computed.
+    ///
     /// Without options: a small demo (a triple pendulum released from tilted:1.0 for
     /// 10 s) written to ./pendulum-run.
     Simulate(Box<SimulateArgs>),
@@ -43,7 +50,8 @@ pub enum Dimension {
     #[value(name = "2")]
     #[serde(rename = "2")]
     Two,
-    /// Spatial chain.
+    /// Spatial chain, integrated in unit link directions (initial states in spherical
+    /// angles: θ from −z, φ azimuth from +x).
     #[value(name = "3")]
     #[serde(rename = "3")]
     Three,
