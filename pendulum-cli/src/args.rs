@@ -39,7 +39,9 @@ pub enum Command {
     /// Evaluate one model at one state and print its terms as JSON: mass matrix M,
     /// velocity terms c, gravity terms k, pivot terms d, generalized forces Q, the
     /// accelerations q̈ = M⁻¹(Q − c − k − d), kinetic energy T and potential energy U
-    /// (equation M q̈ + c + k + d = Q, the sympy reference's form).
+    /// (equation M q̈ + c + k + d = Q, the sympy reference's form). Planar accelerations
+    /// come from the O(n) rod-tension solve, spatial ones from the spherical-angle model
+    /// (singular where a link points straight down or up).
     Eval(EvalArgs),
 }
 
