@@ -26,6 +26,7 @@ mod error;
 mod first_order;
 pub mod integrate;
 mod model;
+mod modes;
 mod planar;
 mod spatial;
 pub mod trajectory;
@@ -40,6 +41,7 @@ pub use energy::{
 pub use error::{Error, Result};
 pub use first_order::{FirstOrder, InputsAt};
 pub use model::{Inputs, Model, ModelAlloc, check_inputs};
+pub use modes::{NormalModes, normal_modes, sign_changes};
 pub use planar::Planar;
 pub use spatial::{SINGULARITY_TOLERANCE, Spatial, check_polar_angle, check_polar_sin};
 
