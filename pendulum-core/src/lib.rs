@@ -29,6 +29,7 @@ mod model;
 mod modes;
 mod planar;
 mod spatial;
+mod stability;
 mod steady;
 pub mod trajectory;
 
@@ -44,6 +45,7 @@ pub use first_order::{FirstOrder, InputsAt};
 pub use model::{Inputs, Model, ModelAlloc, check_inputs};
 pub use modes::{NormalModes, normal_modes, sign_changes};
 pub use planar::Planar;
+pub use stability::{Linearisation, Stability, linearise, stability};
 pub use steady::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};
 pub use spatial::{SINGULARITY_TOLERANCE, Spatial, check_polar_angle, check_polar_sin};
 
