@@ -269,7 +269,7 @@ impl SteadyRotation {
     }
 
     /// The steady shape at angular speed `omega` (rad/s) nearest `guess` (rad), by Newton's
-    /// method on `F(θ, ω) = 0` (steps limited to 0.5 rad).
+    /// method on `F(θ, ω) = 0` (steps limited to 0.5 rad, halved until `|F|` decreases).
     ///
     /// Errors: [`Error::InvalidSteady`] for a negative or non-finite speed,
     /// [`Error::LengthMismatch`] / [`Error::NonFinite`] for a bad guess,
@@ -287,7 +287,7 @@ impl SteadyRotation {
                 iterations: it,
                 residual: self.residual(theta, omega2).norm(),
             };
-            let mut step = self.hessian(&theta, omega2).lu().solve(&(-f)).ok_or_else(|| fail(&theta))?;
+            let mut step = self.hessian(&theta, omega2).lu().solve(&(-&f)).ok_or_else(|| fail(&theta))?;
             let size = step.amax();
             if !size.is_finite() {
                 return Err(fail(&theta));
@@ -295,7 +295,17 @@ impl SteadyRotation {
             if size > 0.5 {
                 step *= 0.5 / size;
             }
-            theta += &step;
+            // Backtracking: halve the step until the residual norm decreases.
+            let f0 = f.norm();
+            let mut trial = &theta + &step;
+            for _ in 0..12 {
+                if self.residual(&trial, omega2).norm() < f0 {
+                    break;
+                }
+                step *= 0.5;
+                trial = &theta + &step;
+            }
+            theta = trial;
             if size < NEWTON_STEP_TOL {
                 return Ok(self.shape(omega, theta));
             }
