@@ -9,7 +9,8 @@
 //! a circle of radius R = 0.02 L) and their data in `docs/data/rotating-*.csv`, and prints
 //! the critical speeds and the stable stretches of each branch. Line styles: thick solid =
 //! stable with any small damping (index 0), thin solid = spectrally stable only
-//! (gyroscopically stabilised; damping destabilises it), dashed = unstable.
+//! (gyroscopically stabilised; damping destabilises it), dashed = unstable; colour = the
+//! shape's node count.
 
 use std::{error::Error, fmt::Write as _, fs, path::PathBuf};
 
@@ -65,7 +66,8 @@ fn classify(problem: &SteadyRotation, branch: &Branch, signed: bool) -> Result<V
     branch
         .points
         .iter()
-        .map(|s| {
+        .enumerate()
+        .map(|(i, s)| {
             let st = stability(problem, s, None)?;
             let class = match (st.spectrally_stable, st.index) {
                 (true, 0) => Class::Stable,
@@ -73,24 +75,27 @@ fn classify(problem: &SteadyRotation, branch: &Branch, signed: bool) -> Result<V
                 (false, _) => Class::Unstable,
             };
             let amplitude = if signed { signed_amplitude(s) } else { s.amplitude() };
-            Ok(Point { omega: s.omega, amplitude, nodes: s.nodes(), growth: st.growth_rate, index: st.index, class })
+            // A bifurcation point (on the vertical) takes the node count of its branch.
+            let shown = if s.amplitude() == 0.0 { branch.points.get(i + 1).unwrap_or(s) } else { s };
+            Ok(Point { omega: s.omega, amplitude, nodes: shown.nodes(), growth: st.growth_rate, index: st.index, class })
         })
         .collect()
 }
 
-/// Runs of consecutive points of one class (each run shares its end point with the next).
-fn runs(points: &[Point]) -> Vec<(Class, Vec<(f64, f64)>)> {
-    let mut out: Vec<(Class, Vec<(f64, f64)>)> = Vec::new();
+/// Runs of consecutive points of one class and node count (each run shares its end
+/// point with the next).
+fn runs(points: &[Point]) -> Vec<(Class, usize, Vec<(f64, f64)>)> {
+    let mut out: Vec<(Class, usize, Vec<(f64, f64)>)> = Vec::new();
     let scale = (GRAVITY / LENGTH).sqrt();
     for p in points {
         let xy = (p.omega / scale, p.amplitude / LENGTH);
         match out.last_mut() {
-            Some((class, run)) if *class == p.class => run.push(xy),
-            Some((_, run)) => {
+            Some((class, nodes, run)) if *class == p.class && *nodes == p.nodes => run.push(xy),
+            Some((_, _, run)) => {
                 let last = *run.last().expect("runs are never empty");
-                out.push((p.class, vec![last, xy]));
+                out.push((p.class, p.nodes, vec![last, xy]));
             }
-            None => out.push((p.class, vec![xy])),
+            None => out.push((p.class, p.nodes, vec![xy])),
         }
     }
     out
@@ -99,9 +104,9 @@ fn runs(points: &[Point]) -> Vec<(Class, Vec<(f64, f64)>)> {
 /// A summary of the stretches of one branch: "stable 1.23–4.56; unstable 4.56–7.89".
 fn stretches(points: &[Point]) -> String {
     let mut s = String::new();
-    for (class, run) in runs(points) {
+    for (class, nodes, run) in runs(points) {
         let (a, b) = (run.first().expect("non-empty").0, run.last().expect("non-empty").0);
-        let _ = write!(s, "{} {:.3}–{:.3}; ", class.name(), a.min(b), a.max(b));
+        let _ = write!(s, "{} ({nodes} nodes) {:.3}–{:.3}; ", class.name(), a.min(b), a.max(b));
     }
     s.trim_end_matches("; ").to_string()
 }
@@ -126,7 +131,7 @@ fn csv(rows: &[(String, &[Point])]) -> String {
 }
 
 fn colour(k: usize) -> RGBColor {
-    [RGBColor(0, 90, 181), RGBColor(220, 50, 32), RGBColor(0, 140, 70), RGBColor(120, 80, 160)][(k + 3) % 4]
+    [RGBColor(0, 90, 181), RGBColor(220, 50, 32), RGBColor(0, 140, 70), RGBColor(120, 80, 160), RGBColor(230, 150, 0)][(k + 4) % 5]
 }
 
 fn plot(
@@ -134,7 +139,7 @@ fn plot(
     title: &str,
     y_label: &str,
     y_range: std::ops::Range<f64>,
-    branches: &[(usize, &[Point])],
+    branches: &[&[Point]],
     critical: &[f64],
 ) -> Result<(), Box<dyn Error>> {
     let scale = (GRAVITY / LENGTH).sqrt();
@@ -162,30 +167,20 @@ fn plot(
             BLACK.mix(0.3).stroke_width(1),
         ))?;
     }
-    let mut labelled = [false; 5];
-    for (k, points) in branches {
-        for (class, run) in runs(points) {
-            let c = colour(*k);
-            match class {
-                Class::Stable | Class::Gyroscopic => {
-                    let width = if class == Class::Stable { 3 } else { 1 };
-                    let series = chart.draw_series(LineSeries::new(run, c.stroke_width(width)))?;
-                    if !labelled[*k] && class == Class::Stable {
-                        labelled[*k] = true;
-                        series
-                            .label(format!("k = {k}"))
-                            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(3)));
-                    }
-                }
-                Class::Unstable => {
-                    let series = chart.draw_series(DashedLineSeries::new(run, 6, 4, c.stroke_width(2)))?;
-                    if !labelled[*k] {
-                        labelled[*k] = true;
-                        series
-                            .label(format!("k = {k}"))
-                            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(3)));
-                    }
-                }
+    let mut labelled = [false; 8];
+    for points in branches {
+        for (class, nodes, run) in runs(points) {
+            let c = colour(nodes);
+            let series = match class {
+                Class::Stable => chart.draw_series(LineSeries::new(run, c.stroke_width(3)))?,
+                Class::Gyroscopic => chart.draw_series(LineSeries::new(run, c.stroke_width(1)))?,
+                Class::Unstable => chart.draw_series(DashedLineSeries::new(run, 6, 4, c.stroke_width(2)))?,
+            };
+            if nodes < labelled.len() && !labelled[nodes] {
+                labelled[nodes] = true;
+                series
+                    .label(format!("{nodes} node{}", if nodes == 1 { "" } else { "s" }))
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(3)));
             }
         }
     }
@@ -233,7 +228,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         &format!("Steady rotation of a uniform {LINKS}-link chain (free pivot)"),
         "amplitude max|x_i| / L",
         0.0..1.0,
-        &free_branches.iter().map(|(k, p, _)| (*k, p.as_slice())).collect::<Vec<_>>(),
+        &free_branches.iter().map(|(_, p, _)| p.as_slice()).collect::<Vec<_>>(),
         &critical,
     )?;
 
@@ -241,12 +236,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     // branch's end shape (both signs) downwards; the forced branches fold.
     let radius = FORCED_RADIUS * LENGTH;
     let forced = SteadyRotation::new(&chain, radius)?;
-    let mut forced_branches: Vec<(String, usize, Vec<Point>)> = Vec::new();
+    let mut forced_branches: Vec<(String, Vec<Point>)> = Vec::new();
     let from_rest = forced.continue_from(&forced.solve(0.0, &DVector::zeros(LINKS))?, true, omega_max, &opts)?;
     let points = classify(&forced, &from_rest, true)?;
     println!("forced R = {radius} m, from rest: {} points, end {:?}", points.len(), from_rest.end);
     println!("        in units of sqrt(g/L): {}", stretches(&points));
-    forced_branches.push(("forced from rest".into(), 1, points));
+    forced_branches.push(("forced from rest".into(), points));
     for (k, _, last) in &free_branches {
         for sign in [1.0, -1.0] {
             let start = forced.solve(0.99 * omega_max, &(&last.theta * sign))?;
@@ -255,19 +250,12 @@ fn main() -> Result<(), Box<dyn Error>> {
             let name = format!("forced from free k={k} sign {sign:+}");
             println!("{name}: {} points, end {:?}", points.len(), branch.end);
             println!("        in units of sqrt(g/L): {}", stretches(&points));
-            forced_branches.push((name, *k, points));
+            forced_branches.push((name, points));
         }
     }
-    let rows: Vec<(String, &[Point])> = forced_branches.iter().map(|(n, _, p)| (n.clone(), p.as_slice())).collect();
+    let rows: Vec<(String, &[Point])> = forced_branches.iter().map(|(n, p)| (n.clone(), p.as_slice())).collect();
     fs::write(docs.join("data/rotating-forced.csv"), csv(&rows))?;
-    let forced_plot: Vec<(usize, &[Point])> = forced_branches
-        .iter()
-        .map(|(_, k, p)| {
-            // Colour by the node count at the high-speed end of each forced branch.
-            let k = p.iter().max_by(|a, b| a.omega.total_cmp(&b.omega)).map_or(*k, |q| q.nodes.min(4));
-            (k, p.as_slice())
-        })
-        .collect();
+    let forced_plot: Vec<&[Point]> = forced_branches.iter().map(|(_, p)| p.as_slice()).collect();
     plot(
         &docs.join("rotating-forced.svg"),
         &format!("Steady rotation with the pivot on a circle, R = {FORCED_RADIUS} L"),
