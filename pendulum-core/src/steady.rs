@@ -429,6 +429,30 @@ impl SteadyRotation {
         Ok(self.follow(start.clone(), tangent, omega_max, options))
     }
 
+    /// Every steady shape at angular speed `omega` (rad/s) on the given branches: where a
+    /// branch crosses `omega` between two of its points, Newton from the linear
+    /// interpolation of their angles; shapes closer than 1e-8 rad to one already found are
+    /// dropped (a branch traversed twice, or two branches of one component).
+    pub fn solutions_at(&self, branches: &[Branch], omega: f64) -> Vec<SteadyShape> {
+        let mut found: Vec<SteadyShape> = Vec::new();
+        for branch in branches {
+            for pair in branch.points.windows(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                if (a.omega - omega) * (b.omega - omega) > 0.0 || a.omega == b.omega {
+                    continue;
+                }
+                let s = (omega - a.omega) / (b.omega - a.omega);
+                let guess = &a.theta * (1.0 - s) + &b.theta * s;
+                if let Ok(shape) = self.solve(omega, &guess)
+                    && found.iter().all(|f| (&f.theta - &shape.theta).amax() > 1e-8)
+                {
+                    found.push(shape);
+                }
+            }
+        }
+        found
+    }
+
     /// The n × (n+1) Jacobian `[H, ∂F/∂p]` in an (n+1) × (n+1) matrix with a zero last row.
     fn bordered(&self, theta: &DVector<f64>, omega2: f64) -> DMatrix<f64> {
         let n = self.links();
@@ -608,6 +632,23 @@ mod tests {
         let last = branch.points.last().unwrap();
         assert_eq!(last.nodes(), 1);
         assert!(last.displacements.iter().all(|&x| x > 0.0));
+    }
+
+    #[test]
+    fn solutions_at_finds_each_branch_once() {
+        let p = uniform(6, 0.0);
+        let speeds = p.bifurcation_speeds(2).unwrap();
+        let opts = ContinuationOptions::default();
+        let branches: Vec<Branch> = (1..=2).map(|k| p.branch(k, 2.0 * speeds[1], &opts).unwrap()).collect();
+        // Between ω_1 and ω_2 only the one-node branch; above ω_2 both (the vertical
+        // itself is the first point of each branch and lies below).
+        let mid = p.solutions_at(&branches, 0.5 * (speeds[0] + speeds[1]));
+        assert_eq!(mid.iter().map(SteadyShape::nodes).collect::<Vec<_>>(), vec![1]);
+        let top = p.solutions_at(&[branches[0].clone(), branches[1].clone(), branches[1].clone()], 1.5 * speeds[1]);
+        assert_eq!(top.iter().map(SteadyShape::nodes).collect::<Vec<_>>(), vec![1, 2]);
+        for s in &top {
+            assert!(p.residual(&s.theta, s.omega * s.omega).norm() < 1e-10);
+        }
     }
 
     #[test]
