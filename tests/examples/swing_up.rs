@@ -16,14 +16,19 @@
 //! are collected from the continuation branches (`SteadyRotation::solutions_at`), and the
 //! nearest to the final shape (largest distance between corresponding masses) is the
 //! matching one; the table reports both node counts, that distance, and the out-of-plane
-//! lag (the inertial damping's doing: the undamped steady shape is planar).
+//! lag (the inertial damping's doing: the undamped steady shape is planar). Last, the
+//! exact damped relative equilibrium nearest the final shape (`relative_equilibrium`,
+//! Newton on the `Directions` model's own equations in the turning frame) gives the
+//! distance to the shape the damped chain should settle into, and the largest real part
+//! of its spectrum with the damping (`relative_spectrum`).
 
 use std::{error::Error, fmt::Write as _, fs, path::PathBuf};
 
 use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Branch, Chain, Circle, ContinuationOptions, Directions, SteadyRotation, SteadyShape, normal_modes, stability,
+    Branch, Chain, Circle, ContinuationOptions, Directions, SteadyRotation, SteadyShape, normal_modes,
+    relative_equilibrium, relative_spectrum, stability,
 };
 
 const LINKS: usize = 20;
@@ -68,6 +73,8 @@ struct Row {
     amplitude: f64,
     class: String,
     solutions: usize,
+    damped_distance: Option<f64>,
+    damped_growth: Option<f64>,
 }
 
 fn run(chain: &Chain<Dyn>, branches: &[Branch], omega: f64) -> Result<Row, Box<dyn Error>> {
@@ -114,14 +121,40 @@ fn run(chain: &Chain<Dyn>, branches: &[Branch], omega: f64) -> Result<Row, Box<d
             let class = match (st.spectrally_stable, st.index) {
                 (true, 0) => "stable".to_string(),
                 (true, i) => format!("gyroscopic (index {i})"),
-                (false, i) => format!("unstable (index {i})"),
+                (false, i) => format!("unstable (index {i}, growth {:.1e} 1/s)", st.growth_rate),
             };
             (Some(shape.nodes()), Some(d), class)
         }
         None => (None, None, "no steady shape on the branches".to_string()),
     };
     let solutions = candidates.len();
-    Ok(Row { omega, settled: drift < 1e-3, drift, nodes_sim, nodes_steady, distance, in_plane, lag, amplitude, class, solutions })
+    // The exact damped relative equilibrium nearest the final shape (Newton on the
+    // Directions model's own equations in the turning frame) and its spectrum.
+    let mut previous = Vector3::new(RADIUS, 0.0, 0.0);
+    let guess: Vec<(f64, f64)> = last
+        .iter()
+        .zip(chain.lengths().iter())
+        .map(|(r, l)| {
+            let u = (r - previous) / *l;
+            previous = *r;
+            (u.x.atan2(-u.z), u.y.clamp(-1.0, 1.0).asin())
+        })
+        .collect();
+    let (damped_distance, damped_growth) = match relative_equilibrium(&model, &guess) {
+        Ok(eq) => {
+            let mut r = Vector3::new(RADIUS, 0.0, 0.0);
+            let positions: Vec<Vector3<f64>> = (0..LINKS)
+                .map(|i| {
+                    r += chain.lengths()[i] * eq.state.fixed_rows::<3>(3 * i).into_owned();
+                    r
+                })
+                .collect();
+            let growth = relative_spectrum(&model, &eq)?.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+            (Some(max_distance(&positions, &last) / LENGTH), Some(growth))
+        }
+        Err(_) => (None, None),
+    };
+    Ok(Row { omega, settled: drift < 1e-3, drift, nodes_sim, nodes_steady, distance, in_plane, lag, amplitude, class, solutions, damped_distance, damped_growth })
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -160,10 +193,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     let fractions = [0.5, 0.9, 1.1, 1.3, 1.6, 2.0, 2.4, 2.6, 2.9, 3.2, 3.6, 4.0, 4.4, 4.8, 5.2];
     let mut table = String::from(
-        "| ω / sqrt(g/L) | ω (rad/s) | settled (drift / L) | nodes (sim) | steady shapes at ω | nodes (nearest) | distance / L | in-plane distance / L | out-of-plane lag / L | signed amplitude / L | nearest steady shape |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| ω / sqrt(g/L) | ω (rad/s) | settled (drift / L) | nodes (sim) | steady shapes at ω | nodes (nearest) | distance / L | in-plane distance / L | out-of-plane lag / L | signed amplitude / L | nearest steady shape | damped steady: distance / L | damped steady: growth (1/s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "omega_rad_s,settled,drift_over_L,nodes_sim,steady_solutions,nodes_steady,distance_over_L,in_plane_distance_over_L,lag_over_L,amplitude_over_L,steady_class\n",
+        "omega_rad_s,settled,drift_over_L,nodes_sim,steady_solutions,nodes_steady,distance_over_L,in_plane_distance_over_L,lag_over_L,amplitude_over_L,steady_class,damped_distance_over_L,damped_growth_rate_1_s\n",
     );
     for f in fractions {
         let omega = f * scale;
@@ -171,7 +204,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let opt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.2e}"));
         let _ = writeln!(
             table,
-            "| {f:.2} | {:.3} | {} ({:.1e}) | {} | {} | {} | {} | {} | {:.1e} | {:+.3} | {} |",
+            "| {f:.2} | {:.3} | {} ({:.1e}) | {} | {} | {} | {} | {} | {:.1e} | {:+.3} | {} | {} | {} |",
             r.omega,
             if r.settled { "yes" } else { "no" },
             r.drift,
@@ -182,11 +215,13 @@ fn main() -> Result<(), Box<dyn Error>> {
             opt(r.in_plane),
             r.lag,
             r.amplitude,
-            r.class
+            r.class,
+            opt(r.damped_distance),
+            r.damped_growth.map_or("–".to_string(), |g| format!("{g:+.2e}"))
         );
         let _ = writeln!(
             csv,
-            "{:.6},{},{:.3e},{},{},{},{},{},{:.3e},{:.6},{}",
+            "{:.6},{},{:.3e},{},{},{},{},{},{:.3e},{:.6},{},{},{}",
             r.omega,
             r.settled,
             r.drift,
@@ -197,7 +232,9 @@ fn main() -> Result<(), Box<dyn Error>> {
             r.in_plane.map_or(String::new(), |d| format!("{d:.3e}")),
             r.lag,
             r.amplitude,
-            r.class
+            r.class,
+            r.damped_distance.map_or(String::new(), |d| format!("{d:.3e}")),
+            r.damped_growth.map_or(String::new(), |g| format!("{g:.3e}"))
         );
         eprintln!("ω / sqrt(g/L) = {f}: done");
     }
