@@ -182,7 +182,11 @@ mod tests {
         assert_relative_eq!(modes.frequencies[1], ((2.0 + 2f64.sqrt()) * g_l).sqrt(), max_relative = 1e-13);
         // Shapes: θ2/θ1 = √2 (in phase) and −√2 (out of phase).
         assert_relative_eq!(modes.shapes[(1, 0)] / modes.shapes[(0, 0)], 2f64.sqrt(), max_relative = 1e-12);
-        assert_relative_eq!(modes.shapes[(1, 1)] / modes.shapes[(0, 1)], -(2f64.sqrt()), max_relative = 1e-12);
+        assert_relative_eq!(
+            modes.shapes[(1, 1)] / modes.shapes[(0, 1)],
+            -(2f64.sqrt()),
+            max_relative = 1e-12
+        );
         check_eigenpairs(&chain, &modes);
     }
 

@@ -108,12 +108,17 @@ fn residual(model: &Directions<U3, Circle>, angles: &[(f64, f64)]) -> Result<DVe
 /// [`Error::NonFinite`] for a non-finite guess, [`Error::SteadyNotConverged`] when Newton
 /// fails (e.g. `R = 0` without damping: the shape can turn freely about the axis and the
 /// Jacobian is singular).
-pub fn relative_equilibrium(model: &Directions<U3, Circle>, guess: &[(f64, f64)]) -> Result<RelativeEquilibrium> {
+pub fn relative_equilibrium(
+    model: &Directions<U3, Circle>,
+    guess: &[(f64, f64)],
+) -> Result<RelativeEquilibrium> {
     let n = model.links();
     if guess.len() != n {
         return Err(Error::LengthMismatch { what: "guess", expected: n, got: guess.len() });
     }
-    if let Some((index, v)) = guess.iter().flat_map(|&(a, b)| [a, b]).enumerate().find(|(_, v)| !v.is_finite()) {
+    if let Some((index, v)) =
+        guess.iter().flat_map(|&(a, b)| [a, b]).enumerate().find(|(_, v)| !v.is_finite())
+    {
         return Err(Error::NonFinite { what: "guess", index, value: v });
     }
     let omega = model.drive().angular_frequency();
@@ -125,7 +130,11 @@ pub fn relative_equilibrium(model: &Directions<U3, Circle>, guess: &[(f64, f64)]
         for j in 0..2 * n {
             let shift = |s: f64| {
                 let mut a = angles.clone();
-                if j % 2 == 0 { a[j / 2].0 += s } else { a[j / 2].1 += s }
+                if j % 2 == 0 {
+                    a[j / 2].0 += s
+                } else {
+                    a[j / 2].1 += s
+                }
                 a
             };
             let col = (residual(model, &shift(h))? - residual(model, &shift(-h))?) / (2.0 * h);
@@ -157,7 +166,10 @@ pub fn relative_equilibrium(model: &Directions<U3, Circle>, guess: &[(f64, f64)]
 ///
 /// Errors: those of the model's accelerations, [`Error::NotPositiveDefinite`] if the
 /// tangent basis is degenerate (cannot happen for unit directions).
-pub fn relative_spectrum(model: &Directions<U3, Circle>, eq: &RelativeEquilibrium) -> Result<Vec<Complex<f64>>> {
+pub fn relative_spectrum(
+    model: &Directions<U3, Circle>,
+    eq: &RelativeEquilibrium,
+) -> Result<Vec<Complex<f64>>> {
     let n = model.links();
     let x0 = &eq.state;
     // Tangent basis: per link (δu, δw) = (t_k, −(t_k·w) u) and (0, t_k), k = 1, 2.

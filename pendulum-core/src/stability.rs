@@ -128,7 +128,11 @@ pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation
 ///
 /// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
 /// [`Error::NotPositiveDefinite`] if `M` fails to factor.
-pub fn stability(problem: &SteadyRotation, shape: &SteadyShape, damping: Option<&[f64]>) -> Result<Stability> {
+pub fn stability(
+    problem: &SteadyRotation,
+    shape: &SteadyShape,
+    damping: Option<&[f64]>,
+) -> Result<Stability> {
     let n = problem.links();
     let lin = linearise(problem, shape);
     let mut friction = lin.gyroscopic.clone();

@@ -140,7 +140,11 @@ impl SteadyRotation {
         DefaultAllocator: Allocator<L>,
     {
         if chain.gravity() <= 0.0 {
-            return Err(Error::InvalidSteady { what: "gravity", requirement: "positive", value: chain.gravity() });
+            return Err(Error::InvalidSteady {
+                what: "gravity",
+                requirement: "positive",
+                value: chain.gravity(),
+            });
         }
         if !(radius.is_finite() && radius >= 0.0) {
             return Err(Error::InvalidSteady {
@@ -254,7 +258,11 @@ impl SteadyRotation {
         if omega.is_finite() && omega >= 0.0 {
             Ok(())
         } else {
-            Err(Error::InvalidSteady { what: "angular speed", requirement: "finite and non-negative", value: omega })
+            Err(Error::InvalidSteady {
+                what: "angular speed",
+                requirement: "finite and non-negative",
+                value: omega,
+            })
         }
     }
 
@@ -322,7 +330,11 @@ impl SteadyRotation {
     pub fn unstable_directions_at_vertical(&self, omega: f64) -> usize {
         let zero = DVector::zeros(self.links());
         let scale = self.force_scale();
-        self.hessian(&zero, omega * omega).symmetric_eigenvalues().iter().filter(|&&v| v < -1e-13 * scale).count()
+        self.hessian(&zero, omega * omega)
+            .symmetric_eigenvalues()
+            .iter()
+            .filter(|&&v| v < -1e-13 * scale)
+            .count()
     }
 
     /// The first `count` speeds (rad/s, ascending) where a branch leaves the vertical:
@@ -384,9 +396,10 @@ impl SteadyRotation {
         let n = self.links();
         let zero = DVector::zeros(n);
         let eigen = self.hessian(&zero, omega_k * omega_k).symmetric_eigen();
-        let (null, _) = eigen.eigenvalues.iter().enumerate().fold((0, f64::INFINITY), |(bi, bv), (i, v)| {
-            if v.abs() < bv { (i, v.abs()) } else { (bi, bv) }
-        });
+        let (null, _) =
+            eigen.eigenvalues.iter().enumerate().fold((0, f64::INFINITY), |(bi, bv), (i, v)| {
+                if v.abs() < bv { (i, v.abs()) } else { (bi, bv) }
+            });
         let mut v: DVector<f64> = eigen.eigenvectors.column(null).into_owned();
         let end_x: f64 = v.iter().zip(&self.lengths).map(|(a, l)| a * l).sum();
         if end_x < 0.0 {
@@ -464,7 +477,13 @@ impl SteadyRotation {
     }
 
     /// Pseudo-arclength continuation from `start` along `tangent` (unit, in `(θ, p)`).
-    fn follow(&self, start: SteadyShape, mut tangent: DVector<f64>, omega_max: f64, o: &ContinuationOptions) -> Branch {
+    fn follow(
+        &self,
+        start: SteadyShape,
+        mut tangent: DVector<f64>,
+        omega_max: f64,
+        o: &ContinuationOptions,
+    ) -> Branch {
         let n = self.links();
         let s2 = self.scale * self.scale;
         let mut y = DVector::zeros(n + 1);
@@ -496,7 +515,8 @@ impl SteadyRotation {
                 }
                 z += &step;
                 if step.amax() < NEWTON_STEP_TOL
-                    || (step.amax() < 1e-9 && self.residual(&z.rows(0, n).into_owned(), z[n] * s2).norm() < 1e-12 * scale)
+                    || (step.amax() < 1e-9
+                        && self.residual(&z.rows(0, n).into_owned(), z[n] * s2).norm() < 1e-12 * scale)
                 {
                     // New tangent from the converged Jacobian, oriented along the old one.
                     let mut b = self.bordered(&z.rows(0, n).into_owned(), z[n] * s2);
@@ -562,7 +582,9 @@ mod tests {
 
     #[test]
     fn hessian_is_the_jacobian_of_the_residual() {
-        let p = SteadyRotation::new(&Chain::<Dyn>::new(&[0.3, 1.2, 0.7], &[0.5, 0.2, 0.9], 9.81).unwrap(), 0.1).unwrap();
+        let p =
+            SteadyRotation::new(&Chain::<Dyn>::new(&[0.3, 1.2, 0.7], &[0.5, 0.2, 0.9], 9.81).unwrap(), 0.1)
+                .unwrap();
         let theta = DVector::from_vec(vec![0.4, -0.9, 1.3]);
         let omega2 = 7.5;
         let h = p.hessian(&theta, omega2);
@@ -588,8 +610,8 @@ mod tests {
         let p = SteadyRotation::new(&chain, 0.0).unwrap();
         let speeds = p.bifurcation_speeds(4).unwrap();
         let modes = crate::normal_modes(&chain);
-        for k in 0..4 {
-            assert_relative_eq!(speeds[k], modes.frequencies[k], max_relative = 1e-11);
+        for (speed, mode) in speeds.iter().zip(modes.frequencies.iter()) {
+            assert_relative_eq!(*speed, *mode, max_relative = 1e-11);
         }
     }
 
@@ -644,7 +666,8 @@ mod tests {
         // itself is the first point of each branch and lies below).
         let mid = p.solutions_at(&branches, 0.5 * (speeds[0] + speeds[1]));
         assert_eq!(mid.iter().map(SteadyShape::nodes).collect::<Vec<_>>(), vec![1]);
-        let top = p.solutions_at(&[branches[0].clone(), branches[1].clone(), branches[1].clone()], 1.5 * speeds[1]);
+        let top =
+            p.solutions_at(&[branches[0].clone(), branches[1].clone(), branches[1].clone()], 1.5 * speeds[1]);
         assert_eq!(top.iter().map(SteadyShape::nodes).collect::<Vec<_>>(), vec![1, 2]);
         for s in &top {
             assert!(p.residual(&s.theta, s.omega * s.omega).norm() < 1e-10);
@@ -667,7 +690,10 @@ mod tests {
             p.solve(1.0, &DVector::zeros(3)),
             Err(Error::LengthMismatch { what: "theta", expected: 2, got: 3 })
         ));
-        assert!(matches!(p.branch(0, 1.0, &ContinuationOptions::default()), Err(Error::InvalidSteady { .. })));
+        assert!(matches!(
+            p.branch(0, 1.0, &ContinuationOptions::default()),
+            Err(Error::InvalidSteady { .. })
+        ));
         let forced = SteadyRotation::new(&chain, 0.1).unwrap();
         assert!(matches!(forced.bifurcation_speeds(1), Err(Error::InvalidSteady { .. })));
     }

@@ -77,15 +77,25 @@ fn classify(problem: &SteadyRotation, branch: &Branch, signed: bool) -> Result<V
             let amplitude = if signed { signed_amplitude(s) } else { s.amplitude() };
             // A bifurcation point (on the vertical) takes the node count of its branch.
             let shown = if s.amplitude() == 0.0 { branch.points.get(i + 1).unwrap_or(s) } else { s };
-            Ok(Point { omega: s.omega, amplitude, nodes: shown.nodes(), growth: st.growth_rate, index: st.index, class })
+            Ok(Point {
+                omega: s.omega,
+                amplitude,
+                nodes: shown.nodes(),
+                growth: st.growth_rate,
+                index: st.index,
+                class,
+            })
         })
         .collect()
 }
 
+/// A stretch of a branch: class, node count, points (ω / sqrt(g/L), amplitude / L).
+type Run = (Class, usize, Vec<(f64, f64)>);
+
 /// Runs of consecutive points of one class and node count (each run shares its end
 /// point with the next).
-fn runs(points: &[Point]) -> Vec<(Class, usize, Vec<(f64, f64)>)> {
-    let mut out: Vec<(Class, usize, Vec<(f64, f64)>)> = Vec::new();
+fn runs(points: &[Point]) -> Vec<Run> {
+    let mut out: Vec<Run> = Vec::new();
     let scale = (GRAVITY / LENGTH).sqrt();
     for p in points {
         let xy = (p.omega / scale, p.amplitude / LENGTH);
@@ -131,7 +141,13 @@ fn csv(rows: &[(String, &[Point])]) -> String {
 }
 
 fn colour(k: usize) -> RGBColor {
-    [RGBColor(0, 90, 181), RGBColor(220, 50, 32), RGBColor(0, 140, 70), RGBColor(120, 80, 160), RGBColor(230, 150, 0)][(k + 4) % 5]
+    [
+        RGBColor(0, 90, 181),
+        RGBColor(220, 50, 32),
+        RGBColor(0, 140, 70),
+        RGBColor(120, 80, 160),
+        RGBColor(230, 150, 0),
+    ][(k + 4) % 5]
 }
 
 fn plot(
@@ -237,7 +253,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let radius = FORCED_RADIUS * LENGTH;
     let forced = SteadyRotation::new(&chain, radius)?;
     let mut forced_branches: Vec<(String, Vec<Point>)> = Vec::new();
-    let from_rest = forced.continue_from(&forced.solve(0.0, &DVector::zeros(LINKS))?, true, omega_max, &opts)?;
+    let from_rest =
+        forced.continue_from(&forced.solve(0.0, &DVector::zeros(LINKS))?, true, omega_max, &opts)?;
     let points = classify(&forced, &from_rest, true)?;
     println!("forced R = {radius} m, from rest: {} points, end {:?}", points.len(), from_rest.end);
     println!("        in units of sqrt(g/L): {}", stretches(&points));
@@ -253,7 +270,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             forced_branches.push((name, points));
         }
     }
-    let rows: Vec<(String, &[Point])> = forced_branches.iter().map(|(n, p)| (n.clone(), p.as_slice())).collect();
+    let rows: Vec<(String, &[Point])> =
+        forced_branches.iter().map(|(n, p)| (n.clone(), p.as_slice())).collect();
     fs::write(docs.join("data/rotating-forced.csv"), csv(&rows))?;
     let forced_plot: Vec<&[Point]> = forced_branches.iter().map(|(_, p)| p.as_slice()).collect();
     plot(

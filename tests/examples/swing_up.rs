@@ -47,9 +47,18 @@ const SETTLE_WINDOW: f64 = 10.0;
 const STEP: f64 = 1e-3;
 
 /// Positions in the frame rotating with the pivot.
-fn rotating_positions(model: &Directions<U3, Circle>, t: f64, x: &DVector<f64>, omega: f64) -> Vec<Vector3<f64>> {
+fn rotating_positions(
+    model: &Directions<U3, Circle>,
+    t: f64,
+    x: &DVector<f64>,
+    omega: f64,
+) -> Vec<Vector3<f64>> {
     let (s, c) = (omega * t).sin_cos();
-    model.positions(t, x).into_iter().map(|r| Vector3::new(c * r.x + s * r.y, -s * r.x + c * r.y, r.z)).collect()
+    model
+        .positions(t, x)
+        .into_iter()
+        .map(|r| Vector3::new(c * r.x + s * r.y, -s * r.x + c * r.y, r.z))
+        .collect()
 }
 
 fn max_distance(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
@@ -149,12 +158,27 @@ fn run(chain: &Chain<Dyn>, branches: &[Branch], omega: f64) -> Result<Row, Box<d
                     r
                 })
                 .collect();
-            let growth = relative_spectrum(&model, &eq)?.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+            let growth =
+                relative_spectrum(&model, &eq)?.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
             (Some(max_distance(&positions, &last) / LENGTH), Some(growth))
         }
         Err(_) => (None, None),
     };
-    Ok(Row { omega, settled: drift < 1e-3, drift, nodes_sim, nodes_steady, distance, in_plane, lag, amplitude, class, solutions, damped_distance, damped_growth })
+    Ok(Row {
+        omega,
+        settled: drift < 1e-3,
+        drift,
+        nodes_sim,
+        nodes_steady,
+        distance,
+        in_plane,
+        lag,
+        amplitude,
+        class,
+        solutions,
+        damped_distance,
+        damped_growth,
+    })
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -183,7 +207,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let opts = ContinuationOptions::default();
     let free = SteadyRotation::new(&chain, 0.0)?;
     let forced = SteadyRotation::new(&chain, RADIUS)?;
-    let mut branches = vec![forced.continue_from(&forced.solve(0.0, &DVector::zeros(LINKS))?, true, omega_max, &opts)?];
+    let mut branches =
+        vec![forced.continue_from(&forced.solve(0.0, &DVector::zeros(LINKS))?, true, omega_max, &opts)?];
     for k in 1..=4 {
         let end = free.branch(k, omega_max, &opts)?.points.pop().expect("branches have points");
         for sign in [1.0, -1.0] {

@@ -16,7 +16,13 @@ fn bifurcation_speeds_match_kolodner_at_100_links() {
     for k in 0..3 {
         let kolodner = 0.5 * J0_ZEROS[k] * (g / length).sqrt();
         let err = (speeds[k] - kolodner) / kolodner;
-        println!("k = {}: ω = {:.6} rad/s, Kolodner {:.6} rad/s, error {:+.3e}", k + 1, speeds[k], kolodner, err);
+        println!(
+            "k = {}: ω = {:.6} rad/s, Kolodner {:.6} rad/s, error {:+.3e}",
+            k + 1,
+            speeds[k],
+            kolodner,
+            err
+        );
         assert!(err.abs() < 0.01, "k = {}: error {err}", k + 1);
     }
 }
@@ -33,7 +39,10 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
         let pts = &branch.points[1..];
         assert!(pts.iter().all(|s| s.nodes() == k && s.omega > speeds[k - 1]), "k = {k}");
         // Amplitude grows with speed along the branch (no fold for the free chain).
-        assert!(pts.windows(2).all(|w| w[1].omega > w[0].omega && w[1].amplitude() > w[0].amplitude()), "k = {k}");
+        assert!(
+            pts.windows(2).all(|w| w[1].omega > w[0].omega && w[1].amplitude() > w[0].amplitude()),
+            "k = {k}"
+        );
     }
     // Only the one-node branch is stable; the others have directions of descent of the
     // amended potential.
@@ -44,10 +53,19 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
 
 /// The spatial (θ, φ) model state of a steady shape at t = 0: polar angle `|θ_i|`,
 /// azimuth 0 or π by the sign of `θ_i`, rates `(0, ω)`.
-fn spatial_state(theta: &nalgebra::DVector<f64>, omega: f64) -> (nalgebra::DVector<f64>, nalgebra::DVector<f64>) {
+fn spatial_state(
+    theta: &nalgebra::DVector<f64>,
+    omega: f64,
+) -> (nalgebra::DVector<f64>, nalgebra::DVector<f64>) {
     let n = theta.len();
     let q = nalgebra::DVector::from_fn(2 * n, |i, _| {
-        if i < n { theta[i].abs() } else if theta[i - n] < 0.0 { std::f64::consts::PI } else { 0.0 }
+        if i < n {
+            theta[i].abs()
+        } else if theta[i - n] < 0.0 {
+            std::f64::consts::PI
+        } else {
+            0.0
+        }
     });
     let qd = nalgebra::DVector::from_fn(2 * n, |i, _| if i < n { 0.0 } else { omega });
     (q, qd)
@@ -121,6 +139,9 @@ fn rotating_frame_spectrum_matches_the_spatial_model_jacobian() {
             assert!(d < 1e-5 * scale, "k = {k}: eigenvalue {z} has no spatial partner (nearest {d:e})");
         }
         let st = if ours.spectrally_stable { "spectrally stable" } else { "unstable" };
-        println!("k = {k}, ω = {:.4}: growth {:.3e}, index {}, {st}", shape.omega, ours.growth_rate, ours.index);
+        println!(
+            "k = {k}, ω = {:.4}: growth {:.3e}, index {}, {st}",
+            shape.omega, ours.growth_rate, ours.index
+        );
     }
 }
