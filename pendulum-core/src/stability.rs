@@ -84,7 +84,6 @@ impl Stability {
 pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation {
     let n = problem.links();
     let (m, l, tails) = problem.parameters();
-    let _ = m;
     let g = problem.gravity();
     let omega = shape.omega;
     let w2 = omega * omega;
@@ -93,7 +92,7 @@ pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation
     let mut s = vec![0.0; n];
     let mut acc = 0.0;
     for i in (0..n).rev() {
-        acc += problem.parameters().0[i] * shape.displacements[i];
+        acc += m[i] * shape.displacements[i];
         s[i] = acc;
     }
     let w = |a: usize, b: usize| tails[a.max(b)] * l[a] * l[b];

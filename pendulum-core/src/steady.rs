@@ -636,8 +636,7 @@ mod tests {
         let p = uniform(5, 1e-6);
         let omega = 0.5 * p.reference_speed();
         let s = p.solve(omega, &DVector::zeros(5)).unwrap();
-        let (m, l, tails) = p.parameters();
-        let _ = m;
+        let (_, l, tails) = p.parameters();
         let h0 = p.hessian(&DVector::zeros(5), omega * omega);
         let rhs = DVector::from_fn(5, |d, _| omega * omega * 1e-6 * tails[d] * l[d]);
         let linear = h0.lu().solve(&rhs).unwrap();
