@@ -6,7 +6,9 @@
 //! cargo run --release -p pendulum-tests --example swing_up
 //! ```
 //!
-//! prints the sweep table (Markdown) and writes `docs/data/swing-up.csv`. The chain is
+//! prints the sweep tables (Markdown) and writes `docs/data/swing-up.csv`. Two sweeps:
+//! the drive switched on at full speed ("sudden"), and its speed ramped linearly from 0
+//! over `RAMP` seconds then held ("ramp"); both run `DURATION` seconds in all. The chain is
 //! simulated in unit link directions (`Directions<U3, Circle>`, RK4 + projection), in
 //! the inertial frame, with the damping of the chain's Rayleigh function
 //! (`D = ½ Σ λ |u̇_i|²`, inertial rates). At the end the positions are turned into the
@@ -27,8 +29,8 @@ use std::{error::Error, fmt::Write as _, fs, path::PathBuf};
 use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Branch, Chain, Circle, ContinuationOptions, Directions, SteadyRotation, SteadyShape, normal_modes,
-    relative_equilibrium, relative_spectrum, stability,
+    Branch, Chain, Circle, ContinuationOptions, Directions, Drive, FnDrive, SteadyRotation, SteadyShape,
+    normal_modes, relative_equilibrium, relative_spectrum, stability,
 };
 
 const LINKS: usize = 20;
@@ -45,20 +47,49 @@ const DURATION: f64 = 600.0;
 const SETTLE_WINDOW: f64 = 10.0;
 /// RK4 step, s.
 const STEP: f64 = 1e-3;
+/// Length of the linear speed ramp of the second sweep, s.
+const RAMP: f64 = 200.0;
 
-/// Positions in the frame rotating with the pivot.
-fn rotating_positions(
-    model: &Directions<U3, Circle>,
+/// Positions in the frame turned by `angle` about z (the pivot's phase).
+fn rotating_positions<Dr: Drive<U3>>(
+    model: &Directions<U3, Dr>,
     t: f64,
     x: &DVector<f64>,
-    omega: f64,
+    angle: f64,
 ) -> Vec<Vector3<f64>> {
-    let (s, c) = (omega * t).sin_cos();
+    let (s, c) = angle.sin_cos();
     model
         .positions(t, x)
         .into_iter()
         .map(|r| Vector3::new(c * r.x + s * r.y, -s * r.x + c * r.y, r.z))
         .collect()
+}
+
+/// Integrate from hanging at rest for `DURATION`; the rotating-frame positions
+/// `SETTLE_WINDOW` before the end and at the end (`phase(t)` the pivot's phase).
+fn simulate<Dr: Drive<U3>>(
+    model: &Directions<U3, Dr>,
+    phase: impl Fn(f64) -> f64,
+) -> Result<(Vec<Vector3<f64>>, Vec<Vector3<f64>>), Box<dyn Error>> {
+    let mut state = State::new(0.0, model.hanging());
+    let mut solver = Projected::new(Rk4::new(model));
+    let steps = (DURATION / STEP).round() as usize;
+    let window = (SETTLE_WINDOW / STEP).round() as usize;
+    let mut before = Vec::new();
+    for k in 0..steps {
+        if k == steps - window {
+            before = rotating_positions(model, state.t(), state.x(), phase(state.t()));
+        }
+        solver.step(model, &mut state, STEP)?;
+    }
+    let last = rotating_positions(model, state.t(), state.x(), phase(state.t()));
+    Ok((before, last))
+}
+
+/// The pivot's phase when its angular speed ramps linearly from 0 to `omega` over `ramp`
+/// seconds and then holds: `φ = ω t² / (2 T)` for `t < T`, `ω (t − T/2)` after.
+fn ramp_phase(omega: f64, ramp: f64) -> impl Fn(f64) -> f64 + Copy {
+    move |t| if t < ramp { 0.5 * omega * t * t / ramp } else { omega * (t - 0.5 * ramp) }
 }
 
 fn max_distance(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
@@ -86,20 +117,37 @@ struct Row {
     damped_growth: Option<f64>,
 }
 
-fn run(chain: &Chain<Dyn>, branches: &[Branch], omega: f64) -> Result<Row, Box<dyn Error>> {
+fn run(
+    chain: &Chain<Dyn>,
+    branches: &[Branch],
+    omega: f64,
+    ramp: Option<f64>,
+) -> Result<Row, Box<dyn Error>> {
+    // The model with the steady circle: simulated directly, and used for the analysis.
     let model = Directions::<U3>::new(chain.clone()).with_drive(Circle::new(RADIUS, omega)?);
-    let mut state = State::new(0.0, model.hanging());
-    let mut solver = Projected::new(Rk4::new(&model));
-    let steps = (DURATION / STEP).round() as usize;
-    let window = (SETTLE_WINDOW / STEP).round() as usize;
-    let mut before = Vec::new();
-    for k in 0..steps {
-        if k == steps - window {
-            before = rotating_positions(&model, state.t(), state.x(), omega);
+    let (before, last) = match ramp {
+        None => simulate(&model, |t| omega * t)?,
+        Some(ramp) => {
+            let phase = ramp_phase(omega, ramp);
+            let rate = move |t: f64| if t < ramp { omega * t / ramp } else { omega };
+            let spin = move |t: f64| if t < ramp { omega / ramp } else { 0.0 };
+            let drive = FnDrive::new(
+                move |t: f64| {
+                    let (s, c) = phase(t).sin_cos();
+                    Vector3::new(c, s, 0.0) * RADIUS
+                },
+                move |t: f64| {
+                    let (s, c) = phase(t).sin_cos();
+                    Vector3::new(-s, c, 0.0) * (RADIUS * rate(t))
+                },
+                move |t: f64| {
+                    let (s, c) = phase(t).sin_cos();
+                    (Vector3::new(-s, c, 0.0) * spin(t) - Vector3::new(c, s, 0.0) * rate(t).powi(2)) * RADIUS
+                },
+            );
+            simulate(&Directions::<U3>::new(chain.clone()).with_drive(drive), phase)?
         }
-        solver.step(&model, &mut state, STEP)?;
-    }
-    let last = rotating_positions(&model, state.t(), state.x(), omega);
+    };
     let drift = max_distance(&before, &last) / LENGTH;
     let sim_x: Vec<f64> = last.iter().map(|r| r.x).collect();
     let nodes_sim = 1 + pendulum_core::sign_changes(&sim_x);
@@ -217,53 +265,58 @@ fn main() -> Result<(), Box<dyn Error>> {
         }
     }
     let fractions = [0.5, 0.9, 1.1, 1.3, 1.6, 2.0, 2.4, 2.6, 2.9, 3.2, 3.6, 4.0, 4.4, 4.8, 5.2];
-    let mut table = String::from(
+    let header = String::from(
         "| ω / sqrt(g/L) | ω (rad/s) | settled (drift / L) | nodes (sim) | steady shapes at ω | nodes (nearest) | distance / L | in-plane distance / L | out-of-plane lag / L | signed amplitude / L | nearest steady shape | damped steady: distance / L | damped steady: growth (1/s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "omega_rad_s,settled,drift_over_L,nodes_sim,steady_solutions,nodes_steady,distance_over_L,in_plane_distance_over_L,lag_over_L,amplitude_over_L,steady_class,damped_distance_over_L,damped_growth_rate_1_s\n",
+        "start,omega_rad_s,settled,drift_over_L,nodes_sim,steady_solutions,nodes_steady,distance_over_L,in_plane_distance_over_L,lag_over_L,amplitude_over_L,steady_class,damped_distance_over_L,damped_growth_rate_1_s\n",
     );
-    for f in fractions {
-        let omega = f * scale;
-        let r = run(&chain, &branches, omega)?;
-        let opt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.2e}"));
-        let _ = writeln!(
-            table,
-            "| {f:.2} | {:.3} | {} ({:.1e}) | {} | {} | {} | {} | {} | {:.1e} | {:+.3} | {} | {} | {} |",
-            r.omega,
-            if r.settled { "yes" } else { "no" },
-            r.drift,
-            r.nodes_sim,
-            r.solutions,
-            r.nodes_steady.map_or("–".to_string(), |n| n.to_string()),
-            opt(r.distance),
-            opt(r.in_plane),
-            r.lag,
-            r.amplitude,
-            r.class,
-            opt(r.damped_distance),
-            r.damped_growth.map_or("–".to_string(), |g| format!("{g:+.2e}"))
-        );
-        let _ = writeln!(
-            csv,
-            "{:.6},{},{:.3e},{},{},{},{},{},{:.3e},{:.6},{},{},{}",
-            r.omega,
-            r.settled,
-            r.drift,
-            r.nodes_sim,
-            r.solutions,
-            r.nodes_steady.map_or(String::new(), |n| n.to_string()),
-            r.distance.map_or(String::new(), |d| format!("{d:.3e}")),
-            r.in_plane.map_or(String::new(), |d| format!("{d:.3e}")),
-            r.lag,
-            r.amplitude,
-            r.class,
-            r.damped_distance.map_or(String::new(), |d| format!("{d:.3e}")),
-            r.damped_growth.map_or(String::new(), |g| format!("{g:.3e}"))
-        );
-        eprintln!("ω / sqrt(g/L) = {f}: done");
+    for ramp in [None, Some(RAMP)] {
+        let start = ramp.map_or("sudden".to_string(), |t| format!("ramp {t} s"));
+        let mut table = header.clone();
+        for f in fractions {
+            let omega = f * scale;
+            let r = run(&chain, &branches, omega, ramp)?;
+            let opt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.2e}"));
+            let _ = writeln!(
+                table,
+                "| {f:.2} | {:.3} | {} ({:.1e}) | {} | {} | {} | {} | {} | {:.1e} | {:+.3} | {} | {} | {} |",
+                r.omega,
+                if r.settled { "yes" } else { "no" },
+                r.drift,
+                r.nodes_sim,
+                r.solutions,
+                r.nodes_steady.map_or("–".to_string(), |n| n.to_string()),
+                opt(r.distance),
+                opt(r.in_plane),
+                r.lag,
+                r.amplitude,
+                r.class,
+                opt(r.damped_distance),
+                r.damped_growth.map_or("–".to_string(), |g| format!("{g:+.2e}"))
+            );
+            let _ = writeln!(
+                csv,
+                "{start},{:.6},{},{:.3e},{},{},{},{},{},{:.3e},{:.6},{},{},{}",
+                r.omega,
+                r.settled,
+                r.drift,
+                r.nodes_sim,
+                r.solutions,
+                r.nodes_steady.map_or(String::new(), |n| n.to_string()),
+                r.distance.map_or(String::new(), |d| format!("{d:.3e}")),
+                r.in_plane.map_or(String::new(), |d| format!("{d:.3e}")),
+                r.lag,
+                r.amplitude,
+                r.class,
+                r.damped_distance.map_or(String::new(), |d| format!("{d:.3e}")),
+                r.damped_growth.map_or(String::new(), |g| format!("{g:.3e}"))
+            );
+            eprintln!("{start}, ω / sqrt(g/L) = {f}: done");
+        }
+        println!("\nstart: {start}");
+        print!("{table}");
     }
-    print!("{table}");
     fs::create_dir_all(docs.join("data"))?;
     fs::write(docs.join("data/swing-up.csv"), csv)?;
     println!("wrote docs/data/swing-up.csv");

@@ -46,7 +46,8 @@ fn driven_damped_chain_settles_onto_the_relative_equilibrium() {
         .fold(0.0, f64::max);
     println!("ω = {omega:.4} rad/s: distance {distance:.2e} m, angles {:?}", eq.angles);
     assert!(distance < 1e-5, "distance to the relative equilibrium {distance} m");
-    let growth = relative_spectrum(&model, &eq).unwrap().iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let growth =
+        relative_spectrum(&model, &eq).unwrap().iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
     println!("growth rate {growth:.3e} 1/s");
     assert!(growth < 0.0, "the equilibrium it settled on has growth rate {growth}");
     // Its in-plane shape is close to an undamped forced steady shape with the same nodes.
