@@ -53,6 +53,8 @@ struct Point {
     amplitude: f64,
     nodes: usize,
     growth: f64,
+    /// |Im| of the eigenvalue with the largest real part, rad/s.
+    growth_frequency: f64,
     index: usize,
     class: Class,
 }
@@ -74,6 +76,8 @@ fn classify(problem: &SteadyRotation, branch: &Branch, signed: bool) -> Result<V
                 (true, _) => Class::Gyroscopic,
                 (false, _) => Class::Unstable,
             };
+            let worst =
+                st.eigenvalues.iter().max_by(|a, b| a.re.total_cmp(&b.re)).map_or(0.0, |z| z.im.abs());
             let amplitude = if signed { signed_amplitude(s) } else { s.amplitude() };
             // A bifurcation point (on the vertical) takes the node count of its branch.
             let shown = if s.amplitude() == 0.0 { branch.points.get(i + 1).unwrap_or(s) } else { s };
@@ -82,6 +86,7 @@ fn classify(problem: &SteadyRotation, branch: &Branch, signed: bool) -> Result<V
                 amplitude,
                 nodes: shown.nodes(),
                 growth: st.growth_rate,
+                growth_frequency: worst,
                 index: st.index,
                 class,
             })
@@ -122,16 +127,19 @@ fn stretches(points: &[Point]) -> String {
 }
 
 fn csv(rows: &[(String, &[Point])]) -> String {
-    let mut out = String::from("branch,omega_rad_s,amplitude_m,nodes,growth_rate_1_s,index,class\n");
+    let mut out = String::from(
+        "branch,omega_rad_s,amplitude_m,nodes,growth_rate_1_s,growth_frequency_rad_s,index,class\n",
+    );
     for (name, points) in rows {
         for p in points.iter() {
             let _ = writeln!(
                 out,
-                "{name},{:.9},{:.9},{},{:.3e},{},{}",
+                "{name},{:.9},{:.9},{},{:.3e},{:.4},{},{}",
                 p.omega,
                 p.amplitude,
                 p.nodes,
                 p.growth,
+                p.growth_frequency,
                 p.index,
                 p.class.name()
             );
