@@ -65,12 +65,15 @@ fn rotating_positions<Dr: Drive<U3>>(
         .collect()
 }
 
+/// Mass positions, m.
+type Shape = Vec<Vector3<f64>>;
+
 /// Integrate from hanging at rest for `DURATION`; the rotating-frame positions
 /// `SETTLE_WINDOW` before the end and at the end (`phase(t)` the pivot's phase).
 fn simulate<Dr: Drive<U3>>(
     model: &Directions<U3, Dr>,
     phase: impl Fn(f64) -> f64,
-) -> Result<(Vec<Vector3<f64>>, Vec<Vector3<f64>>), Box<dyn Error>> {
+) -> Result<(Shape, Shape), Box<dyn Error>> {
     let mut state = State::new(0.0, model.hanging());
     let mut solver = Projected::new(Rk4::new(model));
     let steps = (DURATION / STEP).round() as usize;
