@@ -4,7 +4,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, U1, allocator::Allocator};
 
-use super::gauss::extrapolate_stages;
+use super::gauss::{complete_step, extrapolate_stages};
 use super::{GaussStages, Integrator, State, Stats, System, SystemAlloc, check_step};
 use crate::{Error, Result};
 
@@ -169,18 +169,9 @@ where
             self.stats.failed_steps += 1;
             return Err(e);
         }
-        let b = S::TABLEAU.b;
-        for r in 0..self.dim.value() {
-            self.increment[r] = h * (0..S::dim()).map(|i| b[i] * self.k[(r, i)]).sum::<f64>();
-        }
-        if !self.increment.iter().all(|v| v.is_finite()) {
-            self.stats.failed_steps += 1;
-            return Err(Error::NonFiniteState { t, h });
-        }
-        state.advance(h, &self.increment);
+        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats)?;
         self.x_end.copy_from(state.x());
         self.previous = Some((state.t(), h));
-        self.stats.steps += 1;
         Ok(())
     }
 

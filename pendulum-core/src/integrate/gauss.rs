@@ -389,6 +389,33 @@ where
     }
 }
 
+/// Completes a Gauss step from its stage derivatives `k` (one column per stage):
+/// `x_{n+1} − x_n = h Σ_i b_i k_i` (eq 55), added to `state` with compensated summation.
+/// A non-finite increment leaves the state unchanged and is [`Error::NonFiniteState`];
+/// the step is counted either way.
+pub(super) fn complete_step<D: Dim, S: GaussStages>(
+    k: &OMatrix<f64, D, S>,
+    h: f64,
+    increment: &mut OVector<f64, D>,
+    state: &mut State<D>,
+    stats: &mut Stats,
+) -> Result<()>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, S>,
+{
+    let b = S::TABLEAU.b;
+    for r in 0..increment.len() {
+        increment[r] = h * (0..S::dim()).map(|i| b[i] * k[(r, i)]).sum::<f64>();
+    }
+    if !increment.iter().all(|v| v.is_finite()) {
+        stats.failed_steps += 1;
+        return Err(Error::NonFiniteState { t: state.t(), h });
+    }
+    state.advance(h, increment);
+    stats.steps += 1;
+    Ok(())
+}
+
 /// Continues a Gauss step's collocation polynomial `u(τ)` (degree `s`, `u(0) = 0`,
 /// `u(c_i) = Z_i^prev`, `τ` in units of the previous step) to the nodes of the next step,
 /// `h = ratio · h_prev`: `Z_j = u(1 + c_j ratio) − u(1)`, error `O(h^{s+1})`. `z` holds the
@@ -439,20 +466,9 @@ where
             self.stats.failed_steps += 1;
             return Err(e);
         }
-        // x_{n+1} − x_n = h Σ_i b_i k_i (eq 55).
-        let b = S::TABLEAU.b;
-        for r in 0..self.dim.value() {
-            let sum: f64 = (0..S::dim()).map(|i| b[i] * self.k[(r, i)]).sum();
-            self.increment[r] = h * sum;
-        }
-        if !self.increment.iter().all(|v| v.is_finite()) {
-            self.stats.failed_steps += 1;
-            return Err(Error::NonFiniteState { t, h });
-        }
-        state.advance(h, &self.increment);
+        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats)?;
         self.x_end.copy_from(state.x());
         self.previous = Some((state.t(), h));
-        self.stats.steps += 1;
         Ok(())
     }
 
