@@ -43,6 +43,67 @@ pub enum Command {
     /// come from the O(n) rod-tension solve, spatial ones from the spherical-angle model
     /// (singular where a link points straight down or up).
     Eval(EvalArgs),
+    /// Normal modes of the chain hanging at rest: a table of angular frequencies, periods
+    /// and node counts (with Bernoulli's continuum frequencies for a uniform chain), and
+    /// modes.csv and modes.png (the mode shapes) in the output directory.
+    Modes(ModesArgs),
+    /// Steady rotation about the vertical: the branches of shapes that turn rigidly at
+    /// angular speed ω (leaving the vertical at the critical speeds for a fixed pivot, or
+    /// the forced branch for a pivot on a circle of radius R), as a table, branches.csv,
+    /// the branch diagram branches.png and the shapes at the largest speed, shapes.png.
+    Steady(SteadyArgs),
+}
+
+/// The chain of `pendulum modes` and `pendulum steady`.
+#[derive(Debug, Args)]
+pub struct ChainArgs {
+    /// Number of links (default: the length of a --masses or --lengths list, else 3).
+    #[arg(long, allow_negative_numbers = true)]
+    pub n: Option<usize>,
+    /// Masses, kg: one value, a comma list or a file.
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]
+    pub masses: String,
+    /// Rod lengths, m: one value, a comma list or a file.
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0.5")]
+    pub lengths: String,
+    /// Gravitational acceleration g, m/s².
+    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
+    pub gravity: f64,
+}
+
+/// Options of `pendulum modes`.
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// The chain.
+    #[command(flatten)]
+    pub chain: ChainArgs,
+    /// How many modes, lowest first (default: all, at most 6).
+    #[arg(long, allow_negative_numbers = true)]
+    pub count: Option<usize>,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "pendulum-modes")]
+    pub out: PathBuf,
+}
+
+/// Options of `pendulum steady`.
+#[derive(Debug, Args)]
+pub struct SteadyArgs {
+    /// The chain.
+    #[command(flatten)]
+    pub chain: ChainArgs,
+    /// Radius R of the pivot's horizontal circle, m (0: pivot fixed on the axis).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub radius: f64,
+    /// Largest angular speed to follow the branches to, rad/s (default: 1.5 × the
+    /// highest critical speed; with R > 0, 3 √(g/L)).
+    #[arg(long, allow_negative_numbers = true)]
+    pub omega_max: Option<f64>,
+    /// Fixed pivot: how many branches, lowest critical speed first (default: min(n, 3)).
+    #[arg(long, allow_negative_numbers = true)]
+    pub branches: Option<usize>,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "pendulum-steady")]
+    pub out: PathBuf,
 }
 
 /// Space dimension of the chain.

@@ -9,6 +9,7 @@ mod eval;
 mod ledger;
 mod models;
 mod plot;
+mod rotating;
 mod simulate;
 mod spec;
 
@@ -43,6 +44,8 @@ fn main() -> ExitCode {
             simulate::simulate(args, demo)
         }
         Command::Eval(args) => eval::eval(args),
+        Command::Modes(args) => rotating::modes(args),
+        Command::Steady(args) => rotating::steady(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -26,7 +26,7 @@ pub struct Frame {
 }
 
 /// Registers the embedded font once.
-fn fonts() {
+pub fn fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The font is a valid TTF shipped by the crate; failure would only lose labels.
@@ -34,7 +34,7 @@ fn fonts() {
     });
 }
 
-fn drawing_failed(path: &Path, e: impl std::fmt::Display) -> CliError {
+pub fn drawing_failed(path: &Path, e: impl std::fmt::Display) -> CliError {
     CliError::failed(format!("cannot draw {}: {e}", path.display()))
 }
 
