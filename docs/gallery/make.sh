@@ -32,4 +32,10 @@ cp "$runs/whirl-top/chain.gif" "$gallery/whirl-top.gif"
 # A damped double pendulum: the energy falls by exactly the dissipated energy.
 pendulum simulate --n 2 --damping 0.05 --initial horizontal --end 20 --out "$runs/damped" --quiet
 cp "$runs/damped/energy.png" "$gallery/damped-energy.png"
+# Normal modes of a uniform 12-link chain, and its steady rotating shapes.
+pendulum modes --n 12 --lengths 0.1 --count 4 --out "$runs/modes" > /dev/null
+cp "$runs/modes/modes.png" "$gallery/modes.png"
+pendulum steady --n 12 --lengths 0.1 --out "$runs/steady" > /dev/null
+cp "$runs/steady/branches.png" "$gallery/steady-branches.png"
+cp "$runs/steady/shapes.png" "$gallery/steady-shapes.png"
 ls -l "$gallery"

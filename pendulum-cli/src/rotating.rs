@@ -192,6 +192,29 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         let start = problem.solve(0.05 * reference, &DVector::zeros(n))?;
         let branch = problem.continue_from(&start, true, omega_max, &options)?;
         branches.push(("forced".into(), None, branch));
+        // The branches not connected to slow rotation (they fold back): from the free
+        // chain's shapes at omega_max, on either side of the axis, followed downward.
+        let free = SteadyRotation::new(&chain, 0.0)?;
+        let count = n.min(3);
+        for k in 1..=count {
+            let Ok(free_branch) = free.branch(k, omega_max, &options) else { continue };
+            let Some(shape) = free_branch.points.last() else { continue };
+            for sign in [1.0, -1.0] {
+                let Ok(start) = problem.solve(omega_max, &(&shape.theta * sign)) else { continue };
+                let known = branches.iter().any(|(_, _, b)| {
+                    b.points.iter().any(|p| {
+                        (p.omega - start.omega).abs() < 1e-6 * omega_max
+                            && (&p.theta - &start.theta).amax() < 1e-6
+                    }) || b.points.windows(2).any(|w| near_segment(&w[0], &w[1], &start))
+                });
+                if known {
+                    continue;
+                }
+                if let Ok(branch) = problem.continue_from(&start, false, omega_max, &options) {
+                    branches.push((format!("forced {}", branches.len() + 1), None, branch));
+                }
+            }
+        }
     }
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
@@ -207,6 +230,19 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// `shape` lies on the branch segment between `a` and `b` (same ω range, angles within
+/// 0.02 rad of the linear interpolation: continuation steps are coarse, distinct branches
+/// are much farther apart).
+fn near_segment(a: &SteadyShape, b: &SteadyShape, shape: &SteadyShape) -> bool {
+    let (lo, hi) = if a.omega <= b.omega { (a, b) } else { (b, a) };
+    if !(lo.omega <= shape.omega && shape.omega <= hi.omega) || hi.omega == lo.omega {
+        return false;
+    }
+    let s = (shape.omega - lo.omega) / (hi.omega - lo.omega);
+    let interpolated = &lo.theta * (1.0 - s) + &hi.theta * s;
+    (&interpolated - &shape.theta).amax() < 0.02
 }
 
 fn check_omega_max(omega_max: f64) -> CliResult<()> {

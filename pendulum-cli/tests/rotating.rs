@@ -93,3 +93,27 @@ fn bad_rotation_arguments_are_named() {
         assert!(message.contains(needle), "{args:?}: {message}");
     }
 }
+
+#[test]
+fn a_link_on_a_circling_pivot_has_the_forced_conical_branches_with_a_fold() {
+    let dir = scratch("steady-forced-one");
+    let args =
+        ["steady", "--n", "1", "--lengths", "0.5", "--radius", "0.1", "--omega-max", "10", "--out", "s"];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = Csv::read(&dir.join("s/branches.csv"));
+    let (branch, omega, theta, x) =
+        (csv.column("branch"), csv.column("omega"), csv.column("theta1"), csv.column("x1"));
+    let count = branch.iter().fold(0.0_f64, |a, b| a.max(*b)) as usize;
+    assert!(count >= 2, "the branch from slow rotation and the folded one, got {count}");
+    for i in 0..branch.len() {
+        // The rod carries weight and centrifugal force: g sin θ = ω² cos θ x, x = R + l sin θ.
+        assert!((x[i] - 0.1 - 0.5 * theta[i].sin()).abs() < 1e-12);
+        let residual = 9.81 * theta[i].sin() - omega[i].powi(2) * theta[i].cos() * x[i];
+        assert!(residual.abs() < 1e-8 * (9.81 + omega[i].powi(2)), "row {i}: {residual}");
+    }
+    // The folded branch turns back in ω: its speeds go down, then up again.
+    let second: Vec<f64> = (0..branch.len()).filter(|&i| branch[i] == 2.0).map(|i| omega[i]).collect();
+    let lowest = second.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(lowest > 0.0 && lowest < second[0] && lowest < *second.last().unwrap(), "no fold: {second:?}");
+}
