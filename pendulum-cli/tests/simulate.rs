@@ -326,7 +326,8 @@ fn ctrl_c_leaves_valid_files_for_what_was_computed() {
         std::thread::sleep(Duration::from_millis(50));
     }
     let pid = child.id().to_string();
-    let killed = std::process::Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    // The shell's kill builtin: present wherever `sh` is.
+    let killed = std::process::Command::new("sh").args(["-c", &format!("kill -INT {pid}")]).status().unwrap();
     assert!(killed.success());
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
