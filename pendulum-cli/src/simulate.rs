@@ -23,7 +23,18 @@ pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// Runs `pendulum simulate`.
 pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
     let mut config = match &args.from {
-        Some(path) => RunFile::read(path)?.config,
+        Some(path) => {
+            let file = RunFile::read(path)?;
+            if file.version != env!("CARGO_PKG_VERSION") && !args.quiet {
+                eprintln!(
+                    "pendulum: warning: {} was written by pendulum {}, this is {}; results may differ",
+                    path.display(),
+                    file.version,
+                    env!("CARGO_PKG_VERSION")
+                );
+            }
+            file.config
+        }
         None => RunConfig::from_args(&args.physics, View::Xz, 150)?,
     };
     // Presentation only: may differ from the recorded run.
