@@ -80,7 +80,12 @@ mod tests {
             let generic = Planar::new(Chain::<Dyn>::new(&[m1, m2], &[l1, l2], g).unwrap());
             let mut a = DVector::zeros(2);
             generic
-                .accelerations(&DVector::from_row_slice(&q), &DVector::from_row_slice(&qd), &generic.zero_inputs(), &mut a)
+                .accelerations(
+                    &DVector::from_row_slice(&q),
+                    &DVector::from_row_slice(&qd),
+                    &generic.zero_inputs(),
+                    &mut a,
+                )
                 .unwrap();
 
             let (m, l, g) = (m2 / (m1 + m2), l2 / l1, g / l1);
@@ -90,7 +95,13 @@ mod tests {
             let scale = [terms / den, terms / (l * den)];
             for i in 0..2 {
                 let error = (closed[i] - a[i]).abs() / scale[i];
-                assert!(error < 1e-12, "θ̈{}: closed {} vs generic {} (relative to scale {error:e})", i + 1, closed[i], a[i]);
+                assert!(
+                    error < 1e-12,
+                    "θ̈{}: closed {} vs generic {} (relative to scale {error:e})",
+                    i + 1,
+                    closed[i],
+                    a[i]
+                );
             }
         }
     }

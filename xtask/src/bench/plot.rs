@@ -1,0 +1,121 @@
+//! `docs/bench.svg`: time per evaluation of the accelerations vs n, log–log, one line per
+//! implementation, planar and spatial side by side (plotters, SVG backend).
+//!
+//! No font backend: plotters' SVG backend writes text as `<text>` elements that the
+//! viewer renders with its own fonts, and without the `ttf`/`ab_glyph` features plotters
+//! lays labels out with its built-in estimate of text width. That keeps font-kit and
+//! the system font libraries out of the build.
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+
+use super::report::{KINDS, label};
+use super::results::Results;
+
+/// One colour per implementation, in [`super::report::IMPLEMENTATIONS`] order.
+fn colour(implementation: &str) -> RGBColor {
+    match implementation {
+        "generated" => RGBColor(31, 119, 180),
+        "generic_fixed" => RGBColor(255, 127, 14),
+        "generic_dyn" => RGBColor(214, 39, 40),
+        "closed_form" => RGBColor(44, 160, 44),
+        "tension" => RGBColor(148, 103, 189),
+        "directions" => RGBColor(140, 86, 75),
+        "baseline" => RGBColor(60, 60, 60),
+        _ => RGBColor(127, 127, 127),
+    }
+}
+
+/// The SVG text of the plot of `results`' `<kind>_accelerations` groups.
+pub fn svg(results: &Results) -> Result<String> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (1200, 520)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        let panels = root.split_evenly((1, 2));
+        for (panel, kind) in panels.iter().zip(KINDS) {
+            panel_plot(panel, results, kind)?;
+        }
+        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    }
+    Ok(text)
+}
+
+fn panel_plot(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    results: &Results,
+    kind: &str,
+) -> Result<()> {
+    let group = format!("{kind}_accelerations");
+    let implementations = results.implementations(&group);
+    let all: Vec<(usize, f64)> = implementations.iter().flat_map(|i| results.series(&group, i)).collect();
+    if all.is_empty() {
+        return Ok(());
+    }
+    let n_max = all.iter().map(|&(n, _)| n).max().unwrap_or(1).max(2) as f64;
+    let t_min = all.iter().map(|&(_, t)| t).fold(f64::INFINITY, f64::min);
+    let t_max = all.iter().map(|&(_, t)| t).fold(0.0, f64::max);
+    let err = |e: DrawingAreaErrorKind<_>| anyhow!("plot {kind}: {e}");
+
+    let mut chart = ChartBuilder::on(area)
+        .caption(format!("{kind} accelerations"), ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((1.0..n_max * 1.2).log_scale(), (t_min / 1.5..t_max * 1.5).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("links n")
+        .y_desc("time per evaluation (ns)")
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y:.0}"))
+        .draw()
+        .map_err(err)?;
+    for implementation in
+        super::report::IMPLEMENTATIONS.iter().map(|(i, _)| *i).filter(|i| implementations.contains(i))
+    {
+        let points: Vec<(f64, f64)> =
+            results.series(&group, implementation).into_iter().map(|(n, t)| (n as f64, t)).collect();
+        let style = ShapeStyle::from(colour(implementation)).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(points.clone(), style))
+            .map_err(err)?
+            .label(label(implementation).replace('`', ""))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 3, style.filled()))).map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draws_one_labelled_line_per_implementation() {
+        let mut r = Results::default();
+        for n in [1, 2, 4, 8] {
+            r.insert("planar_accelerations", "generated", n, 10.0 * n as f64);
+            r.insert("planar_accelerations", "generic_dyn", n, 40.0 * n as f64);
+        }
+        r.insert("planar_accelerations", "closed_form", 2, 15.0);
+        let svg = svg(&r).unwrap();
+        assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
+        for text in ["planar accelerations", "generated", "generic Dyn", "closed form (eq 50)", "links n"] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert_eq!(svg.matches("<circle").count(), 4 + 4 + 1, "a marker per measured point");
+        std::fs::write(std::env::temp_dir().join("xtask-plot-test.svg"), &svg).unwrap();
+    }
+}
