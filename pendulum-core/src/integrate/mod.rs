@@ -29,6 +29,7 @@
 
 mod gauss;
 mod lu;
+mod projected;
 mod rk4;
 mod system;
 mod tableau;
@@ -36,6 +37,7 @@ mod tableau;
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};
+pub use projected::{Constrained, Projected};
 pub use rk4::Rk4;
 pub use system::{System, SystemAlloc, central_difference_jacobian};
 pub use tableau::{GAUSS_1, GAUSS_2, GAUSS_3, GaussStages, Tableau};
@@ -91,6 +93,14 @@ where
         self.t = t;
         self.x.clone_from(x);
         self.t_carry = 0.0;
+        self.x_carry.fill(0.0);
+    }
+
+    /// Applies `f` to the state vector (a projection onto a constraint manifold, say) and
+    /// clears its compensation, which no longer matches the moved state; time and its
+    /// compensation are kept.
+    pub fn constrain(&mut self, f: impl FnOnce(&mut OVector<f64, D>)) {
+        f(&mut self.x);
         self.x_carry.fill(0.0);
     }
 

@@ -1,0 +1,495 @@
+//! The chain in unit link directions: no angles, no coordinate singularity, O(n) per
+//! evaluation. The representation for large chains and for 3D chains that hang straight
+//! down, swing through the vertical and spin.
+
+use std::marker::PhantomData;
+
+use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, allocator::Allocator};
+
+use crate::integrate::{Constrained, System};
+use crate::rods::{Rods, with_scratch};
+use crate::{Chain, Drive, Error, Fixed, Result, check_polar_sin};
+
+/// A chain of `n` point masses on rigid rods in the plane (`S = U2`, y up) or in space
+/// (`S = U3`, z up), described by the unit direction `u_i` of each rod (from mass `i−1` to
+/// mass `i`, mass 0 the pivot) and its rate `w_i = u̇_i` (1/s), with the pivot moved by
+/// the drive `Dr` (default [`Fixed`]).
+///
+/// State `x = (u_1, …, u_n, w_1, …, w_n)`, each vector's `S` components in a row:
+/// `2·S·n` entries. The equations of motion are Newton's for the masses with the rod
+/// tensions as unknowns (`rods` module docs):
+/// ```text
+/// u̇_i = w_i,   ẇ_i = ü_i(u, w, p̈(t))    (one tridiagonal solve, O(n))
+/// ```
+/// with gravity `g` along −y (planar) or −z (spatial) and the damping of the chain's
+/// Rayleigh function `D = ½ Σ λ_i |u̇_i|²` (the force pair `F_i = −λ_i w_i / l_i` on rod
+/// `i`; planar this is eq 26's `−λ_i θ̇_i`, spatial the same `λ` as the spherical models).
+/// The same physics as [`Planar`](crate::Planar) and [`Spatial`](crate::Spatial) (tests
+/// compare them to round-off), without their coordinates: the spatial model in angles is
+/// singular where a link hangs straight down; this one is not.
+///
+/// The exact flow keeps `|u_i| = 1` and `u_i · w_i = 0`; a numerical one drifts off
+/// them by its truncation error. [`project`](Constrained::project) puts a state back
+/// (normalise `u_i`, remove the radial part of `w_i`) and
+/// [`Projected`](crate::integrate::Projected) does it after every step, which keeps the
+/// rod lengths exact to round-off (`docs/large-chains.md`).
+///
+/// Only dynamic sizes (`Dyn`): the representation is for long chains; fixed small chains
+/// have the angle models and the generated code.
+#[derive(Debug, Clone)]
+pub struct Directions<S: DimName, Dr = Fixed> {
+    chain: Chain<Dyn>,
+    rods: Rods,
+    drive: Dr,
+    space: PhantomData<S>,
+}
+
+impl<S: DimName> Directions<S, Fixed> {
+    /// The chain with its pivot at rest.
+    ///
+    /// The space must be `U2` or `U3` (other dimensions do not compile into a model:
+    /// [`System::rhs`] would refuse them at run time).
+    pub fn new(chain: Chain<Dyn>) -> Self {
+        let rods = Rods::new(chain.masses().as_slice(), chain.lengths().as_slice());
+        Self { chain, rods, drive: Fixed, space: PhantomData }
+    }
+}
+
+impl<S: DimName, Dr> Directions<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// The same chain with its pivot moved by `drive`.
+    pub fn with_drive<D2: Drive<S>>(self, drive: D2) -> Directions<S, D2> {
+        Directions { chain: self.chain, rods: self.rods, drive, space: PhantomData }
+    }
+
+    /// The chain's parameters.
+    pub fn chain(&self) -> &Chain<Dyn> {
+        &self.chain
+    }
+
+    /// The pivot drive.
+    pub fn drive(&self) -> &Dr {
+        &self.drive
+    }
+
+    /// Number of links.
+    pub fn links(&self) -> usize {
+        self.chain.links()
+    }
+
+    /// Length of the state vector, `2·S·n`.
+    pub fn state_len(&self) -> usize {
+        2 * S::DIM * self.links()
+    }
+
+    /// The chain hanging straight down at rest: `u_i = −e_up`, `w_i = 0`.
+    pub fn hanging(&self) -> DVector<f64> {
+        let mut x = DVector::zeros(self.state_len());
+        for i in 0..self.links() {
+            x[i * S::DIM + S::DIM - 1] = -1.0;
+        }
+        x
+    }
+
+    /// Direction `u_i` of link `i` (0-based) in the state `x`.
+    pub fn direction(&self, x: &DVector<f64>, i: usize) -> OVector<f64, S> {
+        OVector::<f64, S>::from_column_slice(&x.as_slice()[i * S::DIM..(i + 1) * S::DIM])
+    }
+
+    /// Rate `w_i = u̇_i` (1/s) of link `i` (0-based) in the state `x`.
+    pub fn rate(&self, x: &DVector<f64>, i: usize) -> OVector<f64, S> {
+        let base = (self.links() + i) * S::DIM;
+        OVector::<f64, S>::from_column_slice(&x.as_slice()[base..base + S::DIM])
+    }
+
+    /// Errors unless `x` has `2·S·n` finite entries.
+    pub fn check_state(&self, x: &DVector<f64>) -> Result<()> {
+        if x.len() != self.state_len() {
+            return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: x.len() });
+        }
+        // On the slice: nalgebra's strided iterator costs as much as the solve here.
+        if let Some(index) = x.as_slice().iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite { what: "x", index, value: x[index] });
+        }
+        Ok(())
+    }
+
+    /// Positions of the masses relative to the pivot, `r_i − p = Σ_{j≤i} l_j u_j` (m).
+    pub fn relative_positions(&self, x: &DVector<f64>) -> Vec<OVector<f64, S>> {
+        self.cumulative(x, 0)
+    }
+
+    /// Velocities of the masses relative to the pivot, `Σ_{j≤i} l_j w_j` (m/s).
+    pub fn relative_velocities(&self, x: &DVector<f64>) -> Vec<OVector<f64, S>> {
+        self.cumulative(x, self.links())
+    }
+
+    fn cumulative(&self, x: &DVector<f64>, first: usize) -> Vec<OVector<f64, S>> {
+        let lengths = self.chain.lengths();
+        let mut sum = OVector::<f64, S>::zeros();
+        (0..self.links())
+            .map(|i| {
+                let base = (first + i) * S::DIM;
+                for k in 0..S::DIM {
+                    sum[k] += lengths[i] * x[base + k];
+                }
+                sum.clone()
+            })
+            .collect()
+    }
+
+    /// Kinetic energy relative to the pivot, `T = ½ Σ m_i |Σ_{j≤i} l_j w_j|²` (J).
+    pub fn kinetic_energy(&self, x: &DVector<f64>) -> f64 {
+        let masses = self.chain.masses();
+        self.relative_velocities(x).iter().zip(masses.iter()).map(|(v, m)| 0.5 * m * v.norm_squared()).sum()
+    }
+
+    /// Potential energy relative to the pivot, `U = Σ m_i g (r_i − p)·e_up` (J).
+    pub fn potential_energy(&self, x: &DVector<f64>) -> f64 {
+        let (masses, g) = (self.chain.masses(), self.chain.gravity());
+        self.relative_positions(x).iter().zip(masses.iter()).map(|(r, m)| m * g * r[S::DIM - 1]).sum()
+    }
+
+    /// `H = T + U` relative to the pivot (J): conserved when the pivot is at rest and
+    /// there is no damping.
+    pub fn energy(&self, x: &DVector<f64>) -> f64 {
+        self.kinetic_energy(x) + self.potential_energy(x)
+    }
+
+    /// The worst violation of the rod constraints in `x`: `max_i max(||u_i| − 1|, |u_i·w_i| / max(|w_i|, 1))`.
+    pub fn constraint_violation(&self, x: &DVector<f64>) -> f64 {
+        (0..self.links())
+            .map(|i| {
+                let (u, w) = (self.direction(x, i), self.rate(x, i));
+                (u.norm() - 1.0).abs().max(u.dot(&w).abs() / w.norm().max(1.0))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The accelerations `ü_i` (1/s²) and the rod tensions `T_i` (N) at `(t, x)`, written
+    /// into `out` (`S·n` entries) and `tensions` (`n` entries).
+    ///
+    /// Errors: [`Error::LengthMismatch`] / [`Error::NonFinite`] for a bad state or
+    /// buffers.
+    pub fn accelerations(
+        &self,
+        t: f64,
+        x: &DVector<f64>,
+        out: &mut [f64],
+        tensions: Option<&mut [f64]>,
+    ) -> Result<()>
+    where
+        Dr: Drive<S>,
+    {
+        self.check_state(x)?;
+        self.accelerations_of_valid(t, x, out, tensions)
+    }
+
+    /// [`accelerations`](Self::accelerations) for a state already checked.
+    fn accelerations_of_valid(
+        &self,
+        t: f64,
+        x: &DVector<f64>,
+        out: &mut [f64],
+        tensions: Option<&mut [f64]>,
+    ) -> Result<()>
+    where
+        Dr: Drive<S>,
+    {
+        let n = self.links();
+        if out.len() != S::DIM * n {
+            return Err(Error::LengthMismatch { what: "out", expected: S::DIM * n, got: out.len() });
+        }
+        if let Some(t) = &tensions
+            && t.len() != n
+        {
+            return Err(Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
+        }
+        let pivot = self.drive.acceleration(t);
+        match S::DIM {
+            2 => self.solve::<2>(x.as_slice(), [pivot[0], pivot[1]], out, tensions),
+            3 => self.solve::<3>(x.as_slice(), [pivot[0], pivot[1], pivot[2]], out, tensions),
+            d => return Err(Error::LengthMismatch { what: "space", expected: 3, got: d }),
+        }
+        Ok(())
+    }
+
+    /// The tension solve for `C`-dimensional space (`C = S::DIM`).
+    fn solve<const C: usize>(
+        &self,
+        x: &[f64],
+        pivot: [f64; C],
+        out: &mut [f64],
+        tensions: Option<&mut [f64]>,
+    ) {
+        let n = self.links();
+        let (lengths, damping) = (self.chain.lengths(), self.chain.damping());
+        let mut gravity = [0.0; C];
+        gravity[C - 1] = -self.chain.gravity();
+        let (directions, rates) = x.split_at(C * n);
+        with_scratch::<C, _>(n, |s| {
+            for i in 0..n {
+                let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
+                let pull = -damping[i] / lengths[i];
+                let mut w2 = 0.0;
+                for k in 0..C {
+                    s.directions[i][k] = u[k];
+                    s.pairs[i][k] = pull * w[k];
+                    w2 += w[k] * w[k];
+                }
+                s.rate_squared[i] = w2;
+            }
+            self.rods.solve_in_place(gravity, pivot, s);
+            for (chunk, a) in out.chunks_exact_mut(C).zip(&s.direction_accelerations) {
+                chunk.copy_from_slice(a);
+            }
+            if let Some(t) = tensions {
+                t.copy_from_slice(s.tensions());
+            }
+        });
+    }
+}
+
+impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// Positions of the masses in the inertial frame, `p(t) + Σ_{j≤i} l_j u_j` (m).
+    pub fn positions(&self, t: f64, x: &DVector<f64>) -> Vec<OVector<f64, S>> {
+        let p = self.drive.position(t);
+        self.relative_positions(x).into_iter().map(|r| r + &p).collect()
+    }
+
+    /// The inertial-frame energy `H = ½ Σ m_i |ṗ + v_i|² + Σ m_i g (p + r_i)·e_up` (J) of a
+    /// driven chain (`v_i`, `r_i` relative to the pivot).
+    pub fn inertial_energy(&self, t: f64, x: &DVector<f64>) -> f64 {
+        let (masses, g) = (self.chain.masses(), self.chain.gravity());
+        let (p, pd) = (self.drive.position(t), self.drive.velocity(t));
+        let kinetic: f64 = self
+            .relative_velocities(x)
+            .iter()
+            .zip(masses.iter())
+            .map(|(v, m)| 0.5 * m * (v + &pd).norm_squared())
+            .sum();
+        let height = p[S::DIM - 1];
+        kinetic
+            + self
+                .relative_positions(x)
+                .iter()
+                .zip(masses.iter())
+                .map(|(r, m)| m * g * (height + r[S::DIM - 1]))
+                .sum::<f64>()
+    }
+}
+
+impl<Dr> Directions<U2, Dr> {
+    /// The state of planar angles `θ_i` (rad, from the downward vertical) and rates `θ̇_i`
+    /// (rad/s): `u_i = (sin θ_i, −cos θ_i)`, `w_i = θ̇_i (cos θ_i, sin θ_i)`.
+    ///
+    /// Errors: [`Error::LengthMismatch`], [`Error::NonFinite`].
+    pub fn from_angles(&self, theta: &[f64], rates: &[f64]) -> Result<DVector<f64>> {
+        let n = self.links();
+        check_slices(n, &[("theta", theta), ("rates", rates)])?;
+        let mut x = DVector::zeros(4 * n);
+        for i in 0..n {
+            let (s, c) = theta[i].sin_cos();
+            x[2 * i] = s;
+            x[2 * i + 1] = -c;
+            x[2 * (n + i)] = rates[i] * c;
+            x[2 * (n + i) + 1] = rates[i] * s;
+        }
+        Ok(x)
+    }
+
+    /// The angles `θ_i = atan2(u_x, −u_y)` (rad, in (−π, π]) and rates `θ̇_i = n_i·w_i`
+    /// (rad/s) of a planar state.
+    pub fn to_angles(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DVector<f64>)> {
+        self.check_state(x)?;
+        let n = self.links();
+        let theta = DVector::from_fn(n, |i, _| x[2 * i].atan2(-x[2 * i + 1]));
+        let rates = DVector::from_fn(n, |i, _| {
+            let (s, c) = theta[i].sin_cos();
+            c * x[2 * (n + i)] + s * x[2 * (n + i) + 1]
+        });
+        Ok((theta, rates))
+    }
+}
+
+impl<Dr> Directions<U3, Dr> {
+    /// The state of spherical angles `q = (θ_1 … θ_n, φ_1 … φ_n)` (rad; `θ` from −z, `φ`
+    /// azimuth from +x, eqs 27–29) and rates `q̇` (rad/s):
+    /// `u = (sin θ cos φ, sin θ sin φ, −cos θ)`, `w = θ̇ e_θ + φ̇ sin θ e_φ` with
+    /// `e_θ = (cos θ cos φ, cos θ sin φ, sin θ)` and `e_φ = (−sin φ, cos φ, 0)`. Any angles
+    /// are fine here, `θ = 0` included.
+    ///
+    /// Errors: [`Error::LengthMismatch`], [`Error::NonFinite`].
+    pub fn from_spherical(&self, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
+        let n = self.links();
+        check_slices(2 * n, &[("q", q), ("qd", qd)])?;
+        let mut x = DVector::zeros(6 * n);
+        for i in 0..n {
+            let frame = SphericalFrame::new(q[i], q[n + i]);
+            let w = frame.e_theta * qd[i] + frame.e_phi * (qd[n + i] * frame.sin_theta);
+            x.fixed_rows_mut::<3>(3 * i).copy_from(&frame.u);
+            x.fixed_rows_mut::<3>(3 * (n + i)).copy_from(&w);
+        }
+        Ok(x)
+    }
+
+    /// The spherical angles and rates of a state (inverse of
+    /// [`from_spherical`](Self::from_spherical)), `θ ∈ [0, π]`, `φ ∈ (−π, π]`.
+    ///
+    /// Errors: [`Error::SingularAngle`] for a link within
+    /// [`SINGULARITY_TOLERANCE`](crate::SINGULARITY_TOLERANCE) of the vertical, where `φ`
+    /// is undefined; a bad state.
+    pub fn to_spherical(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DVector<f64>)> {
+        self.check_state(x)?;
+        let n = self.links();
+        let (mut q, mut qd) = (DVector::zeros(2 * n), DVector::zeros(2 * n));
+        for i in 0..n {
+            let u = self.direction(x, i);
+            let theta = u.xy().norm().atan2(-u.z);
+            let phi = u.y.atan2(u.x);
+            let frame = SphericalFrame::new(theta, phi);
+            check_polar_sin(i + 1, theta, frame.sin_theta)?;
+            let w = self.rate(x, i);
+            q[i] = theta;
+            q[n + i] = phi;
+            qd[i] = frame.e_theta.dot(&w);
+            qd[n + i] = frame.e_phi.dot(&w) / frame.sin_theta;
+        }
+        Ok((q, qd))
+    }
+}
+
+/// The unit vectors of spherical angles `(θ, φ)`: `u` (radial), `e_θ = ∂u/∂θ` and `e_φ`
+/// with `∂u/∂φ = sin θ e_φ`.
+struct SphericalFrame {
+    u: nalgebra::Vector3<f64>,
+    e_theta: nalgebra::Vector3<f64>,
+    e_phi: nalgebra::Vector3<f64>,
+    sin_theta: f64,
+}
+
+impl SphericalFrame {
+    fn new(theta: f64, phi: f64) -> Self {
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        Self {
+            u: nalgebra::Vector3::new(st * cp, st * sp, -ct),
+            e_theta: nalgebra::Vector3::new(ct * cp, ct * sp, st),
+            e_phi: nalgebra::Vector3::new(-sp, cp, 0.0),
+            sin_theta: st,
+        }
+    }
+}
+
+fn check_slices(expected: usize, slices: &[(&'static str, &[f64])]) -> Result<()> {
+    for &(what, v) in slices {
+        if v.len() != expected {
+            return Err(Error::LengthMismatch { what, expected, got: v.len() });
+        }
+        if let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(Error::NonFinite { what, index, value });
+        }
+    }
+    Ok(())
+}
+
+impl<S: DimName, Dr: Drive<S>> System for Directions<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    type Dim = Dyn;
+
+    fn dim(&self) -> Dyn {
+        Dyn(self.state_len())
+    }
+
+    /// `x' = (w, ü(t, x))`: one O(n) tension solve.
+    fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
+        let half = S::DIM * self.links();
+        if out.len() != 2 * half {
+            return Err(Error::LengthMismatch { what: "out", expected: 2 * half, got: out.len() });
+        }
+        self.check_state(x)?;
+        let (velocity, acceleration) = out.as_mut_slice().split_at_mut(half);
+        velocity.copy_from_slice(&x.as_slice()[half..]);
+        self.accelerations_of_valid(t, x, acceleration, None)
+    }
+}
+
+impl<S: DimName, Dr: Drive<S>> Constrained for Directions<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// Normalises each `u_i` and removes the part of `w_i` along it:
+    /// `u_i ← u_i/|u_i|`, `w_i ← w_i − (u_i·w_i) u_i` (the nearest point of the constraint
+    /// manifold `|u_i| = 1, u_i·w_i = 0`, link by link).
+    fn project(&self, x: &mut DVector<f64>) {
+        let (n, d) = (self.links(), S::DIM);
+        if x.len() != 2 * d * n {
+            return;
+        }
+        let (directions, rates) = x.as_mut_slice().split_at_mut(d * n);
+        for (u, w) in directions.chunks_exact_mut(d).zip(rates.chunks_exact_mut(d)) {
+            let norm = u.iter().map(|v| v * v).sum::<f64>().sqrt();
+            u.iter_mut().for_each(|v| *v /= norm);
+            let radial: f64 = u.iter().zip(w.iter()).map(|(a, b)| a * b).sum();
+            w.iter_mut().zip(u.iter()).for_each(|(b, a)| *b -= radial * a);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn planar_state_round_trips_through_angles() {
+        let model = Directions::<U2>::new(Chain::uniform(3, 1.0, 0.5, 9.81).unwrap());
+        let (theta, rates) = ([0.3, -2.0, 3.0], [1.0, -0.5, 2.0]);
+        let x = model.from_angles(&theta, &rates).unwrap();
+        let (t2, r2) = model.to_angles(&x).unwrap();
+        assert_relative_eq!(t2.as_slice(), &theta[..], epsilon = 1e-15);
+        assert_relative_eq!(r2.as_slice(), &rates[..], epsilon = 1e-15);
+    }
+
+    #[test]
+    fn hanging_chain_stays_at_rest_with_no_singularity() {
+        let model = Directions::<U3>::new(Chain::uniform(4, 1.0, 0.5, 9.81).unwrap());
+        let x = model.hanging();
+        let mut f = DVector::zeros(x.len());
+        model.rhs(0.0, &x, &mut f).unwrap();
+        assert!(f.amax() < 1e-13, "{f}");
+        assert!(matches!(model.to_spherical(&x), Err(Error::SingularAngle { link: 1, .. })));
+    }
+
+    #[test]
+    fn projection_restores_unit_directions_and_tangent_rates() {
+        let model = Directions::<U3>::new(Chain::uniform(2, 1.0, 0.5, 9.81).unwrap());
+        let mut x = model.from_spherical(&[0.5, 1.0, 0.2, -1.0], &[1.0, 2.0, -3.0, 0.5]).unwrap();
+        x.iter_mut().enumerate().for_each(|(i, v)| *v *= 1.0 + 1e-3 * (i as f64 + 1.0));
+        assert!(model.constraint_violation(&x) > 1e-3);
+        model.project(&mut x);
+        assert!(model.constraint_violation(&x) < 1e-15);
+    }
+
+    #[test]
+    fn bad_states_are_errors() {
+        let model = Directions::<U2>::new(Chain::uniform(2, 1.0, 0.5, 9.81).unwrap());
+        let mut f = DVector::zeros(8);
+        let err = model.rhs(0.0, &DVector::zeros(6), &mut f).unwrap_err();
+        assert_eq!(err, Error::LengthMismatch { what: "x", expected: 8, got: 6 });
+        let mut x = model.hanging();
+        x[5] = f64::NAN;
+        assert!(matches!(model.rhs(0.0, &x, &mut f), Err(Error::NonFinite { what: "x", index: 5, .. })));
+        assert!(matches!(
+            model.from_angles(&[0.0], &[0.0, 1.0]),
+            Err(Error::LengthMismatch { what: "theta", .. })
+        ));
+    }
+}

@@ -1,0 +1,217 @@
+//! The planar chain in angle coordinates with O(n) accelerations by the rod tensions.
+
+use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
+
+use crate::rods::{Rods, with_scratch};
+use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
+
+/// A planar chain in absolute link angles, exactly [`Planar`] except for
+/// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric
+/// tridiagonal system, `rods` module docs) instead of factoring the mass matrix: O(n)
+/// work and memory per evaluation instead of O(n³), for chains of any length.
+///
+/// With `u_i = (sin θ_i, −cos θ_i)` and `n_i = ∂u_i/∂θ_i = (cos θ_i, sin θ_i)`:
+/// `|u̇_i|² = θ̇_i²`, the generalized force `Q_i = σ_i − λ_i θ̇_i` (eq 26) acts as the force
+/// pair `F_i = (Q_i / l_i) n_i` on rod `i` (its virtual work `F_i·l_i n_i δθ_i = Q_i δθ_i`),
+/// and `θ̈_i = n_i · ü_i` (since `ü_i = θ̈_i n_i − θ̇_i² u_i`). One `sin_cos` per link.
+///
+/// Mass matrix, force terms and energies are [`Planar`]'s, so the model plugs into
+/// [`FirstOrder`](crate::FirstOrder), [`Canonical`](crate::Canonical) and
+/// [`Accounted`](crate::Accounted) unchanged. Evaluations allocate nothing after the
+/// first on a thread (the solve's buffers are per thread).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarTension<L: Dim = Dyn>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    dense: Planar<L>,
+    rods: Rods,
+}
+
+impl<L: Dim> PlanarTension<L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    /// The O(n) planar model of `chain`.
+    pub fn new(chain: Chain<L>) -> Self {
+        let rods = Rods::new(chain.masses().as_slice(), chain.lengths().as_slice());
+        Self { dense: Planar::new(chain), rods }
+    }
+
+    /// The same chain as a dense [`Planar`] model.
+    pub fn dense(&self) -> &Planar<L> {
+        &self.dense
+    }
+
+    /// Accelerations (rad/s²) like [`Model::accelerations`], and the rod tensions `T_i` (N,
+    /// positive when the rod pulls) written into `tensions` (`n` entries).
+    pub fn accelerations_and_tensions(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        out: &mut OVector<f64, L>,
+        tensions: &mut [f64],
+    ) -> Result<()>
+    where
+        DefaultAllocator: Allocator<L, L> + Allocator<U2>,
+    {
+        self.solve(q, qd, inputs, out, Some(tensions))
+    }
+
+    fn solve(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        out: &mut OVector<f64, L>,
+        tensions: Option<&mut [f64]>,
+    ) -> Result<()>
+    where
+        DefaultAllocator: Allocator<L, L> + Allocator<U2>,
+    {
+        let chain = self.dense.chain();
+        let n = chain.links();
+        check_inputs(n, q, qd, inputs)?;
+        if out.len() != n {
+            return Err(crate::Error::LengthMismatch { what: "out", expected: n, got: out.len() });
+        }
+        if let Some(t) = &tensions
+            && t.len() != n
+        {
+            return Err(crate::Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
+        }
+        let (lengths, damping) = (chain.lengths(), chain.damping());
+        let gravity = [0.0, -chain.gravity()];
+        let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
+        with_scratch::<2, _>(n, |s| {
+            for i in 0..n {
+                let (sin, cos) = q[i].sin_cos();
+                s.directions[i] = [sin, -cos];
+                s.rate_squared[i] = qd[i] * qd[i];
+                let pull = (inputs.torque[i] - damping[i] * qd[i]) / lengths[i];
+                s.pairs[i] = [pull * cos, pull * sin];
+            }
+            self.rods.solve_in_place(gravity, pivot, s);
+            for i in 0..n {
+                let [sin, minus_cos] = s.directions[i];
+                let [ax, ay] = s.direction_accelerations[i];
+                out[i] = -minus_cos * ax + sin * ay;
+            }
+            if let Some(t) = tensions {
+                t.copy_from_slice(s.tensions());
+            }
+        });
+        if out.as_slice().iter().all(|a| a.is_finite()) {
+            Ok(())
+        } else {
+            Err(crate::Error::NotPositiveDefinite)
+        }
+    }
+}
+
+impl<L: Dim> From<Chain<L>> for PlanarTension<L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    fn from(chain: Chain<L>) -> Self {
+        Self::new(chain)
+    }
+}
+
+impl<L: Dim> Model for PlanarTension<L>
+where
+    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2>,
+{
+    type Links = L;
+    type Dof = L;
+    type Space = U2;
+
+    fn chain(&self) -> &Chain<L> {
+        self.dense.chain()
+    }
+
+    fn dof(&self) -> L {
+        self.dense.dof()
+    }
+
+    fn mass_matrix(&self, q: &OVector<f64, L>, out: &mut OMatrix<f64, L, L>) {
+        self.dense.mass_matrix(q, out)
+    }
+
+    fn velocity_terms(&self, q: &OVector<f64, L>, qd: &OVector<f64, L>, out: &mut OVector<f64, L>) {
+        self.dense.velocity_terms(q, qd, out)
+    }
+
+    fn gravity_terms(&self, q: &OVector<f64, L>, out: &mut OVector<f64, L>) {
+        self.dense.gravity_terms(q, out)
+    }
+
+    fn pivot_terms(&self, q: &OVector<f64, L>, a: &OVector<f64, U2>, out: &mut OVector<f64, L>) {
+        self.dense.pivot_terms(q, a, out)
+    }
+
+    fn generalized_forces(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        torque: &OVector<f64, L>,
+        out: &mut OVector<f64, L>,
+    ) {
+        self.dense.generalized_forces(q, qd, torque, out)
+    }
+
+    fn kinetic_energy(&self, q: &OVector<f64, L>, qd: &OVector<f64, L>) -> f64 {
+        self.dense.kinetic_energy(q, qd)
+    }
+
+    fn potential_energy(&self, q: &OVector<f64, L>) -> f64 {
+        self.dense.potential_energy(q)
+    }
+
+    /// `θ̈` by the O(n) tension solve (type docs). Errors: [`crate::Error::LengthMismatch`]
+    /// or [`crate::Error::NonFinite`] for bad inputs.
+    fn accelerations(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        out: &mut OVector<f64, L>,
+    ) -> Result<()> {
+        self.solve(q, qd, inputs, out, None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use nalgebra::{DVector, Vector2};
+
+    #[test]
+    fn triple_pendulum_matches_the_dense_route() {
+        let chain = Chain::<Dyn>::new(&[1.0, 0.3, 2.0], &[0.7, 1.2, 0.4], 9.81)
+            .unwrap()
+            .with_damping(&[0.1, 0.0, 0.3])
+            .unwrap();
+        let fast = PlanarTension::new(chain);
+        let q = DVector::from_vec(vec![0.4, -2.0, 2.9]);
+        let qd = DVector::from_vec(vec![1.1, -0.3, 4.0]);
+        let inputs = Inputs {
+            torque: DVector::from_vec(vec![0.5, -1.0, 0.2]),
+            pivot_acceleration: Vector2::new(3.0, -1.5),
+        };
+        let (mut a, mut b) = (DVector::zeros(3), DVector::zeros(3));
+        fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
+        fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
+        assert_relative_eq!(a, b, epsilon = 1e-12, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn wrong_sizes_are_errors() {
+        let fast = PlanarTension::new(Chain::<Dyn>::uniform(2, 1.0, 1.0, 9.81).unwrap());
+        let mut out = DVector::zeros(3);
+        let err = fast.accelerations(&DVector::zeros(2), &DVector::zeros(2), &fast.zero_inputs(), &mut out);
+        assert_eq!(err, Err(crate::Error::LengthMismatch { what: "out", expected: 2, got: 3 }));
+    }
+}
