@@ -23,9 +23,11 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use nalgebra::{Const, DefaultAllocator, Dim, DimMul, DimProd, Dyn, OMatrix, OVector, U1, U2};
-use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, State};
-use pendulum_core::{FirstOrder, Inputs, Model, ModelAlloc, Planar, Spatial};
+use nalgebra::{
+    Const, DVector, DefaultAllocator, Dim, DimMul, DimName, DimProd, Dyn, OMatrix, OVector, U1, U2, U3,
+};
+use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, State, System};
+use pendulum_core::{Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial};
 use xtask::case::Params;
 use xtask::closed_form::DoublePendulum;
 use xtask::models::{
@@ -118,15 +120,67 @@ where
         })
     });
 
-    c.benchmark_group(format!("{kind}_accelerations")).bench_function(id.clone(), |b| {
+    bench_accelerations(c, kind, name, n, model);
+
+    c.benchmark_group(format!("{kind}_energy"))
+        .bench_function(id, |b| b.iter(|| black_box(model.energy(black_box(&q), black_box(&qd)))));
+}
+
+/// `Model::accelerations` of `model`.
+fn bench_accelerations<M: Model>(c: &mut Criterion, kind: &str, name: &str, n: usize, model: &M)
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    let (q, qd) = state(model.dof());
+    let inputs = model.zero_inputs();
+    let mut out = qd.clone();
+    c.benchmark_group(format!("{kind}_accelerations")).bench_function(BenchmarkId::new(name, n), |b| {
         b.iter(|| {
             model.accelerations(black_box(&q), black_box(&qd), black_box(&inputs), &mut out).unwrap();
             black_box(&out);
         })
     });
+}
 
-    c.benchmark_group(format!("{kind}_energy"))
-        .bench_function(id, |b| b.iter(|| black_box(model.energy(black_box(&q), black_box(&qd)))));
+/// `System::rhs` of the O(n) `Directions` chain of `n` links (`U2` planar, `U3`
+/// spatial), at the state of the same angles as the other routes, in the
+/// `<kind>_accelerations` group.
+fn bench_directions<S: DimName>(
+    c: &mut Criterion,
+    kind: &str,
+    n: usize,
+    to_state: impl Fn(&Directions<S>, &[f64], &[f64]) -> pendulum_core::Result<DVector<f64>>,
+) where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    let system = Directions::<S>::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    let dof = if S::DIM == 2 { n } else { 2 * n };
+    let (q, qd) = state::<Dyn>(Dyn(dof));
+    let x = to_state(&system, q.as_slice(), qd.as_slice()).expect("non-singular state");
+    let mut f = DVector::zeros(x.len());
+    c.benchmark_group(format!("{kind}_accelerations")).bench_function(
+        BenchmarkId::new("directions", n),
+        |b| {
+            b.iter(|| {
+                system.rhs(0.0, black_box(&x), &mut f).unwrap();
+                black_box(&f);
+            })
+        },
+    );
+}
+
+/// The O(n) routes at `n` links: `PlanarTension<Dyn>` accelerations (and, if `step`, its
+/// Gauss–Legendre step), `Directions` rhs planar and spatial (if `spatial`).
+fn bench_linear(c: &mut Criterion, n: usize, step: bool, spatial: bool) {
+    let tension = PlanarTension::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    bench_accelerations(c, "planar", "tension", n, &tension);
+    if step {
+        bench_gl2_step(c, "planar", "tension", n, &tension);
+    }
+    bench_directions::<U2>(c, "planar", n, |s, q, qd| s.from_angles(q, qd));
+    if spatial {
+        bench_directions::<U3>(c, "spatial", n, |s, q, qd| s.from_spherical(q, qd));
+    }
 }
 
 /// One two-stage Gauss–Legendre step (h = 1 ms) of `model` through `FirstOrder`, always
@@ -215,17 +269,35 @@ fn small_chains(c: &mut Criterion) {
     );
     bench_closed_form(c);
     bench_sizes!(c, "spatial", Spatial, 2, 1 => Spatial1, 2 => Spatial2, 3 => Spatial3, 4 => Spatial4);
+    for n in (1..=8).filter(|&n| wanted(n)) {
+        bench_linear(c, n, true, n <= 4);
+    }
 }
 
-/// Beyond the generated sizes: the dense generic route up to [`DENSE_MAX`] links and the
-/// baseline (the O(n) routes join here when they land).
+/// Beyond the generated sizes: the O(n) routes, the dense generic route up to
+/// [`DENSE_MAX`] links and the baseline (accelerations only).
 fn large_chains(c: &mut Criterion) {
     for &n in large_sizes() {
+        bench_linear(c, n, false, true);
         if n <= DENSE_MAX {
-            let model = Planar::new(chain::<Dyn>(&params(n)).expect("valid chain"));
-            bench_evaluations(c, "planar", "generic_dyn", n, &model);
+            let p = params(n);
+            bench_accelerations(
+                c,
+                "planar",
+                "generic_dyn",
+                n,
+                &Planar::new(chain::<Dyn>(&p).expect("valid chain")),
+            );
+            bench_accelerations(
+                c,
+                "spatial",
+                "generic_dyn",
+                n,
+                &Spatial::new(chain::<Dyn>(&p).expect("valid chain")),
+            );
         }
         bench_baseline(c, "planar", n, n);
+        bench_baseline(c, "spatial", n, 2 * n);
     }
 }
 

@@ -31,10 +31,10 @@ pub struct Options {
     pub args: Vec<String>,
 }
 
-/// Criterion settings: (warm-up s, measurement s, samples).
-const FULL: (f64, f64, usize) = (0.3, 0.7, 40);
+/// Criterion settings: (warm-up s, measurement s, samples, bootstrap resamples).
+const FULL: (f64, f64, usize, usize) = (0.3, 0.7, 40, 20_000);
 /// See [`FULL`].
-const QUICK: (f64, f64, usize) = (0.02, 0.05, 10);
+const QUICK: (f64, f64, usize, usize) = (0.02, 0.05, 10, 1_000);
 
 /// Runs the benchmarks and writes the report and plot.
 pub fn run(options: &Options) -> Result<()> {
@@ -71,14 +71,25 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
         std::fs::remove_dir_all(criterion).with_context(|| format!("emptying {}", criterion.display()))?;
     }
     std::fs::create_dir_all(criterion).with_context(|| format!("creating {}", criterion.display()))?;
-    let (warm_up, measurement, samples) = if options.quick { QUICK } else { FULL };
+    let (warm_up, measurement, samples, resamples) = if options.quick { QUICK } else { FULL };
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let build = ["bench", "-p", "xtask", "--bench", "models"];
+    let status = Command::new(&cargo)
+        .current_dir(crate::workspace_root())
+        .args(build)
+        .arg("--no-run")
+        .status()
+        .context("building the benchmarks")?;
+    if !status.success() {
+        bail!("cargo bench --no-run failed ({status})");
+    }
     let mut command = Command::new(cargo);
     command
         .current_dir(crate::workspace_root())
-        .args(["bench", "-p", "xtask", "--bench", "models", "--"])
+        .args(build)
+        .arg("--")
         .args(["--warm-up-time", &warm_up.to_string(), "--measurement-time", &measurement.to_string()])
-        .args(["--sample-size", &samples.to_string()])
+        .args(["--sample-size", &samples.to_string(), "--nresamples", &resamples.to_string()])
         .args(&options.args)
         .env("CRITERION_HOME", criterion)
         .env("PENDULUM_BENCH_QUICK", if options.quick { "1" } else { "0" });
@@ -102,7 +113,8 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
         date,
         machine: machine(),
         settings: format!(
-            "{warm_up} s warm-up, {measurement} s measurement, {samples} samples per benchmark"
+            "{warm_up} s warm-up, {measurement} s measurement, {samples} samples and {resamples} \
+             bootstrap resamples per benchmark"
         ),
         load: (load_before, load_average()),
         seconds,

@@ -68,9 +68,11 @@ fn panel_plot(
         .configure_mesh()
         .x_desc("links n")
         .y_desc("time per evaluation (ns)")
+        .light_line_style(TRANSPARENT)
+        .bold_line_style(BLACK.mix(0.12))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
-        .x_label_formatter(&|x| format!("{x:.0}"))
+        .x_label_formatter(&|x| if is_round(*x) { format!("{x:.0}") } else { String::new() })
         .y_label_formatter(&|y| format!("{y:.0}"))
         .draw()
         .map_err(err)?;
@@ -85,7 +87,10 @@ fn panel_plot(
             .map_err(err)?
             .label(label(implementation).replace('`', ""))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 3, style.filled()))).map_err(err)?;
+        // A lone point (the closed form) gets a larger ring so that it shows above the
+        // generated line it sits on.
+        let (radius, marker) = if points.len() == 1 { (6, style) } else { (3, style.filled()) };
+        chart.draw_series(points.into_iter().map(|p| Circle::new(p, radius, marker))).map_err(err)?;
     }
     chart
         .configure_series_labels()
@@ -98,9 +103,22 @@ fn panel_plot(
     Ok(())
 }
 
+/// Whether `x` is 1, 2 or 5 times a power of ten: the labelled ticks of the log n axis
+/// (plotters puts a tick at every 1..9 × 10^k; labelling all of them overlaps).
+fn is_round(x: f64) -> bool {
+    let mantissa = x / 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-9)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_one_two_five_ticks_are_labelled() {
+        assert!([1.0, 2.0, 5.0, 10.0, 20.0, 500.0, 1000.0].into_iter().all(is_round));
+        assert!(![3.0, 9.0, 30.0, 4096.0].into_iter().any(is_round));
+    }
 
     #[test]
     fn draws_one_labelled_line_per_implementation() {

@@ -32,8 +32,9 @@ pub const IMPLEMENTATIONS: [(&str, &str); 7] = [
 pub const GENERIC: &str = "generic_dyn";
 /// The physical-limit baseline.
 pub const BASELINE: &str = "baseline";
-/// The O(n) accelerations (planar).
-pub const LINEAR: &str = "tension";
+/// The O(n) routes whose crossovers the report gives: (kind, implementation).
+pub const LINEAR: [(&str, &str); 3] =
+    [("planar", "tension"), ("planar", "directions"), ("spatial", "directions")];
 
 /// The line that separates the generated report from the hand-written notes, which
 /// `cargo xtask bench` keeps when it rewrites `docs/bench.md`.
@@ -57,7 +58,7 @@ pub struct RunInfo {
     pub settings: String,
     /// `/proc/loadavg` before and after.
     pub load: (String, String),
-    /// Wall time of the benchmark run, s.
+    /// Wall time of the benchmark run (built beforehand), s.
     pub seconds: f64,
 }
 
@@ -104,14 +105,17 @@ pub struct Targets {
     pub speedups: Vec<(&'static str, usize, Option<f64>)>,
     /// Generated `Planar2` ÷ closed form, accelerations.
     pub closed_form: Option<f64>,
-    /// The first n from which the O(n) route's planar accelerations are faster than the
-    /// generated ones at every measured n, and the ratio O(n) ÷ generated at each common n.
-    pub crossover: Crossover,
+    /// Where each O(n) route of [`LINEAR`] overtakes the generated models.
+    pub crossovers: Vec<Crossover>,
 }
 
-/// Where the O(n) route overtakes another route (planar accelerations).
+/// Where an O(n) route overtakes another route (accelerations).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Crossover {
+    /// Model kind (`planar`, `spatial`).
+    pub kind: &'static str,
+    /// The O(n) route's benchmark name.
+    pub route: &'static str,
     /// `(n, O(n) time ÷ other time)` at every n where both ran.
     pub ratios: Vec<(usize, f64)>,
     /// The smallest measured n from which the O(n) route is faster at every measured n.
@@ -119,16 +123,16 @@ pub struct Crossover {
 }
 
 impl Crossover {
-    /// The crossover of the O(n) route against `other` in planar accelerations.
-    pub fn of(results: &Results, other: &str) -> Self {
-        let group = "planar_accelerations";
+    /// The crossover of `route` against `other` in `<kind>_accelerations`.
+    pub fn of(results: &Results, kind: &'static str, route: &'static str, other: &str) -> Self {
+        let group = format!("{kind}_accelerations");
         let ratios: Vec<(usize, f64)> = results
-            .series(group, LINEAR)
+            .series(&group, route)
             .into_iter()
-            .filter_map(|(n, t)| Some((n, t / results.get(group, other, n)?)))
+            .filter_map(|(n, t)| Some((n, t / results.get(&group, other, n)?)))
             .collect();
         let from = ratios.iter().rposition(|&(_, r)| r >= 1.0).map_or(0, |i| i + 1);
-        Self { from: ratios.get(from).map(|&(n, _)| n), ratios }
+        Self { kind, route, from: ratios.get(from).map(|&(n, _)| n), ratios }
     }
 }
 
@@ -148,7 +152,11 @@ impl Targets {
         let group = "planar_accelerations";
         let closed_form =
             results.get(group, "generated", 2).zip(results.get(group, "closed_form", 2)).map(|(g, c)| g / c);
-        Self { speedups, closed_form, crossover: Crossover::of(results, "generated") }
+        let crossovers = LINEAR
+            .into_iter()
+            .map(|(kind, route)| Crossover::of(results, kind, route, "generated"))
+            .collect();
+        Self { speedups, closed_form, crossovers }
     }
 
     /// The checks as markdown.
@@ -183,26 +191,23 @@ impl Targets {
             ),
             None => writeln!(out, "**Closed form:** not measured in this run.\n"),
         };
-        let c = &self.crossover;
-        let _ = if c.ratios.is_empty() {
-            writeln!(
-                out,
-                "**Crossover of the O(n) route:** not measured in this run (the O(n) route or the \
-                 generated models did not run).\n"
-            )
-        } else {
-            let list: Vec<String> = c.ratios.iter().map(|&(n, r)| format!("n = {n}: {}", ratio(r))).collect();
-            let verdict = match c.from {
-                Some(n) => format!("the O(n) route is faster than the generated models from **n = {n}** on"),
-                None => "the O(n) route is slower than the generated models at every measured n".into(),
+        for c in &self.crossovers {
+            let what = format!("{} {}", c.kind, label(c.route));
+            let _ = if c.ratios.is_empty() {
+                writeln!(out, "**Crossover, {what}:** not measured in this run.\n")
+            } else {
+                let list: Vec<String> = c.ratios.iter().map(|&(n, r)| format!("{n}: {}", ratio(r))).collect();
+                let verdict = match c.from {
+                    Some(n) => format!("faster than the generated models from **n = {n}** on"),
+                    None => "slower than the generated models at every measured n".into(),
+                };
+                writeln!(
+                    out,
+                    "**Crossover, {what}:** {verdict}. Its time ÷ generated time, by n: {}.\n",
+                    list.join(", ")
+                )
             };
-            writeln!(
-                out,
-                "**Crossover of the O(n) route (planar accelerations):** {verdict}. O(n) time ÷ generated \
-                 time: {}.\n",
-                list.join(", ")
-            )
-        };
+        }
         out
     }
 }
@@ -232,10 +237,14 @@ pub fn markdown(results: &Results, info: &RunInfo, notes: &str) -> String {
     let _ = writeln!(out, "![time per evaluation vs n](bench.svg)\n");
     let _ = writeln!(out, "## Targets (issue 4)\n");
     out += &Targets::of(results).markdown();
-    let crossover = Crossover::of(results, GENERIC);
-    if let Some(n) = crossover.from {
-        let _ =
-            writeln!(out, "The O(n) route is faster than the generic dense `Dyn` route from n = {n} on.\n");
+    for (kind, route) in LINEAR {
+        if let Some(n) = Crossover::of(results, kind, route, GENERIC).from {
+            let _ = writeln!(
+                out,
+                "{kind} {} is faster than the dense generic `Dyn` route from n = {n} on.\n",
+                label(route)
+            );
+        }
     }
 
     for kind in KINDS {
@@ -322,7 +331,7 @@ mod tests {
         {
             r.insert(g, "generated", n, generated);
             r.insert(g, GENERIC, n, generic);
-            r.insert(g, LINEAR, n, linear);
+            r.insert(g, "tension", n, linear);
             r.insert(g, BASELINE, n, 5.0 * n as f64);
         }
         r.insert(g, "closed_form", 2, 16.0);
@@ -339,11 +348,15 @@ mod tests {
         assert_eq!(t.speedups[4], ("spatial", 1, Some(2.5)));
         assert_eq!(t.closed_form, Some(1.25));
         // O(n) ÷ generated: 3, 1.25, 0.9, 0.6: faster from n = 4 on.
-        assert_eq!(t.crossover.from, Some(4));
+        assert_eq!(t.crossovers[0].from, Some(4));
+        assert!(t.crossovers[1].ratios.is_empty());
         let md = t.markdown();
         assert!(md.contains("| spatial | 1 | 2.50 | **no**: 17% short |"), "{md}");
         assert!(md.contains("= 1.25 (**not met**, by 4%)"), "{md}");
-        assert!(md.contains("from **n = 4** on"), "{md}");
+        assert!(
+            md.contains("PlanarTension<Dyn>`:** faster than the generated models from **n = 4** on"),
+            "{md}"
+        );
     }
 
     #[test]
@@ -351,11 +364,11 @@ mod tests {
         let mut r = Results::default();
         for (n, linear) in [(1, 0.5), (2, 2.0), (3, 0.5)] {
             r.insert("planar_accelerations", "generated", n, 1.0);
-            r.insert("planar_accelerations", LINEAR, n, linear);
+            r.insert("planar_accelerations", "tension", n, linear);
         }
-        assert_eq!(Crossover::of(&r, "generated").from, Some(3));
-        r.insert("planar_accelerations", LINEAR, 3, 1.5);
-        assert_eq!(Crossover::of(&r, "generated").from, None);
+        assert_eq!(Crossover::of(&r, "planar", "tension", "generated").from, Some(3));
+        r.insert("planar_accelerations", "tension", 3, 1.5);
+        assert_eq!(Crossover::of(&r, "planar", "tension", "generated").from, None);
     }
 
     #[test]
