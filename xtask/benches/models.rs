@@ -244,6 +244,13 @@ fn bench_closed_form(c: &mut Criterion) {
     c.benchmark_group("planar_accelerations").bench_function(BenchmarkId::new("closed_form", 2), |b| {
         b.iter(|| black_box(model.accelerations(black_box(q), black_box(qd))))
     });
+    // The part of the generated model's cost the closed form does not have: validating
+    // the lengths and finiteness of q, q̇, σ and p̈.
+    let (q, qd) = state(Const::<2>);
+    let inputs = Inputs::<Const<2>, U2>::zeros(Const::<2>);
+    c.benchmark_group("planar_input_checks").bench_function(BenchmarkId::new("check_inputs", 2), |b| {
+        b.iter(|| pendulum_core::check_inputs(2, black_box(&q), black_box(&qd), black_box(&inputs)).unwrap())
+    });
 }
 
 /// The generated model of `n` links, the generic one with `L = Const<n>` and with
