@@ -14,7 +14,7 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 use anyhow::{Context, Result, bail};
 
 pub use report::{RunInfo, Targets};
-pub use results::Results;
+pub use results::{Results, Statistic};
 
 /// Options of `cargo xtask bench`.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -50,16 +50,17 @@ pub fn run(options: &Options) -> Result<()> {
             .with_context(|| format!("writing {}", info_path.display()))?;
         info
     };
-    let results = Results::load(&criterion)?;
+    let results = Results::load(&criterion, Statistic::Median)?;
+    let fastest = Results::load(&criterion, Statistic::Fastest)?;
     let out_dir = if options.quick { scratch.clone() } else { crate::workspace_root().join("docs") };
     let md_path = out_dir.join("bench.md");
     let notes = existing_notes(&crate::workspace_root().join("docs").join("bench.md"));
-    std::fs::write(&md_path, report::markdown(&results, &info, &notes))
+    std::fs::write(&md_path, report::markdown(&results, &fastest, &info, &notes))
         .with_context(|| format!("writing {}", md_path.display()))?;
     let svg_path = out_dir.join("bench.svg");
-    std::fs::write(&svg_path, plot::svg(&results)?)
+    std::fs::write(&svg_path, plot::svg(&fastest)?)
         .with_context(|| format!("writing {}", svg_path.display()))?;
-    println!("\n{}", Targets::of(&results).markdown());
+    println!("\n{}", report::targets_markdown(&Targets::of(&results), &Targets::of(&fastest)));
     println!("{} benchmarks; wrote {} and {}", results.len(), md_path.display(), svg_path.display());
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! `docs/bench.svg`: time per evaluation of the accelerations vs n, log–log, one line per
-//! implementation, planar and spatial side by side (plotters, SVG backend).
+//! implementation, planar and spatial side by side (plotters, SVG backend). It plots the
+//! fastest sample of each benchmark ([`super::Statistic::Fastest`]), the figure least
+//! disturbed by other jobs on a shared machine.
 //!
 //! No font backend: plotters' SVG backend writes text as `<text>` elements that the
 //! viewer renders with its own fonts, and without the `ttf`/`ab_glyph` features plotters
@@ -67,13 +69,13 @@ fn panel_plot(
     chart
         .configure_mesh()
         .x_desc("links n")
-        .y_desc("time per evaluation (ns)")
+        .y_desc("time per evaluation (fastest sample)")
         .light_line_style(TRANSPARENT)
         .bold_line_style(BLACK.mix(0.12))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
         .x_label_formatter(&|x| if is_round(*x) { format!("{x:.0}") } else { String::new() })
-        .y_label_formatter(&|y| format!("{y:.0}"))
+        .y_label_formatter(&|y| if is_round(*y) { tick_time(*y) } else { String::new() })
         .draw()
         .map_err(err)?;
     for implementation in
@@ -103,6 +105,17 @@ fn panel_plot(
     Ok(())
 }
 
+/// A round time in ns as a tick label: `10 ns`, `2 µs`, `500 ms`.
+fn tick_time(ns: f64) -> String {
+    let (value, unit) = match ns {
+        t if t < 1e3 - 0.5 => (t, "ns"),
+        t if t < 1e6 - 0.5 => (t / 1e3, "µs"),
+        t if t < 1e9 - 0.5 => (t / 1e6, "ms"),
+        t => (t / 1e9, "s"),
+    };
+    if value < 1.0 { format!("{value} {unit}") } else { format!("{value:.0} {unit}") }
+}
+
 /// Whether `x` is 1, 2 or 5 times a power of ten: the labelled ticks of the log n axis
 /// (plotters puts a tick at every 1..9 × 10^k; labelling all of them overlaps).
 fn is_round(x: f64) -> bool {
@@ -118,6 +131,7 @@ mod tests {
     fn only_one_two_five_ticks_are_labelled() {
         assert!([1.0, 2.0, 5.0, 10.0, 20.0, 500.0, 1000.0].into_iter().all(is_round));
         assert!(![3.0, 9.0, 30.0, 4096.0].into_iter().any(is_round));
+        assert_eq!([10.0, 2000.0, 1e6, 5e8].map(tick_time), ["10 ns", "2 µs", "1 ms", "500 ms"]);
     }
 
     #[test]

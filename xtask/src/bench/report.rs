@@ -166,81 +166,106 @@ impl Targets {
             .collect();
         Self { speedups, closed_form, closed_form_unchecked, crossovers }
     }
+}
 
-    /// The checks as markdown.
-    pub fn markdown(&self) -> String {
-        let mut out = String::new();
+/// `"met"`, or by how much a ratio `r` misses: `at_least` targets need `r ≥ target`,
+/// the others `r ≤ target`.
+fn verdict(r: f64, target: f64, at_least: bool) -> String {
+    match (at_least, r) {
+        (true, r) if r >= target => "met".into(),
+        (true, r) => format!("**missed**, {:.0}% short", 100.0 * (1.0 - r / target)),
+        (false, r) if r <= target => "met".into(),
+        (false, r) => format!("**missed**, {:.0}% over", 100.0 * (r / target - 1.0)),
+    }
+}
+
+fn both(median: Option<f64>, fastest: Option<f64>) -> String {
+    let show = |r: Option<f64>| r.map_or("–".to_string(), ratio);
+    format!("{} / {}", show(median), show(fastest))
+}
+
+/// The checks as markdown, from the medians and from the fastest samples of one run.
+pub fn targets_markdown(median: &Targets, fastest: &Targets) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Each figure is given twice, from the medians / from the fastest samples (the two \
+         statistics of the same run; see the notes on load).\n"
+    );
+    let _ = writeln!(
+        out,
+        "**Generated accelerations ≥ {SPEEDUP_TARGET}× faster than generic `Dyn` for n ≤ 4** \
+         (speed-up = generic `Dyn` time ÷ generated time):\n"
+    );
+    let _ = writeln!(out, "| model | n | speed-up | medians | fastest samples |\n|---|---|---|---|---|");
+    for (&(kind, n, m), &(_, _, f)) in median.speedups.iter().zip(&fastest.speedups) {
+        let v = |r: Option<f64>| r.map_or("not measured".to_string(), |r| verdict(r, SPEEDUP_TARGET, true));
+        let _ = writeln!(out, "| {kind} | {n} | {} | {} | {} |", both(m, f), v(m), v(f));
+    }
+    let _ = writeln!(out);
+    if let (Some(m), Some(f)) = (median.closed_form, fastest.closed_form) {
         let _ = writeln!(
             out,
-            "**Generated accelerations ≥ {SPEEDUP_TARGET}× faster than generic `Dyn` for n ≤ 4** \
-             (speed-up = generic `Dyn` time ÷ generated time):\n"
+            "**Generated `Planar2` within {CLOSED_FORM_TARGET}× of the closed form:** generated ÷ closed \
+             form = {} (medians: {}; fastest samples: {}).\n",
+            both(Some(m), Some(f)),
+            verdict(m, CLOSED_FORM_TARGET, false),
+            verdict(f, CLOSED_FORM_TARGET, false)
         );
-        let _ = writeln!(out, "| model | n | speed-up | target met |\n|---|---|---|---|");
-        for &(kind, n, s) in &self.speedups {
-            let (s, verdict) = match s {
-                Some(s) if s >= SPEEDUP_TARGET => (ratio(s), "yes".to_string()),
-                Some(s) => (ratio(s), format!("**no**: {:.0}% short", 100.0 * (1.0 - s / SPEEDUP_TARGET))),
-                None => ("–".into(), "not measured".into()),
-            };
-            let _ = writeln!(out, "| {kind} | {n} | {s} | {verdict} |");
-        }
-        let _ = writeln!(out);
-        let _ = match self.closed_form {
-            Some(r) => writeln!(
-                out,
-                "**Generated `Planar2` within {CLOSED_FORM_TARGET}× of the closed form:** generated ÷ closed \
-                 form = {} ({}).\n",
-                ratio(r),
-                if r <= CLOSED_FORM_TARGET {
-                    "met".to_string()
-                } else {
-                    format!("**not met**, by {:.0}%", 100.0 * (r / CLOSED_FORM_TARGET - 1.0))
-                }
-            ),
-            None => writeln!(out, "**Closed form:** not measured in this run.\n"),
-        };
-        if let Some((checks, r)) = self.closed_form_unchecked {
-            let _ = writeln!(
-                out,
-                "The generated model validates its inputs (`check_inputs`: lengths and finiteness of \
-                 q, q̇, σ, p̈), which the closed form does not: {} alone at n = 2; without it, generated \
-                 ÷ closed form would be {}.\n",
-                time(checks),
-                ratio(r)
-            );
-        }
-        for c in &self.crossovers {
-            let what = format!("{} {}", c.kind, label(c.route));
-            let _ = if c.ratios.is_empty() {
-                writeln!(out, "**Crossover, {what}:** not measured in this run.\n")
-            } else {
-                let list: Vec<String> = c.ratios.iter().map(|&(n, r)| format!("{n}: {}", ratio(r))).collect();
-                let verdict = match c.from {
-                    Some(n) => format!("faster than the generated models from **n = {n}** on"),
-                    None => "slower than the generated models at every measured n".into(),
-                };
-                writeln!(
-                    out,
-                    "**Crossover, {what}:** {verdict}. Its time ÷ generated time, by n: {}.\n",
-                    list.join(", ")
-                )
-            };
-        }
-        out
+    } else {
+        let _ = writeln!(out, "**Closed form:** not measured in this run.\n");
     }
+    if let (Some((cm, rm)), Some((cf, rf))) = (median.closed_form_unchecked, fastest.closed_form_unchecked) {
+        let _ = writeln!(
+            out,
+            "The generated model validates its inputs (`check_inputs`: lengths and finiteness of \
+             q, q̇, σ, p̈), which the closed form does not: {} / {} alone at n = 2; without it, \
+             generated ÷ closed form would be {}.\n",
+            time(cm),
+            time(cf),
+            both(Some(rm), Some(rf))
+        );
+    }
+    for (m, f) in median.crossovers.iter().zip(&fastest.crossovers) {
+        let what = format!("{} {}", m.kind, label(m.route));
+        if m.ratios.is_empty() {
+            let _ = writeln!(out, "**Crossover, {what}:** not measured in this run.\n");
+            continue;
+        }
+        let from = |c: &Crossover| {
+            c.from.map_or("never (slower at every measured n)".to_string(), |n| format!("n = {n}"))
+        };
+        let list: Vec<String> = m
+            .ratios
+            .iter()
+            .zip(&f.ratios)
+            .map(|(&(n, rm), &(_, rf))| format!("{n}: {}", both(Some(rm), Some(rf))))
+            .collect();
+        let _ = writeln!(
+            out,
+            "**Crossover, {what}:** faster than the generated models from **{}** (medians) / **{}** \
+             (fastest samples) on. Its time ÷ generated time, by n: {}.\n",
+            from(m),
+            from(f),
+            list.join(", ")
+        );
+    }
+    out
 }
 
 /// The generated part of `docs/bench.md`, followed by `notes` (the hand-written part,
 /// starting with [`NOTES_MARKER`]).
-pub fn markdown(results: &Results, info: &RunInfo, notes: &str) -> String {
+///
+/// `results` holds the medians, `fastest` the fastest samples of the same run.
+pub fn markdown(results: &Results, fastest: &Results, info: &RunInfo, notes: &str) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "# Benchmarks: generated vs generic vs closed form vs O(n)\n");
     let _ = writeln!(
         out,
         "Generated by `{}` on {} in {:.0} s of benchmarking. Machine: {}. Load average \
-         (1/5/15 min) before: {}, after: {}. Criterion {}. Times are medians per evaluation. \
-         Every ratio below comes from this one run; absolute times depend on the machine and \
-         its load.\n",
+         (1/5/15 min) before: {}, after: {}. Criterion {}. Times are per evaluation; the tables \
+         give medians, and for the accelerations also the fastest sample. Every ratio below \
+         comes from this one run; absolute times depend on the machine and its load.\n",
         info.command, info.date, info.seconds, info.machine, info.load.0, info.load.1, info.settings
     );
     let _ = writeln!(out, "What is timed (groups `<kind>_<operation>` in `xtask/benches/models.rs`):\n");
@@ -252,9 +277,10 @@ pub fn markdown(results: &Results, info: &RunInfo, notes: &str) -> String {
         "- `baseline`: `dof` calls of `sin_cos` and `2·dof` stores (`dof` = n planar, 2n spatial), \
          the least any evaluation does.\n"
     );
-    let _ = writeln!(out, "![time per evaluation vs n](bench.svg)\n");
+    let _ =
+        writeln!(out, "![time per evaluation vs n (fastest sample of each benchmark), log–log](bench.svg)\n");
     let _ = writeln!(out, "## Targets (issue 4)\n");
-    out += &Targets::of(results).markdown();
+    out += &targets_markdown(&Targets::of(results), &Targets::of(fastest));
     for (kind, route) in LINEAR {
         if let Some(n) = Crossover::of(results, kind, route, GENERIC).from {
             let _ = writeln!(
@@ -272,7 +298,10 @@ pub fn markdown(results: &Results, info: &RunInfo, notes: &str) -> String {
                 continue;
             }
             let _ = writeln!(out, "## {kind} {}\n\n{what}.\n", op.replace('_', " "));
-            out += &medians_table(results, &group);
+            out += &times_table(results, &group, "Median time");
+            if op == "accelerations" {
+                out += &times_table(fastest, &group, "Fastest sample");
+            }
             out += &speedup_table(results, &group);
             if op == "accelerations" {
                 out += &baseline_table(results, &group);
@@ -287,10 +316,10 @@ fn header(columns: &[String]) -> String {
     format!("| n | {} |\n|---|{}\n", columns.join(" | "), "---|".repeat(columns.len()))
 }
 
-fn medians_table(results: &Results, group: &str) -> String {
+fn times_table(results: &Results, group: &str, title: &str) -> String {
     let implementations = ordered(results, group);
     let columns: Vec<String> = implementations.iter().map(|i| label(i).to_string()).collect();
-    let mut out = format!("Median time:\n\n{}", header(&columns));
+    let mut out = format!("{title}:\n\n{}", header(&columns));
     for n in results.sizes(group) {
         let cells: Vec<String> =
             implementations.iter().map(|i| results.get(group, i, n).map_or("–".into(), time)).collect();
@@ -307,7 +336,7 @@ fn speedup_table(results: &Results, group: &str) -> String {
         return String::new();
     }
     let columns: Vec<String> = implementations.iter().map(|i| label(i).to_string()).collect();
-    let mut out = format!("Speed-up over generic `Dyn` (its time ÷ this time):\n\n{}", header(&columns));
+    let mut out = format!("Speed-up over generic `Dyn` (its median ÷ this median):\n\n{}", header(&columns));
     for n in results.sizes(group) {
         let Some(generic) = results.get(group, GENERIC, n) else { continue };
         let cells: Vec<String> = implementations
@@ -325,7 +354,8 @@ fn speedup_table(results: &Results, group: &str) -> String {
 fn baseline_table(results: &Results, group: &str) -> String {
     let implementations: Vec<&str> = ordered(results, group).into_iter().filter(|i| *i != BASELINE).collect();
     let columns: Vec<String> = implementations.iter().map(|i| label(i).to_string()).collect();
-    let mut out = format!("Multiple of the baseline (this time ÷ baseline time):\n\n{}", header(&columns));
+    let mut out =
+        format!("Multiple of the baseline (this median ÷ baseline median):\n\n{}", header(&columns));
     for n in results.sizes(group) {
         let Some(base) = results.get(group, BASELINE, n) else { continue };
         let cells: Vec<String> = implementations
@@ -368,11 +398,11 @@ mod tests {
         // O(n) ÷ generated: 3, 1.25, 0.9, 0.6: faster from n = 4 on.
         assert_eq!(t.crossovers[0].from, Some(4));
         assert!(t.crossovers[1].ratios.is_empty());
-        let md = t.markdown();
-        assert!(md.contains("| spatial | 1 | 2.50 | **no**: 17% short |"), "{md}");
-        assert!(md.contains("= 1.25 (**not met**, by 4%)"), "{md}");
+        let md = targets_markdown(&t, &t);
+        assert!(md.contains("| spatial | 1 | 2.50 / 2.50 | **missed**, 17% short |"), "{md}");
+        assert!(md.contains("= 1.25 / 1.25 (medians: **missed**, 4% over;"), "{md}");
         assert!(
-            md.contains("PlanarTension<Dyn>`:** faster than the generated models from **n = 4** on"),
+            md.contains("PlanarTension<Dyn>`:** faster than the generated models from **n = 4** (medians)"),
             "{md}"
         );
     }
@@ -391,7 +421,7 @@ mod tests {
 
     #[test]
     fn tables_hold_medians_and_ratios() {
-        let md = markdown(&results(), &RunInfo::default(), "NOTES");
+        let md = markdown(&results(), &results(), &RunInfo::default(), "NOTES");
         assert!(md.contains("| 2 | 20.0 ns | 100 ns | 16.0 ns | 25.0 ns | 10.0 ns |"), "{md}");
         // Speed-ups over generic Dyn: generated 5, closed form 6.25, O(n) 4.
         assert!(md.contains("| 2 | 5.00 | 6.25 | 4.00 |"), "{md}");
