@@ -299,12 +299,13 @@ pub fn markdown(results: &Results, fastest: &Results, info: &RunInfo, notes: &st
             }
             let _ = writeln!(out, "## {kind} {}\n\n{what}.\n", op.replace('_', " "));
             out += &times_table(results, &group, "Median time");
+            out += &times_table(fastest, &group, "Fastest sample");
+            let speedup = |t: f64, generic: f64| generic / t;
+            let title = "Speed-up over generic `Dyn`, its time ÷ this time";
+            out += &ratio_table(results, fastest, &group, GENERIC, title, speedup);
             if op == "accelerations" {
-                out += &times_table(fastest, &group, "Fastest sample");
-            }
-            out += &speedup_table(results, &group);
-            if op == "accelerations" {
-                out += &baseline_table(results, &group);
+                let title = "Multiple of the baseline, this time ÷ baseline time";
+                out += &ratio_table(results, fastest, &group, BASELINE, title, |t, base| t / base);
             }
         }
     }
@@ -328,41 +329,35 @@ fn times_table(results: &Results, group: &str, title: &str) -> String {
     out + "\n"
 }
 
-/// Generic `Dyn` time ÷ each implementation's time (above 1: faster than generic).
-fn speedup_table(results: &Results, group: &str) -> String {
+/// A table of ratios `value(t, reference)` of each implementation against `reference`
+/// (generic `Dyn` or the baseline) at each n; each cell "from medians / from fastest samples".
+fn ratio_table(
+    results: &Results,
+    fastest: &Results,
+    group: &str,
+    reference: &str,
+    title: &str,
+    value: fn(f64, f64) -> f64,
+) -> String {
     let implementations: Vec<&str> =
-        ordered(results, group).into_iter().filter(|i| *i != GENERIC && *i != BASELINE).collect();
-    if implementations.is_empty() || results.series(group, GENERIC).is_empty() {
+        ordered(results, group).into_iter().filter(|i| *i != reference && *i != BASELINE).collect();
+    if implementations.is_empty() || results.series(group, reference).is_empty() {
         return String::new();
     }
     let columns: Vec<String> = implementations.iter().map(|i| label(i).to_string()).collect();
-    let mut out = format!("Speed-up over generic `Dyn` (its median ÷ this median):\n\n{}", header(&columns));
+    let mut out = format!("{title} (medians / fastest samples):\n\n{}", header(&columns));
     for n in results.sizes(group) {
-        let Some(generic) = results.get(group, GENERIC, n) else { continue };
-        let cells: Vec<String> = implementations
-            .iter()
-            .map(|i| results.get(group, i, n).map_or("–".into(), |t| ratio(generic / t)))
-            .collect();
+        let cell = |i: &str| {
+            let r = |res: &Results| Some(value(res.get(group, i, n)?, res.get(group, reference, n)?));
+            match (r(results), r(fastest)) {
+                (None, None) => "–".to_string(),
+                (m, f) => both(m, f),
+            }
+        };
+        let cells: Vec<String> = implementations.iter().map(|i| cell(i)).collect();
         if cells.iter().any(|c| c != "–") {
             let _ = writeln!(out, "| {n} | {} |", cells.join(" | "));
         }
-    }
-    out + "\n"
-}
-
-/// Each implementation's time ÷ the baseline's.
-fn baseline_table(results: &Results, group: &str) -> String {
-    let implementations: Vec<&str> = ordered(results, group).into_iter().filter(|i| *i != BASELINE).collect();
-    let columns: Vec<String> = implementations.iter().map(|i| label(i).to_string()).collect();
-    let mut out =
-        format!("Multiple of the baseline (this median ÷ baseline median):\n\n{}", header(&columns));
-    for n in results.sizes(group) {
-        let Some(base) = results.get(group, BASELINE, n) else { continue };
-        let cells: Vec<String> = implementations
-            .iter()
-            .map(|i| results.get(group, i, n).map_or("–".into(), |t| ratio(t / base)))
-            .collect();
-        let _ = writeln!(out, "| {n} | {} |", cells.join(" | "));
     }
     out + "\n"
 }
@@ -424,9 +419,9 @@ mod tests {
         let md = markdown(&results(), &results(), &RunInfo::default(), "NOTES");
         assert!(md.contains("| 2 | 20.0 ns | 100 ns | 16.0 ns | 25.0 ns | 10.0 ns |"), "{md}");
         // Speed-ups over generic Dyn: generated 5, closed form 6.25, O(n) 4.
-        assert!(md.contains("| 2 | 5.00 | 6.25 | 4.00 |"), "{md}");
+        assert!(md.contains("| 2 | 5.00 / 5.00 | 6.25 / 6.25 | 4.00 / 4.00 |"), "{md}");
         // Multiples of the baseline (10 ns at n = 2).
-        assert!(md.contains("| 2 | 2.00 | 10.0 | 1.60 | 2.50 |"), "{md}");
+        assert!(md.contains("| 2 | 2.00 / 2.00 | 10.0 / 10.0 | 1.60 / 1.60 | 2.50 / 2.50 |"), "{md}");
         assert!(md.ends_with("NOTES"));
     }
 
