@@ -65,7 +65,7 @@ pub fn run(options: &Options) -> Result<()> {
     Ok(())
 }
 
-/// Runs `cargo bench -p xtask --bench models` with criterion's output in `criterion`
+/// Runs `cargo bench --workspace --bench models` with criterion's output in `criterion`
 /// (emptied first, so the report never mixes runs).
 fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     if criterion.exists() {
@@ -74,7 +74,9 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     std::fs::create_dir_all(criterion).with_context(|| format!("creating {}", criterion.display()))?;
     let (warm_up, measurement, samples, resamples) = if options.quick { QUICK } else { FULL };
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let build = ["bench", "-p", "xtask", "--bench", "models"];
+    // `--workspace` unifies features as `cargo bench --workspace --no-run` (CI) does, so the
+    // binary CI compiled is reused rather than built again.
+    let build = ["bench", "--workspace", "--bench", "models"];
     let status = Command::new(&cargo)
         .current_dir(crate::workspace_root())
         .args(build)
