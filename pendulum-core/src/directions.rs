@@ -7,7 +7,7 @@ use std::marker::PhantomData;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, allocator::Allocator};
 
 use crate::integrate::{Constrained, System};
-use crate::rods::{Rods, with_scratch};
+use crate::rods::{Load, Rods, with_scratch};
 use crate::{Chain, Drive, Error, Fixed, Result, check_polar_sin};
 
 /// A chain of `n` point masses on rigid rods in the plane (`S = U2`, y up) or in space
@@ -229,25 +229,25 @@ where
         let mut gravity = [0.0; C];
         gravity[C - 1] = -self.chain.gravity();
         let (directions, rates) = x.split_at(C * n);
+        let mut tensions = tensions;
         with_scratch::<C, _>(n, |s| {
-            for i in 0..n {
+            let load = |i: usize| {
                 let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
                 let pull = -damping[i] / lengths[i];
-                let mut w2 = 0.0;
+                let mut load = Load { direction: [0.0; C], rate_squared: 0.0, pair: [0.0; C] };
                 for k in 0..C {
-                    s.directions[i][k] = u[k];
-                    s.pairs[i][k] = pull * w[k];
-                    w2 += w[k] * w[k];
+                    load.direction[k] = u[k];
+                    load.pair[k] = pull * w[k];
+                    load.rate_squared += w[k] * w[k];
                 }
-                s.rate_squared[i] = w2;
-            }
-            self.rods.solve_in_place(gravity, pivot, s);
-            for (chunk, a) in out.chunks_exact_mut(C).zip(&s.direction_accelerations) {
-                chunk.copy_from_slice(a);
-            }
-            if let Some(t) = tensions {
-                t.copy_from_slice(s.tensions());
-            }
+                load
+            };
+            self.rods.solve(gravity, pivot, s, load, |i, a, _, t| {
+                out[i * C..(i + 1) * C].copy_from_slice(&a);
+                if let Some(tensions) = tensions.as_deref_mut() {
+                    tensions[i] = t;
+                }
+            });
         });
     }
 }
@@ -301,6 +301,20 @@ impl<Dr> Directions<U2, Dr> {
             x[2 * (n + i) + 1] = rates[i] * s;
         }
         Ok(x)
+    }
+
+    /// The angle accelerations `θ̈_i = n_i · ü_i` (rad/s²; `n_i = (cos θ_i, sin θ_i)`,
+    /// since `ü_i = θ̈_i n_i − θ̇_i² u_i`) at `(t, x)`: what [`Planar`](crate::Planar)
+    /// computes, by the O(n) route.
+    pub fn angle_accelerations(&self, t: f64, x: &DVector<f64>) -> Result<DVector<f64>>
+    where
+        Dr: Drive<U2>,
+    {
+        let n = self.links();
+        let mut udd = vec![0.0; 2 * n];
+        self.accelerations(t, x, &mut udd, None)?;
+        // n_i = (−u_y, u_x) for a unit u_i = (sin θ_i, −cos θ_i).
+        Ok(DVector::from_fn(n, |i, _| -x[2 * i + 1] * udd[2 * i] + x[2 * i] * udd[2 * i + 1]))
     }
 
     /// The angles `θ_i = atan2(u_x, −u_y)` (rad, in (−π, π]) and rates `θ̇_i = n_i·w_i`
@@ -364,6 +378,40 @@ impl<Dr> Directions<U3, Dr> {
     }
 }
 
+impl<Dr: Drive<U3>> Directions<U3, Dr> {
+    /// The spherical accelerations `q̈ = (θ̈_1 … θ̈_n, φ̈_1 … φ̈_n)` (rad/s²) at time `t`
+    /// and spherical angles `q`, rates `q̇` (rad, rad/s),
+    /// from the direction accelerations `ü_i` of the tension solve:
+    /// ```text
+    /// θ̈ = e_θ·ü + φ̇² sin θ cos θ,   φ̈ = (e_φ·ü − 2 θ̇ φ̇ cos θ) / sin θ
+    /// ```
+    /// (differentiate `u̇ = θ̇ e_θ + φ̇ sin θ e_φ` once more). What the spherical model
+    /// [`Spatial`](crate::Spatial) computes, by an O(n) route; `cargo xtask verify`
+    /// checks it against the sympy reference.
+    ///
+    /// The angles may be any (negative `θ` included) except at the vertical.
+    ///
+    /// Errors: [`Error::SingularAngle`] for `|sin θ_i|` below
+    /// [`SINGULARITY_TOLERANCE`](crate::SINGULARITY_TOLERANCE); those of
+    /// [`from_spherical`](Self::from_spherical).
+    pub fn spherical_accelerations(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
+        let x = self.from_spherical(q, qd)?;
+        let n = self.links();
+        let mut udd = vec![0.0; 3 * n];
+        self.accelerations_of_valid(t, &x, &mut udd, None)?;
+        let mut out = DVector::zeros(2 * n);
+        for i in 0..n {
+            let frame = SphericalFrame::new(q[i], q[n + i]);
+            check_polar_sin(i + 1, q[i], frame.sin_theta)?;
+            let a = nalgebra::Vector3::new(udd[3 * i], udd[3 * i + 1], udd[3 * i + 2]);
+            let cos_theta = -frame.u.z;
+            out[i] = frame.e_theta.dot(&a) + qd[n + i] * qd[n + i] * frame.sin_theta * cos_theta;
+            out[n + i] = (frame.e_phi.dot(&a) - 2.0 * qd[i] * qd[n + i] * cos_theta) / frame.sin_theta;
+        }
+        Ok(out)
+    }
+}
+
 /// The unit vectors of spherical angles `(θ, φ)`: `u` (radial), `e_θ = ∂u/∂θ` and `e_φ`
 /// with `∂u/∂φ = sin θ e_φ`.
 struct SphericalFrame {
@@ -406,6 +454,11 @@ where
 
     fn dim(&self) -> Dyn {
         Dyn(self.state_len())
+    }
+
+    /// `x = (u, w)`, `u' = w`.
+    fn second_order(&self) -> Option<usize> {
+        Some(S::DIM * self.links())
     }
 
     /// `x' = (w, ü(t, x))`: one O(n) tension solve.

@@ -149,6 +149,11 @@ where
         self.model.dof().mul(U2)
     }
 
+    /// `x = (q, q̇)`, `q' = q̇`.
+    fn second_order(&self) -> Option<usize> {
+        Some(self.model.dof().value())
+    }
+
     /// `(q̇, q̈)`; errors of [`Model::accelerations`] pass through.
     fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()> {
         let (q, qd) = self.split(x);

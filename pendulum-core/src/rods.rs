@@ -33,55 +33,31 @@ pub(crate) struct Rods {
     length: Vec<f64>,
 }
 
-/// What the solve needs about the state and the applied forces, per rod.
-pub(crate) struct Loads<'a, const S: usize> {
-    /// Unit rod directions `u_i`.
-    pub directions: &'a [[f64; S]],
-    /// `|u̇_i|²` (1/s²).
-    pub rate_squared: &'a [f64],
-    /// Force pairs `F_i` (N) acting on rod `i` (on mass `i`; the opposite on mass `i−1`).
-    pub pairs: &'a [[f64; S]],
-    /// Gravity vector `g⃗` (m/s²).
-    pub gravity: [f64; S],
-    /// Pivot acceleration `p̈` (m/s²).
-    pub pivot_acceleration: [f64; S],
+/// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
+/// force pair `F_i` (N) acting on it (on mass `i`; the opposite on mass `i−1`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Load<const S: usize> {
+    pub direction: [f64; S],
+    pub rate_squared: f64,
+    pub pair: [f64; S],
 }
 
-/// Scratch of one solve: the elimination's pivots and right-hand sides, the free
-/// accelerations and the tensions.
+/// What the down pass leaves for the up pass, per rod: the direction, the free
+/// acceleration of the mass, the coupling to the rod above, the reciprocal pivot and the
+/// eliminated right-hand side of the tridiagonal system.
+#[derive(Debug, Clone, Copy)]
+struct Row<const S: usize> {
+    direction: [f64; S],
+    free: [f64; S],
+    coupling: f64,
+    inverse_pivot: f64,
+    eliminated: f64,
+}
+
+/// The per-rod buffer of one solve (allocated once per thread, see [`with_scratch`]).
 #[derive(Debug, Default)]
 pub(crate) struct Scratch<const S: usize> {
-    free: Vec<[f64; S]>,
-    coupling: Vec<f64>,
-    inverse_pivot: Vec<f64>,
-    eliminated: Vec<f64>,
-    tension: Vec<f64>,
-    /// Per-rod buffers for the callers: directions, rates squared, force pairs and the
-    /// direction accelerations.
-    pub directions: Vec<[f64; S]>,
-    pub rate_squared: Vec<f64>,
-    pub pairs: Vec<[f64; S]>,
-    pub direction_accelerations: Vec<[f64; S]>,
-}
-
-impl<const S: usize> Scratch<S> {
-    /// Sizes every buffer for `n` rods (allocates only when `n` grows).
-    pub fn resize(&mut self, n: usize) {
-        self.free.resize(n, [0.0; S]);
-        self.coupling.resize(n, 0.0);
-        self.inverse_pivot.resize(n, 0.0);
-        self.eliminated.resize(n, 0.0);
-        self.tension.resize(n, 0.0);
-        self.directions.resize(n, [0.0; S]);
-        self.rate_squared.resize(n, 0.0);
-        self.pairs.resize(n, [0.0; S]);
-        self.direction_accelerations.resize(n, [0.0; S]);
-    }
-
-    /// The rod tensions `T_i` (N) of the last solve.
-    pub fn tensions(&self) -> &[f64] {
-        &self.tension
-    }
+    rows: Vec<Row<S>>,
 }
 
 thread_local! {
@@ -91,7 +67,7 @@ thread_local! {
 
 /// Runs `f` with this thread's scratch for `S`-dimensional chains, sized for `n` rods.
 ///
-/// The buffers live as long as the thread and only grow, so evaluations after the first
+/// The buffer lives as long as the thread and only grows, so evaluations after the first
 /// allocate nothing. Not re-entrant: `f` must not call back into a solve.
 pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scratch<S>) -> R) -> R {
     fn run<const S: usize, R>(
@@ -100,13 +76,23 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
         f: impl FnOnce(&mut Scratch<S>) -> R,
     ) -> R {
         let mut scratch = cell.borrow_mut();
-        scratch.resize(n);
+        if scratch.rows.len() < n {
+            scratch.rows.resize(
+                n,
+                Row {
+                    direction: [0.0; S],
+                    free: [0.0; S],
+                    coupling: 0.0,
+                    inverse_pivot: 0.0,
+                    eliminated: 0.0,
+                },
+            );
+        }
         f(&mut scratch)
     }
-    // Dispatch on S by the size of the scratch type: S is 2 or 3 in this crate.
     match S {
+        // S == 2 here, so Scratch<S> and Scratch<2> are one type and the downcast holds.
         2 => PLANAR.with(|cell| {
-            // S == 2 here, so Scratch<S> and Scratch<2> are one type and the downcast holds.
             let cell: &RefCell<Scratch<S>> = (cell as &dyn std::any::Any).downcast_ref().expect("S = 2");
             run(cell, n, f)
         }),
@@ -142,77 +128,59 @@ impl Rods {
         self.length.len()
     }
 
-    /// Solves for the tensions and writes the direction accelerations `ü_i` (1/s²) into
-    /// `scratch.direction_accelerations`, reading the loads from `scratch.directions`,
-    /// `scratch.rate_squared` and `scratch.pairs` (each `n` long).
-    pub fn solve_in_place<const S: usize>(
+    /// The tension solve (module docs) in two fused passes.
+    ///
+    /// `load(i)` gives rod `i`'s [`Load`] (called once per rod, in order `0, 1, …`);
+    /// `emit(i, ü_i, u_i, T_i)` receives rod `i`'s direction acceleration (1/s²), its
+    /// direction and its tension (N), once per rod in order `n−1, …, 0`. Gravity `g⃗` and
+    /// the pivot acceleration `p̈` in m/s². Work O(n), one division per rod, and one
+    /// buffer row of `2S + 3` numbers per rod, so long chains stay in cache.
+    #[inline(always)]
+    pub fn solve<const S: usize>(
         &self,
         gravity: [f64; S],
         pivot_acceleration: [f64; S],
         scratch: &mut Scratch<S>,
-    ) {
-        let Scratch {
-            free,
-            coupling,
-            inverse_pivot,
-            eliminated,
-            tension,
-            directions,
-            rate_squared,
-            pairs,
-            direction_accelerations,
-        } = scratch;
-        let loads = Loads { directions, rate_squared, pairs, gravity, pivot_acceleration };
-        self.solve(&loads, free, coupling, inverse_pivot, eliminated, tension, direction_accelerations);
-    }
-
-    /// The two passes of the tension solve (module docs).
-    #[allow(clippy::too_many_arguments)]
-    fn solve<const S: usize>(
-        &self,
-        loads: &Loads<'_, S>,
-        free: &mut [[f64; S]],
-        coupling: &mut [f64],
-        inverse_pivot: &mut [f64],
-        eliminated: &mut [f64],
-        tension: &mut [f64],
-        out: &mut [[f64; S]],
+        mut load: impl FnMut(usize) -> Load<S>,
+        mut emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
     ) {
         let n = self.len();
-        let u = loads.directions;
+        let rows = &mut scratch.rows[..n];
         // Down the chain: free accelerations, right-hand sides, elimination.
-        let mut free_above = loads.pivot_acceleration;
+        let mut free_above = pivot_acceleration;
         let mut inverse_mass_above = 0.0;
         let mut pivot_above = 0.0; // 1 / (pivot of the row above)
         let mut eliminated_above = 0.0;
-        for i in 0..n {
+        let mut u_above = [0.0; S];
+        let mut here = load(0);
+        for (i, row) in rows.iter_mut().enumerate() {
+            let below = if i + 1 < n { Some(load(i + 1)) } else { None };
+            let pair_below = below.map_or([0.0; S], |b| b.pair);
             let im = self.inverse_mass[i];
-            let mut a = loads.gravity;
-            let below = if i + 1 < n { loads.pairs[i + 1] } else { [0.0; S] };
+            let u = here.direction;
+            let mut a = gravity;
+            let mut rhs = self.length[i] * here.rate_squared;
             for k in 0..S {
-                a[k] += (loads.pairs[i][k] - below[k]) * im;
-            }
-            let mut rhs = self.length[i] * loads.rate_squared[i];
-            for k in 0..S {
-                rhs += u[i][k] * (a[k] - free_above[k]);
+                a[k] += (here.pair[k] - pair_below[k]) * im;
+                rhs += u[k] * (a[k] - free_above[k]);
             }
             // |u_i|² is 1 on the constraint manifold; keeping it makes u_i·ü_i = −|u̇_i|²
             // hold exactly also at the slightly non-unit directions inside an integrator step.
-            let diagonal = (im + inverse_mass_above) * dot(&u[i], &u[i]);
+            let diagonal = (im + inverse_mass_above) * dot(&u, &u);
             // Off-diagonal entry between rods i−1 and i: −(u_{i−1}·u_i)/m_{i−1}.
-            let off = if i == 0 { 0.0 } else { -dot(&u[i - 1], &u[i]) * inverse_mass_above };
+            let off = -dot(&u_above, &u) * inverse_mass_above;
             let factor = off * pivot_above;
-            let pivot = diagonal - factor * off;
-            let e = rhs - factor * eliminated_above;
-            let inv = 1.0 / pivot;
-            free[i] = a;
-            coupling[i] = off;
-            inverse_pivot[i] = inv;
-            eliminated[i] = e;
+            let inverse_pivot = 1.0 / (diagonal - factor * off);
+            let eliminated = rhs - factor * eliminated_above;
+            *row = Row { direction: u, free: a, coupling: off, inverse_pivot, eliminated };
             free_above = a;
             inverse_mass_above = im;
-            pivot_above = inv;
-            eliminated_above = e;
+            pivot_above = inverse_pivot;
+            eliminated_above = eliminated;
+            u_above = u;
+            if let Some(b) = below {
+                here = b;
+            }
         }
         // Up the chain: tensions, mass accelerations, direction accelerations.
         let mut tension_below = 0.0;
@@ -220,28 +188,32 @@ impl Rods {
         let mut u_below = [0.0; S];
         let mut a_below = [0.0; S];
         for i in (0..n).rev() {
-            let t = (eliminated[i] - coupling_below * tension_below) * inverse_pivot[i];
-            tension[i] = t;
+            let row = &rows[i];
+            let t = (row.eliminated - coupling_below * tension_below) * row.inverse_pivot;
             let im = self.inverse_mass[i];
-            let mut a = free[i];
+            let mut a = row.free;
             for k in 0..S {
-                a[k] += (tension_below * u_below[k] - t * u[i][k]) * im;
+                a[k] += (tension_below * u_below[k] - t * row.direction[k]) * im;
             }
             if i + 1 < n {
                 let il = self.inverse_length[i + 1];
+                let mut udd = [0.0; S];
                 for k in 0..S {
-                    out[i + 1][k] = (a_below[k] - a[k]) * il;
+                    udd[k] = (a_below[k] - a[k]) * il;
                 }
+                emit(i + 1, udd, &u_below, tension_below);
             }
             tension_below = t;
-            coupling_below = coupling[i];
-            u_below = u[i];
+            coupling_below = row.coupling;
+            u_below = row.direction;
             a_below = a;
         }
         let il = self.inverse_length[0];
+        let mut udd = [0.0; S];
         for k in 0..S {
-            out[0][k] = (a_below[k] - loads.pivot_acceleration[k]) * il;
+            udd[k] = (a_below[k] - pivot_acceleration[k]) * il;
         }
+        emit(0, udd, &u_below, tension_below);
     }
 }
 
@@ -249,22 +221,35 @@ impl Rods {
 mod tests {
     use super::*;
 
+    /// Solves for `n` rods with the given directions, rates and pairs; returns (ü, T).
+    fn solve<const S: usize>(rods: &Rods, gravity: [f64; S], loads: &[Load<S>]) -> (Vec<[f64; S]>, Vec<f64>) {
+        let n = loads.len();
+        let (mut udd, mut tension) = (vec![[0.0; S]; n], vec![0.0; n]);
+        with_scratch::<S, _>(n, |s| {
+            rods.solve(
+                gravity,
+                [0.0; S],
+                s,
+                |i| loads[i],
+                |i, a, _, t| {
+                    udd[i] = a;
+                    tension[i] = t;
+                },
+            )
+        });
+        (udd, tension)
+    }
+
     #[test]
     fn hanging_chain_carries_the_weight_below_each_rod() {
-        let masses = [1.0, 2.0, 0.5];
-        let rods = Rods::new(&masses, &[1.0, 0.5, 2.0]);
+        let rods = Rods::new(&[1.0, 2.0, 0.5], &[1.0, 0.5, 2.0]);
         let g = 9.81;
-        with_scratch::<2, _>(3, |s| {
-            s.directions.fill([0.0, -1.0]);
-            s.rate_squared.fill(0.0);
-            s.pairs.fill([0.0; 2]);
-            rods.solve_in_place([0.0, -g], [0.0; 2], s);
-            let expected = [3.5 * g, 2.5 * g, 0.5 * g];
-            for (t, e) in s.tensions().iter().zip(expected) {
-                assert!((t - e).abs() < 1e-12 * e, "{t} vs {e}");
-            }
-            assert!(s.direction_accelerations.iter().flatten().all(|a| a.abs() < 1e-12));
-        });
+        let hanging = Load { direction: [0.0, -1.0], rate_squared: 0.0, pair: [0.0; 2] };
+        let (udd, tension) = solve(&rods, [0.0, -g], &[hanging; 3]);
+        for (t, e) in tension.iter().zip([3.5 * g, 2.5 * g, 0.5 * g]) {
+            assert!((t - e).abs() < 1e-12 * e, "{t} vs {e}");
+        }
+        assert!(udd.iter().flatten().all(|a| a.abs() < 1e-12));
     }
 
     #[test]
@@ -272,13 +257,9 @@ mod tests {
         // One mass m on a rod l turning at ω without gravity: T = m l ω², ü = −ω² u.
         let (m, l, w) = (2.0, 0.5, 3.0);
         let rods = Rods::new(&[m], &[l]);
-        with_scratch::<3, _>(1, |s| {
-            s.directions[0] = [1.0, 0.0, 0.0];
-            s.rate_squared[0] = w * w;
-            s.pairs[0] = [0.0; 3];
-            rods.solve_in_place([0.0; 3], [0.0; 3], s);
-            assert!((s.tensions()[0] - m * l * w * w).abs() < 1e-12);
-            assert!((s.direction_accelerations[0][0] + w * w).abs() < 1e-12);
-        });
+        let load = Load { direction: [1.0, 0.0, 0.0], rate_squared: w * w, pair: [0.0; 3] };
+        let (udd, tension) = solve(&rods, [0.0; 3], &[load]);
+        assert!((tension[0] - m * l * w * w).abs() < 1e-12);
+        assert!((udd[0][0] + w * w).abs() < 1e-12);
     }
 }

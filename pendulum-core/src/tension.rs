@@ -2,7 +2,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
-use crate::rods::{Rods, with_scratch};
+use crate::rods::{Load, Rods, with_scratch};
 use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
@@ -84,23 +84,20 @@ where
         let (lengths, damping) = (chain.lengths(), chain.damping());
         let gravity = [0.0, -chain.gravity()];
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
+        let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
-            for i in 0..n {
+            let load = |i: usize| {
                 let (sin, cos) = q[i].sin_cos();
-                s.directions[i] = [sin, -cos];
-                s.rate_squared[i] = qd[i] * qd[i];
                 let pull = (inputs.torque[i] - damping[i] * qd[i]) / lengths[i];
-                s.pairs[i] = [pull * cos, pull * sin];
-            }
-            self.rods.solve_in_place(gravity, pivot, s);
-            for i in 0..n {
-                let [sin, minus_cos] = s.directions[i];
-                let [ax, ay] = s.direction_accelerations[i];
-                out[i] = -minus_cos * ax + sin * ay;
-            }
-            if let Some(t) = tensions {
-                t.copy_from_slice(s.tensions());
-            }
+                Load { direction: [sin, -cos], rate_squared: qd[i] * qd[i], pair: [pull * cos, pull * sin] }
+            };
+            // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
+            self.rods.solve(gravity, pivot, s, load, |i, [ax, ay], &[ux, uy], t| {
+                out[i] = -uy * ax + ux * ay;
+                if let Some(tensions) = tensions.as_deref_mut() {
+                    tensions[i] = t;
+                }
+            });
         });
         if out.as_slice().iter().all(|a| a.is_finite()) {
             Ok(())

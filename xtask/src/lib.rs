@@ -9,6 +9,7 @@ pub mod document;
 pub mod expr;
 pub mod models;
 pub mod regen;
+pub mod routes;
 pub mod sample;
 pub mod verify;
 

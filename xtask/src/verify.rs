@@ -6,7 +6,8 @@
 //! fixed-N model of that size ([`crate::models`]): mass matrix, velocity, gravity and
 //! pivot terms, generalized forces, kinetic and potential energy, and accelerations.
 //! The worst error per case, quantity and model is printed as a table; any error above
-//! [`BOUND`] fails the run, naming the case, state, quantity and entry.
+//! [`BOUND`] fails the run, naming the case, state, quantity and entry. The O(n) routes
+//! (accelerations only) follow in their own table ([`crate::routes`]).
 
 use std::{fmt, time::Instant};
 
@@ -426,19 +427,19 @@ impl Report {
 }
 
 /// The reference at one state: values, entry scales, floors, and the right-hand side.
-struct Reference {
-    values: Evaluated,
-    scales: Evaluated,
+pub(crate) struct Reference {
+    pub(crate) values: Evaluated,
+    pub(crate) scales: Evaluated,
     /// The scale floor of each entry-wise quantity, in [`Quantity::ALL`] order.
     floors: [f64; 7],
     /// `Q − c − k − d`.
-    rhs: DVector<f64>,
+    pub(crate) rhs: DVector<f64>,
     /// Its scale `S(Q) + S(c) + S(k) + S(d)`.
-    rhs_scale: DVector<f64>,
+    pub(crate) rhs_scale: DVector<f64>,
 }
 
 impl Reference {
-    fn new(case: &Case, params: &Params, point: &Point) -> Self {
+    pub(crate) fn new(case: &Case, params: &Params, point: &Point) -> Self {
         let (values, scales) = case.evaluate_with_scales(params, point);
         let rate = DVectorView::from_slice(&point.qd, point.qd.len()).amax();
         // Terms of the form W u̇·u̇ are bounded by ‖S(M)‖_∞ ‖q̇‖²_∞ (SCALE_FLOOR).
@@ -880,6 +881,11 @@ pub fn run(options: &Options) -> Result<()> {
     }
     println!("\nmodels checked in {:.2} s", start.elapsed().as_secs_f64());
 
+    // The O(n) routes (tension solve), accelerations only, at the same states.
+    println!();
+    let routes = crate::routes::verify_cases(&cases, options.states, options.seed)
+        .and_then(|rows| crate::routes::report(&rows));
+
     // The seed document's printed equations against the reference: prints its own
     // table, errors when reference/ERRATA.md no longer matches what it finds.
     println!();
@@ -895,6 +901,7 @@ pub fn run(options: &Options) -> Result<()> {
     if !report.ok() {
         bail!("verify failed: a spatial model did not report the singularity at theta_1 = 0 or pi");
     }
+    routes?;
     document
 }
 

@@ -252,33 +252,9 @@ where
         Ok(())
     }
 
-    /// Continues the previous step's collocation polynomial `u(τ)` (degree `s`, `u(0) = 0`,
-    /// `u(c_i) = Z_i^prev`, `τ` in units of the previous step) to the new nodes:
-    /// `Z_j = u(1 + c_j h/h_prev) − u(1)`, error `O(h^{s+1})`.
+    /// Continues the previous step's collocation polynomial ([`extrapolate_stages`]).
     fn extrapolate(&mut self, ratio: f64) {
-        let c = S::TABLEAU.c;
-        let s = S::dim();
-        // Lagrange basis on the nodes (0, c_1, …, c_s); the node 0 carries the value 0.
-        let basis = |i: usize, tau: f64| {
-            let mut v = tau / c[i];
-            for m in (0..s).filter(|&m| m != i) {
-                v *= (tau - c[m]) / (c[i] - c[m]);
-            }
-            v
-        };
-        // weights[j][i] = ℓ_i(1 + c_j h/h_prev) − ℓ_i(1).
-        let mut weights = [[0.0; 3]; 3];
-        for (row, cj) in weights.iter_mut().zip(c).take(s) {
-            for (i, w) in row.iter_mut().enumerate().take(s) {
-                *w = basis(i, 1.0 + cj * ratio) - basis(i, 1.0);
-            }
-        }
-        self.k.copy_from(&self.z);
-        for (j, w) in weights.iter().enumerate().take(s) {
-            for r in 0..self.z.nrows() {
-                self.z[(r, j)] = (0..s).map(|i| self.k[(r, i)] * w[i]).sum();
-            }
-        }
+        extrapolate_stages::<D, S>(&mut self.z, &mut self.k, ratio);
     }
 
     fn evaluate_jacobian<Sys: System<Dim = D>>(
@@ -413,6 +389,69 @@ where
     }
 }
 
+/// Completes a Gauss step from its stage derivatives `k` (one column per stage):
+/// `x_{n+1} − x_n = h Σ_i b_i k_i` (eq 55), added to `state` with compensated summation.
+/// A non-finite increment leaves the state unchanged and is [`Error::NonFiniteState`];
+/// the step is counted either way.
+pub(super) fn complete_step<D: Dim, S: GaussStages>(
+    k: &OMatrix<f64, D, S>,
+    h: f64,
+    increment: &mut OVector<f64, D>,
+    state: &mut State<D>,
+    stats: &mut Stats,
+) -> Result<()>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, S>,
+{
+    let b = S::TABLEAU.b;
+    for r in 0..increment.len() {
+        increment[r] = h * (0..S::dim()).map(|i| b[i] * k[(r, i)]).sum::<f64>();
+    }
+    if !increment.iter().all(|v| v.is_finite()) {
+        stats.failed_steps += 1;
+        return Err(Error::NonFiniteState { t: state.t(), h });
+    }
+    state.advance(h, increment);
+    stats.steps += 1;
+    Ok(())
+}
+
+/// Continues a Gauss step's collocation polynomial `u(τ)` (degree `s`, `u(0) = 0`,
+/// `u(c_i) = Z_i^prev`, `τ` in units of the previous step) to the nodes of the next step,
+/// `h = ratio · h_prev`: `Z_j = u(1 + c_j ratio) − u(1)`, error `O(h^{s+1})`. `z` holds the
+/// previous increments on entry and the guess on return; `scratch` is overwritten.
+pub(super) fn extrapolate_stages<D: Dim, S: GaussStages>(
+    z: &mut OMatrix<f64, D, S>,
+    scratch: &mut OMatrix<f64, D, S>,
+    ratio: f64,
+) where
+    DefaultAllocator: Allocator<D, S>,
+{
+    let c = S::TABLEAU.c;
+    let s = S::dim();
+    // Lagrange basis on the nodes (0, c_1, …, c_s); the node 0 carries the value 0.
+    let basis = |i: usize, tau: f64| {
+        let mut v = tau / c[i];
+        for m in (0..s).filter(|&m| m != i) {
+            v *= (tau - c[m]) / (c[i] - c[m]);
+        }
+        v
+    };
+    // weights[j][i] = ℓ_i(1 + c_j h/h_prev) − ℓ_i(1).
+    let mut weights = [[0.0; 3]; 3];
+    for (row, cj) in weights.iter_mut().zip(c).take(s) {
+        for (i, w) in row.iter_mut().enumerate().take(s) {
+            *w = basis(i, 1.0 + cj * ratio) - basis(i, 1.0);
+        }
+    }
+    scratch.copy_from(z);
+    for (j, w) in weights.iter().enumerate().take(s) {
+        for r in 0..z.nrows() {
+            z[(r, j)] = (0..s).map(|i| scratch[(r, i)] * w[i]).sum();
+        }
+    }
+}
+
 impl<D, S, Sys> Integrator<Sys> for GaussLegendre<D, S>
 where
     Sys: System<Dim = D>,
@@ -427,20 +466,9 @@ where
             self.stats.failed_steps += 1;
             return Err(e);
         }
-        // x_{n+1} − x_n = h Σ_i b_i k_i (eq 55).
-        let b = S::TABLEAU.b;
-        for r in 0..self.dim.value() {
-            let sum: f64 = (0..S::dim()).map(|i| b[i] * self.k[(r, i)]).sum();
-            self.increment[r] = h * sum;
-        }
-        if !self.increment.iter().all(|v| v.is_finite()) {
-            self.stats.failed_steps += 1;
-            return Err(Error::NonFiniteState { t, h });
-        }
-        state.advance(h, &self.increment);
+        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats)?;
         self.x_end.copy_from(state.x());
         self.previous = Some((state.t(), h));
-        self.stats.steps += 1;
         Ok(())
     }
 

@@ -27,6 +27,7 @@
 //! assert!(drift.abs() < 1e-6);
 //! ```
 
+mod fixed_point;
 mod gauss;
 mod lu;
 mod projected;
@@ -36,6 +37,7 @@ mod tableau;
 
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
+pub use fixed_point::GaussFixedPoint;
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};
 pub use projected::{Constrained, Projected};
 pub use rk4::Rk4;
