@@ -35,6 +35,13 @@ use xtask::models::{
     Spatial4, chain,
 };
 
+pendulum_macros::model! {
+    /// Generated planar model, 12 links: accelerations only, to locate the crossover.
+    pub struct Planar12 { kind: planar, links: 12 }
+    /// Generated planar model, 16 links: accelerations only, to locate the crossover.
+    pub struct Planar16 { kind: planar, links: 16 }
+}
+
 /// Whether this is the smoke run of `cargo xtask bench --quick` (few sizes).
 fn quick() -> bool {
     std::env::var_os("PENDULUM_BENCH_QUICK").is_some_and(|v| v != "0")
@@ -47,7 +54,7 @@ fn wanted(n: usize) -> bool {
 
 /// Chain lengths beyond the generated models, for the routes that accept any n.
 fn large_sizes() -> &'static [usize] {
-    if quick() { &[64] } else { &[16, 64, 256, 1024, 4096] }
+    if quick() { &[64] } else { &[12, 16, 64, 256, 1024, 4096] }
 }
 
 /// The largest n at which the dense generic route (O(n²) build, O(n³) Cholesky) is timed.
@@ -281,9 +288,27 @@ fn small_chains(c: &mut Criterion) {
     }
 }
 
-/// Beyond the generated sizes: the O(n) routes, the dense generic route up to
-/// [`DENSE_MAX`] links and the baseline (accelerations only).
+/// Beyond the sizes of all five operations: generated planar n = 12 and 16, the O(n)
+/// routes, the dense generic route up to [`DENSE_MAX`] links and the baseline
+/// (accelerations only).
 fn large_chains(c: &mut Criterion) {
+    if !quick() {
+        let (p12, p16) = (params(12), params(16));
+        bench_accelerations(
+            c,
+            "planar",
+            "generated",
+            12,
+            &Planar12::new(chain::<Const<12>>(&p12).expect("valid chain")),
+        );
+        bench_accelerations(
+            c,
+            "planar",
+            "generated",
+            16,
+            &Planar16::new(chain::<Const<16>>(&p16).expect("valid chain")),
+        );
+    }
     for &n in large_sizes() {
         bench_linear(c, n, false, true);
         if n <= DENSE_MAX {
