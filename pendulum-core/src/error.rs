@@ -144,6 +144,29 @@ pub enum Error {
         /// What went wrong.
         source: Box<Error>,
     },
+    /// A steady-rotation or normal-mode request has a parameter out of range.
+    #[error("steady rotation: {what} must be {requirement}, got {value}")]
+    InvalidSteady {
+        /// Which parameter (`"angular speed"`, `"pivot radius"`, `"gravity"`, `"mode"`, ...).
+        what: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// Newton's method on the steady-rotation shape equations did not converge.
+    #[error(
+        "the steady-rotation shape equations at omega = {omega} rad/s did not converge after \
+         {iterations} Newton iterations (residual {residual:e})"
+    )]
+    SteadyNotConverged {
+        /// The angular speed, rad/s.
+        omega: f64,
+        /// Newton iterations spent.
+        iterations: usize,
+        /// The residual norm reached, N·m.
+        residual: f64,
+    },
 }
 
 /// The crate's result type.

@@ -1,0 +1,261 @@
+//! Relative equilibria of the 3D chain in unit link directions with its pivot on a circle,
+//! damping included: the steady shapes a driven, damped chain settles into, and their
+//! spectrum, computed from the [`Directions`] model's own accelerations.
+//!
+//! With the pivot on `p(t) = R (cos ωt, sin ωt, 0)` ([`Circle`]), gravity along −z and the
+//! chain's damping `D = ½ Σ λ_i |u̇_i|²` (inertial rates), the equations are equivariant
+//! under turning about z by `ωt`. In the frame turning with the pivot, with
+//! `ũ_i = Rot(−ωt) u_i`, `w̃_i = Rot(−ωt) w_i` (inertial rates, rotated), the system is
+//! autonomous:
+//!
+//! ```text
+//! dũ_i/dt = w̃_i − Ω × ũ_i,     dw̃_i/dt = a_i(0, ũ, w̃) − Ω × w̃_i,     Ω = ω e_z,
+//! ```
+//!
+//! `a_i(0, ·)` the model's accelerations at `t = 0` (pivot at `(R, 0, 0)`). A relative
+//! equilibrium has `w̃_i = Ω × ũ_i` and `a_i = Ω × (Ω × ũ_i)`; only the two components of
+//! the latter tangent to the unit sphere are unknown (the rod tension fixes the radial one),
+//! so with `ũ_i = (cos ψ_i sin θ_i, sin ψ_i, −cos ψ_i cos θ_i)` Newton solves `2n`
+//! equations in `(θ_i, ψ_i)` with a central-difference Jacobian. Without damping the
+//! solutions are the planar shapes of [`crate::SteadyRotation`] (`ψ = 0`); with damping
+//! they lag out of the plane.
+//!
+//! The spectrum is that of the autonomous system's Jacobian restricted to the tangent
+//! space of the constraint manifold (`|u_i| = 1`, `u_i · w_i = 0`, invariant under the
+//! flow): `4n` eigenvalues from central differences along a basis of that space.
+
+use nalgebra::{Complex, DMatrix, DVector, U3, Vector3};
+
+use crate::{Circle, Directions, Error, Result};
+
+/// A relative equilibrium of a driven chain, in the frame turning with the pivot at
+/// `t = 0` (pivot at `(R, 0, 0)`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RelativeEquilibrium {
+    /// In-plane angles `θ_i` and out-of-plane angles `ψ_i` of the links, rad.
+    pub angles: Vec<(f64, f64)>,
+    /// The model state `x = (u, w)` at `t = 0`: `w_i = Ω × u_i`.
+    pub state: DVector<f64>,
+}
+
+fn direction(theta: f64, psi: f64) -> Vector3<f64> {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = psi.sin_cos();
+    Vector3::new(cp * st, sp, -cp * ct)
+}
+
+/// The unit tangents `∂u/∂θ / cos ψ` and `∂u/∂ψ`, orthonormal and normal to `u`.
+fn tangents(theta: f64, psi: f64) -> (Vector3<f64>, Vector3<f64>) {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = psi.sin_cos();
+    (Vector3::new(ct, 0.0, st), Vector3::new(-sp * st, cp, sp * ct))
+}
+
+fn omega_of(model: &Directions<U3, Circle>) -> Vector3<f64> {
+    Vector3::new(0.0, 0.0, model.drive().angular_frequency())
+}
+
+/// The state `(u, Ω × u)` of the shape with angles `(θ_i, ψ_i)`.
+fn rigid_state(model: &Directions<U3, Circle>, angles: &[(f64, f64)]) -> DVector<f64> {
+    let n = angles.len();
+    let omega = omega_of(model);
+    let mut x = DVector::zeros(6 * n);
+    for (i, &(t, p)) in angles.iter().enumerate() {
+        let u = direction(t, p);
+        let w = omega.cross(&u);
+        x.fixed_rows_mut::<3>(3 * i).copy_from(&u);
+        x.fixed_rows_mut::<3>(3 * (n + i)).copy_from(&w);
+    }
+    x
+}
+
+/// The autonomous rotating-frame vector field `G(x̃)` (module docs).
+fn field(model: &Directions<U3, Circle>, x: &DVector<f64>) -> Result<DVector<f64>> {
+    let n = model.links();
+    let omega = omega_of(model);
+    let mut acc = vec![0.0; 3 * n];
+    model.accelerations(0.0, x, &mut acc, None)?;
+    let mut g = DVector::zeros(6 * n);
+    for i in 0..n {
+        let u = x.fixed_rows::<3>(3 * i).into_owned();
+        let w = x.fixed_rows::<3>(3 * (n + i)).into_owned();
+        let a = Vector3::new(acc[3 * i], acc[3 * i + 1], acc[3 * i + 2]);
+        g.fixed_rows_mut::<3>(3 * i).copy_from(&(w - omega.cross(&u)));
+        g.fixed_rows_mut::<3>(3 * (n + i)).copy_from(&(a - omega.cross(&w)));
+    }
+    Ok(g)
+}
+
+/// The `2n` tangential equilibrium residuals `t_k · (a_i − Ω × (Ω × u_i))`, 1/s².
+fn residual(model: &Directions<U3, Circle>, angles: &[(f64, f64)]) -> Result<DVector<f64>> {
+    let n = angles.len();
+    let x = rigid_state(model, angles);
+    let g = field(model, &x)?;
+    let mut r = DVector::zeros(2 * n);
+    for (i, &(t, p)) in angles.iter().enumerate() {
+        let (t1, t2) = tangents(t, p);
+        let dw = g.fixed_rows::<3>(3 * (n + i)).into_owned();
+        r[2 * i] = t1.dot(&dw);
+        r[2 * i + 1] = t2.dot(&dw);
+    }
+    Ok(r)
+}
+
+/// The relative equilibrium of `model` nearest `guess` (angles `(θ_i, ψ_i)`, rad) by
+/// Newton's method with a central-difference Jacobian (steps limited to 0.3 rad).
+///
+/// Errors: [`Error::LengthMismatch`] when `guess` does not have one pair per link,
+/// [`Error::NonFinite`] for a non-finite guess, [`Error::SteadyNotConverged`] when Newton
+/// fails (e.g. `R = 0` without damping: the shape can turn freely about the axis and the
+/// Jacobian is singular).
+pub fn relative_equilibrium(
+    model: &Directions<U3, Circle>,
+    guess: &[(f64, f64)],
+) -> Result<RelativeEquilibrium> {
+    let n = model.links();
+    if guess.len() != n {
+        return Err(Error::LengthMismatch { what: "guess", expected: n, got: guess.len() });
+    }
+    if let Some((index, v)) =
+        guess.iter().flat_map(|&(a, b)| [a, b]).enumerate().find(|(_, v)| !v.is_finite())
+    {
+        return Err(Error::NonFinite { what: "guess", index, value: v });
+    }
+    let omega = model.drive().angular_frequency();
+    let mut angles = guess.to_vec();
+    let h = 1e-7;
+    for it in 1..=40 {
+        let r = residual(model, &angles)?;
+        let mut jac = DMatrix::zeros(2 * n, 2 * n);
+        for j in 0..2 * n {
+            let shift = |s: f64| {
+                let mut a = angles.clone();
+                if j % 2 == 0 {
+                    a[j / 2].0 += s
+                } else {
+                    a[j / 2].1 += s
+                }
+                a
+            };
+            let col = (residual(model, &shift(h))? - residual(model, &shift(-h))?) / (2.0 * h);
+            jac.set_column(j, &col);
+        }
+        let fail = || Error::SteadyNotConverged { omega, iterations: it, residual: r.norm() };
+        let mut step = jac.lu().solve(&(-&r)).ok_or_else(fail)?;
+        let size = step.amax();
+        if !size.is_finite() {
+            return Err(fail());
+        }
+        if size > 0.3 {
+            step *= 0.3 / size;
+        }
+        for (i, a) in angles.iter_mut().enumerate() {
+            a.0 += step[2 * i];
+            a.1 += step[2 * i + 1];
+        }
+        if size < 1e-11 {
+            let state = rigid_state(model, &angles);
+            return Ok(RelativeEquilibrium { angles, state });
+        }
+    }
+    Err(Error::SteadyNotConverged { omega, iterations: 40, residual: residual(model, &angles)?.norm() })
+}
+
+/// The `4n` eigenvalues (1/s) of the linearisation about `eq` in the turning frame, on the
+/// constraint manifold (module docs), by central differences.
+///
+/// Errors: those of the model's accelerations, [`Error::NotPositiveDefinite`] if the
+/// tangent basis is degenerate (cannot happen for unit directions).
+pub fn relative_spectrum(
+    model: &Directions<U3, Circle>,
+    eq: &RelativeEquilibrium,
+) -> Result<Vec<Complex<f64>>> {
+    let n = model.links();
+    let x0 = &eq.state;
+    // Tangent basis: per link (δu, δw) = (t_k, −(t_k·w) u) and (0, t_k), k = 1, 2.
+    let mut basis = DMatrix::zeros(6 * n, 4 * n);
+    for (i, &(t, p)) in eq.angles.iter().enumerate() {
+        let (t1, t2) = tangents(t, p);
+        let u = x0.fixed_rows::<3>(3 * i).into_owned();
+        let w = x0.fixed_rows::<3>(3 * (n + i)).into_owned();
+        for (k, tk) in [t1, t2].into_iter().enumerate() {
+            let c = 4 * i + k;
+            basis.view_mut((3 * i, c), (3, 1)).copy_from(&tk);
+            basis.view_mut((3 * (n + i), c), (3, 1)).copy_from(&(-(tk.dot(&w)) * u));
+            basis.view_mut((3 * (n + i), c + 2), (3, 1)).copy_from(&tk);
+        }
+    }
+    let h = 1e-7;
+    let mut jb = DMatrix::zeros(6 * n, 4 * n);
+    for c in 0..4 * n {
+        let b = basis.column(c);
+        let col = (field(model, &(x0 + b * h))? - field(model, &(x0 - b * h))?) / (2.0 * h);
+        jb.set_column(c, &col);
+    }
+    // J B = B J_red on the invariant tangent space: J_red = (BᵀB)⁻¹ Bᵀ J B.
+    let gram = basis.transpose() * &basis;
+    let reduced = gram.cholesky().ok_or(Error::NotPositiveDefinite)?.solve(&(basis.transpose() * jb));
+    Ok(reduced.complex_eigenvalues().iter().copied().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Chain, SteadyRotation, stability};
+    use nalgebra::Dyn;
+
+    fn chain() -> Chain<Dyn> {
+        Chain::<Dyn>::new(&[0.3, 1.1, 0.5, 0.8], &[0.25, 0.15, 0.3, 0.2], 9.81).unwrap()
+    }
+
+    #[test]
+    fn undamped_equilibria_are_the_planar_steady_shapes_with_the_same_spectrum() {
+        let (radius, omega) = (0.03, 9.0);
+        let problem = SteadyRotation::new(&chain(), radius).unwrap();
+        let shape = problem.solve(omega, &DVector::from_element(4, 0.9)).unwrap();
+        let model = Directions::<U3>::new(chain()).with_drive(Circle::new(radius, omega).unwrap());
+        let guess: Vec<(f64, f64)> = shape.theta.iter().map(|&t| (t + 0.05, 0.02)).collect();
+        let eq = relative_equilibrium(&model, &guess).unwrap();
+        for (i, &(t, p)) in eq.angles.iter().enumerate() {
+            assert!((t - shape.theta[i]).abs() < 1e-9 && p.abs() < 1e-9, "link {i}: ({t}, {p})");
+        }
+        // The Directions model's spectrum and the analytic rotating-frame one agree.
+        let ours = stability(&problem, &shape, None).unwrap().eigenvalues;
+        let theirs = relative_spectrum(&model, &eq).unwrap();
+        let scale = ours.last().unwrap().norm();
+        for z in &ours {
+            let d = theirs.iter().map(|w| (w - z).norm()).fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-5 * scale, "eigenvalue {z}: nearest {d:e}");
+        }
+    }
+
+    #[test]
+    fn damping_makes_the_shape_lag_and_decay() {
+        let (radius, omega) = (0.03, 9.0);
+        let c = chain().with_damping(&[0.002; 4]).unwrap();
+        let model = Directions::<U3>::new(c).with_drive(Circle::new(radius, omega).unwrap());
+        let problem = SteadyRotation::new(&chain(), radius).unwrap();
+        let shape = problem.solve(omega, &DVector::from_element(4, 0.9)).unwrap();
+        let guess: Vec<(f64, f64)> = shape.theta.iter().map(|&t| (t, 0.0)).collect();
+        let eq = relative_equilibrium(&model, &guess).unwrap();
+        // Drag against the rotation (+y direction of motion at x > 0) tilts links to −y.
+        assert!(eq.angles.iter().all(|&(t, p)| p != 0.0 && p.abs() < 0.1 && t.is_finite()));
+        let spectrum = relative_spectrum(&model, &eq).unwrap();
+        let growth = spectrum.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+        // The in-phase one-node shape stays stable: every mode now decays.
+        assert!(growth < 0.0, "growth {growth}");
+    }
+
+    #[test]
+    fn bad_guess_is_named() {
+        let model = Directions::<U3>::new(chain()).with_drive(Circle::new(0.01, 3.0).unwrap());
+        assert!(matches!(
+            relative_equilibrium(&model, &[(0.0, 0.0)]),
+            Err(Error::LengthMismatch { what: "guess", expected: 4, got: 1 })
+        ));
+        assert!(matches!(
+            relative_equilibrium(&model, &[(0.0, f64::NAN), (0.0, 0.0), (0.0, 0.0), (0.0, 0.0)]),
+            Err(Error::NonFinite { what: "guess", index: 1, .. })
+        ));
+    }
+}

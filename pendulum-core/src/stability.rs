@@ -1,0 +1,274 @@
+//! Linear stability of a steadily rotating chain in the full 3D equations, in the frame
+//! turning with it.
+//!
+//! # Coordinates and linearisation
+//!
+//! Around a steady shape in the turning x–z plane, link `i` points along
+//! `u_i = (cos ψ_i sin θ_i, sin ψ_i, −cos ψ_i cos θ_i)`: `θ_i` in the plane, `ψ_i` out of
+//! it. The chart is regular at `ψ = 0` for every `θ`, including the vertical (unlike the
+//! spherical angles of [`crate::Spatial`]). Positions `r_i = (R, 0, 0) + Σ_{j≤i} l_j u_j`.
+//! The Lagrangian in the frame turning at `Ω = ω e_z` is
+//! `Σ ½ m_i |ṙ_i + Ω × r_i|² − m_i g z_i`; linearised about the steady shape
+//! (`q = (θ, ψ)`, `2n` coordinates) it gives
+//!
+//! ```text
+//! M δq̈ + (G + D) δq̇ + H δq = 0,
+//! M = Σ m_i J_iᵀ J_i:        M_θθ = W_ab cos(θ_a − θ_b),  M_ψψ = W_ab,       M_θψ = 0,
+//! G = 2 Σ m_i J_iᵀ [Ω]× J_i: G_ψaθb = 2ω W_ab cos θ_b = −G_θbψa,  G_θθ = G_ψψ = 0,
+//! H = ∇² V:                  H_θθ = E − ω² W_ab cos θ_a cos θ_b,  H_ψψ = E − ω² W_ab,
+//!                            E = diag(l_a (g M_a cos θ_a + ω² sin θ_a S_a)),  H_θψ = 0,
+//! ```
+//!
+//! (`J_i = ∂r_i/∂q`, `W_ab = M_max(a,b) l_a l_b`, `S_a = Σ_{i≥a} m_i x_i`; `H_θθ` is the
+//! Jacobian of the planar shape equations of [`crate::SteadyRotation`]). `G` is the
+//! gyroscopic (Coriolis) matrix, skew; `D = diag(λ, λ)` optional damping of the link
+//! rates relative to the turning frame.
+//!
+//! # What "stable" means
+//!
+//! Without damping the linearisation is Hamiltonian: its eigenvalues come in quadruples
+//! `±λ, ±λ̄`, so the only possible stability is **spectral stability**, every eigenvalue
+//! on the imaginary axis (oscillation about the steady shape, no decay). That is necessary
+//! for stability but not sufficient: under a small change of parameters two imaginary
+//! pairs of opposite Krein signature can collide and leave the axis (a Hamiltonian–Hopf
+//! bifurcation), while pairs of equal signature pass through each other. If `H` is
+//! positive definite (index 0: the steady shape minimises the amended potential), the
+//! energy is a Lyapunov function and the shape is stable outright (Lagrange–Dirichlet).
+//! If `H` has negative eigenvalues but an even number of them, gyroscopic terms can still
+//! make the shape spectrally stable ("gyroscopic stabilisation"); with an odd number it is
+//! always unstable (a real positive eigenvalue). By Kelvin–Tait–Chetaev, **any** damping
+//! (`D` positive definite) destroys gyroscopic stabilisation: with damping a shape is
+//! asymptotically stable iff its index is 0, and unstable otherwise. Free steady rotation
+//! with `R = 0` has a symmetry (turning the whole shape about the axis), so `H` and the
+//! spectrum have an exact zero there; it is not counted.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+use crate::{Error, Result, SteadyRotation, SteadyShape};
+
+/// The linearised equations `M δq̈ + G δq̇ + H δq = 0` about a steady shape (module
+/// docs), in `q = (θ_1 … θ_n, ψ_1 … ψ_n)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Linearisation {
+    /// Mass matrix `M`, kg·m².
+    pub mass: DMatrix<f64>,
+    /// Gyroscopic matrix `G` (skew), kg·m²/s.
+    pub gyroscopic: DMatrix<f64>,
+    /// Stiffness `H`, the Hessian of the amended potential, N·m.
+    pub stiffness: DMatrix<f64>,
+}
+
+/// The verdict on one steady shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stability {
+    /// Eigenvalues of the first-order linearisation (4n of them), 1/s.
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// The largest real part, 1/s (≤ 0 up to round-off when spectrally stable), without the
+    /// symmetry's zero pair.
+    pub growth_rate: f64,
+    /// The number of negative eigenvalues of `H` (the Morse index of the amended
+    /// potential), out of and in the plane.
+    pub index: usize,
+    /// Spectrally stable: no eigenvalue with real part above the tolerance (module docs).
+    pub spectrally_stable: bool,
+}
+
+impl Stability {
+    /// Stable with any small damping in the turning frame: index 0 (Kelvin–Tait–Chetaev).
+    pub fn stable_with_damping(&self) -> bool {
+        self.index == 0
+    }
+}
+
+/// The linearisation of the 3D equations in the turning frame about `shape` (module docs).
+pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation {
+    let n = problem.links();
+    let (m, l, tails) = problem.parameters();
+    let g = problem.gravity();
+    let omega = shape.omega;
+    let w2 = omega * omega;
+    let theta = &shape.theta;
+    let (sin, cos): (Vec<f64>, Vec<f64>) = theta.iter().map(|t| t.sin_cos()).unzip();
+    let mut s = vec![0.0; n];
+    let mut acc = 0.0;
+    for i in (0..n).rev() {
+        acc += m[i] * shape.displacements[i];
+        s[i] = acc;
+    }
+    let w = |a: usize, b: usize| tails[a.max(b)] * l[a] * l[b];
+    let e: Vec<f64> = (0..n).map(|a| l[a] * (g * tails[a] * cos[a] + w2 * sin[a] * s[a])).collect();
+    let mut mass = DMatrix::zeros(2 * n, 2 * n);
+    let mut gyroscopic = DMatrix::zeros(2 * n, 2 * n);
+    let mut stiffness = DMatrix::zeros(2 * n, 2 * n);
+    for a in 0..n {
+        for b in 0..n {
+            let wab = w(a, b);
+            mass[(a, b)] = wab * (theta[a] - theta[b]).cos();
+            mass[(n + a, n + b)] = wab;
+            gyroscopic[(n + a, b)] = 2.0 * omega * wab * cos[b];
+            gyroscopic[(b, n + a)] = -2.0 * omega * wab * cos[b];
+            stiffness[(a, b)] = -w2 * wab * cos[a] * cos[b];
+            stiffness[(n + a, n + b)] = -w2 * wab;
+        }
+        stiffness[(a, a)] += e[a];
+        stiffness[(n + a, n + a)] += e[a];
+    }
+    Linearisation { mass, gyroscopic, stiffness }
+}
+
+/// Classify `shape` by the eigenvalues of the linearisation, with damping `λ_i` (N·m·s,
+/// one per link, applied to `θ̇_i` and `ψ̇_i` in the turning frame) or `None`.
+///
+/// Eigenvalues are those of `[[0, I], [−M⁻¹H, −M⁻¹(G + D)]]` (dense Schur, O(n³)),
+/// sorted by modulus; a real part counts as growth when above `1e-8 max(|λ|_max, ω,
+/// sqrt(g/L))`. For free rotation (`R = 0`) off the vertical the smallest eigenvalues
+/// are the rotational symmetry's zeros (two undamped, one damped) and are left out of
+/// the growth rate.
+///
+/// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
+/// [`Error::NotPositiveDefinite`] if `M` fails to factor.
+pub fn stability(
+    problem: &SteadyRotation,
+    shape: &SteadyShape,
+    damping: Option<&[f64]>,
+) -> Result<Stability> {
+    let n = problem.links();
+    let lin = linearise(problem, shape);
+    let mut friction = lin.gyroscopic.clone();
+    if let Some(d) = damping {
+        if d.len() != n {
+            return Err(Error::LengthMismatch { what: "damping", expected: n, got: d.len() });
+        }
+        for (i, &v) in d.iter().enumerate() {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidDamping { link: i + 1, value: v });
+            }
+            friction[(i, i)] += v;
+            friction[(n + i, n + i)] += v;
+        }
+    }
+    let chol = lin.mass.clone().cholesky().ok_or(Error::NotPositiveDefinite)?;
+    let k = chol.solve(&lin.stiffness);
+    let c = chol.solve(&friction);
+    let mut a = DMatrix::zeros(4 * n, 4 * n);
+    a.view_mut((0, 2 * n), (2 * n, 2 * n)).fill_with_identity();
+    a.view_mut((2 * n, 0), (2 * n, 2 * n)).copy_from(&(-k));
+    a.view_mut((2 * n, 2 * n), (2 * n, 2 * n)).copy_from(&(-c));
+    let mut eigenvalues: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
+    eigenvalues.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
+    // Free rotation off the vertical: turning the shape about the axis is an exact
+    // symmetry, a double zero eigenvalue undamped (a Jordan block, split by round-off to
+    // O(sqrt(ε)|A|)), a single one damped; it is set aside, not counted as growth.
+    let symmetric = problem.radius() == 0.0 && shape.theta.iter().any(|t| t.sin().abs() > 1e-12);
+    let zeros = match (symmetric, damping.is_some()) {
+        (false, _) => 0,
+        (true, false) => 2,
+        (true, true) => 1,
+    };
+    let counted = &eigenvalues[zeros.min(eigenvalues.len())..];
+    let growth_rate = counted.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let largest = eigenvalues.last().map_or(0.0, |z| z.norm());
+    let tolerance = 1e-8 * largest.max(shape.omega).max(problem.reference_speed());
+    let scale = lin.stiffness.amax();
+    let h_eigen: DVector<f64> = lin.stiffness.symmetric_eigenvalues();
+    let index = h_eigen.iter().filter(|&&v| v < -1e-9 * scale).count();
+    Ok(Stability { eigenvalues, growth_rate, index, spectrally_stable: growth_rate <= tolerance })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Chain, ContinuationOptions, normal_modes};
+    use approx::assert_relative_eq;
+    use nalgebra::Dyn;
+
+    #[test]
+    fn vertical_chain_turns_its_modes_by_omega() {
+        // At θ = 0 the turning frame sees each mode ω_k as ±i(ω_k ± ω).
+        let chain = Chain::<Dyn>::new(&[0.4, 1.0, 0.6], &[0.3, 0.5, 0.2], 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, 0.0).unwrap();
+        let omega = 3.3;
+        let shape = p.shape(omega, DVector::zeros(3));
+        let st = stability(&p, &shape, None).unwrap();
+        let mut found: Vec<f64> = st.eigenvalues.iter().map(|z| z.im).collect();
+        found.sort_by(f64::total_cmp);
+        let mut expected: Vec<f64> = normal_modes(&chain)
+            .frequencies
+            .iter()
+            .flat_map(|w| [w + omega, w - omega, -w + omega, -w - omega])
+            .collect();
+        expected.sort_by(f64::total_cmp);
+        for (f, e) in found.iter().zip(&expected) {
+            assert_relative_eq!(*f, *e, epsilon = 1e-9);
+        }
+        assert!(st.spectrally_stable);
+    }
+
+    #[test]
+    fn conical_pendulum_is_stable_and_damping_keeps_it() {
+        let p = SteadyRotation::new(&Chain::<Dyn>::new(&[1.0], &[1.0], 9.81).unwrap(), 0.0).unwrap();
+        let omega = 5.0;
+        let shape = p.solve(omega, &DVector::from_element(1, 1.0)).unwrap();
+        let st = stability(&p, &shape, None).unwrap();
+        assert!(st.spectrally_stable);
+        assert_eq!(st.index, 0);
+        let damped = stability(&p, &shape, Some(&[0.05])).unwrap();
+        assert!(damped.spectrally_stable);
+        // Small oscillation of the conical pendulum, the in- and out-of-plane motions
+        // coupled by Coriolis: λ²(λ² + ω²(sin²θ + 4 cos²θ)) = 0, ω_osc = ω sqrt(1 + 3 cos²θ).
+        let expected = omega * (1.0 + 3.0 * shape.theta[0].cos().powi(2)).sqrt();
+        assert!(st.eigenvalues.iter().any(|z| (z.im.abs() - expected).abs() < 1e-8), "{:?}", st.eigenvalues);
+    }
+
+    #[test]
+    fn damping_destroys_gyroscopic_stabilisation_of_the_vertical() {
+        // Above the first critical speed the vertical has index 2 (one direction per
+        // plane) yet is spectrally stable; damping in the turning frame makes it unstable.
+        let chain = Chain::<Dyn>::uniform(3, 1.0, 0.3, 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, 0.0).unwrap();
+        let w1 = normal_modes(&chain).frequencies[0];
+        let shape = p.shape(1.2 * w1, DVector::zeros(3));
+        let st = stability(&p, &shape, None).unwrap();
+        assert_eq!(st.index, 2);
+        assert!(st.spectrally_stable);
+        let damped = stability(&p, &shape, Some(&[0.01; 3])).unwrap();
+        assert!(!damped.spectrally_stable);
+        assert!(damped.growth_rate > 0.0);
+    }
+
+    #[test]
+    fn in_plane_stiffness_is_the_shape_equations_hessian() {
+        let chain = Chain::<Dyn>::uniform(4, 1.0, 0.25, 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, 0.05).unwrap();
+        let shape = p.solve(9.0, &DVector::from_element(4, 0.8)).unwrap();
+        let lin = linearise(&p, &shape);
+        let h = p.hessian(&shape.theta, 81.0);
+        assert_relative_eq!(lin.stiffness.view((0, 0), (4, 4)).into_owned(), h, epsilon = 1e-12);
+        assert_relative_eq!(lin.gyroscopic.clone(), -lin.gyroscopic.transpose(), epsilon = 1e-14);
+    }
+
+    #[test]
+    fn first_branch_is_stable_and_the_second_unstable() {
+        let chain = Chain::<Dyn>::uniform(6, 1.0, 1.0 / 6.0, 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, 0.0).unwrap();
+        let speeds = p.bifurcation_speeds(2).unwrap();
+        let opts = ContinuationOptions::default();
+        let b1 = p.branch(1, 1.5 * speeds[1], &opts).unwrap();
+        for s in &b1.points[1..] {
+            let st = stability(&p, s, None).unwrap();
+            assert!(st.spectrally_stable && st.index == 0, "k=1 at ω = {}: {:?}", s.omega, st.growth_rate);
+        }
+        let b2 = p.branch(2, 1.5 * speeds[1], &opts).unwrap();
+        let last = b2.points.last().unwrap();
+        let st = stability(&p, last, None).unwrap();
+        assert!(st.index > 0);
+    }
+
+    #[test]
+    fn bad_damping_is_named() {
+        let p = SteadyRotation::new(&Chain::<Dyn>::uniform(2, 1.0, 1.0, 9.81).unwrap(), 0.0).unwrap();
+        let s = p.shape(1.0, DVector::zeros(2));
+        assert!(matches!(stability(&p, &s, Some(&[0.1])), Err(Error::LengthMismatch { .. })));
+        assert!(matches!(stability(&p, &s, Some(&[0.1, -1.0])), Err(Error::InvalidDamping { link: 2, .. })));
+    }
+}
