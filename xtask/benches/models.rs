@@ -11,10 +11,19 @@
 //!   `FirstOrder`, from the same state each time;
 //! - `energy`: `Model::energy` (`T + U`).
 //!
-//! `<kind>_accelerations` also holds `closed_form` (planar n = 2, the document's eq 50
-//! corrected, `xtask::closed_form`) and `baseline`: `dof` calls of `sin_cos` and `2·dof`
-//! stores, the least any evaluation does (every coordinate's sine and cosine, the
-//! first-order right-hand side `(q̇, q̈)` written out).
+//! Implementations: `generated` (`model!`, planar n = 1..8, spatial n = 1..4; planar 12
+//! and 16 for the accelerations only), `generic_fixed` (`Planar`/`Spatial<Const<n>>`),
+//! `generic_dyn` (`Planar`/`Spatial<Dyn>`, accelerations up to n = 256). The
+//! `<kind>_accelerations` groups also hold:
+//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`xtask::closed_form`);
+//!   `planar_input_checks/check_inputs/2` times the input validation it lacks;
+//! - `tension`: the O(n) `PlanarTension<Dyn>` (also its `gl2_step` for n ≤ 8);
+//! - `directions`: `System::rhs` of the O(n) `Directions` chain (2D and 3D);
+//! - `baseline`: `dof` calls of `sin_cos` and `2·dof` stores, the least any evaluation in
+//!   angle coordinates does (every coordinate's sine and cosine, the first-order
+//!   right-hand side `(q̇, q̈)` written out).
+//!
+//! The O(n) routes and the baseline run at n = 1..8 and 12, 16, 64, 256, 1024, 4096.
 //!
 //! Run through `cargo xtask bench`, which writes `docs/bench.md` and `docs/bench.svg`;
 //! `PENDULUM_BENCH_QUICK=1` selects the few sizes of `cargo xtask bench --quick`.
@@ -47,7 +56,7 @@ fn quick() -> bool {
     std::env::var_os("PENDULUM_BENCH_QUICK").is_some_and(|v| v != "0")
 }
 
-/// Whether the full run covers `n` links of a model generated for 1..=`max` links.
+/// Whether this run times chains of `n` links (the quick run only n = 1, 2, 4).
 fn wanted(n: usize) -> bool {
     !quick() || matches!(n, 1 | 2 | 4)
 }
