@@ -1,7 +1,8 @@
 //! `cargo xtask bench`: runs the criterion benchmarks (`xtask/benches/models.rs`) into a
-//! fresh directory, reads the medians back and writes `docs/bench.md` (tables, targets,
-//! machine, date) and `docs/bench.svg` (log–log plot). `--quick` is a smoke run that
-//! writes its report under the target directory instead of `docs/`.
+//! fresh directory, reads the medians and fastest samples back and writes `docs/bench.md`
+//! (tables, targets, machine, date) and `docs/bench.svg` (log–log plot). `--quick` is a
+//! smoke run, and a run filtered by criterion arguments is partial: both write their
+//! report under the target directory instead of `docs/`.
 
 mod plot;
 mod report;
@@ -26,7 +27,8 @@ pub struct Options {
     /// Do not run the benchmarks: rewrite the report from the last run's estimates.
     #[arg(long)]
     pub report_only: bool,
-    /// Extra arguments for criterion, e.g. a filter such as `planar_accelerations`.
+    /// Extra arguments for criterion, e.g. a filter such as `planar_accelerations`
+    /// (a filtered run's report goes under the target directory, not `docs/`).
     #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
     pub args: Vec<String>,
 }
@@ -35,6 +37,9 @@ pub struct Options {
 const FULL: (f64, f64, usize, usize) = (0.3, 0.7, 40, 20_000);
 /// See [`FULL`].
 const QUICK: (f64, f64, usize, usize) = (0.02, 0.05, 10, 1_000);
+
+/// The command of a complete run, as recorded in its report.
+const FULL_COMMAND: &str = "cargo xtask bench";
 
 /// Runs the benchmarks and writes the report and plot.
 pub fn run(options: &Options) -> Result<()> {
@@ -52,7 +57,9 @@ pub fn run(options: &Options) -> Result<()> {
     };
     let results = Results::load(&criterion, Statistic::Median)?;
     let fastest = Results::load(&criterion, Statistic::Fastest)?;
-    let out_dir = if options.quick { scratch.clone() } else { crate::workspace_root().join("docs") };
+    // Only a complete full run (no criterion filter) goes to docs/.
+    let complete = !options.quick && info.command == FULL_COMMAND;
+    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     let md_path = out_dir.join("bench.md");
     let notes = existing_notes(&crate::workspace_root().join("docs").join("bench.md"));
     std::fs::write(&md_path, report::markdown(&results, &fastest, &info, &notes))
@@ -104,7 +111,7 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     if !status.success() {
         bail!("cargo bench failed ({status})");
     }
-    let mut invocation = String::from("cargo xtask bench");
+    let mut invocation = String::from(FULL_COMMAND);
     if options.quick {
         invocation += " --quick";
     }
