@@ -1,42 +1,156 @@
-//! Unrolled (generated) vs generic models: the cost of one evaluation of the equations of
-//! motion, `Model::accelerations` (mass matrix, forces, Cholesky solve), per model and n.
+//! Unrolled (generated) vs generic vs closed-form models, and the physical-limit
+//! baseline: the cost of the pieces of one evaluation of the equations of motion, per
+//! model and number of links n.
 //!
-//! Run through `cargo xtask bench`, which prints the ratios; or directly with
-//! `cargo bench -p xtask --bench models`.
+//! Groups are `<kind>_<operation>` (kind `planar` or `spatial`), benchmark ids
+//! `<implementation>/<n>`:
+//! - `mass_matrix`: `Model::mass_matrix` (`M(q)`, written into a preallocated matrix);
+//! - `forces`: the right-hand side `Q − c − k − d` from the four building blocks;
+//! - `accelerations`: `Model::accelerations` (input checks, `M`, forces, Cholesky solve);
+//! - `gl2_step`: one step (h = 1 ms) of the two-stage Gauss–Legendre method through
+//!   `FirstOrder`, from the same state each time;
+//! - `energy`: `Model::energy` (`T + U`).
+//!
+//! Implementations: `generated` (`model!`, planar n = 1..8, spatial n = 1..4; planar 12
+//! and 16 for the accelerations only), `generic_fixed` (`Planar`/`Spatial<Const<n>>`),
+//! `generic_dyn` (`Planar`/`Spatial<Dyn>`, accelerations up to n = 256). The
+//! `<kind>_accelerations` groups also hold:
+//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`xtask::closed_form`);
+//!   `planar_input_checks/check_inputs/2` times the input validation it lacks;
+//! - `tension`: the O(n) `PlanarTension<Dyn>` (also its `gl2_step` for n ≤ 8);
+//! - `directions`: `System::rhs` of the O(n) `Directions` chain (2D and 3D);
+//! - `baseline`: `dof` calls of `sin_cos` and `2·dof` stores, the least any evaluation in
+//!   angle coordinates does (every coordinate's sine and cosine, the first-order
+//!   right-hand side `(q̇, q̈)` written out).
+//!
+//! The O(n) routes and the baseline run at n = 1..8 and 12, 16, 64, 256, 1024, 4096.
+//!
+//! Run through `cargo xtask bench`, which writes `docs/bench.md` and `docs/bench.svg`;
+//! `PENDULUM_BENCH_QUICK=1` selects the few sizes of `cargo xtask bench --quick`.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OVector, U1};
-use pendulum_core::{Model, ModelAlloc, Planar, Spatial};
+use nalgebra::{
+    Const, DVector, DefaultAllocator, Dim, DimMul, DimName, DimProd, Dyn, OMatrix, OVector, U1, U2, U3,
+};
+use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, State, System};
+use pendulum_core::{Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial};
 use xtask::case::Params;
-use xtask::models::{Planar1, Planar2, Planar3, Planar4, Planar8, Spatial1, Spatial2, Spatial4, chain};
+use xtask::closed_form::DoublePendulum;
+use xtask::models::{
+    Planar1, Planar2, Planar3, Planar4, Planar5, Planar6, Planar7, Planar8, Spatial1, Spatial2, Spatial3,
+    Spatial4, chain,
+};
+
+pendulum_macros::model! {
+    /// Generated planar model, 12 links: accelerations only, to locate the crossover.
+    pub struct Planar12 { kind: planar, links: 12 }
+    /// Generated planar model, 16 links: accelerations only, to locate the crossover.
+    pub struct Planar16 { kind: planar, links: 16 }
+}
+
+/// Whether this is the smoke run of `cargo xtask bench --quick` (few sizes).
+fn quick() -> bool {
+    std::env::var_os("PENDULUM_BENCH_QUICK").is_some_and(|v| v != "0")
+}
+
+/// Whether this run times chains of `n` links (the quick run only n = 1, 2, 4).
+fn wanted(n: usize) -> bool {
+    !quick() || matches!(n, 1 | 2 | 4)
+}
+
+/// Chain lengths beyond the generated models, for the routes that accept any n.
+fn large_sizes() -> &'static [usize] {
+    if quick() { &[64] } else { &[12, 16, 64, 256, 1024, 4096] }
+}
+
+/// The largest n at which the dense generic route (O(n²) build, O(n³) Cholesky) is timed.
+const DENSE_MAX: usize = 256;
 
 /// A fixed, non-singular state: angles spread over (0.3, 2.8) so that no sin θ vanishes.
-fn state<M: Model>(model: &M) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>)
+fn state<D: Dim>(dof: D) -> (OVector<f64, D>, OVector<f64, D>)
 where
-    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    DefaultAllocator: nalgebra::allocator::Allocator<D>,
 {
-    let dof = model.dof();
     let q = OVector::from_iterator_generic(dof, U1, (0..dof.value()).map(|i| 0.3 + (i as f64 * 0.77) % 2.5));
     let qd =
         OVector::from_iterator_generic(dof, U1, (0..dof.value()).map(|i| ((i as f64) * 1.3).sin() * 3.0));
     (q, qd)
 }
 
-fn bench_one<M: Model>(
-    c: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    name: &str,
-    n: usize,
+/// The benchmarked chain's parameters: `n` links of slowly varying masses and lengths.
+fn params(n: usize) -> Params {
+    Params {
+        masses: (0..n).map(|i| 1.0 + 0.1 * (i % 10) as f64).collect(),
+        lengths: (0..n).map(|i| 0.5 + 0.05 * (i % 10) as f64).collect(),
+        gravity: 9.81,
+        damping: vec![0.01; n],
+    }
+}
+
+/// `out = Q − c − k − d`, the right-hand side of `M q̈ = …`, from the building blocks.
+fn forces<M: Model>(
     model: &M,
+    q: &OVector<f64, M::Dof>,
+    qd: &OVector<f64, M::Dof>,
+    inputs: &Inputs<M::Dof, M::Space>,
+    out: &mut OVector<f64, M::Dof>,
+    tmp: &mut OVector<f64, M::Dof>,
 ) where
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
 {
-    let (q, qd) = state(model);
+    model.generalized_forces(q, qd, &inputs.torque, out);
+    model.velocity_terms(q, qd, tmp);
+    *out -= &*tmp;
+    model.gravity_terms(q, tmp);
+    *out -= &*tmp;
+    model.pivot_terms(q, &inputs.pivot_acceleration, tmp);
+    *out -= &*tmp;
+}
+
+/// The operations cheap at any n: mass matrix, forces, accelerations, energy.
+fn bench_evaluations<M: Model>(c: &mut Criterion, kind: &str, name: &str, n: usize, model: &M)
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    let dof = model.dof();
+    let (q, qd) = state(dof);
+    let inputs = model.zero_inputs();
+    let id = BenchmarkId::new(name, n);
+
+    let mut mass = OMatrix::<f64, M::Dof, M::Dof>::zeros_generic(dof, dof);
+    c.benchmark_group(format!("{kind}_mass_matrix")).bench_function(id.clone(), |b| {
+        b.iter(|| {
+            model.mass_matrix(black_box(&q), &mut mass);
+            black_box(&mass);
+        })
+    });
+
+    let (mut out, mut tmp) = (qd.clone(), qd.clone());
+    c.benchmark_group(format!("{kind}_forces")).bench_function(id.clone(), |b| {
+        b.iter(|| {
+            forces(model, black_box(&q), black_box(&qd), black_box(&inputs), &mut out, &mut tmp);
+            black_box(&out);
+        })
+    });
+
+    bench_accelerations(c, kind, name, n, model);
+
+    c.benchmark_group(format!("{kind}_energy"))
+        .bench_function(id, |b| b.iter(|| black_box(model.energy(black_box(&q), black_box(&qd)))));
+}
+
+/// `Model::accelerations` of `model`.
+fn bench_accelerations<M: Model>(c: &mut Criterion, kind: &str, name: &str, n: usize, model: &M)
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    let (q, qd) = state(model.dof());
     let inputs = model.zero_inputs();
     let mut out = qd.clone();
-    c.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+    c.benchmark_group(format!("{kind}_accelerations")).bench_function(BenchmarkId::new(name, n), |b| {
         b.iter(|| {
             model.accelerations(black_box(&q), black_box(&qd), black_box(&inputs), &mut out).unwrap();
             black_box(&out);
@@ -44,56 +158,196 @@ fn bench_one<M: Model>(
     });
 }
 
-/// The benchmarked chain's parameters: `n` links of slowly growing masses and lengths.
-fn params(n: usize) -> Params {
-    Params {
-        masses: (0..n).map(|i| 1.0 + 0.1 * i as f64).collect(),
-        lengths: (0..n).map(|i| 0.5 + 0.05 * i as f64).collect(),
-        gravity: 9.81,
-        damping: vec![0.01; n],
+/// `System::rhs` of the O(n) `Directions` chain of `n` links (`U2` planar, `U3`
+/// spatial), at the state of the same angles as the other routes, in the
+/// `<kind>_accelerations` group.
+fn bench_directions<S: DimName>(
+    c: &mut Criterion,
+    kind: &str,
+    n: usize,
+    to_state: impl Fn(&Directions<S>, &[f64], &[f64]) -> pendulum_core::Result<DVector<f64>>,
+) where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    let system = Directions::<S>::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    let dof = if S::DIM == 2 { n } else { 2 * n };
+    let (q, qd) = state::<Dyn>(Dyn(dof));
+    let x = to_state(&system, q.as_slice(), qd.as_slice()).expect("non-singular state");
+    let mut f = DVector::zeros(x.len());
+    c.benchmark_group(format!("{kind}_accelerations")).bench_function(
+        BenchmarkId::new("directions", n),
+        |b| {
+            b.iter(|| {
+                system.rhs(0.0, black_box(&x), &mut f).unwrap();
+                black_box(&f);
+            })
+        },
+    );
+}
+
+/// The O(n) routes at `n` links: `PlanarTension<Dyn>` accelerations (and, if `step`, its
+/// Gauss–Legendre step), `Directions` rhs planar and spatial (if `spatial`).
+fn bench_linear(c: &mut Criterion, n: usize, step: bool, spatial: bool) {
+    let tension = PlanarTension::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    bench_accelerations(c, "planar", "tension", n, &tension);
+    if step {
+        bench_gl2_step(c, "planar", "tension", n, &tension);
+    }
+    bench_directions::<U2>(c, "planar", n, |s, q, qd| s.from_angles(q, qd));
+    if spatial {
+        bench_directions::<U3>(c, "spatial", n, |s, q, qd| s.from_spherical(q, qd));
     }
 }
 
-/// The generated model of `n` links and the generic one (`Planar` or `Spatial`) with
-/// `L = Const<n>` and `L = Dyn`.
-macro_rules! bench_models {
-    ($group:expr, $n:literal, $generated:ident, $generic:ident) => {
-        let params = params($n);
-        bench_one(
-            $group,
-            "generated",
-            $n,
-            &$generated::new(chain::<Const<$n>>(&params).expect("valid chain")),
-        );
-        bench_one(
-            $group,
-            "generic_fixed",
-            $n,
-            &$generic::new(chain::<Const<$n>>(&params).expect("valid chain")),
-        );
-        bench_one($group, "generic_dyn", $n, &$generic::new(chain::<Dyn>(&params).expect("valid chain")));
+/// One two-stage Gauss–Legendre step (h = 1 ms) of `model` through `FirstOrder`, always
+/// from the same state.
+fn bench_gl2_step<M: Model + Clone>(c: &mut Criterion, kind: &str, name: &str, n: usize, model: &M)
+where
+    M::Dof: DimMul<U2>,
+    DimProd<M::Dof, U2>: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + GaussAlloc<DimProd<M::Dof, U2>, U2>,
+{
+    let system = FirstOrder::new(model.clone());
+    let (q, qd) = state(model.dof());
+    let x0 = system.state(&q, &qd);
+    let mut solver = GaussLegendre::<_, U2>::new(&system, GaussOptions::default());
+    let mut state = State::new(0.0, x0.clone());
+    c.benchmark_group(format!("{kind}_gl2_step")).bench_function(BenchmarkId::new(name, n), |b| {
+        b.iter(|| {
+            state.set(0.0, &x0);
+            solver.step(&system, &mut state, black_box(1e-3)).unwrap();
+            black_box(state.x());
+        })
+    });
+}
+
+/// All five operations of one model.
+fn bench_model<M: Model + Clone>(c: &mut Criterion, kind: &str, name: &str, n: usize, model: &M)
+where
+    M::Dof: DimMul<U2>,
+    DimProd<M::Dof, U2>: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + GaussAlloc<DimProd<M::Dof, U2>, U2>,
+{
+    bench_evaluations(c, kind, name, n, model);
+    bench_gl2_step(c, kind, name, n, model);
+}
+
+/// The physical-limit baseline for `dof` coordinates: `dof` calls of `sin_cos` and
+/// `2·dof` stores.
+fn bench_baseline(c: &mut Criterion, kind: &str, n: usize, dof: usize) {
+    let (q, _) = state(Dyn(dof));
+    let q: Vec<f64> = q.iter().copied().collect();
+    let mut out = vec![0.0; 2 * dof];
+    c.benchmark_group(format!("{kind}_accelerations")).bench_function(BenchmarkId::new("baseline", n), |b| {
+        b.iter(|| {
+            for (x, pair) in black_box(&q).iter().zip(out.chunks_exact_mut(2)) {
+                let (s, co) = x.sin_cos();
+                pair[0] = s;
+                pair[1] = co;
+            }
+            black_box(&mut out);
+        })
+    });
+}
+
+/// The closed-form double pendulum (eq 50, corrected): its accelerations.
+fn bench_closed_form(c: &mut Criterion) {
+    let p = params(2);
+    let model = DoublePendulum::new(p.masses[0], p.masses[1], p.lengths[0], p.lengths[1], p.gravity)
+        .expect("valid parameters");
+    let (q, qd) = state(Const::<2>);
+    let (q, qd) = ([q[0], q[1]], [qd[0], qd[1]]);
+    c.benchmark_group("planar_accelerations").bench_function(BenchmarkId::new("closed_form", 2), |b| {
+        b.iter(|| black_box(model.accelerations(black_box(q), black_box(qd))))
+    });
+    // The part of the generated model's cost the closed form does not have: validating
+    // the lengths and finiteness of q, q̇, σ and p̈.
+    let (q, qd) = state(Const::<2>);
+    let inputs = Inputs::<Const<2>, U2>::zeros(Const::<2>);
+    c.benchmark_group("planar_input_checks").bench_function(BenchmarkId::new("check_inputs", 2), |b| {
+        b.iter(|| pendulum_core::check_inputs(2, black_box(&q), black_box(&qd), black_box(&inputs)).unwrap())
+    });
+}
+
+/// The generated model of `n` links, the generic one with `L = Const<n>` and with
+/// `L = Dyn`, and the baseline, all five operations each.
+macro_rules! bench_sizes {
+    ($c:expr, $kind:literal, $generic:ident, $dof_per_link:literal, $($n:literal => $generated:ident),* $(,)?) => {
+        $(
+            if wanted($n) {
+                let p = params($n);
+                bench_model($c, $kind, "generated", $n, &$generated::new(chain::<Const<$n>>(&p).expect("valid chain")));
+                bench_model($c, $kind, "generic_fixed", $n, &$generic::new(chain::<Const<$n>>(&p).expect("valid chain")));
+                bench_model($c, $kind, "generic_dyn", $n, &$generic::new(chain::<Dyn>(&p).expect("valid chain")));
+                bench_baseline($c, $kind, $n, $dof_per_link * $n);
+            }
+        )*
     };
 }
 
-fn accelerations(c: &mut Criterion) {
-    let mut group = c.benchmark_group("planar_accelerations");
-    bench_models!(&mut group, 1, Planar1, Planar);
-    bench_models!(&mut group, 2, Planar2, Planar);
-    bench_models!(&mut group, 3, Planar3, Planar);
-    bench_models!(&mut group, 4, Planar4, Planar);
-    bench_models!(&mut group, 8, Planar8, Planar);
-    group.finish();
+fn small_chains(c: &mut Criterion) {
+    bench_sizes!(c, "planar", Planar, 1,
+        1 => Planar1, 2 => Planar2, 3 => Planar3, 4 => Planar4,
+        5 => Planar5, 6 => Planar6, 7 => Planar7, 8 => Planar8,
+    );
+    bench_closed_form(c);
+    bench_sizes!(c, "spatial", Spatial, 2, 1 => Spatial1, 2 => Spatial2, 3 => Spatial3, 4 => Spatial4);
+    for n in (1..=8).filter(|&n| wanted(n)) {
+        bench_linear(c, n, true, n <= 4);
+    }
+}
 
-    let mut group = c.benchmark_group("spatial_accelerations");
-    bench_models!(&mut group, 1, Spatial1, Spatial);
-    bench_models!(&mut group, 2, Spatial2, Spatial);
-    bench_models!(&mut group, 4, Spatial4, Spatial);
-    group.finish();
+/// Beyond the sizes of all five operations: generated planar n = 12 and 16, the O(n)
+/// routes, the dense generic route up to [`DENSE_MAX`] links and the baseline
+/// (accelerations only).
+fn large_chains(c: &mut Criterion) {
+    if !quick() {
+        let (p12, p16) = (params(12), params(16));
+        bench_accelerations(
+            c,
+            "planar",
+            "generated",
+            12,
+            &Planar12::new(chain::<Const<12>>(&p12).expect("valid chain")),
+        );
+        bench_accelerations(
+            c,
+            "planar",
+            "generated",
+            16,
+            &Planar16::new(chain::<Const<16>>(&p16).expect("valid chain")),
+        );
+    }
+    for &n in large_sizes() {
+        bench_linear(c, n, false, true);
+        if n <= DENSE_MAX {
+            let p = params(n);
+            bench_accelerations(
+                c,
+                "planar",
+                "generic_dyn",
+                n,
+                &Planar::new(chain::<Dyn>(&p).expect("valid chain")),
+            );
+            bench_accelerations(
+                c,
+                "spatial",
+                "generic_dyn",
+                n,
+                &Spatial::new(chain::<Dyn>(&p).expect("valid chain")),
+            );
+        }
+        bench_baseline(c, "planar", n, n);
+        bench_baseline(c, "spatial", n, 2 * n);
+    }
 }
 
 criterion_group! {
     name = benches;
-    config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = accelerations
+    config = Criterion::default()
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_millis(700))
+        .sample_size(40);
+    targets = small_chains, large_chains
 }
 criterion_main!(benches);

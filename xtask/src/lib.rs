@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod case;
+pub mod closed_form;
 pub mod document;
 pub mod expr;
 pub mod models;

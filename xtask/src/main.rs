@@ -14,13 +14,10 @@ enum Task {
     /// Compare the generated and generic models (and the document's printed
     /// equations) against the sympy reference at many random states.
     Verify(xtask::verify::Options),
-    /// Benchmark the unrolled (generated) models against the generic ones (criterion)
-    /// and print the times and ratios of this one run.
-    Bench {
-        /// Extra arguments for criterion, e.g. a filter such as `planar`.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    /// Benchmark generated vs generic vs closed-form vs O(n) models (criterion) and write
+    /// docs/bench.md and docs/bench.svg from this one run (`--quick`: a smoke run that
+    /// leaves docs/ alone).
+    Bench(xtask::bench::Options),
     /// Regenerate the sympy reference in reference/cases (needs python3 with sympy 1.14.0).
     Reference {
         /// Regenerate into a scratch directory and fail, naming the files, if the
@@ -34,6 +31,6 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().task {
         Task::Verify(options) => xtask::verify::run(&options),
         Task::Reference { check } => xtask::regen::run(check),
-        Task::Bench { args } => xtask::bench::run(&args),
+        Task::Bench(options) => xtask::bench::run(&options),
     }
 }

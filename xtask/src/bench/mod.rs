@@ -1,0 +1,239 @@
+//! `cargo xtask bench`: runs the criterion benchmarks (`xtask/benches/models.rs`) into a
+//! fresh directory, reads the medians and fastest samples back and writes `docs/bench.md`
+//! (tables, targets, machine, date) and `docs/bench.svg` (log–log plot). `--quick` is a
+//! smoke run, and a run filtered by criterion arguments is partial: both write their
+//! report under the target directory instead of `docs/`.
+
+mod plot;
+mod report;
+mod results;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+use anyhow::{Context, Result, bail};
+
+pub use report::{RunInfo, Targets};
+pub use results::{Results, Statistic};
+
+/// Options of `cargo xtask bench`.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct Options {
+    /// Smoke run (under a minute once built): few sizes, short warm-up and measurement;
+    /// the report goes to `<target>/xtask-bench/quick/`, not `docs/`.
+    #[arg(long)]
+    pub quick: bool,
+    /// Do not run the benchmarks: rewrite the report from the last run's estimates.
+    #[arg(long)]
+    pub report_only: bool,
+    /// Extra arguments for criterion, e.g. a filter such as `planar_accelerations`
+    /// (a filtered run's report goes under the target directory, not `docs/`).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    pub args: Vec<String>,
+}
+
+/// Criterion settings: (warm-up s, measurement s, samples, bootstrap resamples).
+const FULL: (f64, f64, usize, usize) = (0.3, 0.7, 40, 20_000);
+/// See [`FULL`].
+const QUICK: (f64, f64, usize, usize) = (0.02, 0.05, 10, 1_000);
+
+/// The command of a complete run, as recorded in its report.
+const FULL_COMMAND: &str = "cargo xtask bench";
+
+/// Runs the benchmarks and writes the report and plot.
+pub fn run(options: &Options) -> Result<()> {
+    let mode = if options.quick { "quick" } else { "full" };
+    let scratch = target_dir()?.join("xtask-bench").join(mode);
+    let criterion = scratch.join("criterion");
+    let info_path = scratch.join("run.json");
+    let info = if options.report_only {
+        read_info(&info_path)?
+    } else {
+        let info = bench(options, &criterion)?;
+        std::fs::write(&info_path, serde_json::to_string_pretty(&info)?)
+            .with_context(|| format!("writing {}", info_path.display()))?;
+        info
+    };
+    let results = Results::load(&criterion, Statistic::Median)?;
+    let fastest = Results::load(&criterion, Statistic::Fastest)?;
+    // Only a complete full run (no criterion filter) goes to docs/.
+    let complete = !options.quick && info.command == FULL_COMMAND;
+    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
+    let md_path = out_dir.join("bench.md");
+    let notes = existing_notes(&crate::workspace_root().join("docs").join("bench.md"));
+    std::fs::write(&md_path, report::markdown(&results, &fastest, &info, &notes))
+        .with_context(|| format!("writing {}", md_path.display()))?;
+    let svg_path = out_dir.join("bench.svg");
+    std::fs::write(&svg_path, plot::svg(&fastest)?)
+        .with_context(|| format!("writing {}", svg_path.display()))?;
+    println!("\n{}", report::targets_markdown(&Targets::of(&results), &Targets::of(&fastest)));
+    println!("{} benchmarks; wrote {} and {}", results.len(), md_path.display(), svg_path.display());
+    Ok(())
+}
+
+/// Runs `cargo bench --workspace --bench models` with criterion's output in `criterion`
+/// (emptied first, so the report never mixes runs).
+fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
+    if criterion.exists() {
+        std::fs::remove_dir_all(criterion).with_context(|| format!("emptying {}", criterion.display()))?;
+    }
+    std::fs::create_dir_all(criterion).with_context(|| format!("creating {}", criterion.display()))?;
+    let (warm_up, measurement, samples, resamples) = if options.quick { QUICK } else { FULL };
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // `--workspace` unifies features as `cargo bench --workspace --no-run` (CI) does, so the
+    // binary CI compiled is reused rather than built again.
+    let build = ["bench", "--workspace", "--bench", "models"];
+    let status = Command::new(&cargo)
+        .current_dir(crate::workspace_root())
+        .args(build)
+        .arg("--no-run")
+        .status()
+        .context("building the benchmarks")?;
+    if !status.success() {
+        bail!("cargo bench --no-run failed ({status})");
+    }
+    let mut command = Command::new(cargo);
+    command
+        .current_dir(crate::workspace_root())
+        .args(build)
+        .arg("--")
+        .args(["--warm-up-time", &warm_up.to_string(), "--measurement-time", &measurement.to_string()])
+        .args(["--sample-size", &samples.to_string(), "--nresamples", &resamples.to_string()])
+        .args(&options.args)
+        .env("CRITERION_HOME", criterion)
+        .env("PENDULUM_BENCH_QUICK", if options.quick { "1" } else { "0" });
+    let date = utc_now();
+    let load_before = load_average();
+    let start = Instant::now();
+    let status = command.status().context("running cargo bench")?;
+    let seconds = start.elapsed().as_secs_f64();
+    if !status.success() {
+        bail!("cargo bench failed ({status})");
+    }
+    let mut invocation = String::from(FULL_COMMAND);
+    if options.quick {
+        invocation += " --quick";
+    }
+    for a in &options.args {
+        invocation += &format!(" {a}");
+    }
+    Ok(RunInfo {
+        command: invocation,
+        date,
+        machine: machine(),
+        settings: format!(
+            "{warm_up} s warm-up, {measurement} s measurement, {samples} samples and {resamples} \
+             bootstrap resamples per benchmark"
+        ),
+        load: (load_before, load_average()),
+        seconds,
+    })
+}
+
+/// The cargo target directory (honours `CARGO_TARGET_DIR` and cargo config), from
+/// `cargo metadata`.
+fn target_dir() -> Result<PathBuf> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let output = Command::new(cargo)
+        .current_dir(crate::workspace_root())
+        .args(["metadata", "--format-version", "1", "--no-deps", "--offline"])
+        .output()
+        .context("running cargo metadata")?;
+    if !output.status.success() {
+        bail!("cargo metadata failed: {}", String::from_utf8_lossy(&output.stderr));
+    }
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).context("parsing cargo metadata")?;
+    let dir = json["target_directory"].as_str().context("cargo metadata: no target_directory")?;
+    Ok(PathBuf::from(dir))
+}
+
+/// The hand-written notes of the committed report: from [`report::NOTES_MARKER`] to
+/// the end, or the marker alone if there are none.
+fn existing_notes(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    match text.find(report::NOTES_MARKER) {
+        Some(i) => text[i..].to_string(),
+        None => format!("{}\n", report::NOTES_MARKER),
+    }
+}
+
+/// `"<cpu model>, <n> logical cores"` from `/proc/cpuinfo` (Linux) and the standard
+/// library's count.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!("{model}, {cores} logical cores")
+}
+
+/// The 1, 5 and 15 minute load averages from `/proc/loadavg`, or `"unknown"`.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// The current UTC time as `YYYY-MM-DD HH:MM UTC`.
+fn utc_now() -> String {
+    let secs = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    utc(secs)
+}
+
+/// `secs` since the Unix epoch as `YYYY-MM-DD HH:MM UTC` (proleptic Gregorian calendar;
+/// the days-to-civil conversion of H. Hinnant's `chrono` algorithms).
+fn utc(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let (hour, minute) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02} UTC")
+}
+
+/// The [`RunInfo`] saved by the last run (for `--report-only`).
+fn read_info(path: &Path) -> Result<RunInfo> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading {} (run `cargo xtask bench` first)", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_dates() {
+        assert_eq!(utc(0), "1970-01-01 00:00 UTC");
+        // 2000-02-29 12:34 (leap day of a century leap year).
+        assert_eq!(utc(951_827_640), "2000-02-29 12:34 UTC");
+        assert_eq!(utc(1_795_320_000), "2026-11-22 04:00 UTC");
+    }
+
+    #[test]
+    fn notes_are_kept_from_the_marker_on() {
+        let dir = std::env::temp_dir().join(format!("xtask-bench-notes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bench.md");
+        std::fs::write(&path, format!("# generated\n| table |\n{}\nwhy it is slow\n", report::NOTES_MARKER))
+            .unwrap();
+        let notes = existing_notes(&path);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(notes, format!("{}\nwhy it is slow\n", report::NOTES_MARKER));
+        assert_eq!(existing_notes(&dir.join("missing.md")), format!("{}\n", report::NOTES_MARKER));
+    }
+}
