@@ -246,10 +246,7 @@ fn stage_solve_hint(e: &pendulum_core::Error, solver: StageSolver) -> &'static s
             " (the fixed-point stage solve converges only for steps shorter than about the \
              chain's fastest period: use a smaller --step, --solver newton or --integrator rk4)"
         }
-        (true, StageSolver::Newton) => {
-            " (Newton's stage solve is known to fail from exactly straight chains of more than \
-             about 5 links, such as horizontal or tilted starts; --solver fixed-point avoids it)"
-        }
+        (true, StageSolver::Newton) => " (use a smaller --step, or --integrator rk4)",
     }
 }
 

@@ -81,19 +81,19 @@ pub enum Error {
     /// through round-off in extreme parameter ranges).
     #[error("the mass matrix is not numerically positive definite at this state")]
     NotPositiveDefinite,
-    /// The implicit stage equations of an integrator step did not converge: the Newton
-    /// iterations (simplified, then full) diverged, stalled above round-off, or ran out of
-    /// iterations. The state is left as it was before the step.
+    /// The implicit stage equations of an integrator step did not converge: the
+    /// iterations (Newton, simplified then full, or fixed-point sweeps) diverged, stalled
+    /// above round-off, or ran out. The state is left as it was before the step.
     #[error(
         "the stage equations of the step from t = {t} s with h = {h} s did not converge \
-         after {iterations} Newton iterations; try a smaller step"
+         after {iterations} iterations; try a smaller step"
     )]
     StageSolveFailed {
         /// Time at the start of the step, s.
         t: f64,
         /// The step size, s.
         h: f64,
-        /// Newton iterations spent on the step, over all attempts.
+        /// Iterations spent on the step, over all attempts.
         iterations: usize,
     },
     /// An integrator step produced an infinite or NaN state. The state is left as it was

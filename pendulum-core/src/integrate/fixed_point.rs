@@ -136,13 +136,14 @@ where
             if !norm.is_finite() {
                 break;
             }
-            if norm == 0.0 {
-                return Ok(());
-            }
             // The increments need not shrink monotonically at first (the iteration matrix
             // h A ⊗ J of a second-order system is far from normal), so the iteration
-            // stops when they stop shrinking only once they are small: at round-off.
+            // stops when they stop shrinking only once they are small: at round-off; an
+            // increment below the round-off of the largest value ends it at once.
             let scale = x_scale.max(self.z.amax()).max(f64::MIN_POSITIVE);
+            if norm <= f64::EPSILON * scale {
+                return Ok(());
+            }
             if norm >= previous_norm && previous_norm <= 1e-10 * scale {
                 return Ok(());
             }

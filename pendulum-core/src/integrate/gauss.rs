@@ -372,10 +372,14 @@ where
                     self.z[(r, i)] += self.delta[i * n + r];
                 }
             }
-            if norm == 0.0 {
+            let scale = x_scale.max(self.z.amax()).max(f64::MIN_POSITIVE);
+            // An increment below the round-off of the largest value can change nothing
+            // that matters; it may still shrink geometrically for ever (entries far
+            // smaller than the rest, e.g. the differences of a straight chain's equal
+            // angles), so it counts as converged rather than waiting for a stall.
+            if norm <= f64::EPSILON * scale {
                 return Ok(Some(rate));
             }
-            let scale = x_scale.max(self.z.amax()).max(f64::MIN_POSITIVE);
             if norm >= previous_norm {
                 let converged = previous_norm <= self.options.stall_threshold * scale;
                 return Ok(converged.then_some(rate));
@@ -674,18 +678,38 @@ mod tests {
     /// Extrapolating the previous collocation polynomial makes the first iterate nearly
     /// exact, so steady stepping needs few iterations.
     #[test]
+    fn straight_chain_converges_in_few_iterations() {
+        // Regression: from an exactly straight chain (equal angles) some increments keep
+        // shrinking geometrically far below round-off; they must count as converged, not
+        // run out of iterations (this failed every step after the first for n ≥ 6).
+        use crate::{Chain, FirstOrder, Planar};
+        let n = 8;
+        let system = FirstOrder::new(Planar::new(Chain::<Dyn>::uniform(n, 1.0, 0.5, 9.81).unwrap()));
+        let mut state = State::new(0.0, system.state(&DVector::from_element(n, 1.0), &DVector::zeros(n)));
+        let mut solver = GaussLegendre::<Dyn, U2>::new(&system, GaussOptions::default());
+        solver.integrate(&system, &mut state, 0.1, 20).unwrap();
+        let per_step = solver.stats().newton_iterations as f64 / 20.0;
+        assert!(per_step <= 8.0, "{per_step} iterations per step, {:?}", solver.stats());
+        assert_eq!(solver.stats().full_newton_steps, 0);
+    }
+
+    #[test]
     fn extrapolated_guess_saves_iterations() {
+        // A nonlinear system: on a linear one with its exact Jacobian Newton converges in
+        // one iteration from any guess.
+        use crate::{Chain, FirstOrder, Planar};
         let run = |extrapolate: bool| {
-            let system = Oscillator(3.0);
+            let system =
+                FirstOrder::new(Planar::new(Chain::<Dyn>::new(&[1.0, 0.7], &[1.0, 0.6], 9.81).unwrap()));
             let options = GaussOptions { extrapolate, ..GaussOptions::default() };
             let mut solver = GaussLegendre::<_, U3>::new(&system, options);
-            let mut state = State::new(0.0, DVector::from_vec(vec![0.4, 1.7]));
+            let mut state = State::new(0.0, DVector::from_vec(vec![1.2, -0.4, 0.3, 2.0]));
             solver.integrate(&system, &mut state, 1.0, 100).unwrap();
             (solver.stats().newton_iterations, state.into_x())
         };
         let (with, x_with) = run(true);
         let (without, x_without) = run(false);
         assert!(with < without, "{with} vs {without} iterations");
-        assert!((x_with - x_without).amax() < 1e-14);
+        assert!((x_with - x_without).amax() < 1e-13);
     }
 }
