@@ -278,18 +278,6 @@ const _: () = {
             inputs: &Inputs<Const<4>, U3>,
             out: &mut SVector<f64, 4>,
         ) -> Result<()> {
-            if ((((q[0] - q[0]) + ((q[1] - q[1]) + (q[2] - q[2])))
-                + (((q[3] - q[3]) + (qd[0] - qd[0])) + ((qd[1] - qd[1]) + (qd[2] - qd[2]))))
-                + ((((qd[3] - qd[3]) + (inputs.torque[0] - inputs.torque[0]))
-                    + ((inputs.torque[1] - inputs.torque[1]) + (inputs.torque[2] - inputs.torque[2])))
-                    + (((inputs.torque[3] - inputs.torque[3])
-                        + (inputs.pivot_acceleration[0] - inputs.pivot_acceleration[0]))
-                        + ((inputs.pivot_acceleration[1] - inputs.pivot_acceleration[1])
-                            + (inputs.pivot_acceleration[2] - inputs.pivot_acceleration[2])))))
-                != 0.0
-            {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-            }
             let torque = &inputs.torque;
             let pivot_acceleration = &inputs.pivot_acceleration;
             let damping = self.chain.damping();
@@ -298,8 +286,14 @@ const _: () = {
             let lam1 = damping[1];
             let (st0, ct0) = q[0].sin_cos();
             let (st1, ct1) = q[1].sin_cos();
-            ::pendulum_core::check_polar_sin(1, q[0], st0)?;
-            ::pendulum_core::check_polar_sin(2, q[1], st1)?;
+            if let Err(error) = ::pendulum_core::check_polar_sin(1, q[0], st0) {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
+                return Err(error);
+            }
+            if let Err(error) = ::pendulum_core::check_polar_sin(2, q[1], st1) {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
+                return Err(error);
+            }
             let (sp0, cp0) = q[2].sin_cos();
             let (sp1, cp1) = q[3].sin_cos();
             let dth0 = qd[0];
@@ -363,6 +357,7 @@ const _: () = {
             let r3 = f3 - c3 - kd3;
             let piv0 = a0_0;
             if piv0.is_nan() || piv0 <= 0.0 {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
             let inv0 = 1.0 / piv0;
@@ -370,6 +365,7 @@ const _: () = {
             let fac3_0 = a3_0 * inv0;
             let piv1 = a1_1 - a1_0 * fac1_0;
             if piv1.is_nan() || piv1 <= 0.0 {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
             let inv1 = 1.0 / piv1;
@@ -378,6 +374,7 @@ const _: () = {
             let fac3_1 = u3_1 * inv1;
             let piv2 = a2_2 - a2_1 * fac2_1;
             if piv2.is_nan() || piv2 <= 0.0 {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
             let inv2 = 1.0 / piv2;
@@ -385,6 +382,7 @@ const _: () = {
             let fac3_2 = u3_2 * inv2;
             let piv3 = a3_3 - a3_0 * fac3_0 - u3_1 * fac3_1 - u3_2 * fac3_2;
             if piv3.is_nan() || piv3 <= 0.0 {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
             let y1 = r1 - fac1_0 * r0;
@@ -395,6 +393,7 @@ const _: () = {
             let x1 = y1 * inv1 - fac2_1 * x2 - fac3_1 * x3;
             let x0 = r0 * inv0 - fac1_0 * x1 - fac3_0 * x3;
             if (((x0 - x0) + (x1 - x1)) + ((x2 - x2) + (x3 - x3))) != 0.0 {
+                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
             out[0] = x0;

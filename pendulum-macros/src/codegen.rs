@@ -61,15 +61,27 @@ fn space(plan: &Plan) -> Ident {
 
 /// `check_polar_sin(link, q[i], st_i)?;` for every link whose polar angle can be singular,
 /// and the sines `st_i` they need from the lets: the one place the checks are written, for
-/// `check_configuration` and `accelerations` alike.
-fn polar_checks(plan: &Plan) -> (Vec<Sym>, TokenStream) {
+/// `check_configuration` and `accelerations` alike. A non-empty `first` runs before a
+/// failed check returns its error (`accelerations`: the input checks, whose errors come
+/// first).
+fn polar_checks(plan: &Plan, first: &TokenStream) -> (Vec<Sym>, TokenStream) {
     let mut sines = Vec::new();
     let mut checks = TokenStream::new();
     for (link, i) in plan.singular_links() {
         let sin = Sym::Trig(plan.angle(i), Trig::Sin);
         sines.push(sin);
         let (link, i, sin) = (index(link), index(i), ident(sin));
-        checks.extend(quote!(::pendulum_core::check_polar_sin(#link, q[#i], #sin)?;));
+        let check = quote!(::pendulum_core::check_polar_sin(#link, q[#i], #sin));
+        checks.extend(if first.is_empty() {
+            quote!(#check?;)
+        } else {
+            quote! {
+                if let Err(error) = #check {
+                    #first
+                    return Err(error);
+                }
+            }
+        });
     }
     (sines, checks)
 }
@@ -158,20 +170,21 @@ struct Body {
 
 impl Body {
     fn new<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
-        Self::build(plan, exprs, false)
+        Self::build(plan, exprs, None)
     }
 
-    /// [`Body::new`] that also runs the [`polar_checks`] as soon as their sines are known.
-    fn checked<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
-        Self::build(plan, exprs, true)
+    /// [`Body::new`] that also runs the [`polar_checks`] as soon as their sines are known,
+    /// `first` before a failed one returns.
+    fn checked<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, first: &TokenStream) -> Self {
+        Self::build(plan, exprs, Some(first))
     }
 
-    fn build<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, checked: bool) -> Self {
+    fn build<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, checked: Option<&TokenStream>) -> Self {
         let mut roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
         let mut checks = TokenStream::new();
-        if checked {
+        if let Some(first) = checked {
             let sines;
-            (sines, checks) = polar_checks(plan);
+            (sines, checks) = polar_checks(plan, first);
             roots.extend(sines);
         }
         let syms = plan.closure(roots);
@@ -267,7 +280,7 @@ fn model(def: &ModelDef) -> TokenStream {
     let (energy_q, energy_qd, energy_lets) = (energy.q(), energy.qd(), &energy.lets);
 
     let check_configuration = (!plan.singular_links().is_empty()).then(|| {
-        let checks = &Body::checked(&plan, []).lets;
+        let checks = &Body::checked(&plan, [], &TokenStream::new()).lets;
         quote! {
             fn check_configuration(&self, q: &#vector) -> Result<()> {
                 #checks
@@ -442,31 +455,34 @@ fn finite_probe(values: &[TokenStream]) -> TokenStream {
     }
 }
 
-/// `accelerations`: a one-pass finiteness probe of the inputs (the full
-/// `pendulum_core::check_inputs`, which names the bad value, runs only when the probe
-/// fails), `M` and `Q − c − (k + d)` as lets with the polar-angle checks among them, an
-/// unrolled `M = L D Lᵀ` factorisation (`L` unit lower triangular, column by column; no
-/// square roots, one division per pivot; entries known to be zero are skipped) and
-/// forward and back substitution.
+/// `accelerations`: `M` and `Q − c − (k + d)` as lets with the polar-angle checks among
+/// them, an unrolled `M = L D Lᵀ` factorisation (`L` unit lower triangular, column by
+/// column; no square roots, one division per pivot; entries known to be zero are
+/// skipped), forward and back substitution, and one finiteness probe of the result.
+///
+/// The inputs are checked (`pendulum_core::check_inputs`, sizes being fixed by the types)
+/// only on the way to an error, which is where any non-finite input ends: every entry of
+/// `q`, `q̇`, `σ` and `p̈` is an operand of the right-hand side `r_a` of its own
+/// coordinate or link (`q` through `J_a·(p̈ + g ẑ)`, `q̇` through the damping, `σ`
+/// directly), IEEE arithmetic keeps ±∞ and NaN non-finite through `+ − ×` and through
+/// division by a finite pivot, and the pivots `d_j` depend on `q` alone (NaN, caught by
+/// their check, or finite and positive). So a non-finite `r_a` makes `x_a` non-finite or
+/// a pivot fail. `tests/agrees_with_generic.rs` checks every entry with NaN and ±∞.
 fn accelerations(plan: &Plan) -> TokenStream {
     let d = plan.dof();
     let dof = index(d);
     let space = space(plan);
     let mut roots: Vec<Expr> = plan.mass_entries().into_iter().map(Expr::of).collect();
     roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
-    let body = Body::checked(plan, &roots);
+    // The input checks, which name a bad value, run on the way to any error: a non-finite
+    // input always ends there (see below), and its error comes before the others.
+    let check_inputs = quote!(::pendulum_core::check_inputs(#dof, q, qd, inputs)?;);
+    let body = Body::checked(plan, &roots, &check_inputs);
     let lets = &body.lets;
     let torque = body.uses(|s| matches!(s, Sym::Torque(_))).then(|| quote!(let torque = &inputs.torque;));
     let pivot = body
         .uses(|s| matches!(s, Sym::Pivot(_)))
         .then(|| quote!(let pivot_acceleration = &inputs.pivot_acceleration;));
-
-    let mut inputs: Vec<TokenStream> = Vec::new();
-    for vector in [quote!(q), quote!(qd), quote!(inputs.torque)] {
-        inputs.extend((0..d).map(index).map(|i| quote!(#vector[#i])));
-    }
-    inputs.extend((0..plan.space()).map(index).map(|i| quote!(inputs.pivot_acceleration[#i])));
-    let input_probe = finite_probe(&inputs);
 
     let entry = |r: usize, c: usize| plan.mass_entry(r, c).map(ident);
     let inv = |j: usize| format_ident!("inv{j}");
@@ -483,6 +499,7 @@ fn accelerations(plan: &Plan) -> TokenStream {
         factor.extend(quote! {
             let #piv_j = #value;
             if #piv_j.is_nan() || #piv_j <= 0.0 {
+                #check_inputs
                 return Err(Error::NotPositiveDefinite);
             }
         });
@@ -556,17 +573,13 @@ fn accelerations(plan: &Plan) -> TokenStream {
             inputs: &Inputs<Const<#dof>, #space>,
             out: &mut SVector<f64, #dof>,
         ) -> Result<()> {
-            // Sizes are fixed by the types; one probe for finiteness, and the full check,
-            // which names the bad value, only when it fails.
-            if #input_probe != 0.0 {
-                ::pendulum_core::check_inputs(#dof, q, qd, inputs)?;
-            }
             #torque
             #pivot
             #lets
             #factor
             #solve
             if #output_probe != 0.0 {
+                #check_inputs
                 return Err(Error::NotPositiveDefinite);
             }
             #(out[#indices] = #xs;)*
