@@ -23,6 +23,8 @@ pub struct Planar3 {
     ml1: ::core::primitive::f64,
     #[doc = " `M_2 l_2` (0-based), kg·m."]
     ml2: ::core::primitive::f64,
+    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal."]
+    inv0: ::core::primitive::f64,
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -49,7 +51,8 @@ const _: () = {
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
             let ml2 = mt2 * l2;
-            Self { chain, w0_0, w0_1, w0_2, w1_1, w1_2, w2_2, ml0, ml1, ml2 }
+            let inv0 = 1.0 / w0_0;
+            Self { chain, w0_0, w0_1, w0_2, w1_1, w1_2, w2_2, ml0, ml1, ml2, inv0 }
         }
     }
     #[automatically_derived]
@@ -324,7 +327,7 @@ const _: () = {
                 ::pendulum_core::check_inputs(3, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
-            let inv0 = 1.0 / piv0;
+            let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac2_0 = a2_0 * inv0;
             let piv1 = a1_1 - a1_0 * fac1_0;

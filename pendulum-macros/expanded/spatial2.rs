@@ -15,6 +15,8 @@ pub struct Spatial2 {
     ml0: ::core::primitive::f64,
     #[doc = " `M_1 l_1` (0-based), kg·m."]
     ml1: ::core::primitive::f64,
+    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal."]
+    inv0: ::core::primitive::f64,
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -35,7 +37,8 @@ const _: () = {
             let w1_1 = mt1 * l1 * l1;
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
-            Self { chain, w0_0, w0_1, w1_1, ml0, ml1 }
+            let inv0 = 1.0 / w0_0;
+            Self { chain, w0_0, w0_1, w1_1, ml0, ml1, inv0 }
         }
     }
     #[automatically_derived]
@@ -360,7 +363,7 @@ const _: () = {
                 ::pendulum_core::check_inputs(4, q, qd, inputs)?;
                 return Err(Error::NotPositiveDefinite);
             }
-            let inv0 = 1.0 / piv0;
+            let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac3_0 = a3_0 * inv0;
             let piv1 = a1_1 - a1_0 * fac1_0;

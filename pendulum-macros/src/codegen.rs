@@ -306,6 +306,9 @@ fn model(def: &ModelDef) -> TokenStream {
         quote!(#[doc = #what])
     });
     let constructor_lets = lets_from(&plan, &plan.full_closure(stored.clone()), TokenStream::new(), &quote!(chain), false);
+    // The first pivot of `accelerations`' factorisation is `M_00 = W_00`: its reciprocal too.
+    let w00 = ident(Sym::Weight(0, 0));
+    assert!(stored.contains(&Sym::Weight(0, 0)), "W_00 is stored");
 
     quote! {
         #(#attrs)*
@@ -314,6 +317,8 @@ fn model(def: &ModelDef) -> TokenStream {
         #vis struct #name {
             chain: ::pendulum_core::Chain<::pendulum_core::__private::nalgebra::Const<#n>>,
             #(#stored_docs #stored_idents: ::core::primitive::f64,)*
+            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal.
+            inv0: ::core::primitive::f64,
         }
 
         #(#cfgs)*
@@ -327,7 +332,8 @@ fn model(def: &ModelDef) -> TokenStream {
                 /// The model of `chain`.
                 #vis fn new(chain: Chain<Const<#n>>) -> Self {
                     #constructor_lets
-                    Self { chain, #(#stored_idents),* }
+                    let inv0 = 1.0 / #w00;
+                    Self { chain, #(#stored_idents,)* inv0 }
                 }
             }
 
@@ -503,8 +509,12 @@ fn accelerations(plan: &Plan) -> TokenStream {
                 return Err(Error::NotPositiveDefinite);
             }
         });
-        // The last pivot divides once, in the back substitution.
-        if j + 1 < d {
+        // The first pivot is `M_00 = W_00`, its reciprocal stored; the last divides once,
+        // in the back substitution.
+        if j == 0 {
+            assert_eq!(plan.definition(Sym::MassEntry(0, 0)), Some(Expr::of(Sym::Weight(0, 0))));
+            factor.extend(quote!(let #inv_j = self.inv0;));
+        } else if j + 1 < d {
             factor.extend(quote!(let #inv_j = 1.0 / #piv_j;));
         }
         for i in j + 1..d {
@@ -548,7 +558,7 @@ fn accelerations(plan: &Plan) -> TokenStream {
     for i in (0..d).rev() {
         let products: Vec<(Ident, Ident)> = (i + 1..d).filter_map(|k| Some((fac(k, i)?, x(k)))).collect();
         let yi = &ys[i];
-        let scaled = if i + 1 == d {
+        let scaled = if i + 1 == d && i > 0 {
             let p = piv(i);
             quote!(#yi / #p)
         } else {
