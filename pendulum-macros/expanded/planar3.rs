@@ -260,6 +260,7 @@ const _: () = {
             let potential = -mt0 * g * l0 * ct0 - mt1 * g * l1 * ct1 - mt2 * g * l2 * ct2;
             kinetic + potential
         }
+        #[inline]
         fn accelerations(
             &self,
             q: &SVector<f64, 3>,
@@ -267,6 +268,22 @@ const _: () = {
             inputs: &Inputs<Const<3>, U2>,
             out: &mut SVector<f64, 3>,
         ) -> Result<()> {
+            #[doc = r" The error of a failed evaluation: the input checks' if they fail (a"]
+            #[doc = r" non-finite input always ends here), else `error`. Out of line: the hot path"]
+            #[doc = r" stays small."]
+            #[cold]
+            #[inline(never)]
+            fn failure(
+                q: &SVector<f64, 3>,
+                qd: &SVector<f64, 3>,
+                inputs: &Inputs<Const<3>, U2>,
+                error: Error,
+            ) -> Error {
+                match ::pendulum_core::check_inputs(3, q, qd, inputs) {
+                    Err(input_error) => input_error,
+                    Ok(()) => error,
+                }
+            }
             let torque = &inputs.torque;
             let pivot_acceleration = &inputs.pivot_acceleration;
             let damping = self.chain.damping();
@@ -324,24 +341,21 @@ const _: () = {
             let r2 = f2 - c2 - kd2;
             let piv0 = a0_0;
             if piv0.is_nan() || piv0 <= 0.0 {
-                ::pendulum_core::check_inputs(3, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac2_0 = a2_0 * inv0;
             let piv1 = a1_1 - a1_0 * fac1_0;
             if piv1.is_nan() || piv1 <= 0.0 {
-                ::pendulum_core::check_inputs(3, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let inv1 = 1.0 / piv1;
             let u2_1 = a2_1 - a2_0 * fac1_0;
             let fac2_1 = u2_1 * inv1;
             let piv2 = a2_2 - a2_0 * fac2_0 - u2_1 * fac2_1;
             if piv2.is_nan() || piv2 <= 0.0 {
-                ::pendulum_core::check_inputs(3, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let y1 = r1 - fac1_0 * r0;
             let y2 = r2 - fac2_0 * r0 - fac2_1 * y1;
@@ -349,8 +363,7 @@ const _: () = {
             let x1 = y1 * inv1 - fac2_1 * x2;
             let x0 = r0 * inv0 - fac1_0 * x1 - fac2_0 * x2;
             if ((x0 - x0) + ((x1 - x1) + (x2 - x2))) != 0.0 {
-                ::pendulum_core::check_inputs(3, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             out[0] = x0;
             out[1] = x1;

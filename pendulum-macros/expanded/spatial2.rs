@@ -274,6 +274,7 @@ const _: () = {
             ::pendulum_core::check_polar_sin(2, q[1], st1)?;
             Ok(())
         }
+        #[inline]
         fn accelerations(
             &self,
             q: &SVector<f64, 4>,
@@ -281,6 +282,22 @@ const _: () = {
             inputs: &Inputs<Const<4>, U3>,
             out: &mut SVector<f64, 4>,
         ) -> Result<()> {
+            #[doc = r" The error of a failed evaluation: the input checks' if they fail (a"]
+            #[doc = r" non-finite input always ends here), else `error`. Out of line: the hot path"]
+            #[doc = r" stays small."]
+            #[cold]
+            #[inline(never)]
+            fn failure(
+                q: &SVector<f64, 4>,
+                qd: &SVector<f64, 4>,
+                inputs: &Inputs<Const<4>, U3>,
+                error: Error,
+            ) -> Error {
+                match ::pendulum_core::check_inputs(4, q, qd, inputs) {
+                    Err(input_error) => input_error,
+                    Ok(()) => error,
+                }
+            }
             let torque = &inputs.torque;
             let pivot_acceleration = &inputs.pivot_acceleration;
             let damping = self.chain.damping();
@@ -290,12 +307,10 @@ const _: () = {
             let (st0, ct0) = q[0].sin_cos();
             let (st1, ct1) = q[1].sin_cos();
             if let Err(error) = ::pendulum_core::check_polar_sin(1, q[0], st0) {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(error);
+                return Err(failure(q, qd, inputs, error));
             }
             if let Err(error) = ::pendulum_core::check_polar_sin(2, q[1], st1) {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(error);
+                return Err(failure(q, qd, inputs, error));
             }
             let (sp0, cp0) = q[2].sin_cos();
             let (sp1, cp1) = q[3].sin_cos();
@@ -360,16 +375,14 @@ const _: () = {
             let r3 = f3 - c3 - kd3;
             let piv0 = a0_0;
             if piv0.is_nan() || piv0 <= 0.0 {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac3_0 = a3_0 * inv0;
             let piv1 = a1_1 - a1_0 * fac1_0;
             if piv1.is_nan() || piv1 <= 0.0 {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let inv1 = 1.0 / piv1;
             let fac2_1 = a2_1 * inv1;
@@ -377,16 +390,14 @@ const _: () = {
             let fac3_1 = u3_1 * inv1;
             let piv2 = a2_2 - a2_1 * fac2_1;
             if piv2.is_nan() || piv2 <= 0.0 {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let inv2 = 1.0 / piv2;
             let u3_2 = a3_2 - u3_1 * fac2_1;
             let fac3_2 = u3_2 * inv2;
             let piv3 = a3_3 - a3_0 * fac3_0 - u3_1 * fac3_1 - u3_2 * fac3_2;
             if piv3.is_nan() || piv3 <= 0.0 {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             let y1 = r1 - fac1_0 * r0;
             let y2 = r2 - fac2_1 * y1;
@@ -396,8 +407,7 @@ const _: () = {
             let x1 = y1 * inv1 - fac2_1 * x2 - fac3_1 * x3;
             let x0 = r0 * inv0 - fac1_0 * x1 - fac3_0 * x3;
             if (((x0 - x0) + (x1 - x1)) + ((x2 - x2) + (x3 - x3))) != 0.0 {
-                ::pendulum_core::check_inputs(4, q, qd, inputs)?;
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             out[0] = x0;
             out[1] = x1;

@@ -61,9 +61,9 @@ fn space(plan: &Plan) -> Ident {
 
 /// `check_polar_sin(link, q[i], st_i)?;` for every link whose polar angle can be singular,
 /// and the sines `st_i` they need from the lets: the one place the checks are written, for
-/// `check_configuration` and `accelerations` alike. A non-empty `first` runs before a
-/// failed check returns its error (`accelerations`: the input checks, whose errors come
-/// first).
+/// `check_configuration` and `accelerations` alike. With a non-empty `first` (a function
+/// of `q`, `qd`, `inputs` and the error), a failed check returns `first`'s error
+/// (`accelerations`: the input checks', which come first).
 fn polar_checks(plan: &Plan, first: &TokenStream) -> (Vec<Sym>, TokenStream) {
     let mut sines = Vec::new();
     let mut checks = TokenStream::new();
@@ -77,8 +77,7 @@ fn polar_checks(plan: &Plan, first: &TokenStream) -> (Vec<Sym>, TokenStream) {
         } else {
             quote! {
                 if let Err(error) = #check {
-                    #first
-                    return Err(error);
+                    return Err(#first(q, qd, inputs, error));
                 }
             }
         });
@@ -482,8 +481,7 @@ fn accelerations(plan: &Plan) -> TokenStream {
     roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
     // The input checks, which name a bad value, run on the way to any error: a non-finite
     // input always ends there (see below), and its error comes before the others.
-    let check_inputs = quote!(::pendulum_core::check_inputs(#dof, q, qd, inputs)?;);
-    let body = Body::checked(plan, &roots, &check_inputs);
+    let body = Body::checked(plan, &roots, &quote!(failure));
     let lets = &body.lets;
     let torque = body.uses(|s| matches!(s, Sym::Torque(_))).then(|| quote!(let torque = &inputs.torque;));
     let pivot = body
@@ -505,8 +503,7 @@ fn accelerations(plan: &Plan) -> TokenStream {
         factor.extend(quote! {
             let #piv_j = #value;
             if #piv_j.is_nan() || #piv_j <= 0.0 {
-                #check_inputs
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
         });
         // The first pivot is `M_00 = W_00`, its reciprocal stored; the last divides once,
@@ -575,7 +572,10 @@ fn accelerations(plan: &Plan) -> TokenStream {
     }).collect();
     let output_probe = finite_probe(&xs);
     let indices = (0..d).map(index);
+    // Small models: the call would cost as much as the arithmetic.
+    let inline = (d <= 4).then(|| quote!(#[inline]));
     quote! {
+        #inline
         fn accelerations(
             &self,
             q: &SVector<f64, #dof>,
@@ -583,14 +583,29 @@ fn accelerations(plan: &Plan) -> TokenStream {
             inputs: &Inputs<Const<#dof>, #space>,
             out: &mut SVector<f64, #dof>,
         ) -> Result<()> {
+            /// The error of a failed evaluation: the input checks' if they fail (a
+            /// non-finite input always ends here), else `error`. Out of line: the hot path
+            /// stays small.
+            #[cold]
+            #[inline(never)]
+            fn failure(
+                q: &SVector<f64, #dof>,
+                qd: &SVector<f64, #dof>,
+                inputs: &Inputs<Const<#dof>, #space>,
+                error: Error,
+            ) -> Error {
+                match ::pendulum_core::check_inputs(#dof, q, qd, inputs) {
+                    Err(input_error) => input_error,
+                    Ok(()) => error,
+                }
+            }
             #torque
             #pivot
             #lets
             #factor
             #solve
             if #output_probe != 0.0 {
-                #check_inputs
-                return Err(Error::NotPositiveDefinite);
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             #(out[#indices] = #xs;)*
             Ok(())
