@@ -94,7 +94,13 @@ fn lets(plan: &Plan, syms: &[Sym], checks: TokenStream) -> TokenStream {
 
 /// [`lets`] reading the parameters from the chain `chain`; [stored](Sym::is_stored)
 /// symbols are read from `self` when `read_stored`, else computed (the constructor).
-fn lets_from(plan: &Plan, syms: &[Sym], checks: TokenStream, chain: &TokenStream, read_stored: bool) -> TokenStream {
+fn lets_from(
+    plan: &Plan,
+    syms: &[Sym],
+    checks: TokenStream,
+    chain: &TokenStream,
+    read_stored: bool,
+) -> TokenStream {
     let has = |f: fn(&Sym) -> bool| syms.iter().any(f);
     let mut out = TokenStream::new();
     // Each chain vector is borrowed once, each entry read once.
@@ -178,7 +184,11 @@ impl Body {
         Self::build(plan, exprs, Some(first))
     }
 
-    fn build<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, checked: Option<&TokenStream>) -> Self {
+    fn build<'a>(
+        plan: &Plan,
+        exprs: impl IntoIterator<Item = &'a Expr>,
+        checked: Option<&TokenStream>,
+    ) -> Self {
         let mut roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
         let mut checks = TokenStream::new();
         if let Some(first) = checked {
@@ -304,7 +314,8 @@ fn model(def: &ModelDef) -> TokenStream {
         };
         quote!(#[doc = #what])
     });
-    let constructor_lets = lets_from(&plan, &plan.full_closure(stored.clone()), TokenStream::new(), &quote!(chain), false);
+    let constructor_lets =
+        lets_from(&plan, &plan.full_closure(stored.clone()), TokenStream::new(), &quote!(chain), false);
     // The first pivot of `accelerations`' factorisation is `M_00 = W_00`: its reciprocal too.
     let w00 = ident(Sym::Weight(0, 0));
     assert!(stored.contains(&Sym::Weight(0, 0)), "W_00 is stored");
@@ -566,10 +577,12 @@ fn accelerations(plan: &Plan) -> TokenStream {
         let xi = x(i);
         solve.extend(quote!(let #xi = #value;));
     }
-    let xs: Vec<TokenStream> = (0..d).map(|i| {
-        let xi = x(i);
-        quote!(#xi)
-    }).collect();
+    let xs: Vec<TokenStream> = (0..d)
+        .map(|i| {
+            let xi = x(i);
+            quote!(#xi)
+        })
+        .collect();
     let output_probe = finite_probe(&xs);
     let indices = (0..d).map(index);
     // Small models: the call would cost as much as the arithmetic.

@@ -335,7 +335,9 @@ where
     let dof = model.dof();
     let space = <M::Space as DimName>::dim();
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        for (what, len) in [("q", dof.value()), ("qd", dof.value()), ("torque", dof.value()), ("pivot_acceleration", space)] {
+        for (what, len) in
+            [("q", dof.value()), ("qd", dof.value()), ("torque", dof.value()), ("pivot_acceleration", space)]
+        {
             for index in 0..len {
                 let mut q = OVector::<f64, M::Dof>::from_iterator_generic(dof, U1, q0.iter().copied());
                 let mut qd = OVector::<f64, M::Dof>::from_iterator_generic(dof, U1, qd0.iter().copied());
