@@ -23,7 +23,9 @@ pub struct Planar3 {
     ml1: ::core::primitive::f64,
     #[doc = " `M_2 l_2` (0-based), kg·m."]
     ml2: ::core::primitive::f64,
-    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal."]
+    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not"]
+    #[doc = r" positive (underflow), which makes every acceleration NaN and"]
+    #[doc = r" `accelerations` fail as not positive definite."]
     inv0: ::core::primitive::f64,
 }
 const _: () = {
@@ -51,7 +53,7 @@ const _: () = {
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
             let ml2 = mt2 * l2;
-            let inv0 = 1.0 / w0_0;
+            let inv0 = if w0_0 > 0.0 { 1.0 / w0_0 } else { ::core::primitive::f64::NAN };
             Self { chain, w0_0, w0_1, w0_2, w1_1, w1_2, w2_2, ml0, ml1, ml2, inv0 }
         }
     }
@@ -312,7 +314,6 @@ const _: () = {
             let p0 = ax * ct0 + lift * st0;
             let p1 = ax * ct1 + lift * st1;
             let p2 = ax * ct2 + lift * st2;
-            let w0_0 = self.w0_0;
             let w0_1 = self.w0_1;
             let w0_2 = self.w0_2;
             let w1_1 = self.w1_1;
@@ -321,7 +322,6 @@ const _: () = {
             let ml0 = self.ml0;
             let ml1 = self.ml1;
             let ml2 = self.ml2;
-            let a0_0 = w0_0;
             let a1_0 = w0_1 * cth0_1;
             let a1_1 = w1_1;
             let a2_0 = w0_2 * cth0_2;
@@ -339,10 +339,6 @@ const _: () = {
             let r0 = f0 - c0 - kd0;
             let r1 = f1 - c1 - kd1;
             let r2 = f2 - c2 - kd2;
-            let piv0 = a0_0;
-            if piv0.is_nan() || piv0 <= 0.0 {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
-            }
             let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac2_0 = a2_0 * inv0;

@@ -15,7 +15,9 @@ pub struct Spatial2 {
     ml0: ::core::primitive::f64,
     #[doc = " `M_1 l_1` (0-based), kg·m."]
     ml1: ::core::primitive::f64,
-    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal."]
+    #[doc = r" `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not"]
+    #[doc = r" positive (underflow), which makes every acceleration NaN and"]
+    #[doc = r" `accelerations` fail as not positive definite."]
     inv0: ::core::primitive::f64,
 }
 const _: () = {
@@ -37,7 +39,7 @@ const _: () = {
             let w1_1 = mt1 * l1 * l1;
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
-            let inv0 = 1.0 / w0_0;
+            let inv0 = if w0_0 > 0.0 { 1.0 / w0_0 } else { ::core::primitive::f64::NAN };
             Self { chain, w0_0, w0_1, w1_1, ml0, ml1, inv0 }
         }
     }
@@ -337,7 +339,6 @@ const _: () = {
             let w1_1 = self.w1_1;
             let ml0 = self.ml0;
             let ml1 = self.ml1;
-            let a0_0 = w0_0;
             let a1_0 = w0_1 * ct0 * ct1 * cph0_1 + w0_1 * st0 * st1;
             let a1_1 = w1_1;
             let a2_1 = -w0_1 * sph0_1 * st0 * ct1;
@@ -373,10 +374,6 @@ const _: () = {
             let r1 = f1 - c1 - kd1;
             let r2 = f2 - c2 - kd2;
             let r3 = f3 - c3 - kd3;
-            let piv0 = a0_0;
-            if piv0.is_nan() || piv0 <= 0.0 {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
-            }
             let inv0 = self.inv0;
             let fac1_0 = a1_0 * inv0;
             let fac3_0 = a3_0 * inv0;

@@ -327,7 +327,9 @@ fn model(def: &ModelDef) -> TokenStream {
         #vis struct #name {
             chain: ::pendulum_core::Chain<::pendulum_core::__private::nalgebra::Const<#n>>,
             #(#stored_docs #stored_idents: ::core::primitive::f64,)*
-            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal.
+            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not
+            /// positive (underflow), which makes every acceleration NaN and
+            /// `accelerations` fail as not positive definite.
             inv0: ::core::primitive::f64,
         }
 
@@ -342,7 +344,7 @@ fn model(def: &ModelDef) -> TokenStream {
                 /// The model of `chain`.
                 #vis fn new(chain: Chain<Const<#n>>) -> Self {
                     #constructor_lets
-                    let inv0 = 1.0 / #w00;
+                    let inv0 = if #w00 > 0.0 { 1.0 / #w00 } else { ::core::primitive::f64::NAN };
                     Self { chain, #(#stored_idents,)* inv0 }
                 }
             }
@@ -488,7 +490,10 @@ fn accelerations(plan: &Plan) -> TokenStream {
     let d = plan.dof();
     let dof = index(d);
     let space = space(plan);
-    let mut roots: Vec<Expr> = plan.mass_entries().into_iter().map(Expr::of).collect();
+    // `M_00 = W_00` enters through its stored reciprocal alone.
+    assert_eq!(plan.definition(Sym::MassEntry(0, 0)), Some(Expr::of(Sym::Weight(0, 0))));
+    let mut roots: Vec<Expr> =
+        plan.mass_entries().into_iter().filter(|&s| s != Sym::MassEntry(0, 0)).map(Expr::of).collect();
     roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
     // The input checks, which name a bad value, run on the way to any error: a non-finite
     // input always ends there (see below), and its error comes before the others.
@@ -506,24 +511,25 @@ fn accelerations(plan: &Plan) -> TokenStream {
     let mut low: Vec<Vec<Option<(Ident, Ident)>>> = vec![vec![None; d]; d];
     let mut factor = TokenStream::new();
     for j in 0..d {
-        // d_j = M_jj − Σ_{k<j} (L_jk d_k) L_jk
-        let products: Vec<(Ident, Ident)> = low[j][..j].iter().flatten().cloned().collect();
-        let diagonal = entry(j, j).expect("the diagonal of M is never identically zero");
-        let value = minus_products(Some(quote!(#diagonal)), &products).expect("non-empty");
         let (piv_j, inv_j) = (piv(j), inv(j));
-        factor.extend(quote! {
-            let #piv_j = #value;
-            if #piv_j.is_nan() || #piv_j <= 0.0 {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
-            }
-        });
-        // The first pivot is `M_00 = W_00`, its reciprocal stored; the last divides once,
-        // in the back substitution.
         if j == 0 {
-            assert_eq!(plan.definition(Sym::MassEntry(0, 0)), Some(Expr::of(Sym::Weight(0, 0))));
+            // d_0 = M_00 = W_00: its reciprocal is stored, NaN if W_00 is not positive.
             factor.extend(quote!(let #inv_j = self.inv0;));
-        } else if j + 1 < d {
-            factor.extend(quote!(let #inv_j = 1.0 / #piv_j;));
+        } else {
+            // d_j = M_jj − Σ_{k<j} (L_jk d_k) L_jk
+            let products: Vec<(Ident, Ident)> = low[j][..j].iter().flatten().cloned().collect();
+            let diagonal = entry(j, j).expect("the diagonal of M is never identically zero");
+            let value = minus_products(Some(quote!(#diagonal)), &products).expect("non-empty");
+            factor.extend(quote! {
+                let #piv_j = #value;
+                if #piv_j.is_nan() || #piv_j <= 0.0 {
+                    return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+                }
+            });
+            // The last pivot divides once, in the back substitution.
+            if j + 1 < d {
+                factor.extend(quote!(let #inv_j = 1.0 / #piv_j;));
+            }
         }
         for i in j + 1..d {
             // L_ij d_j = M_ij − Σ_{k<j} (L_ik d_k) L_jk
