@@ -61,15 +61,26 @@ fn space(plan: &Plan) -> Ident {
 
 /// `check_polar_sin(link, q[i], st_i)?;` for every link whose polar angle can be singular,
 /// and the sines `st_i` they need from the lets: the one place the checks are written, for
-/// `check_configuration` and `accelerations` alike.
-fn polar_checks(plan: &Plan) -> (Vec<Sym>, TokenStream) {
+/// `check_configuration` and `accelerations` alike. With a non-empty `first` (a function
+/// of `q`, `qd`, `inputs` and the error), a failed check returns `first`'s error
+/// (`accelerations`: the input checks', which come first).
+fn polar_checks(plan: &Plan, first: &TokenStream) -> (Vec<Sym>, TokenStream) {
     let mut sines = Vec::new();
     let mut checks = TokenStream::new();
     for (link, i) in plan.singular_links() {
         let sin = Sym::Trig(plan.angle(i), Trig::Sin);
         sines.push(sin);
         let (link, i, sin) = (index(link), index(i), ident(sin));
-        checks.extend(quote!(::pendulum_core::check_polar_sin(#link, q[#i], #sin)?;));
+        let check = quote!(::pendulum_core::check_polar_sin(#link, q[#i], #sin));
+        checks.extend(if first.is_empty() {
+            quote!(#check?;)
+        } else {
+            quote! {
+                if let Err(error) = #check {
+                    return Err(#first(q, qd, inputs, error));
+                }
+            }
+        });
     }
     (sines, checks)
 }
@@ -78,20 +89,32 @@ fn polar_checks(plan: &Plan) -> (Vec<Sym>, TokenStream) {
 /// arguments `q`, `qd`, `torque`, `pivot_acceleration`; `checks` go right after the lets
 /// of the polar angles' sines and cosines.
 fn lets(plan: &Plan, syms: &[Sym], checks: TokenStream) -> TokenStream {
+    lets_from(plan, syms, checks, &quote!(self.chain), true)
+}
+
+/// [`lets`] reading the parameters from the chain `chain`; [stored](Sym::is_stored)
+/// symbols are read from `self` when `read_stored`, else computed (the constructor).
+fn lets_from(
+    plan: &Plan,
+    syms: &[Sym],
+    checks: TokenStream,
+    chain: &TokenStream,
+    read_stored: bool,
+) -> TokenStream {
     let has = |f: fn(&Sym) -> bool| syms.iter().any(f);
     let mut out = TokenStream::new();
     // Each chain vector is borrowed once, each entry read once.
     if has(|s| matches!(s, Sym::Mass(_))) {
-        out.extend(quote!(let masses = self.chain.masses();));
+        out.extend(quote!(let masses = #chain.masses();));
     }
     if has(|s| matches!(s, Sym::Tail(_))) {
-        out.extend(quote!(let tail_masses = self.chain.tail_masses();));
+        out.extend(quote!(let tail_masses = #chain.tail_masses();));
     }
     if has(|s| matches!(s, Sym::Length(_))) {
-        out.extend(quote!(let lengths = self.chain.lengths();));
+        out.extend(quote!(let lengths = #chain.lengths();));
     }
     if has(|s| matches!(s, Sym::Damping(_))) {
-        out.extend(quote!(let damping = self.chain.damping();));
+        out.extend(quote!(let damping = #chain.damping();));
     }
     let set: BTreeSet<Sym> = syms.iter().copied().collect();
     let last_polar = syms.iter().rposition(|s| matches!(s, Sym::Trig(Angle::Theta(_), _)));
@@ -100,7 +123,8 @@ fn lets(plan: &Plan, syms: &[Sym], checks: TokenStream) -> TokenStream {
     for (k, &sym) in syms.iter().enumerate() {
         let name = ident(sym);
         let stmt = match sym {
-            Sym::Gravity => quote!(let #name = self.chain.gravity();),
+            Sym::Gravity => quote!(let #name = #chain.gravity();),
+            _ if sym.is_stored() && read_stored => quote!(let #name = self.#name;),
             Sym::Mass(i) => vector_entry(&name, "masses", i),
             Sym::Tail(i) => vector_entry(&name, "tail_masses", i),
             Sym::Length(i) => vector_entry(&name, "lengths", i),
@@ -151,20 +175,25 @@ struct Body {
 
 impl Body {
     fn new<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
-        Self::build(plan, exprs, false)
+        Self::build(plan, exprs, None)
     }
 
-    /// [`Body::new`] that also runs the [`polar_checks`] as soon as their sines are known.
-    fn checked<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>) -> Self {
-        Self::build(plan, exprs, true)
+    /// [`Body::new`] that also runs the [`polar_checks`] as soon as their sines are known,
+    /// `first` before a failed one returns.
+    fn checked<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, first: &TokenStream) -> Self {
+        Self::build(plan, exprs, Some(first))
     }
 
-    fn build<'a>(plan: &Plan, exprs: impl IntoIterator<Item = &'a Expr>, checked: bool) -> Self {
+    fn build<'a>(
+        plan: &Plan,
+        exprs: impl IntoIterator<Item = &'a Expr>,
+        checked: Option<&TokenStream>,
+    ) -> Self {
         let mut roots: Vec<Sym> = exprs.into_iter().flat_map(Expr::symbols).collect();
         let mut checks = TokenStream::new();
-        if checked {
+        if let Some(first) = checked {
             let sines;
-            (sines, checks) = polar_checks(plan);
+            (sines, checks) = polar_checks(plan, first);
             roots.extend(sines);
         }
         let syms = plan.closure(roots);
@@ -260,7 +289,7 @@ fn model(def: &ModelDef) -> TokenStream {
     let (energy_q, energy_qd, energy_lets) = (energy.q(), energy.qd(), &energy.lets);
 
     let check_configuration = (!plan.singular_links().is_empty()).then(|| {
-        let checks = &Body::checked(&plan, []).lets;
+        let checks = &Body::checked(&plan, [], &TokenStream::new()).lets;
         quote! {
             fn check_configuration(&self, q: &#vector) -> Result<()> {
                 #checks
@@ -270,12 +299,38 @@ fn model(def: &ModelDef) -> TokenStream {
     });
     let accelerations = accelerations(&plan);
 
+    // What depends on the chain alone (the weights `W_ij`, the moments `M_i l_i`): computed
+    // once by `new`, stored as fields named like the symbols.
+    let method_roots = plan.mass_entries().into_iter().chain((0..plan.dof()).flat_map(|a| {
+        [Sym::VelocityTerm(a), Sym::GravityTerm(a), Sym::PivotTerm(a), Sym::Force(a), Sym::Rhs(a)]
+    }));
+    let stored: Vec<Sym> = plan.closure(method_roots).into_iter().filter(|s| s.is_stored()).collect();
+    let stored_idents: Vec<Ident> = stored.iter().map(|&s| ident(s)).collect();
+    let stored_docs = stored.iter().map(|&s| {
+        let what = match s {
+            Sym::Weight(i, j) => format!(" `W_{i}{j} = M_{j} l_{i} l_{j}` (0-based), kg·m²."),
+            Sym::Moment(i) => format!(" `M_{i} l_{i}` (0-based), kg·m."),
+            _ => unreachable!("{s:?} is not stored"),
+        };
+        quote!(#[doc = #what])
+    });
+    let constructor_lets =
+        lets_from(&plan, &plan.full_closure(stored.clone()), TokenStream::new(), &quote!(chain), false);
+    // The first pivot of `accelerations`' factorisation is `M_00 = W_00`: its reciprocal too.
+    let w00 = ident(Sym::Weight(0, 0));
+    assert!(stored.contains(&Sym::Weight(0, 0)), "W_00 is stored");
+
     quote! {
         #(#attrs)*
         #(#[doc = #doc])*
-        #[derive(::core::fmt::Debug, ::core::clone::Clone, ::core::cmp::PartialEq)]
+        #[derive(::core::clone::Clone)]
         #vis struct #name {
             chain: ::pendulum_core::Chain<::pendulum_core::__private::nalgebra::Const<#n>>,
+            #(#stored_docs #stored_idents: ::core::primitive::f64,)*
+            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not
+            /// positive (underflow), which makes every acceleration NaN and
+            /// `accelerations` fail as not positive definite.
+            inv0: ::core::primitive::f64,
         }
 
         #(#cfgs)*
@@ -288,7 +343,24 @@ fn model(def: &ModelDef) -> TokenStream {
             impl #name {
                 /// The model of `chain`.
                 #vis fn new(chain: Chain<Const<#n>>) -> Self {
-                    Self { chain }
+                    #constructor_lets
+                    let inv0 = if #w00 > 0.0 { 1.0 / #w00 } else { ::core::primitive::f64::NAN };
+                    Self { chain, #(#stored_idents,)* inv0 }
+                }
+            }
+
+            // The stored quantities are functions of the chain: it alone is shown and compared.
+            #[automatically_derived]
+            impl ::core::fmt::Debug for #name {
+                fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                    f.debug_struct(::core::stringify!(#name)).field("chain", &self.chain).finish_non_exhaustive()
+                }
+            }
+
+            #[automatically_derived]
+            impl ::core::cmp::PartialEq for #name {
+                fn eq(&self, other: &Self) -> bool {
+                    self.chain == other.chain
                 }
             }
 
@@ -300,9 +372,10 @@ fn model(def: &ModelDef) -> TokenStream {
             }
 
             // `mul_add` would be a slow libm call on targets without FMA, and would round
-            // differently from the generic models.
+            // differently from the generic models. `x - x` is the finiteness probe
+            // (NaN for ±∞ and NaN, 0 otherwise).
             #[automatically_derived]
-            #[allow(clippy::suboptimal_flops)]
+            #[allow(clippy::suboptimal_flops, clippy::eq_op)]
             impl Model for #name {
                 type Links = Const<#n>;
                 type Dof = Const<#dof>;
@@ -373,10 +446,10 @@ fn model(def: &ModelDef) -> TokenStream {
 }
 
 /// `a - p·q - …` (or `-p·q - …` when `a` is zero); `None` when everything is zero.
-fn minus_products(first: Option<&Ident>, products: &[(Ident, Ident)]) -> Option<TokenStream> {
+fn minus_products(first: Option<TokenStream>, products: &[(Ident, Ident)]) -> Option<TokenStream> {
     let mut products = products.iter().map(|(p, q)| quote!(#p * #q));
     let start = match first {
-        Some(a) => quote!(#a),
+        Some(a) => a,
         None => {
             let p = products.next()?;
             quote!(-#p)
@@ -385,21 +458,46 @@ fn minus_products(first: Option<&Ident>, products: &[(Ident, Ident)]) -> Option<
     Some(products.fold(start, |acc, p| quote!(#acc - #p)))
 }
 
-/// `(sum) * inv` (no parentheses around a single name).
-fn scaled(sum: TokenStream, is_single: bool, inv: &Ident) -> TokenStream {
-    if is_single { quote!(#sum * #inv) } else { quote!((#sum) * #inv) }
+/// `Σ (x − x)` over `values` as a balanced tree of additions (latency `log₂` of their
+/// number): `0.0` exactly when every value is finite, NaN otherwise (`x − x` is NaN for
+/// ±∞ and NaN). One subtraction and one addition per value, no branch per value.
+fn finite_probe(values: &[TokenStream]) -> TokenStream {
+    match values {
+        [] => quote!(0.0),
+        [x] => quote!((#x - #x)),
+        _ => {
+            let (a, b) = values.split_at(values.len() / 2);
+            let (a, b) = (finite_probe(a), finite_probe(b));
+            quote!((#a + #b))
+        }
+    }
 }
 
-/// `accelerations`: `M` and `Q − c − k − d` as lets with the polar-angle checks among them,
-/// an unrolled Cholesky factorisation `M = L Lᵀ` (column by column; entries known to be
-/// zero are skipped) and forward and back substitution.
+/// `accelerations`: `M` and `Q − c − (k + d)` as lets with the polar-angle checks among
+/// them, an unrolled `M = L D Lᵀ` factorisation (`L` unit lower triangular, column by
+/// column; no square roots, one division per pivot; entries known to be zero are
+/// skipped), forward and back substitution, and one finiteness probe of the result.
+///
+/// The inputs are checked (`pendulum_core::check_inputs`, sizes being fixed by the types)
+/// only on the way to an error, which is where any non-finite input ends: every entry of
+/// `q`, `q̇`, `σ` and `p̈` is an operand of the right-hand side `r_a` of its own
+/// coordinate or link (`q` through `J_a·(p̈ + g ẑ)`, `q̇` through the damping, `σ`
+/// directly), IEEE arithmetic keeps ±∞ and NaN non-finite through `+ − ×` and through
+/// division by a finite pivot, and the pivots `d_j` depend on `q` alone (NaN, caught by
+/// their check, or finite and positive). So a non-finite `r_a` makes `x_a` non-finite or
+/// a pivot fail. `tests/agrees_with_generic.rs` checks every entry with NaN and ±∞.
 fn accelerations(plan: &Plan) -> TokenStream {
     let d = plan.dof();
     let dof = index(d);
     let space = space(plan);
-    let mut roots: Vec<Expr> = plan.mass_entries().into_iter().map(Expr::of).collect();
+    // `M_00 = W_00` enters through its stored reciprocal alone.
+    assert_eq!(plan.definition(Sym::MassEntry(0, 0)), Some(Expr::of(Sym::Weight(0, 0))));
+    let mut roots: Vec<Expr> =
+        plan.mass_entries().into_iter().filter(|&s| s != Sym::MassEntry(0, 0)).map(Expr::of).collect();
     roots.extend((0..d).map(|a| Expr::of(Sym::Rhs(a))));
-    let body = Body::checked(plan, &roots);
+    // The input checks, which name a bad value, run on the way to any error: a non-finite
+    // input always ends there (see below), and its error comes before the others.
+    let body = Body::checked(plan, &roots, &quote!(failure));
     let lets = &body.lets;
     let torque = body.uses(|s| matches!(s, Sym::Torque(_))).then(|| quote!(let torque = &inputs.torque;));
     let pivot = body
@@ -407,61 +505,96 @@ fn accelerations(plan: &Plan) -> TokenStream {
         .then(|| quote!(let pivot_acceleration = &inputs.pivot_acceleration;));
 
     let entry = |r: usize, c: usize| plan.mass_entry(r, c).map(ident);
-    let fac_name = |i: usize, j: usize| format_ident!("fac{i}_{j}");
     let inv = |j: usize| format_ident!("inv{j}");
-    // fac[i][j] = L_ij (i > j), `None` where it is known to be zero.
-    let mut fac: Vec<Vec<Option<Ident>>> = vec![vec![None; d]; d];
+    let piv = |j: usize| format_ident!("piv{j}");
+    // low[i][j] = (L_ij d_j, L_ij) for i > j, `None` where known to be zero.
+    let mut low: Vec<Vec<Option<(Ident, Ident)>>> = vec![vec![None; d]; d];
     let mut factor = TokenStream::new();
     for j in 0..d {
-        let products: Vec<(Ident, Ident)> =
-            (0..j).filter_map(|k| fac[j][k].clone().map(|f| (f.clone(), f))).collect();
-        let diagonal = entry(j, j).expect("the diagonal of M is never identically zero");
-        let value = minus_products(Some(&diagonal), &products).expect("non-empty");
-        let (piv, inv_j) = (format_ident!("piv{j}"), inv(j));
-        factor.extend(quote! {
-            let #piv = #value;
-            if #piv.is_nan() || #piv <= 0.0 {
-                return Err(Error::NotPositiveDefinite);
-            }
-            let #inv_j = 1.0 / #piv.sqrt();
-        });
-        for i in j + 1..d {
-            let products: Vec<(Ident, Ident)> =
-                (0..j).filter_map(|k| Some((fac[i][k].clone()?, fac[j][k].clone()?))).collect();
-            let a = entry(i, j);
-            let single = a.is_some() && products.is_empty();
-            if let Some(sum) = minus_products(a.as_ref(), &products) {
-                let name = fac_name(i, j);
-                let value = scaled(sum, single, &inv_j);
-                factor.extend(quote!(let #name = #value;));
-                fac[i][j] = Some(name);
+        let (piv_j, inv_j) = (piv(j), inv(j));
+        if j == 0 {
+            // d_0 = M_00 = W_00: its reciprocal is stored, NaN if W_00 is not positive.
+            factor.extend(quote!(let #inv_j = self.inv0;));
+        } else {
+            // d_j = M_jj − Σ_{k<j} (L_jk d_k) L_jk
+            let products: Vec<(Ident, Ident)> = low[j][..j].iter().flatten().cloned().collect();
+            let diagonal = entry(j, j).expect("the diagonal of M is never identically zero");
+            let value = minus_products(Some(quote!(#diagonal)), &products).expect("non-empty");
+            factor.extend(quote! {
+                let #piv_j = #value;
+                if #piv_j.is_nan() || #piv_j <= 0.0 {
+                    return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+                }
+            });
+            // The last pivot divides once, in the back substitution.
+            if j + 1 < d {
+                factor.extend(quote!(let #inv_j = 1.0 / #piv_j;));
             }
         }
+        for i in j + 1..d {
+            // L_ij d_j = M_ij − Σ_{k<j} (L_ik d_k) L_jk
+            let products: Vec<(Ident, Ident)> =
+                (0..j).filter_map(|k| Some((low[i][k].clone()?.0, low[j][k].clone()?.1))).collect();
+            let a = entry(i, j);
+            let Some(sum) = minus_products(a.as_ref().map(|a| quote!(#a)), &products) else { continue };
+            let unscaled = match (&a, products.is_empty()) {
+                (Some(a), true) => a.clone(),
+                _ => {
+                    let u = format_ident!("u{i}_{j}");
+                    factor.extend(quote!(let #u = #sum;));
+                    u
+                }
+            };
+            let fac = format_ident!("fac{i}_{j}");
+            factor.extend(quote!(let #fac = #unscaled * #inv_j;));
+            low[i][j] = Some((unscaled, fac));
+        }
     }
-    let y = |i: usize| format_ident!("y{i}");
-    let x = |i: usize| format_ident!("x{i}");
+    let fac = |i: usize, k: usize| low[i][k].as_ref().map(|(_, l)| l.clone());
     let mut solve = TokenStream::new();
     // L y = r
-    for (i, row) in fac.iter().enumerate() {
+    let mut ys: Vec<Ident> = Vec::new();
+    for i in 0..d {
         let products: Vec<(Ident, Ident)> =
-            row[..i].iter().enumerate().filter_map(|(k, f)| Some((f.clone()?, y(k)))).collect();
+            (0..i).filter_map(|k| Some((fac(i, k)?, ys[k].clone()))).collect();
         let r = ident(Sym::Rhs(i));
-        let sum = minus_products(Some(&r), &products).expect("non-empty");
-        let (yi, value) = (y(i), scaled(sum, products.is_empty(), &inv(i)));
-        solve.extend(quote!(let #yi = #value;));
+        if products.is_empty() {
+            ys.push(r);
+        } else {
+            let sum = minus_products(Some(quote!(#r)), &products).expect("non-empty");
+            let yi = format_ident!("y{i}");
+            solve.extend(quote!(let #yi = #sum;));
+            ys.push(yi);
+        }
     }
-    // Lᵀ x = y
+    // D Lᵀ x = y: x_i = y_i / d_i − Σ_{k>i} L_ki x_k
+    let x = |i: usize| format_ident!("x{i}");
     for i in (0..d).rev() {
-        let products: Vec<(Ident, Ident)> =
-            (i + 1..d).filter_map(|k| Some((fac[k][i].clone()?, x(k)))).collect();
-        let yi = y(i);
-        let sum = minus_products(Some(&yi), &products).expect("non-empty");
-        let (xi, value) = (x(i), scaled(sum, products.is_empty(), &inv(i)));
+        let products: Vec<(Ident, Ident)> = (i + 1..d).filter_map(|k| Some((fac(k, i)?, x(k)))).collect();
+        let yi = &ys[i];
+        let scaled = if i + 1 == d && i > 0 {
+            let p = piv(i);
+            quote!(#yi / #p)
+        } else {
+            let v = inv(i);
+            quote!(#yi * #v)
+        };
+        let value = minus_products(Some(scaled), &products).expect("non-empty");
+        let xi = x(i);
         solve.extend(quote!(let #xi = #value;));
     }
-    let xs: Vec<Ident> = (0..d).map(x).collect();
+    let xs: Vec<TokenStream> = (0..d)
+        .map(|i| {
+            let xi = x(i);
+            quote!(#xi)
+        })
+        .collect();
+    let output_probe = finite_probe(&xs);
     let indices = (0..d).map(index);
+    // Small models: the call would cost as much as the arithmetic.
+    let inline = (d <= 4).then(|| quote!(#[inline]));
     quote! {
+        #inline
         fn accelerations(
             &self,
             q: &SVector<f64, #dof>,
@@ -469,14 +602,29 @@ fn accelerations(plan: &Plan) -> TokenStream {
             inputs: &Inputs<Const<#dof>, #space>,
             out: &mut SVector<f64, #dof>,
         ) -> Result<()> {
-            ::pendulum_core::check_inputs(#dof, q, qd, inputs)?;
+            /// The error of a failed evaluation: the input checks' if they fail (a
+            /// non-finite input always ends here), else `error`. Out of line: the hot path
+            /// stays small.
+            #[cold]
+            #[inline(never)]
+            fn failure(
+                q: &SVector<f64, #dof>,
+                qd: &SVector<f64, #dof>,
+                inputs: &Inputs<Const<#dof>, #space>,
+                error: Error,
+            ) -> Error {
+                match ::pendulum_core::check_inputs(#dof, q, qd, inputs) {
+                    Err(input_error) => input_error,
+                    Ok(()) => error,
+                }
+            }
             #torque
             #pivot
             #lets
             #factor
             #solve
-            if #(!#xs.is_finite())||* {
-                return Err(Error::NotPositiveDefinite);
+            if #output_probe != 0.0 {
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
             }
             #(out[#indices] = #xs;)*
             Ok(())

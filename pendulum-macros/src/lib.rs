@@ -37,17 +37,21 @@ use proc_macro::TokenStream;
 /// - `links`: an integer literal from 1 to 16.
 ///
 /// Each item becomes `vis struct Name { chain: Chain<Const<n>> }` (the attributes and doc
-/// comments pass through; `Debug`, `Clone` and `PartialEq` are derived) with
-/// `vis fn new(chain) -> Self`, `From<Chain<Const<n>>>` and an impl of
+/// comments pass through; `Clone` is derived, `Debug` and `PartialEq` show and compare
+/// the chain) with `vis fn new(chain) -> Self`, `From<Chain<Const<n>>>` and an impl of
 /// `pendulum_core::Model` that gives the same results as `pendulum_core::Planar` /
 /// `pendulum_core::Spatial`, to round-off. Every method is straight-line code: each
 /// angle's sine and cosine computed once, angle differences from the angle-sum
-/// identities, tail masses and `W_ij = M_max(i,j) l_i l_j` as named temporaries, no loops
-/// and no allocation; `energy` shares one set of temporaries between `T` and `U`.
-/// `accelerations` checks its inputs (`check_inputs`, and for spatial models
-/// `check_polar_sin` on every link, with the sines it computes anyway), then solves
-/// `M q̈ = Q − c − k − d` by an unrolled Cholesky factorisation, returning
-/// `Error::NotPositiveDefinite` if a pivot is not positive or the result is not finite.
+/// identities, no loops and no allocation; what depends on the chain alone
+/// (`W_ij = M_max(i,j) l_i l_j`, `M_i l_i`, `1/W_00`) is computed by `new` and stored;
+/// `energy` shares one set of temporaries between `T` and `U`.
+/// `accelerations` solves `M q̈ = Q − c − (k + d)` by an unrolled `L D Lᵀ`
+/// factorisation (no square roots, one division per pivot), with `check_polar_sin` on
+/// every link for spatial models (with the sines it computes anyway). It returns
+/// `Error::NotPositiveDefinite` if a pivot is not positive or the result is not finite,
+/// and on the way to any error runs `check_inputs` first, whose error (a non-finite or
+/// missized input, named) takes precedence: a non-finite input always makes the result
+/// non-finite, so the happy path does not check the inputs one by one.
 ///
 /// Mistakes in the input are compile errors pointing at the offending token, all
 /// reported at once.

@@ -103,8 +103,17 @@ pub enum Sym {
     CosDiff(Angle, Angle),
     /// `sin(a − b)` for two angles of the same kind, `a` on the lower link.
     SinDiff(Angle, Angle),
-    /// `W_ij = M_max(i,j) l_i l_j` with `i ≤ j`, kg·m².
+    /// The vertical component of `p̈ + g ẑ` (y planar, z spatial), m/s²: the pivot
+    /// acceleration and gravity act on the chain together, as `p̈ − g` with `g = −g ẑ`.
+    Lift,
+    /// `J_a·(p̈ + g ẑ)` for coordinate `a`, m/s².
+    Reach(usize),
+    /// `W_ij = M_max(i,j) l_i l_j` with `i ≤ j`, kg·m². Stored in the model at
+    /// construction ([`Sym::is_stored`]).
     Weight(usize, usize),
+    /// `M_i l_i`, kg·m, the moment of the tail masses on link `i`. Stored in the model at
+    /// construction.
+    Moment(usize),
     /// Component `axis` of the velocity of mass `k` relative to the pivot, m/s.
     Velocity(usize, usize),
     /// Mass-matrix entry `M_rc` with `r ≥ c` (generalized-coordinate indices).
@@ -115,9 +124,11 @@ pub enum Sym {
     GravityTerm(usize),
     /// Pivot term `d_a`.
     PivotTerm(usize),
+    /// Gravity and pivot terms together, `k_a + d_a = M_i l_i J_a·(p̈ + g ẑ)` (`a` on link `i`).
+    Load(usize),
     /// Generalized force `Q_a`.
     Force(usize),
-    /// Right-hand side `Q_a − c_a − k_a − d_a` of `M q̈ = …`.
+    /// Right-hand side `Q_a − c_a − (k_a + d_a)` of `M q̈ = …`.
     Rhs(usize),
 }
 
@@ -125,6 +136,12 @@ impl Sym {
     /// Whether the symbol is read from the chain or an argument rather than computed.
     pub fn is_input(self) -> bool {
         self < Sym::CosDiff(Angle::Theta(0), Angle::Theta(0))
+    }
+
+    /// Whether the symbol depends on the chain's parameters alone: computed once by the
+    /// constructor, stored in the model and read by the methods.
+    pub fn is_stored(self) -> bool {
+        matches!(self, Sym::Weight(..) | Sym::Moment(_))
     }
 
     /// The symbol's variable name in the generated code.
@@ -156,12 +173,16 @@ impl Sym {
             Sym::Pivot(axis) => ["ax", "ay", "az"][axis].into(),
             Sym::CosDiff(a, b) => format!("c{}{}_{}", a.tag(), a.link(), b.link()),
             Sym::SinDiff(a, b) => format!("s{}{}_{}", a.tag(), a.link(), b.link()),
+            Sym::Lift => "lift".into(),
+            Sym::Reach(a) => format!("p{a}"),
             Sym::Weight(i, j) => format!("w{i}_{j}"),
+            Sym::Moment(i) => format!("ml{i}"),
             Sym::Velocity(k, axis) => format!("v{}{k}", ['x', 'y', 'z'][axis]),
             Sym::MassEntry(r, c) => format!("a{r}_{c}"),
             Sym::VelocityTerm(a) => format!("c{a}"),
             Sym::GravityTerm(a) => format!("k{a}"),
             Sym::PivotTerm(a) => format!("d{a}"),
+            Sym::Load(a) => format!("kd{a}"),
             Sym::Force(a) => format!("f{a}"),
             Sym::Rhs(a) => format!("r{a}"),
         }
@@ -332,8 +353,24 @@ impl Plan {
             Sym::SinDiff(a, b) => {
                 e.add(1.0, &[sin(a), cos(b)]).add(-1.0, &[cos(a), sin(b)]);
             }
+            Sym::Lift => {
+                e.add(1.0, &[Sym::Pivot(self.space() - 1)]).add(1.0, &[Sym::Gravity]);
+            }
+            Sym::Reach(a) => {
+                let angle = self.angle(a);
+                for axis in 0..self.space() {
+                    let p = if axis + 1 == self.space() { Sym::Lift } else { Sym::Pivot(axis) };
+                    e.add_product(&[p], &self.jacobian(angle, axis), &[]);
+                }
+            }
             Sym::Weight(i, j) => {
                 e.add(1.0, &[Sym::Tail(j), Sym::Length(i), Sym::Length(j)]);
+            }
+            Sym::Moment(i) => {
+                e.add(1.0, &[Sym::Tail(i), Sym::Length(i)]);
+            }
+            Sym::Load(a) => {
+                e.add(1.0, &[Sym::Moment(self.angle(a).link()), Sym::Reach(a)]);
             }
             // v_k = v_{k−1} + l_k u̇_k, u̇_k = Σ_a J_a q̇_a over link k's angles.
             Sym::Velocity(k, axis) => {
@@ -348,7 +385,7 @@ impl Plan {
             Sym::VelocityTerm(a) => self.velocity_term_expr(a, &mut e),
             Sym::GravityTerm(a) => {
                 if let Theta(i) = self.angle(a) {
-                    e.add(1.0, &[Sym::Tail(i), Sym::Gravity, Sym::Length(i), sin(Theta(i))]);
+                    e.add(1.0, &[Sym::Moment(i), Sym::Gravity, sin(Theta(i))]);
                 }
             }
             // d_a = M_i l_i J_a·p̈ (`a` on link `i`); planar d_i = M_i l_i (p̈_x cθ + p̈_y sθ).
@@ -356,7 +393,7 @@ impl Plan {
                 let angle = self.angle(a);
                 let i = angle.link();
                 for axis in 0..self.space() {
-                    let before = [Sym::Tail(i), Sym::Length(i), Sym::Pivot(axis)];
+                    let before = [Sym::Moment(i), Sym::Pivot(axis)];
                     e.add_product(&before, &self.jacobian(angle, axis), &[]);
                 }
             }
@@ -373,7 +410,7 @@ impl Plan {
             }
             Sym::Rhs(a) => {
                 e.add(1.0, &[Sym::Force(a)]);
-                for term in [Sym::VelocityTerm(a), Sym::GravityTerm(a), Sym::PivotTerm(a)] {
+                for term in [Sym::VelocityTerm(a), Sym::Load(a)] {
                     if !self.is_zero(term) {
                         e.add(-1.0, &[term]);
                     }
@@ -537,12 +574,24 @@ impl Plan {
         }
     }
 
-    /// `roots` and everything they depend on, sorted into a valid statement order.
+    /// `roots` and everything they depend on, sorted into a valid statement order, as a
+    /// method computes them: [stored](Sym::is_stored) symbols are read, not expanded.
     pub fn closure(&self, roots: impl IntoIterator<Item = Sym>) -> Vec<Sym> {
+        self.closure_of(roots, false)
+    }
+
+    /// [`Plan::closure`] expanding stored symbols too, down to the chain's parameters:
+    /// what the constructor computes.
+    pub fn full_closure(&self, roots: impl IntoIterator<Item = Sym>) -> Vec<Sym> {
+        self.closure_of(roots, true)
+    }
+
+    fn closure_of(&self, roots: impl IntoIterator<Item = Sym>, expand_stored: bool) -> Vec<Sym> {
         let mut done = BTreeSet::new();
         let mut todo: Vec<Sym> = roots.into_iter().collect();
         while let Some(sym) = todo.pop() {
             if done.insert(sym)
+                && (expand_stored || !sym.is_stored())
                 && let Some(def) = self.definition(sym)
             {
                 todo.extend(def.symbols());
@@ -557,7 +606,7 @@ mod tests {
     use super::*;
 
     fn inputs_of(plan: &Plan, sym: Sym) -> Vec<Sym> {
-        plan.closure([sym]).into_iter().filter(|s| s.is_input()).collect()
+        plan.full_closure([sym]).into_iter().filter(|s| s.is_input()).collect()
     }
 
     #[test]
@@ -590,6 +639,12 @@ mod tests {
     fn planar_diagonal_is_the_weight_alone() {
         let plan = Plan::new(Kind::Planar, 3);
         assert_eq!(plan.definition(Sym::MassEntry(1, 1)).unwrap().to_string(), "w1_1");
+        // Stored: a method reads the weight, the constructor computes it.
+        assert_eq!(plan.closure([Sym::MassEntry(1, 1)]), [Sym::Weight(1, 1), Sym::MassEntry(1, 1)]);
+        assert_eq!(
+            plan.full_closure([Sym::MassEntry(1, 1)]),
+            [Sym::Tail(1), Sym::Length(1), Sym::Weight(1, 1), Sym::MassEntry(1, 1)]
+        );
         assert_eq!(plan.definition(Sym::Weight(1, 1)).unwrap().to_string(), "mt1*l1*l1");
     }
 
@@ -614,7 +669,11 @@ mod tests {
             plan.per_coordinate(Sym::GravityTerm),
             [Some(Sym::GravityTerm(0)), Some(Sym::GravityTerm(1)), None, None]
         );
-        assert_eq!(plan.definition(Sym::Rhs(3)).unwrap().to_string(), "f3 - c3 - d3");
+        assert_eq!(plan.definition(Sym::Rhs(3)).unwrap().to_string(), "f3 - c3 - kd3");
+        // J_φ has no z component: gravity and the vertical pivot acceleration drop out.
+        assert_eq!(plan.definition(Sym::Reach(3)).unwrap().to_string(), "-ax*st1*sp1 + ay*st1*cp1");
+        assert_eq!(plan.definition(Sym::Reach(1)).unwrap().to_string(), "ax*ct1*cp1 + ay*ct1*sp1 + lift*st1");
+        assert_eq!(plan.definition(Sym::Lift).unwrap().to_string(), "az + g");
     }
 
     #[test]
@@ -633,7 +692,7 @@ mod tests {
             let roots = (0..plan.dof()).flat_map(|a| (0..=a).map(move |b| Sym::MassEntry(a, b)));
             let roots = roots.chain((0..plan.dof()).map(Sym::Rhs));
             let roots = roots.chain(plan.kinetic_energy().symbols().collect::<Vec<_>>());
-            for sym in plan.closure(roots) {
+            for sym in plan.full_closure(roots) {
                 for dep in plan.definition(sym).unwrap_or_default().symbols() {
                     assert!(dep < sym, "{plan:?}: {sym} uses {dep}, which sorts after it");
                 }

@@ -323,3 +323,79 @@ fn generated_types_have_the_expected_shape_and_derives() {
     assert_eq!(spatial.dof(), nalgebra::Const::<6>);
     assert_eq!(spatial.zero_inputs().pivot_acceleration.len(), 3);
 }
+
+/// Sets entry `index` of `what` (`q`, `qd`, `torque` or `pivot_acceleration`) to `bad` in
+/// states built from `q0`, `qd0` (torques 0.5, pivot acceleration (0.3, −0.2[, 0.1])) and
+/// checks that `accelerations` names exactly that entry: the generated models check their
+/// inputs only on the way to an error, so every entry must reach one.
+fn every_bad_entry_is_named<M: Model>(model: &M, q0: &[f64], qd0: &[f64], label: &str)
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    let dof = model.dof();
+    let space = <M::Space as DimName>::dim();
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        for (what, len) in
+            [("q", dof.value()), ("qd", dof.value()), ("torque", dof.value()), ("pivot_acceleration", space)]
+        {
+            for index in 0..len {
+                let mut q = OVector::<f64, M::Dof>::from_iterator_generic(dof, U1, q0.iter().copied());
+                let mut qd = OVector::<f64, M::Dof>::from_iterator_generic(dof, U1, qd0.iter().copied());
+                let mut inputs: Inputs<M::Dof, M::Space> = model.zero_inputs();
+                inputs.torque.fill(0.5);
+                for (k, p) in inputs.pivot_acceleration.iter_mut().enumerate() {
+                    *p = [0.3, -0.2, 0.1][k];
+                }
+                match what {
+                    "q" => q[index] = bad,
+                    "qd" => qd[index] = bad,
+                    "torque" => inputs.torque[index] = bad,
+                    _ => inputs.pivot_acceleration[index] = bad,
+                }
+                let mut out = OVector::<f64, M::Dof>::zeros_generic(dof, U1);
+                let err = model.accelerations(&q, &qd, &inputs, &mut out);
+                let named = matches!(
+                    err,
+                    Err(Error::NonFinite { what: w, index: i, value })
+                        if w == what && i == index && value.to_bits() == bad.to_bits()
+                );
+                assert!(named, "{label}: {what}[{index}] = {bad} gave {err:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_non_finite_entry_is_named_even_where_it_is_multiplied_by_zero() {
+    // Zero angles, rates, damping and gravity: many products with a bad entry are ∞·0.
+    fn still<L: Dim>(n: usize) -> Chain<L>
+    where
+        DefaultAllocator: nalgebra::allocator::Allocator<L>,
+    {
+        Chain::new(&vec![1.0; n], &vec![0.5; n], 0.0).unwrap()
+    }
+    fn moving<L: Dim>(n: usize) -> Chain<L>
+    where
+        DefaultAllocator: nalgebra::allocator::Allocator<L>,
+    {
+        let damping: Vec<f64> = (0..n).map(|i| 0.1 * (i + 1) as f64).collect();
+        uniform::<L>(n).with_damping(&damping).unwrap()
+    }
+    let angles = |n: usize| (0..n).map(|i| 0.3 + 0.4 * i as f64).collect::<Vec<_>>();
+    let rates = |n: usize| (0..n).map(|i| 0.7 - 0.5 * i as f64).collect::<Vec<_>>();
+    every_bad_entry_is_named(&Planar1::new(still(1)), &[0.0], &[0.0], "planar 1 still");
+    every_bad_entry_is_named(&Planar2::new(still(2)), &[0.0; 2], &[0.0; 2], "planar 2 still");
+    every_bad_entry_is_named(&Planar3::new(still(3)), &[0.0; 3], &[0.0; 3], "planar 3 still");
+    every_bad_entry_is_named(&Planar2::new(moving(2)), &angles(2), &rates(2), "planar 2");
+    every_bad_entry_is_named(&Planar4::new(moving(4)), &angles(4), &rates(4), "planar 4");
+    every_bad_entry_is_named(&Planar16::new(moving(16)), &angles(16), &rates(16), "planar 16");
+    // Spatial: θ away from the poles, φ = 0.
+    let spatial_still = |n: usize| [vec![0.5; n], vec![0.0; n]].concat();
+    every_bad_entry_is_named(&Spatial1::new(still(1)), &spatial_still(1), &[0.0; 2], "spatial 1 still");
+    every_bad_entry_is_named(&Spatial2::new(still(2)), &spatial_still(2), &[0.0; 4], "spatial 2 still");
+    every_bad_entry_is_named(&Spatial3::new(still(3)), &spatial_still(3), &[0.0; 6], "spatial 3 still");
+    every_bad_entry_is_named(&Spatial3::new(moving(3)), &angles(6), &rates(6), "spatial 3");
+    // A singular angle too: the input error comes first.
+    let singular = [0.0, 0.5, 0.0, 0.0];
+    every_bad_entry_is_named(&Spatial2::new(moving(2)), &singular, &rates(4), "spatial 2 singular");
+}
