@@ -14,7 +14,8 @@ fuzz_target!(|data: &[u8]| {
     match Case::load(&path) {
         Ok(case) => {
             let (n, dof, space) = (case.links, case.dof(), case.kind.space());
-            let params = Params { masses: vec![1.0; n], lengths: vec![1.0; n], gravity: 9.81, damping: vec![0.1; n] };
+            let params =
+                Params { masses: vec![1.0; n], lengths: vec![1.0; n], gravity: 9.81, damping: vec![0.1; n] };
             let point = Point {
                 q: vec![0.3; dof],
                 qd: vec![0.2; dof],
