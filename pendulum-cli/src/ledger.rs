@@ -70,6 +70,11 @@ where
         Dyn(self.motion_len() + 2)
     }
 
+    /// `x = (u, w, ledger)`, `u' = w`.
+    fn second_order(&self) -> Option<usize> {
+        self.chain.second_order()
+    }
+
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
         let len = self.motion_len();
         let motion = self.motion(x);

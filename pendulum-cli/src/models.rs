@@ -4,8 +4,7 @@
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U1, U2, U3, Vector2, Vector3};
 use pendulum_core::integrate::{
-    Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, State, Stats,
-    System,
+    Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System,
 };
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc,
@@ -93,21 +92,7 @@ fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
     solver: StageSolver,
     system: &S,
 ) -> Box<dyn Integrator<S> + 'a> {
-    Box::new(Projected::new(Boxed(plain_integrator(kind, solver, system))))
-}
-
-/// A boxed integrator as an [`Integrator`] (the core implements the trait for concrete
-/// integrators, which [`Projected`] wraps).
-struct Boxed<'a, S: System<Dim = Dyn>>(Box<dyn Integrator<S> + 'a>);
-
-impl<S: System<Dim = Dyn>> Integrator<S> for Boxed<'_, S> {
-    fn step(&mut self, system: &S, state: &mut State<Dyn>, h: f64) -> pendulum_core::Result<()> {
-        self.0.step(system, state, h)
-    }
-
-    fn stats(&self) -> &Stats {
-        self.0.stats()
-    }
+    Box::new(Projected::new(plain_integrator(kind, solver, system)))
 }
 
 /// An angle model with a boxed pivot drive, constant torques and the energy ledger.

@@ -347,6 +347,11 @@ where
         Dyn(2 * self.model.dof().value() + 3)
     }
 
+    /// `x = (q, q̇, ledger)`, `q' = q̇`.
+    fn second_order(&self) -> Option<usize> {
+        Some(self.model.dof().value())
+    }
+
     /// `(q̇, q̈, P_drive, P_torque, P_damping)`; errors of [`Model::accelerations`] pass
     /// through.
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {

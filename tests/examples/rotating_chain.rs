@@ -219,6 +219,12 @@ fn plot(
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
+    // Labels are laid out with the embedded Ubuntu Light (plotters' ab_glyph backend).
+    let _ = plotters::style::register_font(
+        "sans-serif",
+        plotters::style::FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    );
     let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs");
     fs::create_dir_all(docs.join("data"))?;
     let chain = Chain::<Dyn>::uniform(LINKS, 1.0 / LINKS as f64, LENGTH / LINKS as f64, GRAVITY)?;

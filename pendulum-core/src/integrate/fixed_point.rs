@@ -99,7 +99,7 @@ where
             }
         }
         let x_scale = x.amax();
-        let second_order = system.second_order().filter(|&m| 2 * m == self.dim.value());
+        let second_order = system.second_order().filter(|&m| 2 * m <= self.dim.value());
         let mut previous_norm = f64::INFINITY;
         let mut first_norm: Option<f64> = None;
         for _ in 0..self.max_iterations {

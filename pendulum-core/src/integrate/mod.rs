@@ -180,6 +180,21 @@ where
     }
 }
 
+/// A boxed integrator is an integrator (to choose one at run time, and wrap it, e.g. in
+/// [`Projected`]).
+impl<S: System, I: Integrator<S> + ?Sized> Integrator<S> for Box<I>
+where
+    DefaultAllocator: SystemAlloc<S::Dim>,
+{
+    fn step(&mut self, system: &S, state: &mut State<S::Dim>, h: f64) -> Result<()> {
+        (**self).step(system, state, h)
+    }
+
+    fn stats(&self) -> &Stats {
+        (**self).stats()
+    }
+}
+
 /// Checks a step size and the state's length before a step.
 fn check_step<D: Dim>(expected: usize, x: &OVector<f64, D>, h: f64) -> Result<()>
 where

@@ -33,10 +33,11 @@ where
     /// here; the integrators treat it as a failed step.
     fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()>;
 
-    /// `Some(m)` when the system is of second order in the form `x = (q, v)`, `q' = v`
-    /// with `q` the first `m = dim/2` entries: [`GaussFixedPoint`](super::GaussFixedPoint)
-    /// then keeps the stage positions exactly consistent with the stage velocities, which
-    /// makes its iteration converge in far fewer sweeps. Default `None`.
+    /// `Some(m)` when the state starts with positions and velocities, `x = (q, v, …)` with
+    /// `q` the first `m` entries, `v` the next `m` and `q' = v` (any further entries, such
+    /// as an energy ledger, are free): [`GaussFixedPoint`](super::GaussFixedPoint) then
+    /// keeps the stage positions exactly consistent with the stage velocities, which
+    /// makes its iteration converge in fewer sweeps. Default `None`.
     fn second_order(&self) -> Option<usize> {
         None
     }

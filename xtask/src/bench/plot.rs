@@ -3,10 +3,10 @@
 //! fastest sample of each benchmark ([`super::Statistic::Fastest`]), the figure least
 //! disturbed by other jobs on a shared machine.
 //!
-//! No font backend: plotters' SVG backend writes text as `<text>` elements that the
-//! viewer renders with its own fonts, and without the `ttf`/`ab_glyph` features plotters
-//! lays labels out with its built-in estimate of text width. That keeps font-kit and
-//! the system font libraries out of the build.
+//! Text: the SVG backend writes `<text>` elements that the viewer renders with its own
+//! fonts; plotters lays the labels out with the `ab_glyph` backend and the Ubuntu Light
+//! font embedded in `epaint_default_fonts` (registered once here), so no system font
+//! library or font file is involved.
 
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
@@ -30,6 +30,14 @@ fn colour(implementation: &str) -> RGBColor {
 
 /// The SVG text of the plot of `results`' `<kind>_accelerations` groups.
 pub fn svg(results: &Results) -> Result<String> {
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (1200, 520)).into_drawing_area();
