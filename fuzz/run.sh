@@ -16,7 +16,9 @@ export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4
 -Cllvm-args=-sanitizer-coverage-inline-8bit-counters -Cllvm-args=-sanitizer-coverage-pc-table \
 -Cllvm-args=-sanitizer-coverage-trace-compares --cfg fuzzing -Cdebug-assertions -Coverflow-checks"
 # --target: build scripts and proc macros stay uninstrumented, as with cargo-fuzz.
-cargo build --release --locked --target "$host" --bins
+# Not --locked: fuzz/Cargo.lock is a copy of the workspace lock plus libfuzzer-sys and
+# would go stale whenever a workspace dependency changes; cargo resolves it minimally.
+cargo build --release --target "$host" --bins
 [ "$seconds" -gt 0 ] || exit 0
 for t in reference_expr reference_case cli_numbers cli_run_json; do
     work="$target_dir/fuzz-corpus/$t"
