@@ -21,7 +21,7 @@ pub enum Error {
         got: usize,
     },
     /// A mass is zero, negative, infinite or NaN.
-    #[error("mass of link {link} must be finite and positive, got {value}")]
+    #[error("mass of link {link} must be finite and positive, got {}", num(.value))]
     InvalidMass {
         /// 1-based link number.
         link: usize,
@@ -29,7 +29,7 @@ pub enum Error {
         value: f64,
     },
     /// A length is zero, negative, infinite or NaN.
-    #[error("length of link {link} must be finite and positive, got {value}")]
+    #[error("length of link {link} must be finite and positive, got {}", num(.value))]
     InvalidLength {
         /// 1-based link number.
         link: usize,
@@ -37,13 +37,13 @@ pub enum Error {
         value: f64,
     },
     /// Gravity is negative, infinite or NaN.
-    #[error("gravity g must be finite and non-negative, got {value}")]
+    #[error("gravity g must be finite and non-negative, got {}", num(.value))]
     InvalidGravity {
         /// The offending value, m/s².
         value: f64,
     },
     /// A damping coefficient is negative, infinite or NaN.
-    #[error("damping of link {link} must be finite and non-negative, got {value}")]
+    #[error("damping of link {link} must be finite and non-negative, got {}", num(.value))]
     InvalidDamping {
         /// 1-based link number.
         link: usize,
@@ -51,7 +51,7 @@ pub enum Error {
         value: f64,
     },
     /// A state or input entry is infinite or NaN.
-    #[error("{what}[{index}] must be finite, got {value}")]
+    #[error("{what}[{index}] must be finite, got {}", num(.value))]
     NonFinite {
         /// Which vector (`"q"`, `"qd"`, `"torque"`, `"pivot_acceleration"`).
         what: &'static str,
@@ -62,11 +62,9 @@ pub enum Error {
     },
     /// A link of a spatial (θ, φ) model points straight down or up, where φ is undefined
     /// and the mass matrix is singular.
-    #[error(
-        "link {link} sits at the spherical-angle singularity: theta = {theta} rad \
+    #[error("link {link} sits at the spherical-angle singularity: theta = {} rad \
          (|sin theta| = {sin_theta:e} < {tolerance:e}); the (theta, phi) coordinates cannot \
-         give its phi acceleration there"
-    )]
+         give its phi acceleration there", num(.theta))]
     SingularAngle {
         /// 1-based link number.
         link: usize,
@@ -84,10 +82,8 @@ pub enum Error {
     /// The implicit stage equations of an integrator step did not converge: the
     /// iterations (Newton, simplified then full, or fixed-point sweeps) diverged, stalled
     /// above round-off, or ran out. The state is left as it was before the step.
-    #[error(
-        "the stage equations of the step from t = {t} s with h = {h} s did not converge \
-         after {iterations} iterations; try a smaller step"
-    )]
+    #[error("the stage equations of the step from t = {} s with h = {} s did not converge \
+         after {iterations} iterations; try a smaller step", num(.t), num(.h))]
     StageSolveFailed {
         /// Time at the start of the step, s.
         t: f64,
@@ -98,7 +94,7 @@ pub enum Error {
     },
     /// An integrator step produced an infinite or NaN state. The state is left as it was
     /// before the step.
-    #[error("the step from t = {t} s with h = {h} s produced a non-finite state")]
+    #[error("the step from t = {} s with h = {} s produced a non-finite state", num(.t), num(.h))]
     NonFiniteState {
         /// Time at the start of the step, s.
         t: f64,
@@ -106,14 +102,14 @@ pub enum Error {
         h: f64,
     },
     /// An integrator was asked for a step of size zero, infinite or NaN.
-    #[error("step size h must be finite and non-zero, got {h}")]
+    #[error("step size h must be finite and non-zero, got {}", num(.h))]
     InvalidStepSize {
         /// The offending value, s.
         h: f64,
     },
     /// A pivot drive parameter is out of range (non-finite, negative amplitude or radius,
     /// zero direction).
-    #[error("drive {what} must be {requirement}, got {value}")]
+    #[error("drive {what} must be {requirement}, got {}", num(.value))]
     InvalidDrive {
         /// Which parameter (`"amplitude"`, `"angular frequency"`, `"phase"`, `"radius"`,
         /// `"direction norm"`).
@@ -124,7 +120,7 @@ pub enum Error {
         value: f64,
     },
     /// A trajectory run was asked for with a bad end time or sampling.
-    #[error("trajectory {what} must be {requirement}, got {value}")]
+    #[error("trajectory {what} must be {requirement}, got {}", num(.value))]
     InvalidRun {
         /// Which parameter (`"end time"`, `"step size"`, `"sampling interval"`).
         what: &'static str,
@@ -135,7 +131,7 @@ pub enum Error {
     },
     /// A step of a trajectory run failed; `source` is the integrator's or the system's
     /// error. The state is left at time `t`, the start of the failed step.
-    #[error("step {step} of the run, from t = {t} s, failed: {source}")]
+    #[error("step {step} of the run, from t = {} s, failed: {source}", num(.t))]
     StepFailed {
         /// Time at the start of the failed step, s.
         t: f64,
@@ -145,7 +141,7 @@ pub enum Error {
         source: Box<Error>,
     },
     /// A steady-rotation or normal-mode request has a parameter out of range.
-    #[error("steady rotation: {what} must be {requirement}, got {value}")]
+    #[error("steady rotation: {what} must be {requirement}, got {}", num(.value))]
     InvalidSteady {
         /// Which parameter (`"angular speed"`, `"pivot radius"`, `"gravity"`, `"mode"`, ...).
         what: &'static str,
@@ -155,10 +151,8 @@ pub enum Error {
         value: f64,
     },
     /// Newton's method on the steady-rotation shape equations did not converge.
-    #[error(
-        "the steady-rotation shape equations at omega = {omega} rad/s did not converge after \
-         {iterations} Newton iterations (residual {residual:e})"
-    )]
+    #[error("the steady-rotation shape equations at omega = {} rad/s did not converge after \
+         {iterations} Newton iterations (residual {residual:e})", num(.omega))]
     SteadyNotConverged {
         /// The angular speed, rad/s.
         omega: f64,
@@ -169,5 +163,34 @@ pub enum Error {
     },
 }
 
+/// A value for an error message: plain decimals (`-1`, `0.5`, `NaN`, `inf`) in the
+/// usual range, scientific notation (`1e-300`, `2.5e20`) for the very small and very large,
+/// which plain `{}` would print as hundreds of digits.
+fn num(value: &f64) -> String {
+    let magnitude = value.abs();
+    if magnitude != 0.0 && magnitude.is_finite() && !(1e-5..1e16).contains(&magnitude) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
+    }
+}
+
 /// The crate's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extreme_values_are_printed_in_scientific_notation() {
+        let e = Error::InvalidRun { what: "step size", requirement: "not absurdly small", value: 1e-300 };
+        assert_eq!(e.to_string(), "trajectory step size must be not absurdly small, got 1e-300");
+        let e = Error::InvalidGravity { value: -2.5e20 };
+        assert_eq!(e.to_string(), "gravity g must be finite and non-negative, got -2.5e20");
+        let e = Error::InvalidMass { link: 2, value: -1.0 };
+        assert_eq!(e.to_string(), "mass of link 2 must be finite and positive, got -1");
+        let e = Error::InvalidStepSize { h: f64::NAN };
+        assert_eq!(e.to_string(), "step size h must be finite and non-zero, got NaN");
+    }
+}
