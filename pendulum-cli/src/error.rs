@@ -30,6 +30,15 @@ impl CliError {
         Self::Failed(message.into())
     }
 
+    /// The same error with `prefix: ` in front of its message (for example the input
+    /// file a rejected value came from).
+    pub fn context(self, prefix: impl fmt::Display) -> Self {
+        match self {
+            Self::Usage(m) => Self::Usage(format!("{prefix}: {m}")),
+            Self::Failed(m) => Self::Failed(format!("{prefix}: {m}")),
+        }
+    }
+
     /// 2 for usage errors, 1 for failures.
     pub fn exit_code(&self) -> ExitCode {
         match self {

@@ -41,7 +41,11 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
     config.view = args.view.unwrap_or(config.view);
     config.frames = args.frames.unwrap_or(config.frames);
     config.check()?;
-    let simulation = build(&config)?;
+    // A value the chain, drive or state rejects names the file it came from.
+    let simulation = build(&config).map_err(|e| match &args.from {
+        Some(path) => e.context(format_args!("--from {}", path.display())),
+        None => e,
+    })?;
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;

@@ -109,7 +109,8 @@ fn an_extreme_chain_fails_at_run_time_with_a_message() {
 #[test]
 fn a_run_json_with_a_zero_mass_is_rejected_by_the_chain_check() {
     // Found by the cli_run_json fuzz target: `RunFile::read` checks list lengths and run
-    // times, the chain's own validation the values; the user sees the latter.
+    // times, the chain's own validation the values; the user sees the latter, with the
+    // file it came from.
     let dir = scratch("bad-zero-mass");
     let text = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/cli_run_json/zero_mass"),
@@ -118,5 +119,8 @@ fn a_run_json_with_a_zero_mass_is_rejected_by_the_chain_check() {
     std::fs::write(dir.join("zero.json"), text).unwrap();
     let out = run_in(&dir, &["simulate", "--from", "zero.json", "--out", "run", "--no-plots"]);
     assert_eq!(out.status.code(), Some(2));
-    assert_eq!(stderr(&out).trim_end(), "error: mass of link 1 must be finite and positive, got 0");
+    assert_eq!(
+        stderr(&out).trim_end(),
+        "error: --from zero.json: mass of link 1 must be finite and positive, got 0"
+    );
 }
