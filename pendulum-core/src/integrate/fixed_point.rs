@@ -4,7 +4,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, U1, allocator::Allocator};
 
-use super::gauss::{complete_step, extrapolate_stages};
+use super::gauss::{LastStep, complete_step, extrapolate_stages};
 use super::{GaussStages, Integrator, State, Stats, System, SystemAlloc, check_step};
 use crate::{Error, Result};
 
@@ -38,8 +38,7 @@ where
     y: OVector<f64, D>,
     fy: OVector<f64, D>,
     increment: OVector<f64, D>,
-    x_end: OVector<f64, D>,
-    previous: Option<(f64, f64)>,
+    last: LastStep<D>,
 }
 
 impl<D, S> GaussFixedPoint<D, S>
@@ -62,8 +61,7 @@ where
             y: vector(),
             fy: vector(),
             increment: vector(),
-            x_end: vector(),
-            previous: None,
+            last: LastStep::new(dim),
         }
     }
 
@@ -83,13 +81,9 @@ where
     ) -> Result<()> {
         let tableau = S::TABLEAU;
         let s = S::dim();
-        match self.previous.take() {
-            Some((t_end, h_prev))
-                if t_end == t && *x == self.x_end && h / h_prev > 0.0 && h / h_prev <= 2.0 =>
-            {
-                extrapolate_stages::<D, S>(&mut self.z, &mut self.k, h / h_prev)
-            }
-            _ => {
+        match self.last.continued_by(t, x, h) {
+            Some(ratio) => extrapolate_stages::<D, S>(&mut self.z, &mut self.k, ratio),
+            None => {
                 system.rhs(t, x, &mut self.fy)?;
                 self.stats.rhs_evaluations += 1;
                 for i in 0..s {
@@ -170,10 +164,7 @@ where
             self.stats.failed_steps += 1;
             return Err(e);
         }
-        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats)?;
-        self.x_end.copy_from(state.x());
-        self.previous = Some((state.t(), h));
-        Ok(())
+        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats, &mut self.last)
     }
 
     fn stats(&self) -> &Stats {

@@ -113,16 +113,14 @@ where
     /// `f(t, x)` at the start of the step.
     f0: OVector<f64, D>,
     increment: OVector<f64, D>,
-    /// The state after the last successful step, to recognise a continuation.
-    x_end: OVector<f64, D>,
+    /// The last successful step, to recognise a continuation.
+    last: LastStep<D>,
     /// `jacobian` holds the Jacobian at some earlier state of this run.
     jacobian_valid: bool,
     /// The last simplified iteration contracted too slowly: evaluate a fresh Jacobian.
     refresh_jacobian: bool,
     /// `newton` holds the LU factors of `I − h A ⊗ J` for this `h` and the current `J`.
     factored_h: Option<f64>,
-    /// The last successful step: its end time and size.
-    previous: Option<(f64, f64)>,
 }
 
 impl<D, S> GaussLegendre<D, S>
@@ -155,11 +153,10 @@ where
             fy: vector(),
             f0: vector(),
             increment: vector(),
-            x_end: vector(),
+            last: LastStep::new(dim),
             jacobian_valid: false,
             refresh_jacobian: true,
             factored_h: None,
-            previous: None,
         }
     }
 
@@ -178,7 +175,7 @@ where
     pub fn reset(&mut self) {
         self.jacobian_valid = false;
         self.factored_h = None;
-        self.previous = None;
+        self.last.forget();
     }
 
     /// Solves the stage equations of the step `(t, x, h)` into `z` and `k`.
@@ -189,19 +186,11 @@ where
         x: &OVector<f64, D>,
         h: f64,
     ) -> Result<()> {
-        let previous = self.previous.take();
+        let continued = self.last.continued_by(t, x, h);
         let mut iterations = 0;
         let mut have_f0 = false;
-        match previous {
-            Some((t_end, h_prev))
-                if self.options.extrapolate
-                    && t_end == t
-                    && *x == self.x_end
-                    && h / h_prev > 0.0
-                    && h / h_prev <= 2.0 =>
-            {
-                self.extrapolate(h / h_prev)
-            }
+        match continued {
+            Some(ratio) if self.options.extrapolate => self.extrapolate(ratio),
             _ => self.simple_guess(system, t, x, h, &mut have_f0)?,
         }
 
@@ -393,16 +382,60 @@ where
     }
 }
 
+/// The end of the last successful step of a Gauss solver, to recognise a step that
+/// continues it (and start its stage solve from the extrapolated collocation polynomial).
+#[derive(Debug, Clone)]
+pub(super) struct LastStep<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// The state after the step.
+    x_end: OVector<f64, D>,
+    /// Its end time and size, `None` before the first step or after [`Self::forget`].
+    end: Option<(f64, f64)>,
+}
+
+impl<D: Dim> LastStep<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// No step yet, for states of dimension `dim`.
+    pub(super) fn new(dim: D) -> Self {
+        Self { x_end: OVector::zeros_generic(dim, U1), end: None }
+    }
+
+    /// `h / h_prev` when the step `(t, x, h)` starts where the last one ended and
+    /// `0 < h / h_prev ≤ 2` (extrapolation further out guesses worse than Euler). Forgets
+    /// the last step either way: a failed step must not be continued.
+    pub(super) fn continued_by(&mut self, t: f64, x: &OVector<f64, D>, h: f64) -> Option<f64> {
+        let (t_end, h_prev) = self.end.take()?;
+        let ratio = h / h_prev;
+        (t_end == t && *x == self.x_end && ratio > 0.0 && ratio <= 2.0).then_some(ratio)
+    }
+
+    /// Forgets the last step.
+    pub(super) fn forget(&mut self) {
+        self.end = None;
+    }
+
+    /// Records a successful step of size `h` that ended at `state`.
+    fn record(&mut self, state: &State<D>, h: f64) {
+        self.x_end.copy_from(state.x());
+        self.end = Some((state.t(), h));
+    }
+}
+
 /// Completes a Gauss step from its stage derivatives `k` (one column per stage):
-/// `x_{n+1} − x_n = h Σ_i b_i k_i` (eq 55), added to `state` with compensated summation.
-/// A non-finite increment leaves the state unchanged and is [`Error::NonFiniteState`];
-/// the step is counted either way.
+/// `x_{n+1} − x_n = h Σ_i b_i k_i` (eq 55), added to `state` with compensated summation,
+/// and records it in `last`. A non-finite increment leaves the state unchanged and is
+/// [`Error::NonFiniteState`]; the step is counted either way.
 pub(super) fn complete_step<D: Dim, S: GaussStages>(
     k: &OMatrix<f64, D, S>,
     h: f64,
     increment: &mut OVector<f64, D>,
     state: &mut State<D>,
     stats: &mut Stats,
+    last: &mut LastStep<D>,
 ) -> Result<()>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, S>,
@@ -417,6 +450,7 @@ where
     }
     state.advance(h, increment);
     stats.steps += 1;
+    last.record(state, h);
     Ok(())
 }
 
@@ -470,10 +504,7 @@ where
             self.stats.failed_steps += 1;
             return Err(e);
         }
-        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats)?;
-        self.x_end.copy_from(state.x());
-        self.previous = Some((state.t(), h));
-        Ok(())
+        complete_step::<D, S>(&self.k, h, &mut self.increment, state, &mut self.stats, &mut self.last)
     }
 
     fn stats(&self) -> &Stats {
