@@ -6,7 +6,6 @@ mod args;
 mod config;
 mod error;
 mod eval;
-mod ledger;
 mod models;
 mod plot;
 mod rotating;

@@ -7,12 +7,11 @@ use pendulum_core::integrate::{
     Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System,
 };
 use pendulum_core::{
-    Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic, Ledger, Model, ModelAlloc,
-    PlanarTension, Spatial,
+    Accounted, AccountedDirections, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic,
+    Ledger, Model, ModelAlloc, PlanarTension, Spatial,
 };
 
 use crate::args::{IntegratorKind, StageSolver};
-use crate::ledger::LedgeredDirections;
 
 use crate::args::Dimension;
 use crate::config::{DriveConfig, RunConfig};
@@ -191,12 +190,12 @@ where
 }
 
 /// A chain in unit link directions ([`Directions`], no coordinate singularity) with its
-/// energy ledger ([`LedgeredDirections`]).
+/// energy ledger ([`AccountedDirections`]).
 pub struct DirectionsSimulation<S: DimName>
 where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
-    system: LedgeredDirections<S>,
+    system: AccountedDirections<S, Box<dyn Drive<S>>>,
     x0: DVector<f64>,
 }
 
@@ -204,7 +203,7 @@ impl<S: DimName> Simulation for DirectionsSimulation<S>
 where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
-    type Sys = LedgeredDirections<S>;
+    type Sys = AccountedDirections<S, Box<dyn Drive<S>>>;
 
     fn system(&self) -> &Self::Sys {
         &self.system
@@ -229,14 +228,13 @@ where
     fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
         let motion = self.system.motion(x);
         let chain = self.system.chain();
-        let (drive, damped) = self.system.ledger(x);
         Sample {
             t,
             state: motion.as_slice().to_vec(),
             pivot: to3(&chain.drive().position(t)),
             masses: chain.positions(t, &motion).iter().map(to3).collect(),
             energy: chain.inertial_energy(t, &motion),
-            ledger: Ledger { drive, torque: 0.0, damped },
+            ledger: self.system.ledger(x),
         }
     }
 
@@ -311,8 +309,8 @@ fn spatial_simulation(
 ) -> CliResult<DirectionsSimulation<U3>> {
     let directions = Directions::<U3>::new(chain).with_drive(drive);
     let motion = directions.from_spherical(q, qd)?;
-    let system = LedgeredDirections::new(directions);
-    let x0 = system.state(&motion);
+    let system = AccountedDirections::new(directions);
+    let x0 = system.state(&motion)?;
     Ok(DirectionsSimulation { system, x0 })
 }
 

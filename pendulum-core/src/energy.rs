@@ -207,9 +207,19 @@ impl Ledger {
     pub fn net(&self) -> f64 {
         self.drive + self.torque - self.damped
     }
+
+    /// The energy exchanged from the ledger `start` to this one, J.
+    pub fn since(&self, start: &Ledger) -> Ledger {
+        Ledger {
+            drive: self.drive - start.drive,
+            torque: self.torque - start.torque,
+            damped: self.damped - start.damped,
+        }
+    }
 }
 
-/// How well the energy balance closes between two states of an [`Accounted`] run.
+/// How well the energy balance closes between two states of an [`Accounted`] (or
+/// [`AccountedDirections`](crate::AccountedDirections)) run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Balance {
     /// `H_in(t0)`, J.
@@ -222,6 +232,27 @@ pub struct Balance {
     pub residual: f64,
     /// `|residual| / (|H_in(t0)| + |H_in(t)| + |W_drive| + |W_torque| + E_damped)`.
     pub relative: f64,
+}
+
+impl Balance {
+    /// The balance between the inertial-frame energies `initial_energy = H_in(t0)` and
+    /// `energy = H_in(t)` (J) and the ledgers `start` (at `t0`) and `end` (at `t`).
+    pub fn between(initial_energy: f64, energy: f64, start: &Ledger, end: &Ledger) -> Self {
+        let ledger = end.since(start);
+        let residual = energy - initial_energy - ledger.net();
+        let scale = initial_energy.abs()
+            + energy.abs()
+            + ledger.drive.abs()
+            + ledger.torque.abs()
+            + ledger.damped.abs();
+        Self {
+            initial_energy,
+            energy,
+            ledger,
+            residual,
+            relative: residual.abs() / scale.max(f64::MIN_POSITIVE),
+        }
+    }
 }
 
 /// A driven chain as a first-order system whose state carries its energy ledger:
@@ -313,27 +344,9 @@ where
 
     /// The energy balance from `(t0, x0)` to `(t, x)` (see [`Balance`]).
     pub fn balance(&self, t0: f64, x0: &DVector<f64>, t: f64, x: &DVector<f64>) -> Balance {
-        let (initial_energy, energy) = (self.energy(t0, x0), self.energy(t, x));
         let (.., start) = self.split(x0);
         let (.., end) = self.split(x);
-        let ledger = Ledger {
-            drive: end.drive - start.drive,
-            torque: end.torque - start.torque,
-            damped: end.damped - start.damped,
-        };
-        let residual = energy - initial_energy - ledger.net();
-        let scale = initial_energy.abs()
-            + energy.abs()
-            + ledger.drive.abs()
-            + ledger.torque.abs()
-            + ledger.damped.abs();
-        Balance {
-            initial_energy,
-            energy,
-            ledger,
-            residual,
-            relative: residual.abs() / scale.max(f64::MIN_POSITIVE),
-        }
+        Balance::between(self.energy(t0, x0), self.energy(t, x), &start, &end)
     }
 }
 

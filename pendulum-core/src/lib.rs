@@ -14,13 +14,15 @@
 //!   prescribed pivot motion `p(t)` and torques `σ(t)`, combined by [`Driven`] into the
 //!   inputs of a [`FirstOrder`] system.
 //! - [`Accounted`]: the inertial-frame energy `H = T + U` of a driven chain with the work
-//!   of drive and torques and the damping losses integrated along the run.
+//!   of drive and torques and the damping losses integrated along the run;
+//!   [`AccountedDirections`] the same for a [`Directions`] chain.
 //! - [`trajectory::run`]: integrate from `t0` to `t1`, sampling every k steps, stopping
 //!   early on request.
 //!
 //! Equation numbers refer to the seed document (`shared/seed`); where it is wrong the
 //! code follows the sympy derivation and `reference/ERRATA.md` says so.
 
+mod accounted_directions;
 mod canonical;
 mod chain;
 mod directions;
@@ -40,6 +42,7 @@ mod steady;
 mod tension;
 pub mod trajectory;
 
+pub use accounted_directions::AccountedDirections;
 pub use canonical::{Canonical, KineticGradient};
 pub use chain::Chain;
 pub use directions::Directions;
