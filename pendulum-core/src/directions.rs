@@ -50,7 +50,8 @@ impl<S: DimName> Directions<S, Fixed> {
     /// The space must be `U2` or `U3` (other dimensions do not compile into a model:
     /// [`System::rhs`] would refuse them at run time).
     pub fn new(chain: Chain<Dyn>) -> Self {
-        let rods = Rods::new(chain.masses().as_slice(), chain.lengths().as_slice());
+        let rods =
+            Rods::new(chain.masses().as_slice(), chain.lengths().as_slice(), chain.damping().as_slice());
         Self { chain, rods, drive: Fixed, space: PhantomData }
     }
 }
@@ -225,7 +226,7 @@ where
         tensions: Option<&mut [f64]>,
     ) {
         let n = self.links();
-        let (lengths, damping) = (self.chain.lengths(), self.chain.damping());
+        let drag = self.rods.drag();
         let mut gravity = [0.0; C];
         gravity[C - 1] = -self.chain.gravity();
         let (directions, rates) = x.split_at(C * n);
@@ -233,7 +234,7 @@ where
         with_scratch::<C, _>(n, |s| {
             let load = |i: usize| {
                 let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
-                let pull = -damping[i] / lengths[i];
+                let pull = -drag[i];
                 let mut load = Load { direction: [0.0; C], rate_squared: 0.0, pair: [0.0; C] };
                 for k in 0..C {
                     load.direction[k] = u[k];

@@ -42,12 +42,14 @@
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
-/// Per-chain constants of the solve: reciprocal masses and lengths.
+/// Per-chain constants of the solve: reciprocal masses and lengths, and the drag
+/// coefficients `λ_i / l_i` the models use to build the force pairs.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Rods {
     inverse_mass: Vec<f64>,
     inverse_length: Vec<f64>,
     length: Vec<f64>,
+    drag: Vec<f64>,
 }
 
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
@@ -148,18 +150,31 @@ fn normalizer(x: f64) -> f64 {
 }
 
 impl Rods {
-    /// The constants of a chain with these masses (kg) and lengths (m), both positive.
-    pub fn new(masses: &[f64], lengths: &[f64]) -> Self {
+    /// The constants of a chain with these masses (kg) and lengths (m), both positive, and
+    /// damping coefficients `λ_i` (N·m·s).
+    pub fn new(masses: &[f64], lengths: &[f64], damping: &[f64]) -> Self {
         Self {
             inverse_mass: masses.iter().map(|m| 1.0 / m).collect(),
             inverse_length: lengths.iter().map(|l| 1.0 / l).collect(),
             length: lengths.to_vec(),
+            drag: damping.iter().zip(lengths).map(|(d, l)| d / l).collect(),
         }
     }
 
     /// Number of rods.
     pub fn len(&self) -> usize {
         self.length.len()
+    }
+
+    /// `1 / l_i` (1/m) per rod.
+    pub fn inverse_length(&self) -> &[f64] {
+        &self.inverse_length
+    }
+
+    /// `λ_i / l_i` (N·s) per rod: damping `λ_i θ̇_i` (or `λ_i w_i`) acts on rod `i` as the
+    /// force pair `−(λ_i / l_i) θ̇_i n_i` (or `−(λ_i / l_i) w_i`).
+    pub fn drag(&self) -> &[f64] {
+        &self.drag
     }
 
     /// The tension solve (module docs): a down pass and an up pass over the chain.
@@ -409,7 +424,7 @@ mod tests {
                 Load { direction: [s, -c], rate_squared: rate * rate, pair: [pull * c, pull * s] }
             })
             .collect();
-        (Rods::new(&masses, &lengths), loads)
+        (Rods::new(&masses, &lengths, &vec![0.0; n]), loads)
     }
 
     /// Largest difference of `a` from `b`, relative to the largest `|b_i|`.
@@ -448,7 +463,7 @@ mod tests {
             let (_, loads) = random_chain(4096, (0.0, 0.0), seed);
             let masses: Vec<f64> = (0..4096).map(|i| if i % 2 == 0 { 1e-6 } else { 1e6 }).collect();
             let lengths: Vec<f64> = (0..4096).map(|i| if i % 3 == 0 { 1e6 } else { 1e-6 }).collect();
-            continuants_against_pivots(&Rods::new(&masses, &lengths), &loads, 1e-6);
+            continuants_against_pivots(&Rods::new(&masses, &lengths, &[0.0; 4096]), &loads, 1e-6);
         }
     }
 
@@ -459,7 +474,11 @@ mod tests {
         let n = 4096;
         let masses: Vec<f64> = (0..n).map(|i| 10f64.powf(6.0 - 12.0 * i as f64 / (n - 1) as f64)).collect();
         let straight = Load { direction: [0.0, -1.0], rate_squared: 1.0, pair: [0.0; 2] };
-        continuants_against_pivots(&Rods::new(&masses, &vec![1.0; n]), &vec![straight; n], 1e-12);
+        continuants_against_pivots(
+            &Rods::new(&masses, &vec![1.0; n], &vec![0.0; n]),
+            &vec![straight; n],
+            1e-12,
+        );
     }
 
     #[test]
@@ -467,7 +486,7 @@ mod tests {
         // Masses of 1e-150 kg make pivots near 2⁵⁰⁰: the continuants leave their range
         // within two rods, and the pivots still give the weight below each rod.
         let masses = [1e-150, 3e-150, 2e-150, 1e-150];
-        let rods = Rods::new(&masses, &[1.0, 0.5, 2.0, 1.0]);
+        let rods = Rods::new(&masses, &[1.0, 0.5, 2.0, 1.0], &[0.0; 4]);
         let hanging = Load { direction: [0.0, -1.0], rate_squared: 0.0, pair: [0.0; 2] };
         let ((_, tension), in_range, _) = solve_as(&rods, [0.0, -9.81], &[hanging; 4], Route::Solve);
         assert!(!in_range);
@@ -487,7 +506,7 @@ mod tests {
 
     #[test]
     fn hanging_chain_carries_the_weight_below_each_rod() {
-        let rods = Rods::new(&[1.0, 2.0, 0.5], &[1.0, 0.5, 2.0]);
+        let rods = Rods::new(&[1.0, 2.0, 0.5], &[1.0, 0.5, 2.0], &[0.0; 3]);
         let g = 9.81;
         let hanging = Load { direction: [0.0, -1.0], rate_squared: 0.0, pair: [0.0; 2] };
         let (udd, tension) = solve(&rods, [0.0, -g], &[hanging; 3]);
@@ -501,7 +520,7 @@ mod tests {
     fn spinning_single_rod_pulls_with_the_centripetal_force() {
         // One mass m on a rod l turning at ω without gravity: T = m l ω², ü = −ω² u.
         let (m, l, w) = (2.0, 0.5, 3.0);
-        let rods = Rods::new(&[m], &[l]);
+        let rods = Rods::new(&[m], &[l], &[0.0]);
         let load = Load { direction: [1.0, 0.0, 0.0], rate_squared: w * w, pair: [0.0; 3] };
         let (udd, tension) = solve(&rods, [0.0; 3], &[load]);
         assert!((tension[0] - m * l * w * w).abs() < 1e-12);

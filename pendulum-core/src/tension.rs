@@ -34,7 +34,8 @@ where
 {
     /// The O(n) planar model of `chain`.
     pub fn new(chain: Chain<L>) -> Self {
-        let rods = Rods::new(chain.masses().as_slice(), chain.lengths().as_slice());
+        let rods =
+            Rods::new(chain.masses().as_slice(), chain.lengths().as_slice(), chain.damping().as_slice());
         Self { dense: Planar::new(chain), rods }
     }
 
@@ -81,14 +82,14 @@ where
         {
             return Err(crate::Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
         }
-        let (lengths, damping) = (chain.lengths(), chain.damping());
+        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
         let gravity = [0.0, -chain.gravity()];
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
             let load = |i: usize| {
                 let (sin, cos) = q[i].sin_cos();
-                let pull = (inputs.torque[i] - damping[i] * qd[i]) / lengths[i];
+                let pull = inputs.torque[i] * inverse_length[i] - drag[i] * qd[i];
                 Load { direction: [sin, -cos], rate_squared: qd[i] * qd[i], pair: [pull * cos, pull * sin] }
             };
             // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
