@@ -243,7 +243,7 @@ where
                 }
                 load
             };
-            self.rods.solve(gravity, pivot, s, load, |i, a, _, t| {
+            self.rods.solve(gravity, pivot, &mut s.rows, load, |i, a, _, t| {
                 out[i * C..(i + 1) * C].copy_from_slice(&a);
                 if let Some(tensions) = tensions.as_deref_mut() {
                     tensions[i] = t;

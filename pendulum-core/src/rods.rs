@@ -74,10 +74,17 @@ struct Row<const S: usize> {
     rhs: f64,
 }
 
-/// The per-rod buffer of one solve (allocated once per thread, see [`with_scratch`]).
+/// The rows the down pass leaves for the up pass (see [`Rods::solve`]).
+#[derive(Debug, Default)]
+pub(crate) struct Rows<const S: usize>(Vec<Row<S>>);
+
+/// The per-rod buffers of one solve (allocated once per thread, see [`with_scratch`]):
+/// the solve's rows, and room for the models to prepare the rods' [`Load`]s in a pass of
+/// their own before the solve.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch<const S: usize> {
-    rows: Vec<Row<S>>,
+    pub rows: Rows<S>,
+    pub loads: Vec<Load<S>>,
 }
 
 thread_local! {
@@ -96,10 +103,11 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
         f: impl FnOnce(&mut Scratch<S>) -> R,
     ) -> R {
         let mut scratch = cell.borrow_mut();
-        if scratch.rows.len() < n {
-            scratch
-                .rows
-                .resize(n, Row { direction: [0.0; S], free: [0.0; S], factor: 0.0, scaled: 0.0, rhs: 0.0 });
+        if scratch.rows.0.len() < n {
+            let row = Row { direction: [0.0; S], free: [0.0; S], factor: 0.0, scaled: 0.0, rhs: 0.0 };
+            scratch.rows.0.resize(n, row);
+            let load = Load { direction: [0.0; S], rate_squared: 0.0, pair: [0.0; S] };
+            scratch.loads.resize(n, load);
         }
         f(&mut scratch)
     }
@@ -189,11 +197,11 @@ impl Rods {
         &self,
         gravity: [f64; S],
         pivot_acceleration: [f64; S],
-        scratch: &mut Scratch<S>,
+        rows: &mut Rows<S>,
         load: impl FnMut(usize) -> Load<S>,
         emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
     ) {
-        let rows = &mut scratch.rows[..self.len()];
+        let rows = &mut rows.0[..self.len()];
         if !self.eliminate(gravity, pivot_acceleration, rows, load) {
             self.eliminate_by_pivots(rows);
         }
@@ -370,7 +378,7 @@ mod tests {
             tension[i] = t;
         };
         let (in_range, rows) = with_scratch::<S, _>(n, |s| {
-            let rows = &mut s.rows[..n];
+            let rows = &mut s.rows.0[..n];
             let in_range = rods.eliminate(gravity, pivot, rows, |i| loads[i]);
             if !in_range || route == Route::Pivots {
                 rods.eliminate_by_pivots(rows);

@@ -87,24 +87,33 @@ where
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
-            let load = |i: usize| {
+            // The trigonometry in a loop of its own: the calls do not stall the solve.
+            let loads = &mut s.loads[..n];
+            for (i, load) in loads.iter_mut().enumerate() {
                 let (sin, cos) = q[i].sin_cos();
                 let pull = inputs.torque[i] * inverse_length[i] - drag[i] * qd[i];
-                Load { direction: [sin, -cos], rate_squared: qd[i] * qd[i], pair: [pull * cos, pull * sin] }
-            };
+                *load = Load {
+                    direction: [sin, -cos],
+                    rate_squared: qd[i] * qd[i],
+                    pair: [pull * cos, pull * sin],
+                };
+            }
+            let loads = &*loads;
             // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
-            self.rods.solve(gravity, pivot, s, load, |i, [ax, ay], &[ux, uy], t| {
-                out[i] = -uy * ax + ux * ay;
-                if let Some(tensions) = tensions.as_deref_mut() {
-                    tensions[i] = t;
-                }
-            });
+            self.rods.solve(
+                gravity,
+                pivot,
+                &mut s.rows,
+                |i| loads[i],
+                |i, [ax, ay], &[ux, uy], t| {
+                    out[i] = -uy * ax + ux * ay;
+                    if let Some(tensions) = tensions.as_deref_mut() {
+                        tensions[i] = t;
+                    }
+                },
+            );
         });
-        if out.as_slice().iter().all(|a| a.is_finite()) {
-            Ok(())
-        } else {
-            Err(crate::Error::NotPositiveDefinite)
-        }
+        if out.as_slice().iter().all(|a| a.is_finite()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
     }
 }
 
