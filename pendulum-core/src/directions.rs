@@ -7,6 +7,7 @@ use std::marker::PhantomData;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, allocator::Allocator};
 
 use crate::integrate::{Constrained, System};
+use crate::model::all_finite;
 use crate::rods::{Load, Rods, with_scratch};
 use crate::{Chain, Drive, Error, Fixed, Result, check_polar_sin};
 
@@ -110,8 +111,10 @@ where
         if x.len() != self.state_len() {
             return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: x.len() });
         }
-        // On the slice: nalgebra's strided iterator costs as much as the solve here.
-        if let Some(index) = x.as_slice().iter().position(|v| !v.is_finite()) {
+        // On the slice, vectorised: a scalar search costs a third of the solve here.
+        if !all_finite(x.as_slice())
+            && let Some(index) = x.as_slice().iter().position(|v| !v.is_finite())
+        {
             return Err(Error::NonFinite { what: "x", index, value: x[index] });
         }
         Ok(())

@@ -2,6 +2,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
+use crate::model::all_finite;
 use crate::rods::{Load, Rods, with_scratch};
 use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 
@@ -113,7 +114,7 @@ where
                 },
             );
         });
-        if out.as_slice().iter().all(|a| a.is_finite()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
+        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
     }
 }
 
