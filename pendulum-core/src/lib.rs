@@ -39,6 +39,7 @@ mod stability;
 mod steady;
 mod tension;
 pub mod trajectory;
+mod trig;
 
 pub use canonical::{Canonical, KineticGradient};
 pub use chain::Chain;

@@ -79,11 +79,12 @@ struct Row<const S: usize> {
 pub(crate) struct Rows<const S: usize>(Vec<Row<S>>);
 
 /// The per-rod buffers of one solve (allocated once per thread, see [`with_scratch`]):
-/// the solve's rows, and room for the models to prepare the rods' [`Load`]s in a pass of
-/// their own before the solve.
+/// the solve's rows, and room for a model to prepare `(sin θ_i, cos θ_i)` and the rods'
+/// [`Load`]s in passes of their own before the solve.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch<const S: usize> {
     pub rows: Rows<S>,
+    pub sin_cos: Vec<[f64; 2]>,
     pub loads: Vec<Load<S>>,
 }
 
@@ -106,6 +107,7 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
         if scratch.rows.0.len() < n {
             let row = Row { direction: [0.0; S], free: [0.0; S], factor: 0.0, scaled: 0.0, rhs: 0.0 };
             scratch.rows.0.resize(n, row);
+            scratch.sin_cos.resize(n, [0.0; 2]);
             let load = Load { direction: [0.0; S], rate_squared: 0.0, pair: [0.0; S] };
             scratch.loads.resize(n, load);
         }

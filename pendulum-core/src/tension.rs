@@ -4,6 +4,7 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allo
 
 use crate::model::all_finite;
 use crate::rods::{Load, Rods, with_scratch};
+use crate::trig::sin_cos_into;
 use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
@@ -14,7 +15,10 @@ use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 /// With `u_i = (sin θ_i, −cos θ_i)` and `n_i = ∂u_i/∂θ_i = (cos θ_i, sin θ_i)`:
 /// `|u̇_i|² = θ̇_i²`, the generalized force `Q_i = σ_i − λ_i θ̇_i` (eq 26) acts as the force
 /// pair `F_i = (Q_i / l_i) n_i` on rod `i` (its virtual work `F_i·l_i n_i δθ_i = Q_i δθ_i`),
-/// and `θ̈_i = n_i · ü_i` (since `ü_i = θ̈_i n_i − θ̇_i² u_i`). One `sin_cos` per link.
+/// and `θ̈_i = n_i · ü_i` (since `ü_i = θ̈_i n_i − θ̇_i² u_i`). The `sin θ_i`, `cos θ_i` come
+/// first, all at once, from a vectorised polynomial kernel (`trig` module docs: within
+/// 1 ulp of `f64::sin_cos`, which it calls for `|θ_i| > 8192`), then the loads, then the
+/// solve: three loops over the links.
 ///
 /// Mass matrix, force terms and energies are [`Planar`]'s, so the model plugs into
 /// [`FirstOrder`](crate::FirstOrder), [`Canonical`](crate::Canonical) and
@@ -88,10 +92,13 @@ where
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
-            // The trigonometry in a loop of its own: the calls do not stall the solve.
+            // The trigonometry in a vectorised loop of its own, before the solve.
+            let sin_cos = &mut s.sin_cos[..n];
+            sin_cos_into(q.as_slice(), sin_cos);
+            // The loads too: built inside the solve (bounds checks and all), the builder was
+            // not inlined and cost a call per link.
             let loads = &mut s.loads[..n];
-            for (i, load) in loads.iter_mut().enumerate() {
-                let (sin, cos) = q[i].sin_cos();
+            for (i, (load, &[sin, cos])) in loads.iter_mut().zip(&*sin_cos).enumerate() {
                 let pull = inputs.torque[i] * inverse_length[i] - drag[i] * qd[i];
                 *load = Load {
                     direction: [sin, -cos],
@@ -100,19 +107,14 @@ where
                 };
             }
             let loads = &*loads;
+            let load = |i: usize| loads[i];
             // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
-            self.rods.solve(
-                gravity,
-                pivot,
-                &mut s.rows,
-                |i| loads[i],
-                |i, [ax, ay], &[ux, uy], t| {
-                    out[i] = -uy * ax + ux * ay;
-                    if let Some(tensions) = tensions.as_deref_mut() {
-                        tensions[i] = t;
-                    }
-                },
-            );
+            self.rods.solve(gravity, pivot, &mut s.rows, load, |i, [ax, ay], &[ux, uy], t| {
+                out[i] = -uy * ax + ux * ay;
+                if let Some(tensions) = tensions.as_deref_mut() {
+                    tensions[i] = t;
+                }
+            });
         });
         if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
     }
