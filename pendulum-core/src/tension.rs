@@ -98,13 +98,21 @@ where
             // The loads too: built inside the solve (bounds checks and all), the builder was
             // not inlined and cost a call per link.
             let loads = &mut s.loads[..n];
-            for (i, (load, &[sin, cos])) in loads.iter_mut().zip(&*sin_cos).enumerate() {
-                let pull = inputs.torque[i] * inverse_length[i] - drag[i] * qd[i];
-                *load = Load {
-                    direction: [sin, -cos],
-                    rate_squared: qd[i] * qd[i],
-                    pair: [pull * cos, pull * sin],
-                };
+            let (qd, torque) = (&qd.as_slice()[..n], &inputs.torque.as_slice()[..n]);
+            let build = |[sin, cos]: [f64; 2], rate: f64, pull: f64| Load {
+                direction: [sin, -cos],
+                rate_squared: rate * rate,
+                pair: [pull * cos, pull * sin],
+            };
+            // Without torques (the common case) the pull is the damping's alone.
+            if all_zero(torque) {
+                for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
+                    *load = build(trig, qd[i], -drag[i] * qd[i]);
+                }
+            } else {
+                for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
+                    *load = build(trig, qd[i], torque[i] * inverse_length[i] - drag[i] * qd[i]);
+                }
             }
             let loads = &*loads;
             let load = |i: usize| loads[i];
@@ -118,6 +126,11 @@ where
         });
         if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
     }
+}
+
+/// Whether every entry of `v` is zero (no early exit, so that it vectorises).
+fn all_zero(v: &[f64]) -> bool {
+    v.iter().fold(true, |zero, x| zero & (*x == 0.0))
 }
 
 impl<L: Dim> From<Chain<L>> for PlanarTension<L>
@@ -215,6 +228,26 @@ mod tests {
         fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
         fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
         assert_relative_eq!(a, b, epsilon = 1e-12, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn with_and_without_torques_match_the_dense_route() {
+        // Zero torques take the damping-only loop; one non-zero torque among zeros must not.
+        let n = 40;
+        let masses: Vec<f64> = (0..n).map(|i| 0.5 + (i as f64 * 0.37).sin().abs()).collect();
+        let lengths: Vec<f64> = (0..n).map(|i| 0.2 + (i as f64 * 0.71).cos().abs()).collect();
+        let chain = Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap().with_damping(&vec![0.05; n]).unwrap();
+        let fast = PlanarTension::new(chain);
+        let q = DVector::from_fn(n, |i, _| 0.3 + (i as f64 * 0.77) % 2.5);
+        let qd = DVector::from_fn(n, |i, _| (i as f64 * 1.3).sin() * 3.0);
+        let mut inputs = fast.zero_inputs();
+        for torque in [0.0, 0.7] {
+            inputs.torque[n / 2] = torque;
+            let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
+            fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
+            fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
+            assert_relative_eq!(a, b, epsilon = 1e-10, max_relative = 1e-10);
+        }
     }
 
     #[test]
