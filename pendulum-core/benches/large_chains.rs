@@ -74,6 +74,18 @@ fn planar(c: &mut Criterion) {
                 black_box(&sc);
             })
         });
+        // The same with each pair stored together: LLVM then merges the two into one libm
+        // `sincos` call (above it calls `sin` and `cos` apart), the floor a model pays.
+        group.bench_with_input(BenchmarkId::new("sincos", n), &n, |b, _| {
+            b.iter(|| {
+                for (pair, &angle) in sc.chunks_exact_mut(2).zip(black_box(&q).iter()) {
+                    let (s, co) = angle.sin_cos();
+                    pair[0] = s;
+                    pair[1] = co;
+                }
+                black_box(&sc);
+            })
+        });
     }
     group.finish();
 }

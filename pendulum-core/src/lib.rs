@@ -41,6 +41,7 @@ mod stability;
 mod steady;
 mod tension;
 pub mod trajectory;
+mod trig;
 
 pub use accounted_directions::AccountedDirections;
 pub use canonical::{Canonical, KineticGradient};

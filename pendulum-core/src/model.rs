@@ -193,9 +193,49 @@ where
         if v.len() != expected {
             return Err(Error::LengthMismatch { what, expected, got: v.len() });
         }
-        if let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        if !all_finite(v)
+            && let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite())
+        {
             return Err(Error::NonFinite { what, index, value });
         }
     }
     Ok(())
+}
+
+/// Whether every entry of `v` is finite: `Σ 0·v_i` is zero when they all are and NaN as
+/// soon as one is infinite or NaN. Summed in eight lanes without an early exit, so that it
+/// vectorises; the cheap test before searching for the first bad entry.
+#[inline]
+pub(crate) fn all_finite(v: &[f64]) -> bool {
+    let mut lanes = [0.0f64; 8];
+    let chunks = v.chunks_exact(8);
+    for (lane, x) in lanes.iter_mut().zip(chunks.remainder()) {
+        *lane += x * 0.0;
+    }
+    for chunk in chunks {
+        for (lane, x) in lanes.iter_mut().zip(chunk) {
+            *lane += x * 0.0;
+        }
+    }
+    lanes.iter().all(|lane| *lane == 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_finite_finds_every_bad_entry_at_every_position() {
+        for n in 0..27 {
+            let good: Vec<f64> = (0..n).map(|i| [f64::MAX, -f64::MAX, 5e-324, -0.0, 1.5][i % 5]).collect();
+            assert!(all_finite(&good), "n = {n}");
+            for i in 0..n {
+                for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+                    let mut v = good.clone();
+                    v[i] = bad;
+                    assert!(!all_finite(&v), "n = {n}, {bad} at {i}");
+                }
+            }
+        }
+    }
 }

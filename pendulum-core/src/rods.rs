@@ -21,16 +21,35 @@
 //! back-substitution pass up it give the tensions, the mass accelerations and
 //! `ü_i = (a_i − a_{i−1}) / l_i`: O(n) work, one division per rod, no trigonometry.
 //!
+//! With `d_i = A_ii` and `c_i = A_{i,i−1}` (`c_1 = 0`), Gaussian elimination has the
+//! pivots `D_i = d_i − c_i² / D_{i−1}`, a division on the serial chain of every rod. The
+//! down pass computes them instead as ratios of continuants (the leading principal minors
+//! of `A`, all positive):
+//! ```text
+//! P_i = d_i P_{i−1} − c_i² P_{i−2}      (P_0 = 1),      1/D_i = P_{i−1} / P_i
+//! f_i = c_i / D_{i−1},   e_i = b_i − f_i e_{i−1},   h_i = e_i / D_i
+//! ```
+//! so each serial chain (`P`, `e`) is one multiply and one subtraction per rod and the
+//! divisions are independent of each other. `P` grows or shrinks geometrically; every 16
+//! rods both `P_{i−1}` and `P_{i−2}` are multiplied by the power of two that brings
+//! `P_{i−1}` into `[1, 2)` (exact, and the ratios are unchanged). Should a continuant
+//! still leave `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (pivots beyond `2^±48` for 16 rods in a row: masses far
+//! outside `1e-6 … 1e6` kg), the pivots are redone the classical way
+//! from the stored `b_i`. The up pass is `T_n = h_n`, `T_i = h_i − f_{i+1} T_{i+1}`: one
+//! multiply and one subtraction per rod on its chain.
+//!
 //! This is the same physics as the Lagrangian models (`reference/`): the tests in
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
-/// Per-chain constants of the solve: reciprocal masses and lengths.
+/// Per-chain constants of the solve: reciprocal masses and lengths, and the drag
+/// coefficients `λ_i / l_i` the models use to build the force pairs.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Rods {
     inverse_mass: Vec<f64>,
     inverse_length: Vec<f64>,
     length: Vec<f64>,
+    drag: Vec<f64>,
 }
 
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
@@ -42,22 +61,31 @@ pub(crate) struct Load<const S: usize> {
     pub pair: [f64; S],
 }
 
-/// What the down pass leaves for the up pass, per rod: the direction, the free
-/// acceleration of the mass, the coupling to the rod above, the reciprocal pivot and the
-/// eliminated right-hand side of the tridiagonal system.
+/// What the down pass leaves for the up pass, per rod: the direction `u_i`, the free
+/// acceleration `a°_i` of the mass (m/s²), the elimination factor `f_i = c_i / D_{i−1}`, the
+/// scaled eliminated right-hand side `h_i = e_i / D_i` (N) and the right-hand side `b_i`
+/// itself (kept for [`Rods::eliminate_by_pivots`]).
 #[derive(Debug, Clone, Copy)]
 struct Row<const S: usize> {
     direction: [f64; S],
     free: [f64; S],
-    coupling: f64,
-    inverse_pivot: f64,
-    eliminated: f64,
+    factor: f64,
+    scaled: f64,
+    rhs: f64,
 }
 
-/// The per-rod buffer of one solve (allocated once per thread, see [`with_scratch`]).
+/// The rows the down pass leaves for the up pass (see [`Rods::solve`]).
+#[derive(Debug, Default)]
+pub(crate) struct Rows<const S: usize>(Vec<Row<S>>);
+
+/// The per-rod buffers of one solve (allocated once per thread, see [`with_scratch`]):
+/// the solve's rows, and room for a model to prepare `(sin θ_i, cos θ_i)` and the rods'
+/// [`Load`]s in passes of their own before the solve.
 #[derive(Debug, Default)]
 pub(crate) struct Scratch<const S: usize> {
-    rows: Vec<Row<S>>,
+    pub rows: Rows<S>,
+    pub sin_cos: Vec<[f64; 2]>,
+    pub loads: Vec<Load<S>>,
 }
 
 thread_local! {
@@ -76,17 +104,12 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
         f: impl FnOnce(&mut Scratch<S>) -> R,
     ) -> R {
         let mut scratch = cell.borrow_mut();
-        if scratch.rows.len() < n {
-            scratch.rows.resize(
-                n,
-                Row {
-                    direction: [0.0; S],
-                    free: [0.0; S],
-                    coupling: 0.0,
-                    inverse_pivot: 0.0,
-                    eliminated: 0.0,
-                },
-            );
+        if scratch.rows.0.len() < n {
+            let row = Row { direction: [0.0; S], free: [0.0; S], factor: 0.0, scaled: 0.0, rhs: 0.0 };
+            scratch.rows.0.resize(n, row);
+            scratch.sin_cos.resize(n, [0.0; 2]);
+            let load = Load { direction: [0.0; S], rate_squared: 0.0, pair: [0.0; S] };
+            scratch.loads.resize(n, load);
         }
         f(&mut scratch)
     }
@@ -113,13 +136,38 @@ fn dot<const S: usize>(a: &[f64; S], b: &[f64; S]) -> f64 {
     s
 }
 
+/// Rows between two rescalings of the continuants in [`Rods::solve`]. Each row multiplies
+/// `P` by its pivot `D_i`; 16 rows of pivots between 2⁻⁴⁸ and 2⁴⁸ keep `P` inside
+/// [`CONTINUANT_RANGE`].
+const BLOCK: usize = 16;
+
+/// The continuants `P_i` of the fast down pass must stay in `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (as bit
+/// patterns: `low ≤ bits(P_i) ≤ low + span`), far from overflow and from the subnormals
+/// where they would lose digits; otherwise the pivots are redone by
+/// [`Rods::eliminate_by_pivots`]. Negative, zero, infinite and NaN values fall outside too.
+const CONTINUANT_RANGE: (u64, u64) = {
+    let low = (1023 - 800) << 52; // 2⁻⁸⁰⁰
+    let high = (1023 + 800) << 52; // 2⁸⁰⁰
+    (low, high - low)
+};
+
+/// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`: the exact power of two that brings a positive
+/// normal `x` into `[1, 2)`. (Only reached with `x` in [`CONTINUANT_RANGE`].)
+#[inline(always)]
+fn normalizer(x: f64) -> f64 {
+    let biased = (x.to_bits() >> 52) & 0x7ff;
+    f64::from_bits(((2046 - biased as i64) as u64 & 0x7ff) << 52)
+}
+
 impl Rods {
-    /// The constants of a chain with these masses (kg) and lengths (m), both positive.
-    pub fn new(masses: &[f64], lengths: &[f64]) -> Self {
+    /// The constants of a chain with these masses (kg) and lengths (m), both positive, and
+    /// damping coefficients `λ_i` (N·m·s).
+    pub fn new(masses: &[f64], lengths: &[f64], damping: &[f64]) -> Self {
         Self {
             inverse_mass: masses.iter().map(|m| 1.0 / m).collect(),
             inverse_length: lengths.iter().map(|l| 1.0 / l).collect(),
             length: lengths.to_vec(),
+            drag: damping.iter().zip(lengths).map(|(d, l)| d / l).collect(),
         }
     }
 
@@ -128,30 +176,61 @@ impl Rods {
         self.length.len()
     }
 
-    /// The tension solve (module docs) in two fused passes.
+    /// `1 / l_i` (1/m) per rod.
+    pub fn inverse_length(&self) -> &[f64] {
+        &self.inverse_length
+    }
+
+    /// `λ_i / l_i` (N·s) per rod: damping `λ_i θ̇_i` (or `λ_i w_i`) acts on rod `i` as the
+    /// force pair `−(λ_i / l_i) θ̇_i n_i` (or `−(λ_i / l_i) w_i`).
+    pub fn drag(&self) -> &[f64] {
+        &self.drag
+    }
+
+    /// The tension solve (module docs): a down pass and an up pass over the chain.
     ///
     /// `load(i)` gives rod `i`'s [`Load`] (called once per rod, in order `0, 1, …`);
     /// `emit(i, ü_i, u_i, T_i)` receives rod `i`'s direction acceleration (1/s²), its
     /// direction and its tension (N), once per rod in order `n−1, …, 0`. Gravity `g⃗` and
-    /// the pivot acceleration `p̈` in m/s². Work O(n), one division per rod, and one
-    /// buffer row of `2S + 3` numbers per rod, so long chains stay in cache.
+    /// the pivot acceleration `p̈` in m/s². Work O(n), one division per rod (off the serial
+    /// chains), and one buffer row of `2S + 3` numbers per rod, so long chains stay in cache.
     #[inline(always)]
     pub fn solve<const S: usize>(
         &self,
         gravity: [f64; S],
         pivot_acceleration: [f64; S],
-        scratch: &mut Scratch<S>,
-        mut load: impl FnMut(usize) -> Load<S>,
-        mut emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
+        rows: &mut Rows<S>,
+        load: impl FnMut(usize) -> Load<S>,
+        emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
     ) {
-        let n = self.len();
-        let rows = &mut scratch.rows[..n];
-        // Down the chain: free accelerations, right-hand sides, elimination.
+        let rows = &mut rows.0[..self.len()];
+        if !self.eliminate(gravity, pivot_acceleration, rows, load) {
+            self.eliminate_by_pivots(rows);
+        }
+        self.substitute(pivot_acceleration, rows, emit);
+    }
+
+    /// The down pass: free accelerations, right-hand sides and the elimination by
+    /// continuants (module docs), rescaled by a power of two every [`BLOCK`] rows. Returns
+    /// `false` when a continuant left [`CONTINUANT_RANGE`]; the rows then hold `b_i` and
+    /// the directions but not yet `f_i` and `h_i`.
+    #[inline(always)]
+    fn eliminate<const S: usize>(
+        &self,
+        gravity: [f64; S],
+        pivot_acceleration: [f64; S],
+        rows: &mut [Row<S>],
+        mut load: impl FnMut(usize) -> Load<S>,
+    ) -> bool {
+        let n = rows.len();
+        let (low, span) = CONTINUANT_RANGE;
         let mut free_above = pivot_acceleration;
         let mut inverse_mass_above = 0.0;
-        let mut pivot_above = 0.0; // 1 / (pivot of the row above)
-        let mut eliminated_above = 0.0;
         let mut u_above = [0.0; S];
+        // P_{i−1}, P_{i−2} (P_{−1} = 1; P_{−2} only meets c_0 = 0), 1/D_{i−1}, e_{i−1}.
+        let (mut p_above, mut p_above2) = (1.0, 0.0);
+        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+        let mut out_of_range = false;
         let mut here = load(0);
         for (i, row) in rows.iter_mut().enumerate() {
             let below = if i + 1 < n { Some(load(i + 1)) } else { None };
@@ -167,29 +246,76 @@ impl Rods {
             // |u_i|² is 1 on the constraint manifold; keeping it makes u_i·ü_i = −|u̇_i|²
             // hold exactly also at the slightly non-unit directions inside an integrator step.
             let diagonal = (im + inverse_mass_above) * dot(&u, &u);
-            // Off-diagonal entry between rods i−1 and i: −(u_{i−1}·u_i)/m_{i−1}.
+            // Off-diagonal entry between rods i−1 and i: c_i = −(u_{i−1}·u_i)/m_{i−1}.
             let off = -dot(&u_above, &u) * inverse_mass_above;
-            let factor = off * pivot_above;
-            let inverse_pivot = 1.0 / (diagonal - factor * off);
+            if i % BLOCK == 0 {
+                let scale = normalizer(p_above);
+                p_above *= scale;
+                p_above2 *= scale;
+            }
+            // The serial chain: one multiply and one subtraction per rod.
+            let p = diagonal * p_above - (off * off) * p_above2;
+            out_of_range |= p.to_bits().wrapping_sub(low) > span;
+            let inverse_pivot = p_above / p;
+            let factor = off * inverse_pivot_above;
             let eliminated = rhs - factor * eliminated_above;
-            *row = Row { direction: u, free: a, coupling: off, inverse_pivot, eliminated };
+            *row = Row { direction: u, free: a, factor, scaled: eliminated * inverse_pivot, rhs };
             free_above = a;
             inverse_mass_above = im;
-            pivot_above = inverse_pivot;
-            eliminated_above = eliminated;
             u_above = u;
+            (p_above2, p_above) = (p_above, p);
+            (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
             if let Some(b) = below {
                 here = b;
             }
         }
-        // Up the chain: tensions, mass accelerations, direction accelerations.
+        !out_of_range
+    }
+
+    /// The elimination by pivots, `D_i = A_ii − c_i² / D_{i−1}`, for the rows left by
+    /// [`eliminate`](Self::eliminate) when its continuants left their range: the same `f_i`
+    /// and `h_i` (to round-off) with a division on the serial chain, slower but needing no
+    /// rescaling.
+    #[cold]
+    #[inline(never)]
+    fn eliminate_by_pivots<const S: usize>(&self, rows: &mut [Row<S>]) {
+        let mut inverse_mass_above = 0.0;
+        let mut u_above = [0.0; S];
+        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+        for (i, row) in rows.iter_mut().enumerate() {
+            let im = self.inverse_mass[i];
+            let u = row.direction;
+            let diagonal = (im + inverse_mass_above) * dot(&u, &u);
+            let off = -dot(&u_above, &u) * inverse_mass_above;
+            let factor = off * inverse_pivot_above;
+            let inverse_pivot = 1.0 / (diagonal - factor * off);
+            let eliminated = row.rhs - factor * eliminated_above;
+            row.factor = factor;
+            row.scaled = eliminated * inverse_pivot;
+            inverse_mass_above = im;
+            u_above = u;
+            (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
+        }
+    }
+
+    /// The up pass: tensions `T_i = h_i − f_{i+1} T_{i+1}`, mass accelerations and
+    /// `ü_i = (a_i − a_{i−1}) / l_i`, handed to `emit` from the free end up.
+    #[inline(always)]
+    fn substitute<const S: usize>(
+        &self,
+        pivot_acceleration: [f64; S],
+        rows: &[Row<S>],
+        mut emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
+    ) {
+        let n = rows.len();
         let mut tension_below = 0.0;
-        let mut coupling_below = 0.0;
+        let mut factor_below = 0.0;
         let mut u_below = [0.0; S];
         let mut a_below = [0.0; S];
         for i in (0..n).rev() {
             let row = &rows[i];
-            let t = (row.eliminated - coupling_below * tension_below) * row.inverse_pivot;
+            // The serial chain: one multiply and one subtraction per rod.
+            let t = row.scaled - factor_below * tension_below;
             let im = self.inverse_mass[i];
             let mut a = row.free;
             for k in 0..S {
@@ -204,7 +330,7 @@ impl Rods {
                 emit(i + 1, udd, &u_below, tension_below);
             }
             tension_below = t;
-            coupling_below = row.coupling;
+            factor_below = row.factor;
             u_below = row.direction;
             a_below = a;
         }
@@ -222,27 +348,175 @@ mod tests {
     use super::*;
 
     /// Solves for `n` rods with the given directions, rates and pairs; returns (ü, T).
-    fn solve<const S: usize>(rods: &Rods, gravity: [f64; S], loads: &[Load<S>]) -> (Vec<[f64; S]>, Vec<f64>) {
+    fn solve<const S: usize>(rods: &Rods, gravity: [f64; S], loads: &[Load<S>]) -> Solution<S> {
+        solve_as(rods, gravity, loads, Route::Solve).0
+    }
+
+    /// Direction accelerations `ü_i` (1/s²) and tensions `T_i` (N) of one solve.
+    type Solution<const S: usize> = (Vec<[f64; S]>, Vec<f64>);
+
+    /// Which elimination [`solve_as`] runs.
+    #[derive(Clone, Copy, PartialEq)]
+    enum Route {
+        /// [`Rods::solve`] as the models call it.
+        Solve,
+        /// [`Rods::eliminate_by_pivots`] whatever the continuants did.
+        Pivots,
+    }
+
+    /// Solves by `route`; returns (ü, T), whether the continuants stayed in range, and the
+    /// backward error of the tensions: `max_i |(A T − b)_i| / max_i (|A| |T| + |b|)_i`.
+    fn solve_as<const S: usize>(
+        rods: &Rods,
+        gravity: [f64; S],
+        loads: &[Load<S>],
+        route: Route,
+    ) -> (Solution<S>, bool, f64) {
         let n = loads.len();
         let (mut udd, mut tension) = (vec![[0.0; S]; n], vec![0.0; n]);
-        with_scratch::<S, _>(n, |s| {
-            rods.solve(
-                gravity,
-                [0.0; S],
-                s,
-                |i| loads[i],
-                |i, a, _, t| {
-                    udd[i] = a;
-                    tension[i] = t;
-                },
-            )
+        let pivot = [0.0; S];
+        let emit = |i: usize, a: [f64; S], _: &[f64; S], t: f64| {
+            udd[i] = a;
+            tension[i] = t;
+        };
+        let (in_range, rows) = with_scratch::<S, _>(n, |s| {
+            let rows = &mut s.rows.0[..n];
+            let in_range = rods.eliminate(gravity, pivot, rows, |i| loads[i]);
+            if !in_range || route == Route::Pivots {
+                rods.eliminate_by_pivots(rows);
+            }
+            rods.substitute(pivot, rows, emit);
+            (in_range, rows.to_vec())
         });
-        (udd, tension)
+        let (mut residual, mut size) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            let u = &rows[i].direction;
+            let above = if i > 0 { rods.inverse_mass[i - 1] } else { 0.0 };
+            let mut terms = [(above + rods.inverse_mass[i]) * dot(u, u) * tension[i], -rows[i].rhs, 0.0, 0.0];
+            if i > 0 {
+                terms[2] = -dot(&rows[i - 1].direction, u) * above * tension[i - 1];
+            }
+            if i + 1 < n {
+                terms[3] = -dot(u, &rows[i + 1].direction) * rods.inverse_mass[i] * tension[i + 1];
+            }
+            residual = residual.max(terms.iter().sum::<f64>().abs());
+            size = size.max(terms.iter().map(|t| t.abs()).sum());
+        }
+        ((udd, tension), in_range, residual / size)
+    }
+
+    /// A deterministic stream of numbers in [0, 1) (a 64-bit LCG's high bits).
+    struct Stream(u64);
+
+    impl Stream {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        /// `10^x` with `x` uniform in `[lo, hi]`.
+        fn decades(&mut self, lo: f64, hi: f64) -> f64 {
+            10f64.powf(lo + (hi - lo) * self.next())
+        }
+    }
+
+    /// A planar chain of `n` rods with masses and lengths log-uniform over `decades`
+    /// (powers of ten), random angles, rates and damping-like pairs.
+    fn random_chain(n: usize, decades: (f64, f64), seed: u64) -> (Rods, Vec<Load<2>>) {
+        let mut r = Stream(seed);
+        let masses: Vec<f64> = (0..n).map(|_| r.decades(decades.0, decades.1)).collect();
+        let lengths: Vec<f64> = (0..n).map(|_| r.decades(decades.0, decades.1)).collect();
+        let loads = (0..n)
+            .map(|_| {
+                let (s, c) = (6.0 * r.next()).sin_cos();
+                let rate = 4.0 * r.next() - 2.0;
+                let pull = 2.0 * r.next() - 1.0;
+                Load { direction: [s, -c], rate_squared: rate * rate, pair: [pull * c, pull * s] }
+            })
+            .collect();
+        (Rods::new(&masses, &lengths, &vec![0.0; n]), loads)
+    }
+
+    /// Largest difference of `a` from `b`, relative to the largest `|b_i|`.
+    fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
+        let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+    }
+
+    /// Solves `loads` by the continuants (which must stay in range) and by the pivots;
+    /// asserts both tension vectors have a backward error below 4 ε and differ by no more
+    /// than `forward` (relative to the largest tension).
+    fn continuants_against_pivots(rods: &Rods, loads: &[Load<2>], forward: f64) {
+        let ((_, tension), in_range, error) = solve_as(rods, [0.0, -9.81], loads, Route::Solve);
+        assert!(in_range, "the continuants left their range");
+        let ((_, tension_p), _, error_p) = solve_as(rods, [0.0, -9.81], loads, Route::Pivots);
+        let difference = relative_difference(&tension, &tension_p);
+        assert!(
+            error < 4.0 * f64::EPSILON && error_p < 4.0 * f64::EPSILON && difference < forward,
+            "backward errors {error:.1e} (continuants), {error_p:.1e} (pivots); difference {difference:.1e}"
+        );
+    }
+
+    #[test]
+    fn continuants_match_pivots_on_a_long_chain_over_twelve_decades() {
+        // n = 4096: 256 rescalings; masses and lengths from 1e-6 to 1e6.
+        let (rods, loads) = random_chain(4096, (-6.0, 6.0), 7);
+        continuants_against_pivots(&rods, &loads, 1e-12);
+    }
+
+    #[test]
+    fn continuants_match_pivots_at_alternating_extreme_masses() {
+        // Masses alternating 1e-6 and 1e6 kg: the pivots swing by twelve decades per rod.
+        // The system is ill-conditioned here, so the two routes, both backward stable, may
+        // differ by its condition number times ε.
+        for seed in 1..4 {
+            let (_, loads) = random_chain(4096, (0.0, 0.0), seed);
+            let masses: Vec<f64> = (0..4096).map(|i| if i % 2 == 0 { 1e-6 } else { 1e6 }).collect();
+            let lengths: Vec<f64> = (0..4096).map(|i| if i % 3 == 0 { 1e6 } else { 1e-6 }).collect();
+            continuants_against_pivots(&Rods::new(&masses, &lengths, &[0.0; 4096]), &loads, 1e-6);
+        }
+    }
+
+    #[test]
+    fn continuants_match_pivots_on_a_straight_heavy_to_light_chain() {
+        // Aligned rods, masses falling from 1e6 to 1e-6 kg: the pivots become as small
+        // as the tridiagonal system lets them.
+        let n = 4096;
+        let masses: Vec<f64> = (0..n).map(|i| 10f64.powf(6.0 - 12.0 * i as f64 / (n - 1) as f64)).collect();
+        let straight = Load { direction: [0.0, -1.0], rate_squared: 1.0, pair: [0.0; 2] };
+        continuants_against_pivots(
+            &Rods::new(&masses, &vec![1.0; n], &vec![0.0; n]),
+            &vec![straight; n],
+            1e-12,
+        );
+    }
+
+    #[test]
+    fn continuants_out_of_range_fall_back_to_pivots() {
+        // Masses of 1e-150 kg make pivots near 2⁵⁰⁰: the continuants leave their range
+        // within two rods, and the pivots still give the weight below each rod.
+        let masses = [1e-150, 3e-150, 2e-150, 1e-150];
+        let rods = Rods::new(&masses, &[1.0, 0.5, 2.0, 1.0], &[0.0; 4]);
+        let hanging = Load { direction: [0.0, -1.0], rate_squared: 0.0, pair: [0.0; 2] };
+        let ((_, tension), in_range, _) = solve_as(&rods, [0.0, -9.81], &[hanging; 4], Route::Solve);
+        assert!(!in_range);
+        for (i, t) in tension.iter().enumerate() {
+            let weight = 9.81 * masses[i..].iter().sum::<f64>();
+            assert!((t - weight).abs() < 1e-14 * weight, "rod {i}: {t:e} vs {weight:e}");
+        }
+    }
+
+    #[test]
+    fn normalizer_is_the_power_of_two_into_one_to_two() {
+        for x in [1.0, 1.5, 3.0, 0.75, 2f64.powi(700), 1.9 * 2f64.powi(-700), f64::MIN_POSITIVE] {
+            let y = x * normalizer(x);
+            assert!((1.0..2.0).contains(&y), "{x:e} → {y}");
+        }
     }
 
     #[test]
     fn hanging_chain_carries_the_weight_below_each_rod() {
-        let rods = Rods::new(&[1.0, 2.0, 0.5], &[1.0, 0.5, 2.0]);
+        let rods = Rods::new(&[1.0, 2.0, 0.5], &[1.0, 0.5, 2.0], &[0.0; 3]);
         let g = 9.81;
         let hanging = Load { direction: [0.0, -1.0], rate_squared: 0.0, pair: [0.0; 2] };
         let (udd, tension) = solve(&rods, [0.0, -g], &[hanging; 3]);
@@ -256,7 +530,7 @@ mod tests {
     fn spinning_single_rod_pulls_with_the_centripetal_force() {
         // One mass m on a rod l turning at ω without gravity: T = m l ω², ü = −ω² u.
         let (m, l, w) = (2.0, 0.5, 3.0);
-        let rods = Rods::new(&[m], &[l]);
+        let rods = Rods::new(&[m], &[l], &[0.0]);
         let load = Load { direction: [1.0, 0.0, 0.0], rate_squared: w * w, pair: [0.0; 3] };
         let (udd, tension) = solve(&rods, [0.0; 3], &[load]);
         assert!((tension[0] - m * l * w * w).abs() < 1e-12);

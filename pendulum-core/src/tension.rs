@@ -2,7 +2,9 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
+use crate::model::all_finite;
 use crate::rods::{Load, Rods, with_scratch};
+use crate::trig::sin_cos_into;
 use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
@@ -13,7 +15,10 @@ use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
 /// With `u_i = (sin θ_i, −cos θ_i)` and `n_i = ∂u_i/∂θ_i = (cos θ_i, sin θ_i)`:
 /// `|u̇_i|² = θ̇_i²`, the generalized force `Q_i = σ_i − λ_i θ̇_i` (eq 26) acts as the force
 /// pair `F_i = (Q_i / l_i) n_i` on rod `i` (its virtual work `F_i·l_i n_i δθ_i = Q_i δθ_i`),
-/// and `θ̈_i = n_i · ü_i` (since `ü_i = θ̈_i n_i − θ̇_i² u_i`). One `sin_cos` per link.
+/// and `θ̈_i = n_i · ü_i` (since `ü_i = θ̈_i n_i − θ̇_i² u_i`). The `sin θ_i`, `cos θ_i` come
+/// first, all at once, from a vectorised polynomial kernel (`trig` module docs: within
+/// 1 ulp of `f64::sin_cos`, which it calls for `|θ_i| > 8192`), then the loads, then the
+/// solve: three loops over the links.
 ///
 /// Mass matrix, force terms and energies are [`Planar`]'s, so the model plugs into
 /// [`FirstOrder`](crate::FirstOrder), [`Canonical`](crate::Canonical) and
@@ -34,7 +39,8 @@ where
 {
     /// The O(n) planar model of `chain`.
     pub fn new(chain: Chain<L>) -> Self {
-        let rods = Rods::new(chain.masses().as_slice(), chain.lengths().as_slice());
+        let rods =
+            Rods::new(chain.masses().as_slice(), chain.lengths().as_slice(), chain.damping().as_slice());
         Self { dense: Planar::new(chain), rods }
     }
 
@@ -81,30 +87,50 @@ where
         {
             return Err(crate::Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
         }
-        let (lengths, damping) = (chain.lengths(), chain.damping());
+        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
         let gravity = [0.0, -chain.gravity()];
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
-            let load = |i: usize| {
-                let (sin, cos) = q[i].sin_cos();
-                let pull = (inputs.torque[i] - damping[i] * qd[i]) / lengths[i];
-                Load { direction: [sin, -cos], rate_squared: qd[i] * qd[i], pair: [pull * cos, pull * sin] }
+            // The trigonometry in a vectorised loop of its own, before the solve.
+            let sin_cos = &mut s.sin_cos[..n];
+            sin_cos_into(q.as_slice(), sin_cos);
+            // The loads too: built inside the solve (bounds checks and all), the builder was
+            // not inlined and cost a call per link.
+            let loads = &mut s.loads[..n];
+            let (qd, torque) = (&qd.as_slice()[..n], &inputs.torque.as_slice()[..n]);
+            let build = |[sin, cos]: [f64; 2], rate: f64, pull: f64| Load {
+                direction: [sin, -cos],
+                rate_squared: rate * rate,
+                pair: [pull * cos, pull * sin],
             };
+            // Without torques (the common case) the pull is the damping's alone.
+            if all_zero(torque) {
+                for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
+                    *load = build(trig, qd[i], -drag[i] * qd[i]);
+                }
+            } else {
+                for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
+                    *load = build(trig, qd[i], torque[i] * inverse_length[i] - drag[i] * qd[i]);
+                }
+            }
+            let loads = &*loads;
+            let load = |i: usize| loads[i];
             // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
-            self.rods.solve(gravity, pivot, s, load, |i, [ax, ay], &[ux, uy], t| {
+            self.rods.solve(gravity, pivot, &mut s.rows, load, |i, [ax, ay], &[ux, uy], t| {
                 out[i] = -uy * ax + ux * ay;
                 if let Some(tensions) = tensions.as_deref_mut() {
                     tensions[i] = t;
                 }
             });
         });
-        if out.as_slice().iter().all(|a| a.is_finite()) {
-            Ok(())
-        } else {
-            Err(crate::Error::NotPositiveDefinite)
-        }
+        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
     }
+}
+
+/// Whether every entry of `v` is zero (no early exit, so that it vectorises).
+fn all_zero(v: &[f64]) -> bool {
+    v.iter().fold(true, |zero, x| zero & (*x == 0.0))
 }
 
 impl<L: Dim> From<Chain<L>> for PlanarTension<L>
@@ -202,6 +228,26 @@ mod tests {
         fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
         fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
         assert_relative_eq!(a, b, epsilon = 1e-12, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn with_and_without_torques_match_the_dense_route() {
+        // Zero torques take the damping-only loop; one non-zero torque among zeros must not.
+        let n = 40;
+        let masses: Vec<f64> = (0..n).map(|i| 0.5 + (i as f64 * 0.37).sin().abs()).collect();
+        let lengths: Vec<f64> = (0..n).map(|i| 0.2 + (i as f64 * 0.71).cos().abs()).collect();
+        let chain = Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap().with_damping(&vec![0.05; n]).unwrap();
+        let fast = PlanarTension::new(chain);
+        let q = DVector::from_fn(n, |i, _| 0.3 + (i as f64 * 0.77) % 2.5);
+        let qd = DVector::from_fn(n, |i, _| (i as f64 * 1.3).sin() * 3.0);
+        let mut inputs = fast.zero_inputs();
+        for torque in [0.0, 0.7] {
+            inputs.torque[n / 2] = torque;
+            let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
+            fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
+            fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
+            assert_relative_eq!(a, b, epsilon = 1e-10, max_relative = 1e-10);
+        }
     }
 
     #[test]
