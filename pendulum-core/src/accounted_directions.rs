@@ -105,10 +105,8 @@ where
                 return Err(Error::LengthMismatch { what, expected: len + 2, got });
             }
         }
-        let motion = self.motion(x);
-        let mut flow = DVector::zeros(len);
-        self.chain.rhs(t, &motion, &mut flow)?;
-        out.rows_mut(0, len).copy_from(&flow);
+        // The chain's part in place: no copy of the state, nothing allocated per call.
+        self.chain.flow(t, &x.as_slice()[..len], &mut out.as_mut_slice()[..len])?;
         let c = self.chain.chain();
         let (n, d) = (c.links(), S::DIM);
         let (tails, lengths, damping) = (c.tail_masses(), c.lengths(), c.damping());
@@ -118,7 +116,7 @@ where
         let mut force = &pivot_acceleration * total;
         force[d - 1] += total * c.gravity();
         let mut damped = 0.0;
-        let (w, wd) = (&motion.as_slice()[len / 2..], &flow.as_slice()[len / 2..]);
+        let (w, wd) = (&x.as_slice()[len / 2..len], &out.as_slice()[len / 2..len]);
         for j in 0..n {
             let weight = tails[j] * lengths[j];
             let mut w2 = 0.0;
@@ -145,9 +143,7 @@ where
         if x.len() != len + 2 {
             return;
         }
-        let mut motion = self.motion(x);
-        self.chain.project(&mut motion);
-        x.rows_mut(0, len).copy_from(&motion);
+        self.chain.project_slice(&mut x.as_mut_slice()[..len]);
     }
 }
 

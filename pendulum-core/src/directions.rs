@@ -108,12 +108,17 @@ where
 
     /// Errors unless `x` has `2·S·n` finite entries.
     pub fn check_state(&self, x: &DVector<f64>) -> Result<()> {
+        self.check_state_slice(x.as_slice())
+    }
+
+    /// [`check_state`](Self::check_state) of a state held as a slice.
+    fn check_state_slice(&self, x: &[f64]) -> Result<()> {
         if x.len() != self.state_len() {
             return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: x.len() });
         }
-        // On the slice, vectorised: a scalar search costs a third of the solve here.
-        if !all_finite(x.as_slice())
-            && let Some(index) = x.as_slice().iter().position(|v| !v.is_finite())
+        // Vectorised: a scalar search costs a third of the solve here.
+        if !all_finite(x)
+            && let Some(index) = x.iter().position(|v| !v.is_finite())
         {
             return Err(Error::NonFinite { what: "x", index, value: x[index] });
         }
@@ -188,14 +193,14 @@ where
         Dr: Drive<S>,
     {
         self.check_state(x)?;
-        self.accelerations_of_valid(t, x, out, tensions)
+        self.accelerations_of_valid(t, x.as_slice(), out, tensions)
     }
 
     /// [`accelerations`](Self::accelerations) for a state already checked.
     fn accelerations_of_valid(
         &self,
         t: f64,
-        x: &DVector<f64>,
+        x: &[f64],
         out: &mut [f64],
         tensions: Option<&mut [f64]>,
     ) -> Result<()>
@@ -213,11 +218,27 @@ where
         }
         let pivot = self.drive.acceleration(t);
         match S::DIM {
-            2 => self.solve::<2>(x.as_slice(), [pivot[0], pivot[1]], out, tensions),
-            3 => self.solve::<3>(x.as_slice(), [pivot[0], pivot[1], pivot[2]], out, tensions),
+            2 => self.solve::<2>(x, [pivot[0], pivot[1]], out, tensions),
+            3 => self.solve::<3>(x, [pivot[0], pivot[1], pivot[2]], out, tensions),
             d => return Err(Error::LengthMismatch { what: "space", expected: 3, got: d }),
         }
         Ok(())
+    }
+
+    /// [`System::rhs`] on slices, `out = (w, ü(t, x))`, for systems that hold the chain's
+    /// state inside a longer one ([`AccountedDirections`](crate::AccountedDirections)).
+    pub(crate) fn flow(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<()>
+    where
+        Dr: Drive<S>,
+    {
+        let half = S::DIM * self.links();
+        if out.len() != 2 * half {
+            return Err(Error::LengthMismatch { what: "out", expected: 2 * half, got: out.len() });
+        }
+        self.check_state_slice(x)?;
+        let (velocity, acceleration) = out.split_at_mut(half);
+        velocity.copy_from_slice(&x[half..]);
+        self.accelerations_of_valid(t, x, acceleration, None)
     }
 
     /// The tension solve for `C`-dimensional space (`C = S::DIM`).
@@ -402,7 +423,7 @@ impl<Dr: Drive<U3>> Directions<U3, Dr> {
         let x = self.from_spherical(q, qd)?;
         let n = self.links();
         let mut udd = vec![0.0; 3 * n];
-        self.accelerations_of_valid(t, &x, &mut udd, None)?;
+        self.accelerations_of_valid(t, x.as_slice(), &mut udd, None)?;
         let mut out = DVector::zeros(2 * n);
         for i in 0..n {
             let frame = SphericalFrame::new(q[i], q[n + i]);
@@ -467,14 +488,7 @@ where
 
     /// `x' = (w, ü(t, x))`: one O(n) tension solve.
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
-        let half = S::DIM * self.links();
-        if out.len() != 2 * half {
-            return Err(Error::LengthMismatch { what: "out", expected: 2 * half, got: out.len() });
-        }
-        self.check_state(x)?;
-        let (velocity, acceleration) = out.as_mut_slice().split_at_mut(half);
-        velocity.copy_from_slice(&x.as_slice()[half..]);
-        self.accelerations_of_valid(t, x, acceleration, None)
+        self.flow(t, x.as_slice(), out.as_mut_slice())
     }
 }
 
@@ -486,11 +500,18 @@ where
     /// `u_i ← u_i/|u_i|`, `w_i ← w_i − (u_i·w_i) u_i` (the nearest point of the constraint
     /// manifold `|u_i| = 1, u_i·w_i = 0`, link by link).
     fn project(&self, x: &mut DVector<f64>) {
-        let (n, d) = (self.links(), S::DIM);
+        self.project_slice(x.as_mut_slice());
+    }
+}
+
+impl<S: DimName, Dr> Directions<S, Dr> {
+    /// [`Constrained::project`] on a slice (a state of the wrong length is left alone).
+    pub(crate) fn project_slice(&self, x: &mut [f64]) {
+        let (n, d) = (self.chain.links(), S::DIM);
         if x.len() != 2 * d * n {
             return;
         }
-        let (directions, rates) = x.as_mut_slice().split_at_mut(d * n);
+        let (directions, rates) = x.split_at_mut(d * n);
         for (u, w) in directions.chunks_exact_mut(d).zip(rates.chunks_exact_mut(d)) {
             let norm = u.iter().map(|v| v * v).sum::<f64>().sqrt();
             u.iter_mut().for_each(|v| *v /= norm);
