@@ -80,12 +80,24 @@ pub(crate) struct Rows<const S: usize>(Vec<Row<S>>);
 
 /// The per-rod buffers of one solve (allocated once per thread, see [`with_scratch`]):
 /// the solve's rows, and room for a model to prepare `(sin θ_i, cos θ_i)` and the rods'
-/// [`Load`]s in passes of their own before the solve.
+/// [`Load`]s in passes of their own before the solve ([`Scratch::staging`]).
 #[derive(Debug, Default)]
 pub(crate) struct Scratch<const S: usize> {
     pub rows: Rows<S>,
-    pub sin_cos: Vec<[f64; 2]>,
-    pub loads: Vec<Load<S>>,
+    sin_cos: Vec<[f64; 2]>,
+    loads: Vec<Load<S>>,
+}
+
+impl<const S: usize> Scratch<S> {
+    /// Room for `n` rods' `(sin θ_i, cos θ_i)` and [`Load`]s (grown on first use, so models
+    /// that build their loads inside the solve pay nothing for it), and the solve's rows.
+    pub fn staging(&mut self, n: usize) -> (&mut [[f64; 2]], &mut [Load<S>], &mut Rows<S>) {
+        if self.loads.len() < n {
+            self.sin_cos.resize(n, [0.0; 2]);
+            self.loads.resize(n, Load { direction: [0.0; S], rate_squared: 0.0, pair: [0.0; S] });
+        }
+        (&mut self.sin_cos[..n], &mut self.loads[..n], &mut self.rows)
+    }
 }
 
 thread_local! {
@@ -107,9 +119,6 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
         if scratch.rows.0.len() < n {
             let row = Row { direction: [0.0; S], free: [0.0; S], factor: 0.0, scaled: 0.0, rhs: 0.0 };
             scratch.rows.0.resize(n, row);
-            scratch.sin_cos.resize(n, [0.0; 2]);
-            let load = Load { direction: [0.0; S], rate_squared: 0.0, pair: [0.0; S] };
-            scratch.loads.resize(n, load);
         }
         f(&mut scratch)
     }
@@ -134,6 +143,22 @@ fn dot<const S: usize>(a: &[f64; S], b: &[f64; S]) -> f64 {
         s += a[k] * b[k];
     }
     s
+}
+
+/// Row `i` of the tridiagonal system `A T = b` (module docs): the diagonal entry
+/// `A_ii = (1/m_i + 1/m_{i−1}) |u_i|²` and the entry `c_i = A_{i,i−1} = −(u_{i−1}·u_i)/m_{i−1}`
+/// (1/kg), from `1/m_i`, `1/m_{i−1}` (0 for the first rod) and the directions.
+///
+/// `|u_i|²` is 1 on the constraint manifold; keeping it makes `u_i·ü_i = −|u̇_i|²` hold
+/// exactly also at the slightly non-unit directions inside an integrator step.
+#[inline(always)]
+fn entries<const S: usize>(
+    inverse_mass: f64,
+    inverse_mass_above: f64,
+    u_above: &[f64; S],
+    u: &[f64; S],
+) -> (f64, f64) {
+    ((inverse_mass + inverse_mass_above) * dot(u, u), -dot(u_above, u) * inverse_mass_above)
 }
 
 /// Rows between two rescalings of the continuants in [`Rods::solve`]. Each row multiplies
@@ -243,11 +268,7 @@ impl Rods {
                 a[k] += (here.pair[k] - pair_below[k]) * im;
                 rhs += u[k] * (a[k] - free_above[k]);
             }
-            // |u_i|² is 1 on the constraint manifold; keeping it makes u_i·ü_i = −|u̇_i|²
-            // hold exactly also at the slightly non-unit directions inside an integrator step.
-            let diagonal = (im + inverse_mass_above) * dot(&u, &u);
-            // Off-diagonal entry between rods i−1 and i: c_i = −(u_{i−1}·u_i)/m_{i−1}.
-            let off = -dot(&u_above, &u) * inverse_mass_above;
+            let (diagonal, off) = entries(im, inverse_mass_above, &u_above, &u);
             if i % BLOCK == 0 {
                 let scale = normalizer(p_above);
                 p_above *= scale;
@@ -283,10 +304,8 @@ impl Rods {
         let mut u_above = [0.0; S];
         let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
         for (i, row) in rows.iter_mut().enumerate() {
-            let im = self.inverse_mass[i];
-            let u = row.direction;
-            let diagonal = (im + inverse_mass_above) * dot(&u, &u);
-            let off = -dot(&u_above, &u) * inverse_mass_above;
+            let (im, u) = (self.inverse_mass[i], row.direction);
+            let (diagonal, off) = entries(im, inverse_mass_above, &u_above, &u);
             let factor = off * inverse_pivot_above;
             let inverse_pivot = 1.0 / (diagonal - factor * off);
             let eliminated = row.rhs - factor * eliminated_above;
@@ -391,13 +410,17 @@ mod tests {
         let (mut residual, mut size) = (0.0f64, 0.0f64);
         for i in 0..n {
             let u = &rows[i].direction;
-            let above = if i > 0 { rods.inverse_mass[i - 1] } else { 0.0 };
-            let mut terms = [(above + rods.inverse_mass[i]) * dot(u, u) * tension[i], -rows[i].rhs, 0.0, 0.0];
+            let above =
+                if i > 0 { (rods.inverse_mass[i - 1], rows[i - 1].direction) } else { (0.0, [0.0; S]) };
+            let (diagonal, off) = entries(rods.inverse_mass[i], above.0, &above.1, u);
+            let mut terms = [diagonal * tension[i], -rows[i].rhs, 0.0, 0.0];
             if i > 0 {
-                terms[2] = -dot(&rows[i - 1].direction, u) * above * tension[i - 1];
+                terms[2] = off * tension[i - 1];
             }
             if i + 1 < n {
-                terms[3] = -dot(u, &rows[i + 1].direction) * rods.inverse_mass[i] * tension[i + 1];
+                let (_, off_below) =
+                    entries(rods.inverse_mass[i + 1], rods.inverse_mass[i], u, &rows[i + 1].direction);
+                terms[3] = off_below * tension[i + 1];
             }
             residual = residual.max(terms.iter().sum::<f64>().abs());
             size = size.max(terms.iter().map(|t| t.abs()).sum());

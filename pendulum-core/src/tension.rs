@@ -92,12 +92,11 @@ where
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let mut tensions = tensions;
         with_scratch::<2, _>(n, |s| {
-            // The trigonometry in a vectorised loop of its own, before the solve.
-            let sin_cos = &mut s.sin_cos[..n];
+            // The trigonometry in a vectorised loop of its own, before the solve. The loads
+            // too: built inside the solve (bounds checks and all), the builder was not
+            // inlined and cost a call per link.
+            let (sin_cos, loads, rows) = s.staging(n);
             sin_cos_into(q.as_slice(), sin_cos);
-            // The loads too: built inside the solve (bounds checks and all), the builder was
-            // not inlined and cost a call per link.
-            let loads = &mut s.loads[..n];
             let (qd, torque) = (&qd.as_slice()[..n], &inputs.torque.as_slice()[..n]);
             let build = |[sin, cos]: [f64; 2], rate: f64, pull: f64| Load {
                 direction: [sin, -cos],
@@ -117,7 +116,7 @@ where
             let loads = &*loads;
             let load = |i: usize| loads[i];
             // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
-            self.rods.solve(gravity, pivot, &mut s.rows, load, |i, [ax, ay], &[ux, uy], t| {
+            self.rods.solve(gravity, pivot, rows, load, |i, [ax, ay], &[ux, uy], t| {
                 out[i] = -uy * ax + ux * ay;
                 if let Some(tensions) = tensions.as_deref_mut() {
                     tensions[i] = t;
