@@ -364,6 +364,9 @@ impl Rods {
 
 #[cfg(test)]
 mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
     use super::*;
 
     /// Solves for `n` rods with the given directions, rates and pairs; returns (ü, T).
@@ -428,32 +431,22 @@ mod tests {
         ((udd, tension), in_range, residual / size)
     }
 
-    /// A deterministic stream of numbers in [0, 1) (a 64-bit LCG's high bits).
-    struct Stream(u64);
-
-    impl Stream {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        /// `10^x` with `x` uniform in `[lo, hi]`.
-        fn decades(&mut self, lo: f64, hi: f64) -> f64 {
-            10f64.powf(lo + (hi - lo) * self.next())
-        }
+    /// `10^x` with `x` uniform in `[lo, hi]`.
+    fn decades(r: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+        10f64.powf(lo + (hi - lo) * r.random::<f64>())
     }
 
     /// A planar chain of `n` rods with masses and lengths log-uniform over `decades`
     /// (powers of ten), random angles, rates and damping-like pairs.
-    fn random_chain(n: usize, decades: (f64, f64), seed: u64) -> (Rods, Vec<Load<2>>) {
-        let mut r = Stream(seed);
-        let masses: Vec<f64> = (0..n).map(|_| r.decades(decades.0, decades.1)).collect();
-        let lengths: Vec<f64> = (0..n).map(|_| r.decades(decades.0, decades.1)).collect();
+    fn random_chain(n: usize, decades_range: (f64, f64), seed: u64) -> (Rods, Vec<Load<2>>) {
+        let mut r = ChaCha8Rng::seed_from_u64(seed);
+        let masses: Vec<f64> = (0..n).map(|_| decades(&mut r, decades_range.0, decades_range.1)).collect();
+        let lengths: Vec<f64> = (0..n).map(|_| decades(&mut r, decades_range.0, decades_range.1)).collect();
         let loads = (0..n)
             .map(|_| {
-                let (s, c) = (6.0 * r.next()).sin_cos();
-                let rate = 4.0 * r.next() - 2.0;
-                let pull = 2.0 * r.next() - 1.0;
+                let (s, c) = r.random_range(0.0..6.0f64).sin_cos();
+                let rate = r.random_range(-2.0..2.0);
+                let pull = r.random_range(-1.0..1.0);
                 Load { direction: [s, -c], rate_squared: rate * rate, pair: [pull * c, pull * s] }
             })
             .collect();

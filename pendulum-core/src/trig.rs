@@ -127,6 +127,9 @@ fn sin_cos_loop(angles: &[f64], out: &mut [[f64; 2]]) {
 
 #[cfg(test)]
 mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
     use super::*;
 
     /// Distance in units in the last place (`±0` equal; NaN against NaN is 0).
@@ -156,15 +159,10 @@ mod tests {
         worst
     }
 
-    /// A deterministic stream of numbers in [0, 1) (a 64-bit LCG's high bits).
+    /// `n` numbers uniform in [0, 1) from a seeded generator.
     fn stream(seed: u64, n: usize) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                (s >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .collect()
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n).map(|_| rng.random()).collect()
     }
 
     #[test]
