@@ -2,7 +2,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, allocator::Allocator};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The physical parameters of an n-link chain, validated once at construction.
 ///

@@ -11,7 +11,8 @@ use std::borrow::Cow;
 
 use nalgebra::{DefaultAllocator, Dim, DimName, OVector, U1, U3, Vector3, allocator::Allocator};
 
-use crate::{Error, Inputs, InputsAt, Result};
+use crate::error::{Error, Result};
+use crate::model::{Inputs, InputsAt};
 
 /// A prescribed pivot motion: position `p(t)` (m), velocity `ṗ(t)` (m/s) and acceleration
 /// `p̈(t)` (m/s²) in the model's space `S` (`U2` planar, `U3` spatial).

@@ -1,67 +1,62 @@
 //! Dynamics of N-link pendulums: chains of point masses on massless rigid rods hung from a
 //! pivot, planar and spatial.
 //!
-//! - [`Chain`]: validated parameters (masses, lengths, gravity, damping).
-//! - [`Model`]: the equations of motion `M(q) q̈ + c + k + d = Q`, implemented by the
-//!   generic [`Planar`] and [`Spatial`] models here and by the unrolled fixed-N models
-//!   `pendulum-macros` generates.
-//! - [`PlanarTension`]: the planar model with O(n) accelerations by the rod tensions, and
-//!   [`Directions`]: the chain in unit link directions, 2D or 3D, O(n) and free of the
-//!   spherical angles' singularity (large chains, `docs/large-chains.md`).
-//! - [`Canonical`]: a model as the first-order system in canonical variables `(q, p)`,
-//!   `p = M(q) q̇`, where Gauss–Legendre methods are symplectic (`docs/integrators.md`).
-//! - [`Drive`] ([`Fixed`], [`Harmonic`], [`Circle`], [`FnDrive`]) and [`TorqueAt`]: a
-//!   prescribed pivot motion `p(t)` and torques `σ(t)`, combined by [`Driven`] into the
-//!   inputs of a [`FirstOrder`] system.
-//! - [`Accounted`]: the inertial-frame energy `H = T + U` of a driven chain with the work
-//!   of drive and torques and the damping losses integrated along the run;
-//!   [`AccountedDirections`] the same for a [`Directions`] chain.
-//! - [`trajectory::run`]: integrate from `t0` to `t1`, sampling every k steps, stopping
-//!   early on request.
+//! The crate in layers, each folder importing only from the ones above it in this list:
+//! - [`Chain`]: validated parameters (masses, lengths, gravity, damping); [`Error`].
+//! - [`kinematics`]: the chain's geometry in angle coordinates ([`kinematics::Chart`]:
+//!   planar and spherical angles), the one place link directions are written.
+//! - [`Model`]: the equations of motion `M(q) q̈ + c + k + d = Q`, with its [`Inputs`];
+//!   [`Drive`] ([`Fixed`], [`Harmonic`], [`Circle`], [`FnDrive`]) and [`TorqueAt`]: a
+//!   prescribed pivot motion `p(t)` and torques `σ(t)`, combined by [`Driven`].
+//! - [`models`]: the generic [`Planar`] and [`Spatial`] models (the fixed-N models
+//!   `pendulum-macros` generates implement the same trait), and the O(n) routes
+//!   [`PlanarTension`] and [`Directions`] (unit link directions, 2D or 3D, free of the
+//!   spherical angles' singularity; `docs/large-chains.md`).
+//! - [`systems`]: a model as a first-order system for the integrators, [`FirstOrder`]
+//!   `x = (q, q̇)` or [`Canonical`] `x = (q, p)` (symplectic with Gauss–Legendre,
+//!   `docs/integrators.md`).
+//! - [`energy`]: the inertial-frame energy `H = T + U` and the powers of drive, torques and
+//!   damping; [`Accounted`] integrates them along a run, for chains in angles and in
+//!   directions alike.
+//! - [`integrate`]: the integrators, which know nothing of pendulums; [`trajectory::run`]
+//!   integrates from `t0` to `t1`, sampling every k steps, stopping early on request.
+//! - [`analysis`]: normal modes, steady rotation and its stability, relative equilibria.
 //!
-//! Equation numbers refer to the seed document (`shared/seed`); where it is wrong the
-//! code follows the sympy derivation and `reference/ERRATA.md` says so.
+//! Every item is also re-exported here at the root, the paths of earlier releases.
+//!
+//! Equation numbers refer to the seed document ("鎖を振り回したい", 中山大樹, 2018, the
+//! document the project grew out of); where it is wrong the code follows the sympy derivation and
+//! `reference/ERRATA.md` says so.
 
-mod accounted_directions;
-mod canonical;
 mod chain;
-mod directions;
 mod drive;
-mod energy;
 mod error;
-mod first_order;
-pub mod integrate;
 mod model;
-mod modes;
-mod planar;
-mod relative;
-mod rods;
-mod spatial;
-mod stability;
-mod steady;
-mod tension;
-pub mod trajectory;
-mod trig;
 
-pub use accounted_directions::AccountedDirections;
-pub use canonical::{Canonical, KineticGradient};
+pub mod analysis;
+pub mod energy;
+pub mod integrate;
+pub mod kinematics;
+pub mod models;
+pub mod systems;
+pub mod trajectory;
+
+pub use analysis::{
+    Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, Stability,
+    SteadyRotation, SteadyShape, linearise, normal_modes, relative_equilibrium, relative_spectrum,
+    sign_changes, stability,
+};
 pub use chain::Chain;
-pub use directions::Directions;
 pub use drive::{Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, TorqueAt};
 pub use energy::{
-    Accounted, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum, pivot_momentum_rate,
-    powers,
+    Accounted, AccountedDirections, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum,
+    pivot_momentum_rate, powers,
 };
 pub use error::{Error, Result};
-pub use first_order::{FirstOrder, InputsAt};
-pub use model::{Inputs, Model, ModelAlloc, check_inputs};
-pub use modes::{NormalModes, normal_modes, sign_changes};
-pub use planar::Planar;
-pub use relative::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
-pub use spatial::{SINGULARITY_TOLERANCE, Spatial, check_polar_angle, check_polar_sin};
-pub use stability::{Linearisation, Stability, linearise, stability};
-pub use steady::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};
-pub use tension::PlanarTension;
+pub use kinematics::{SINGULARITY_TOLERANCE, check_polar_angle, check_polar_sin};
+pub use model::{Inputs, InputsAt, Model, ModelAlloc, check_inputs};
+pub use models::{Directions, Planar, PlanarTension, Spatial};
+pub use systems::{Canonical, FirstOrder};
 
 /// Re-exports for code generated by `pendulum-macros`. Not a public API.
 #[doc(hidden)]

@@ -1,8 +1,12 @@
 //! The trait every chain model implements, generated fixed-N and generic dynamic-N alike.
 
+use std::borrow::Cow;
+
 use nalgebra::{DefaultAllocator, Dim, DimName, OMatrix, OVector, allocator::Allocator};
 
-use crate::{Chain, Error, Result};
+use crate::chain::Chain;
+use crate::error::{Error, Result};
+use crate::kinematics::Chart;
 
 /// The allocator bounds a [`Model`] needs, in one name.
 ///
@@ -48,6 +52,38 @@ where
     }
 }
 
+/// The inputs (torques, pivot acceleration) acting at time `t`: the seam for a
+/// time-dependent drive.
+///
+/// Constant [`Inputs`] implement it (borrowed, no copy), and so does any closure
+/// `Fn(f64) -> Inputs` (`t` in s) and [`Driven`](crate::drive::Driven), a pivot
+/// [`Drive`](crate::drive::Drive) with torques of time.
+pub trait InputsAt<D: Dim, S: DimName>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    /// The inputs at time `t` (s).
+    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>>;
+}
+
+impl<D: Dim, S: DimName> InputsAt<D, S> for Inputs<D, S>
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    fn inputs_at(&self, _t: f64) -> Cow<'_, Inputs<D, S>> {
+        Cow::Borrowed(self)
+    }
+}
+
+impl<D: Dim, S: DimName, F: Fn(f64) -> Inputs<D, S>> InputsAt<D, S> for F
+where
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+{
+    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>> {
+        Cow::Owned(self(t))
+    }
+}
+
 /// An n-link chain's equations of motion in generalized coordinates `q`:
 ///
 /// ```text
@@ -74,6 +110,10 @@ where
     type Dof: Dim;
     /// The pivot's space: `U2` planar (x, y), `U3` spatial (x, y, z).
     type Space: DimName;
+    /// The angle coordinates `q` is written in ([`PlanarAngles`](crate::kinematics::PlanarAngles)
+    /// or [`SphericalAngles`](crate::kinematics::SphericalAngles)): where the link
+    /// geometry (directions, positions, `∂T/∂q`) comes from.
+    type Chart: Chart<Space = Self::Space>;
 
     /// The chain's parameters.
     fn chain(&self) -> &Chain<Self::Links>;
@@ -159,6 +199,18 @@ where
         if out.iter().all(|a| a.is_finite()) { Ok(()) } else { Err(Error::NotPositiveDefinite) }
     }
 
+    /// The gradient `∂T/∂q` of the kinetic energy at fixed rates `q̇` (N·m), written into
+    /// `out`: the chart's [`Chart::kinetic_gradient`]. The canonical form's momentum
+    /// equation needs it (`∂T/∂q = Ṁ q̇ − c`, but `∂M/∂q` is not part of the trait).
+    fn kinetic_gradient(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        Self::Chart::kinetic_gradient(self.chain(), q.as_slice(), qd.as_slice(), out.as_mut_slice());
+    }
+
     /// Total mechanical energy `H = T + U` (J) relative to the pivot.
     fn energy(&self, q: &OVector<f64, Self::Dof>, qd: &OVector<f64, Self::Dof>) -> f64 {
         self.kinetic_energy(q, qd) + self.potential_energy(q)
@@ -189,15 +241,23 @@ where
         ("pivot_acceleration", inputs.pivot_acceleration.as_slice()),
     ];
     for (what, v) in vectors {
-        let expected = if what == "pivot_acceleration" { S::dim() } else { dof };
-        if v.len() != expected {
-            return Err(Error::LengthMismatch { what, expected, got: v.len() });
-        }
-        if !all_finite(v)
-            && let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite())
-        {
-            return Err(Error::NonFinite { what, index, value });
-        }
+        check_vector(what, v, if what == "pivot_acceleration" { S::dim() } else { dof })?;
+    }
+    Ok(())
+}
+
+/// Errors unless `v` has `expected` entries, all finite: [`Error::LengthMismatch`] or
+/// [`Error::NonFinite`] naming `what` and the first bad entry. The one input check behind
+/// every model's and system's.
+pub(crate) fn check_vector(what: &'static str, v: &[f64], expected: usize) -> Result<()> {
+    if v.len() != expected {
+        return Err(Error::LengthMismatch { what, expected, got: v.len() });
+    }
+    // Vectorised first: a scalar search costs a third of an O(n) evaluation.
+    if !all_finite(v)
+        && let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite())
+    {
+        return Err(Error::NonFinite { what, index, value });
     }
     Ok(())
 }

@@ -24,8 +24,8 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DefaultAllocator, OVector};
 
+use crate::error::{Error, Result};
 use crate::integrate::{Integrator, State, System, SystemAlloc};
-use crate::{Error, Result};
 
 /// What a [`run`] did.
 #[derive(Debug, Clone, Copy, PartialEq)]

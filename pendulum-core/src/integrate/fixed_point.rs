@@ -6,7 +6,7 @@ use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, U1, allocator::Allocator
 
 use super::gauss::{LastStep, complete_step, extrapolate_stages};
 use super::{GaussStages, Integrator, State, Stats, System, SystemAlloc, check_step};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The Gauss–Legendre method with `S` stages (`U1`, `U2`, `U3`: orders 2, 4, 6), its stage
 /// equations
@@ -177,8 +177,10 @@ mod tests {
     use nalgebra::{DVector, Dyn, U2, U3, Vector1};
 
     use super::*;
+    use crate::chain::Chain;
     use crate::integrate::{GaussLegendre, GaussOptions};
-    use crate::{Chain, FirstOrder, Planar};
+    use crate::models::planar::Planar;
+    use crate::systems::first_order::FirstOrder;
 
     fn double_pendulum() -> FirstOrder<Planar, crate::Inputs<Dyn, U2>> {
         FirstOrder::new(Planar::new(Chain::new(&[1.0, 0.7], &[1.0, 0.6], 9.81).unwrap()))

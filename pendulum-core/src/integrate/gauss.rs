@@ -4,7 +4,7 @@
 use nalgebra::{DefaultAllocator, Dim, DimMul, DimProd, OMatrix, OVector, U1, allocator::Allocator};
 
 use super::{GaussStages, Integrator, State, Stats, System, SystemAlloc, check_step, lu};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The allocator bounds of a [`GaussLegendre`] method with `S` stages on a system of
 /// dimension `D`, in one name: the system's own, the `D × S` stage matrices and the
@@ -713,7 +713,9 @@ mod tests {
         // Regression: from an exactly straight chain (equal angles) some increments keep
         // shrinking geometrically far below round-off; they must count as converged, not
         // run out of iterations (this failed every step after the first for n ≥ 6).
-        use crate::{Chain, FirstOrder, Planar};
+        use crate::chain::Chain;
+        use crate::models::planar::Planar;
+        use crate::systems::first_order::FirstOrder;
         let n = 8;
         let system = FirstOrder::new(Planar::new(Chain::<Dyn>::uniform(n, 1.0, 0.5, 9.81).unwrap()));
         let mut state = State::new(0.0, system.state(&DVector::from_element(n, 1.0), &DVector::zeros(n)));
@@ -728,7 +730,9 @@ mod tests {
     fn extrapolated_guess_saves_iterations() {
         // A nonlinear system: on a linear one with its exact Jacobian Newton converges in
         // one iteration from any guess.
-        use crate::{Chain, FirstOrder, Planar};
+        use crate::chain::Chain;
+        use crate::models::planar::Planar;
+        use crate::systems::first_order::FirstOrder;
         let run = |extrapolate: bool| {
             let system =
                 FirstOrder::new(Planar::new(Chain::<Dyn>::new(&[1.0, 0.7], &[1.0, 0.6], 9.81).unwrap()));

@@ -44,7 +44,7 @@ pub use rk4::Rk4;
 pub use system::{System, SystemAlloc, central_difference_jacobian};
 pub use tableau::{GAUSS_1, GAUSS_2, GAUSS_3, GaussStages, Tableau};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The time `t` (s) and state `x` of an integration, with the compensation terms of
 /// Kahan's summation for both.

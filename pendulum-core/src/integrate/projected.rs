@@ -3,7 +3,7 @@
 use nalgebra::{DefaultAllocator, OVector};
 
 use super::{Integrator, State, Stats, System, SystemAlloc};
-use crate::Result;
+use crate::error::Result;
 
 /// A system whose exact solutions stay on a manifold (invariants such as unit link
 /// directions), with a map back onto it for states a numerical method has moved off.

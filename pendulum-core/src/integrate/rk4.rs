@@ -3,7 +3,7 @@
 use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 
 use super::{Integrator, State, Stats, System, SystemAlloc, check_step};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Classical RK4 for a system of dimension `D`:
 /// ```text

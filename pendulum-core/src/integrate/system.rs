@@ -2,7 +2,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, U1, allocator::Allocator};
 
-use crate::Result;
+use crate::error::Result;
 
 /// The allocator bounds a [`System`] of dimension `D` needs, in one name: vectors of `D`
 /// entries and `D × D` Jacobians.

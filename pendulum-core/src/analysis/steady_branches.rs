@@ -47,7 +47,9 @@
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dim, allocator::Allocator};
 
-use crate::{Chain, Error, Result, sign_changes};
+use crate::analysis::modes::sign_changes;
+use crate::chain::Chain;
+use crate::error::{Error, Result};
 
 /// The steady-rotation problem of one chain: parameters and pivot radius.
 #[derive(Debug, Clone, PartialEq)]

@@ -28,7 +28,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, DimDiff, DimSub, OMatrix, OVector, U1, allocator::Allocator};
 
-use crate::Chain;
+use crate::chain::Chain;
 
 /// The normal modes of a chain hanging at rest.
 ///

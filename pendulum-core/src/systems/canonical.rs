@@ -2,99 +2,13 @@
 //! the variables in which Gauss–Legendre methods are symplectic.
 
 use nalgebra::{
-    Cholesky, DefaultAllocator, Dim, DimMul, DimName, DimProd, OMatrix, OVector, U1, U2, U3, Vector3,
-    allocator::Allocator,
+    Cholesky, DefaultAllocator, Dim, DimMul, DimProd, OMatrix, OVector, U1, U2, allocator::Allocator,
 };
 
+use crate::error::{Error, Result};
 use crate::integrate::{System, SystemAlloc};
-use crate::spatial::Frame;
-use crate::{Chain, Error, Inputs, InputsAt, Model, ModelAlloc, Planar, Result, Spatial, check_inputs};
-
-/// The gradient `∂T/∂q` of the kinetic energy at fixed rates `q̇` (N·m), the term the
-/// momentum equation of [`Canonical`] needs and the [`Model`] trait does not offer.
-///
-/// With `T = ½ q̇ᵀ M(q) q̇`, `∂T/∂q_k = ½ q̇ᵀ (∂M/∂q_k) q̇`. Lagrange's equations
-/// `d/dt (M q̇) − ∂T/∂q = Q − k − d` and the model's form `M q̈ + c + k + d = Q` give the
-/// identity `∂T/∂q = Ṁ q̇ − c`, but `Ṁ q̇` needs `∂M/∂q`, which the trait does not expose
-/// either; so the gradient is written here in closed form for the two kinds of chain
-/// (both in `W_ij = M_max(i,j) l_i l_j`, eq 10 tail masses):
-///
-/// - planar (`Space = U2`, `q = (θ_1 … θ_n)`, `T = ½ Σ_ij W_ij cos(θ_i − θ_j) θ̇_i θ̇_j`):
-///   `∂T/∂θ_k = −Σ_j W_kj sin(θ_k − θ_j) θ̇_k θ̇_j`;
-/// - spatial (`Space = U3`, `q = (θ_1 … θ_n, φ_1 … φ_n)`, `T = ½ Σ_ij W_ij u̇_i·u̇_j`):
-///   `∂T/∂q_a = (∂u̇_k/∂q_a) · Σ_j W_kj u̇_j` for `q_a` an angle of link `k`, with
-///   `∂u̇/∂θ = u_θθ θ̇ + u_θφ φ̇` and `∂u̇/∂φ = u_θφ θ̇ + u_φφ φ̇`.
-///
-/// The provided method picks the formula from `Self::Space` and the chain, so a model
-/// in these coordinates (the fixed-N models of `pendulum-macros` are) opts in with an
-/// empty `impl KineticGradient for MyModel {}`. A model in other coordinates must
-/// override [`kinetic_gradient`](KineticGradient::kinetic_gradient).
-pub trait KineticGradient: Model
-where
-    DefaultAllocator: ModelAlloc<Self::Links, Self::Dof, Self::Space>,
-{
-    /// Writes `∂T/∂q (q, q̇)` (N·m) into `out`.
-    ///
-    /// Panics if the model's `dof` is not `n` (planar) or `2n` (spatial) for its `n`
-    /// links, i.e. if the default is used for a model it does not describe.
-    fn kinetic_gradient(
-        &self,
-        q: &OVector<f64, Self::Dof>,
-        qd: &OVector<f64, Self::Dof>,
-        out: &mut OVector<f64, Self::Dof>,
-    ) {
-        let chain = self.chain();
-        match Self::Space::dim() {
-            2 => planar_kinetic_gradient(chain, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
-            3 => spatial_kinetic_gradient(chain, q.as_slice(), qd.as_slice(), out.as_mut_slice()),
-            d => panic!("no default kinetic gradient for a model in a space of dimension {d}"),
-        }
-    }
-}
-
-impl<L: Dim> KineticGradient for Planar<L> where
-    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2>
-{
-}
-
-impl<L> KineticGradient for Spatial<L>
-where
-    L: Dim + DimMul<U2>,
-    DefaultAllocator:
-        Allocator<L> + Allocator<DimProd<L, U2>> + Allocator<DimProd<L, U2>, DimProd<L, U2>> + Allocator<U3>,
-{
-}
-
-/// `∂T/∂θ_k = −Σ_j W_kj sin(θ_k − θ_j) θ̇_k θ̇_j` of the planar chain.
-fn planar_kinetic_gradient<L: Dim>(chain: &Chain<L>, q: &[f64], qd: &[f64], out: &mut [f64])
-where
-    DefaultAllocator: Allocator<L>,
-{
-    let n = chain.links();
-    assert_eq!(q.len(), n, "a planar chain of {n} links has {n} coordinates");
-    for k in 0..n {
-        let sum: f64 = (0..n).map(|j| chain.weight(k, j) * (q[k] - q[j]).sin() * qd[j]).sum();
-        out[k] = -qd[k] * sum;
-    }
-}
-
-/// `∂T/∂θ_k = ∂u̇_k/∂θ_k · V_k`, `∂T/∂φ_k = ∂u̇_k/∂φ_k · V_k` with `V_k = Σ_j W_kj u̇_j`, of
-/// the spatial chain in `q = (θ_1 … θ_n, φ_1 … φ_n)`.
-fn spatial_kinetic_gradient<L: Dim>(chain: &Chain<L>, q: &[f64], qd: &[f64], out: &mut [f64])
-where
-    DefaultAllocator: Allocator<L>,
-{
-    let n = chain.links();
-    assert_eq!(q.len(), 2 * n, "a spatial chain of {n} links has {} coordinates", 2 * n);
-    let frames: Vec<Frame> = (0..n).map(|k| Frame::new(q[k], q[n + k])).collect();
-    let velocities: Vec<Vector3<f64>> = (0..n).map(|k| frames[k].velocity(qd[k], qd[n + k])).collect();
-    for (k, frame) in frames.iter().enumerate() {
-        let v = (0..n).fold(Vector3::new(0.0, 0.0, 0.0), |v, j| v + velocities[j] * chain.weight(k, j));
-        let (d_theta, d_phi) = frame.velocity_gradient(qd[k], qd[n + k]);
-        out[k] = d_theta.dot(&v);
-        out[n + k] = d_phi.dot(&v);
-    }
-}
+use crate::model::{Inputs, InputsAt, Model, ModelAlloc, check_inputs};
+use crate::systems::first_order::{stack, unstack};
 
 /// Coordinates and rates (or momenta), one vector each.
 type Pair<D> = (OVector<f64, D>, OVector<f64, D>);
@@ -112,7 +26,7 @@ type Pair<D> = (OVector<f64, D>, OVector<f64, D>);
 /// momentum equation is Lagrange's `d/dt(∂T/∂q̇) − ∂T/∂q = Q − k − d`, so both forms
 /// describe the same motion; `docs/integrators.md` compares them on long runs.
 ///
-/// `q̇` comes from a Cholesky solve with `M(q)`; `∂T/∂q` from [`KineticGradient`]. The
+/// `q̇` comes from a Cholesky solve with `M(q)`; `∂T/∂q` from [`Model::kinetic_gradient`]. The
 /// Jacobian is the finite-difference default of [`System::jacobian`].
 #[derive(Debug, Clone)]
 pub struct Canonical<M, I> {
@@ -131,7 +45,7 @@ where
     }
 }
 
-impl<M: KineticGradient, I> Canonical<M, I>
+impl<M: Model, I> Canonical<M, I>
 where
     M::Dof: DimMul<U2>,
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
@@ -157,7 +71,7 @@ where
         q: &OVector<f64, M::Dof>,
         p: &OVector<f64, M::Dof>,
     ) -> OVector<f64, DimProd<M::Dof, U2>> {
-        crate::first_order::stack(self.model.dof(), q, p)
+        stack(self.model.dof(), q, p)
     }
 
     /// Splits a state into `(q, p)`.
@@ -165,7 +79,7 @@ where
         &self,
         x: &OVector<f64, DimProd<M::Dof, U2>>,
     ) -> (OVector<f64, M::Dof>, OVector<f64, M::Dof>) {
-        crate::first_order::unstack(self.model.dof(), x)
+        unstack(self.model.dof(), x)
     }
 
     /// The momenta `p = M(q) q̇` (kg·m²/s) of rates `q̇` (rad/s).
@@ -220,7 +134,7 @@ where
     }
 }
 
-impl<M: KineticGradient, I: InputsAt<M::Dof, M::Space>> System for Canonical<M, I>
+impl<M: Model, I: InputsAt<M::Dof, M::Space>> System for Canonical<M, I>
 where
     M::Dof: DimMul<U2>,
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<DimProd<M::Dof, U2>>,
@@ -268,7 +182,10 @@ mod tests {
     use nalgebra::{Const, DVector, Dyn, SVector, Vector2};
 
     use super::*;
-    use crate::FirstOrder;
+    use crate::chain::Chain;
+    use crate::models::planar::Planar;
+    use crate::models::spatial::Spatial;
+    use crate::systems::first_order::FirstOrder;
 
     /// Central difference of `T` in each coordinate, step `1e-5`: error ~1e-10 · scale.
     fn numeric_gradient<M: Model>(model: &M, q: &OVector<f64, M::Dof>, qd: &OVector<f64, M::Dof>) -> Vec<f64>

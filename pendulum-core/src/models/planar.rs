@@ -2,7 +2,9 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
-use crate::{Chain, Model};
+use crate::chain::Chain;
+use crate::kinematics::PlanarAngles;
+use crate::model::Model;
 
 /// A planar chain in absolute link angles `θ_i` from the downward vertical (eqs 1–2),
 /// for any number of links `L` (`Dyn` by default; `Const<N>` gives a fixed-size generic).
@@ -50,6 +52,7 @@ where
     type Links = L;
     type Dof = L;
     type Space = U2;
+    type Chart = PlanarAngles;
 
     fn chain(&self) -> &Chain<L> {
         &self.chain
@@ -129,7 +132,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Error, Inputs};
+    use crate::error::Error;
+    use crate::model::Inputs;
     use approx::assert_relative_eq;
     use nalgebra::{DVector, Vector2};
 

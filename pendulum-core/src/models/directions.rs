@@ -6,10 +6,13 @@ use std::marker::PhantomData;
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U2, U3, allocator::Allocator};
 
+use crate::chain::Chain;
+use crate::drive::{Drive, Fixed};
+use crate::error::{Error, Result};
 use crate::integrate::{Constrained, System};
-use crate::model::all_finite;
-use crate::rods::{Load, Rods, with_scratch};
-use crate::{Chain, Drive, Error, Fixed, Result, check_polar_sin};
+use crate::kinematics::{Chart, PlanarAngles, SphericalAngles, SphericalLink, check_polar_sin};
+use crate::model::check_vector;
+use crate::models::rods::{Load, Rods, with_scratch};
 
 /// A chain of `n` point masses on rigid rods in the plane (`S = U2`, y up) or in space
 /// (`S = U3`, z up), described by the unit direction `u_i` of each rod (from mass `i−1` to
@@ -113,16 +116,7 @@ where
 
     /// [`check_state`](Self::check_state) of a state held as a slice.
     fn check_state_slice(&self, x: &[f64]) -> Result<()> {
-        if x.len() != self.state_len() {
-            return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: x.len() });
-        }
-        // Vectorised: a scalar search costs a third of the solve here.
-        if !all_finite(x)
-            && let Some(index) = x.iter().position(|v| !v.is_finite())
-        {
-            return Err(Error::NonFinite { what: "x", index, value: x[index] });
-        }
-        Ok(())
+        check_vector("x", x, self.state_len())
     }
 
     /// Positions of the masses relative to the pivot, `r_i − p = Σ_{j≤i} l_j u_j` (m).
@@ -226,7 +220,7 @@ where
     }
 
     /// [`System::rhs`] on slices, `out = (w, ü(t, x))`, for systems that hold the chain's
-    /// state inside a longer one ([`AccountedDirections`](crate::AccountedDirections)).
+    /// state inside a longer one ([`Accounted`](crate::energy::Accounted)).
     pub(crate) fn flow(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<()>
     where
         Dr: Drive<S>,
@@ -316,14 +310,12 @@ impl<Dr> Directions<U2, Dr> {
     /// Errors: [`Error::LengthMismatch`], [`Error::NonFinite`].
     pub fn from_angles(&self, theta: &[f64], rates: &[f64]) -> Result<DVector<f64>> {
         let n = self.links();
-        check_slices(n, &[("theta", theta), ("rates", rates)])?;
+        check_vector("theta", theta, n)?;
+        check_vector("rates", rates, n)?;
         let mut x = DVector::zeros(4 * n);
         for i in 0..n {
-            let (s, c) = theta[i].sin_cos();
-            x[2 * i] = s;
-            x[2 * i + 1] = -c;
-            x[2 * (n + i)] = rates[i] * c;
-            x[2 * (n + i) + 1] = rates[i] * s;
+            x.fixed_rows_mut::<2>(2 * i).copy_from(&PlanarAngles::direction(theta, i));
+            x.fixed_rows_mut::<2>(2 * (n + i)).copy_from(&PlanarAngles::link_velocity(theta, rates, i));
         }
         Ok(x)
     }
@@ -338,8 +330,9 @@ impl<Dr> Directions<U2, Dr> {
         let n = self.links();
         let mut udd = vec![0.0; 2 * n];
         self.accelerations(t, x, &mut udd, None)?;
-        // n_i = (−u_y, u_x) for a unit u_i = (sin θ_i, −cos θ_i).
-        Ok(DVector::from_fn(n, |i, _| -x[2 * i + 1] * udd[2 * i] + x[2 * i] * udd[2 * i + 1]))
+        Ok(DVector::from_fn(n, |i, _| {
+            PlanarAngles::angle_acceleration([x[2 * i], x[2 * i + 1]], [udd[2 * i], udd[2 * i + 1]])
+        }))
     }
 
     /// The angles `θ_i = atan2(u_x, −u_y)` (rad, in (−π, π]) and rates `θ̇_i = n_i·w_i`
@@ -347,11 +340,11 @@ impl<Dr> Directions<U2, Dr> {
     pub fn to_angles(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DVector<f64>)> {
         self.check_state(x)?;
         let n = self.links();
-        let theta = DVector::from_fn(n, |i, _| x[2 * i].atan2(-x[2 * i + 1]));
-        let rates = DVector::from_fn(n, |i, _| {
-            let (s, c) = theta[i].sin_cos();
-            c * x[2 * (n + i)] + s * x[2 * (n + i) + 1]
-        });
+        let (mut theta, mut rates) = (DVector::zeros(n), DVector::zeros(n));
+        for i in 0..n {
+            let w = [x[2 * (n + i)], x[2 * (n + i) + 1]];
+            (theta[i], rates[i]) = PlanarAngles::from_direction([x[2 * i], x[2 * i + 1]], w);
+        }
         Ok((theta, rates))
     }
 }
@@ -366,13 +359,13 @@ impl<Dr> Directions<U3, Dr> {
     /// Errors: [`Error::LengthMismatch`], [`Error::NonFinite`].
     pub fn from_spherical(&self, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
         let n = self.links();
-        check_slices(2 * n, &[("q", q), ("qd", qd)])?;
+        check_vector("q", q, 2 * n)?;
+        check_vector("qd", qd, 2 * n)?;
         let mut x = DVector::zeros(6 * n);
         for i in 0..n {
-            let frame = SphericalFrame::new(q[i], q[n + i]);
-            let w = frame.e_theta * qd[i] + frame.e_phi * (qd[n + i] * frame.sin_theta);
-            x.fixed_rows_mut::<3>(3 * i).copy_from(&frame.u);
-            x.fixed_rows_mut::<3>(3 * (n + i)).copy_from(&w);
+            let link = SphericalLink::of(q, i);
+            x.fixed_rows_mut::<3>(3 * i).copy_from(&link.u);
+            x.fixed_rows_mut::<3>(3 * (n + i)).copy_from(&link.velocity(qd[i], qd[n + i]));
         }
         Ok(x)
     }
@@ -388,16 +381,12 @@ impl<Dr> Directions<U3, Dr> {
         let n = self.links();
         let (mut q, mut qd) = (DVector::zeros(2 * n), DVector::zeros(2 * n));
         for i in 0..n {
-            let u = self.direction(x, i);
-            let theta = u.xy().norm().atan2(-u.z);
-            let phi = u.y.atan2(u.x);
-            let frame = SphericalFrame::new(theta, phi);
-            check_polar_sin(i + 1, theta, frame.sin_theta)?;
-            let w = self.rate(x, i);
+            let (theta, phi) = SphericalAngles::angles_of(&self.direction(x, i));
+            let link = SphericalLink::new(theta, phi);
+            check_polar_sin(i + 1, theta, link.sin_theta)?;
             q[i] = theta;
             q[n + i] = phi;
-            qd[i] = frame.e_theta.dot(&w);
-            qd[n + i] = frame.e_phi.dot(&w) / frame.sin_theta;
+            (qd[i], qd[n + i]) = link.rates(&self.rate(x, i));
         }
         Ok((q, qd))
     }
@@ -426,49 +415,13 @@ impl<Dr: Drive<U3>> Directions<U3, Dr> {
         self.accelerations_of_valid(t, x.as_slice(), &mut udd, None)?;
         let mut out = DVector::zeros(2 * n);
         for i in 0..n {
-            let frame = SphericalFrame::new(q[i], q[n + i]);
-            check_polar_sin(i + 1, q[i], frame.sin_theta)?;
+            let link = SphericalLink::of(q, i);
+            check_polar_sin(i + 1, q[i], link.sin_theta)?;
             let a = nalgebra::Vector3::new(udd[3 * i], udd[3 * i + 1], udd[3 * i + 2]);
-            let cos_theta = -frame.u.z;
-            out[i] = frame.e_theta.dot(&a) + qd[n + i] * qd[n + i] * frame.sin_theta * cos_theta;
-            out[n + i] = (frame.e_phi.dot(&a) - 2.0 * qd[i] * qd[n + i] * cos_theta) / frame.sin_theta;
+            (out[i], out[n + i]) = link.angle_accelerations(&a, qd[i], qd[n + i]);
         }
         Ok(out)
     }
-}
-
-/// The unit vectors of spherical angles `(θ, φ)`: `u` (radial), `e_θ = ∂u/∂θ` and `e_φ`
-/// with `∂u/∂φ = sin θ e_φ`.
-struct SphericalFrame {
-    u: nalgebra::Vector3<f64>,
-    e_theta: nalgebra::Vector3<f64>,
-    e_phi: nalgebra::Vector3<f64>,
-    sin_theta: f64,
-}
-
-impl SphericalFrame {
-    fn new(theta: f64, phi: f64) -> Self {
-        let (st, ct) = theta.sin_cos();
-        let (sp, cp) = phi.sin_cos();
-        Self {
-            u: nalgebra::Vector3::new(st * cp, st * sp, -ct),
-            e_theta: nalgebra::Vector3::new(ct * cp, ct * sp, st),
-            e_phi: nalgebra::Vector3::new(-sp, cp, 0.0),
-            sin_theta: st,
-        }
-    }
-}
-
-fn check_slices(expected: usize, slices: &[(&'static str, &[f64])]) -> Result<()> {
-    for &(what, v) in slices {
-        if v.len() != expected {
-            return Err(Error::LengthMismatch { what, expected, got: v.len() });
-        }
-        if let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
-            return Err(Error::NonFinite { what, index, value });
-        }
-    }
-    Ok(())
 }
 
 impl<S: DimName, Dr: Drive<S>> System for Directions<S, Dr>

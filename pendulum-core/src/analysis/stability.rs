@@ -44,7 +44,8 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use crate::{Error, Result, SteadyRotation, SteadyShape};
+use crate::analysis::steady_branches::{SteadyRotation, SteadyShape};
+use crate::error::{Error, Result};
 
 /// The linearised equations `M δq̈ + G δq̇ + H δq = 0` about a steady shape (module
 /// docs), in `q = (θ_1 … θ_n, ψ_1 … ψ_n)`.
@@ -178,7 +179,9 @@ pub fn stability(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Chain, ContinuationOptions, normal_modes};
+    use crate::analysis::modes::normal_modes;
+    use crate::analysis::steady_branches::ContinuationOptions;
+    use crate::chain::Chain;
     use approx::assert_relative_eq;
     use nalgebra::Dyn;
 

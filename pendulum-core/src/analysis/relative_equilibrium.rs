@@ -26,7 +26,10 @@
 
 use nalgebra::{Complex, DMatrix, DVector, U3, Vector3};
 
-use crate::{Circle, Directions, Error, Result};
+use crate::drive::Circle;
+use crate::error::{Error, Result};
+use crate::kinematics::tilt::{direction, tangents};
+use crate::models::directions::Directions;
 
 /// A relative equilibrium of a driven chain, in the frame turning with the pivot at
 /// `t = 0` (pivot at `(R, 0, 0)`).
@@ -36,19 +39,6 @@ pub struct RelativeEquilibrium {
     pub angles: Vec<(f64, f64)>,
     /// The model state `x = (u, w)` at `t = 0`: `w_i = Ω × u_i`.
     pub state: DVector<f64>,
-}
-
-fn direction(theta: f64, psi: f64) -> Vector3<f64> {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = psi.sin_cos();
-    Vector3::new(cp * st, sp, -cp * ct)
-}
-
-/// The unit tangents `∂u/∂θ / cos ψ` and `∂u/∂ψ`, orthonormal and normal to `u`.
-fn tangents(theta: f64, psi: f64) -> (Vector3<f64>, Vector3<f64>) {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = psi.sin_cos();
-    (Vector3::new(ct, 0.0, st), Vector3::new(-sp * st, cp, sp * ct))
 }
 
 fn omega_of(model: &Directions<U3, Circle>) -> Vector3<f64> {
@@ -201,7 +191,9 @@ pub fn relative_spectrum(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Chain, SteadyRotation, stability};
+    use crate::analysis::stability::stability;
+    use crate::analysis::steady_branches::SteadyRotation;
+    use crate::chain::Chain;
     use nalgebra::Dyn;
 
     fn chain() -> Chain<Dyn> {

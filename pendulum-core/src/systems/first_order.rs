@@ -1,44 +1,11 @@
 //! The adapter that turns a chain [`Model`] into a first-order [`System`]
 //! `x' = f(t, x)` with `x = (q, q̇)`, for the integrators.
 
-use std::borrow::Cow;
+use nalgebra::{DefaultAllocator, Dim, DimMul, DimProd, OVector, U1, U2, allocator::Allocator};
 
-use nalgebra::{DefaultAllocator, Dim, DimMul, DimName, DimProd, OVector, U1, U2, allocator::Allocator};
-
+use crate::error::Result;
 use crate::integrate::{System, SystemAlloc};
-use crate::{Inputs, Model, ModelAlloc, Result};
-
-/// The inputs (torques, pivot acceleration) acting at time `t`: the seam for a
-/// time-dependent drive.
-///
-/// Constant [`Inputs`] implement it (borrowed, no copy), and so does any closure
-/// `Fn(f64) -> Inputs` (`t` in s) and [`Driven`](crate::Driven), a pivot
-/// [`Drive`](crate::Drive) with torques of time.
-pub trait InputsAt<D: Dim, S: DimName>
-where
-    DefaultAllocator: Allocator<D> + Allocator<S>,
-{
-    /// The inputs at time `t` (s).
-    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>>;
-}
-
-impl<D: Dim, S: DimName> InputsAt<D, S> for Inputs<D, S>
-where
-    DefaultAllocator: Allocator<D> + Allocator<S>,
-{
-    fn inputs_at(&self, _t: f64) -> Cow<'_, Inputs<D, S>> {
-        Cow::Borrowed(self)
-    }
-}
-
-impl<D: Dim, S: DimName, F: Fn(f64) -> Inputs<D, S>> InputsAt<D, S> for F
-where
-    DefaultAllocator: Allocator<D> + Allocator<S>,
-{
-    fn inputs_at(&self, t: f64) -> Cow<'_, Inputs<D, S>> {
-        Cow::Owned(self(t))
-    }
-}
+use crate::model::{Inputs, InputsAt, Model, ModelAlloc};
 
 /// A chain model as the first-order system
 /// ```text
@@ -67,11 +34,7 @@ where
     }
 }
 
-impl<M: Model, I> FirstOrder<M, I>
-where
-    M::Dof: DimMul<U2>,
-    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
-{
+impl<M, I> FirstOrder<M, I> {
     /// The chain driven by `inputs` (constant [`Inputs`] or a closure of time).
     pub fn with_inputs(model: M, inputs: I) -> Self {
         Self { model, inputs }
@@ -86,7 +49,13 @@ where
     pub fn inputs(&self) -> &I {
         &self.inputs
     }
+}
 
+impl<M: Model, I> FirstOrder<M, I>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
+{
     /// The state `x = (q, q̇)` (rad, rad/s).
     pub fn state(
         &self,
@@ -173,7 +142,8 @@ mod tests {
     use nalgebra::{Const, DVector, Dyn, Vector2, Vector4};
 
     use super::*;
-    use crate::{Chain, Planar};
+    use crate::chain::Chain;
+    use crate::models::planar::Planar;
 
     #[test]
     fn rhs_is_velocity_then_acceleration() {

@@ -4,30 +4,11 @@ use nalgebra::{
     DefaultAllocator, Dim, DimMul, DimProd, Dyn, OMatrix, OVector, U2, U3, Vector3, allocator::Allocator,
 };
 
-use crate::{Chain, Error, Model, Result};
-
-/// Below this `|sin θ_i|` a spatial (θ, φ) model refuses to compute accelerations.
-///
-/// The φ rows of the mass matrix scale with `sin θ_i`, so its condition number grows like
-/// `1 / sin² θ_i`: at `1e-6` about twelve of sixteen digits are already gone.
-pub const SINGULARITY_TOLERANCE: f64 = 1e-6;
-
-/// [`Error::SingularAngle`] if `|sin θ|` of link `link` (1-based) is below
-/// [`SINGULARITY_TOLERANCE`].
-pub fn check_polar_angle(link: usize, theta: f64) -> Result<()> {
-    check_polar_sin(link, theta, theta.sin())
-}
-
-/// [`check_polar_angle`] for a caller that already has `sin_theta = theta.sin()`, so the
-/// sine is computed once (the code `pendulum-macros` generates).
-pub fn check_polar_sin(link: usize, theta: f64, sin_theta: f64) -> Result<()> {
-    let sin_theta = sin_theta.abs();
-    if sin_theta < SINGULARITY_TOLERANCE {
-        Err(Error::SingularAngle { link, theta, sin_theta, tolerance: SINGULARITY_TOLERANCE })
-    } else {
-        Ok(())
-    }
-}
+use crate::chain::Chain;
+use crate::error::Result;
+use crate::kinematics::SphericalLink;
+use crate::kinematics::{SphericalAngles, check_polar_angle};
+use crate::model::Model;
 
 /// A spatial chain in spherical angles: `θ_i` from the −z axis, `φ_i` the azimuth from
 /// +x (eqs 27–29), for any number of links `L`.
@@ -74,76 +55,13 @@ where
     }
 }
 
-/// The geometry of one link's direction `u = (sin θ cos φ, sin θ sin φ, −cos θ)` at
-/// angles (θ, φ): its first and second partial derivatives. The one place the spatial
-/// model, the canonical form ([`crate::Canonical`]) and the energy ledger get them from.
-pub(crate) struct Frame {
-    /// `∂u/∂θ`.
-    pub(crate) d_theta: Vector3<f64>,
-    /// `∂u/∂φ`.
-    pub(crate) d_phi: Vector3<f64>,
-    /// `∂²u/∂θ² = −u`.
-    pub(crate) d_theta2: Vector3<f64>,
-    /// `∂²u/∂φ²`.
-    pub(crate) d_phi2: Vector3<f64>,
-    /// `∂²u/∂θ∂φ`.
-    pub(crate) d_theta_phi: Vector3<f64>,
-}
-
-impl Frame {
-    pub(crate) fn new(theta: f64, phi: f64) -> Self {
-        let (st, ct) = theta.sin_cos();
-        let (sp, cp) = phi.sin_cos();
-        Self {
-            d_theta: Vector3::new(ct * cp, ct * sp, st),
-            d_phi: Vector3::new(-st * sp, st * cp, 0.0),
-            d_theta2: Vector3::new(-st * cp, -st * sp, ct),
-            d_phi2: Vector3::new(-st * cp, -st * sp, 0.0),
-            d_theta_phi: Vector3::new(-ct * sp, ct * cp, 0.0),
-        }
-    }
-
-    /// `u̇ = ∂u/∂θ θ̇ + ∂u/∂φ φ̇`.
-    pub(crate) fn velocity(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
-        self.d_theta * theta_dot + self.d_phi * phi_dot
-    }
-
-    /// `ü` at `q̈ = 0`: the part of the acceleration quadratic in the rates.
-    pub(crate) fn centripetal(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
-        self.d_theta2 * (theta_dot * theta_dot)
-            + self.d_phi2 * (phi_dot * phi_dot)
-            + self.d_theta_phi * (2.0 * theta_dot * phi_dot)
-    }
-
-    /// `ü = ∂u/∂θ θ̈ + ∂u/∂φ φ̈ +` [`centripetal`](Self::centripetal).
-    pub(crate) fn acceleration(
-        &self,
-        theta_dot: f64,
-        phi_dot: f64,
-        theta_ddot: f64,
-        phi_ddot: f64,
-    ) -> Vector3<f64> {
-        self.d_theta * theta_ddot + self.d_phi * phi_ddot + self.centripetal(theta_dot, phi_dot)
-    }
-
-    /// `∂u̇/∂θ = ∂²u/∂θ² θ̇ + ∂²u/∂θ∂φ φ̇` and `∂u̇/∂φ = ∂²u/∂θ∂φ θ̇ + ∂²u/∂φ² φ̇`: how the
-    /// link's velocity changes with its angles at fixed rates.
-    pub(crate) fn velocity_gradient(&self, theta_dot: f64, phi_dot: f64) -> (Vector3<f64>, Vector3<f64>) {
-        (
-            self.d_theta2 * theta_dot + self.d_theta_phi * phi_dot,
-            self.d_theta_phi * theta_dot + self.d_phi2 * phi_dot,
-        )
-    }
-}
-
 impl<L> Spatial<L>
 where
     L: Dim + DimMul<U2>,
     DefaultAllocator: Allocator<L> + Allocator<DimProd<L, U2>>,
 {
-    fn frames(&self, q: &OVector<f64, DimProd<L, U2>>) -> Vec<Frame> {
-        let n = self.chain.links();
-        (0..n).map(|i| Frame::new(q[i], q[n + i])).collect()
+    fn frames(&self, q: &OVector<f64, DimProd<L, U2>>) -> Vec<SphericalLink> {
+        (0..self.chain.links()).map(|i| SphericalLink::of(q.as_slice(), i)).collect()
     }
 }
 
@@ -156,6 +74,7 @@ where
     type Links = L;
     type Dof = DimProd<L, U2>;
     type Space = U3;
+    type Chart = SphericalAngles;
 
     fn chain(&self) -> &Chain<L> {
         &self.chain
@@ -271,6 +190,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
     use approx::assert_relative_eq;
     use nalgebra::DVector;
 

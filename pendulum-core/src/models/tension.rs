@@ -2,10 +2,14 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
+use crate::chain::Chain;
+use crate::error::Result;
+use crate::kinematics::PlanarAngles;
 use crate::model::all_finite;
-use crate::rods::{Load, Rods, with_scratch};
-use crate::trig::sin_cos_into;
-use crate::{Chain, Inputs, Model, Planar, Result, check_inputs};
+use crate::model::{Inputs, Model, check_inputs};
+use crate::models::planar::Planar;
+use crate::models::rods::{Load, Rods, with_scratch};
+use crate::models::trig::sin_cos_into;
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
 /// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric
@@ -148,6 +152,7 @@ where
     type Links = L;
     type Dof = L;
     type Space = U2;
+    type Chart = PlanarAngles;
 
     fn chain(&self) -> &Chain<L> {
         self.dense.chain()

@@ -1,0 +1,15 @@
+//! What the equations say about a chain beyond one trajectory: its normal modes about the
+//! hanging rest (`modes`), the undamped steady shapes turning rigidly about the vertical
+//! as branches over the speed ω (`steady_branches`) and their stability (`stability`),
+//! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
+//! with their spectrum (`relative_equilibrium`).
+
+pub(crate) mod modes;
+pub(crate) mod relative_equilibrium;
+pub(crate) mod stability;
+pub(crate) mod steady_branches;
+
+pub use modes::{NormalModes, normal_modes, sign_changes};
+pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
+pub use stability::{Linearisation, Stability, linearise, stability};
+pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};

@@ -1,0 +1,15 @@
+//! The chain models: the generic dense models in angles ([`Planar`], [`Spatial`]), and the
+//! O(n) routes by the rod tensions ([`PlanarTension`] in planar angles, [`Directions`] in
+//! unit link directions), with the tension solve and the sine kernel they share.
+
+pub(crate) mod directions;
+pub(crate) mod planar;
+pub(crate) mod rods;
+pub(crate) mod spatial;
+pub(crate) mod tension;
+pub(crate) mod trig;
+
+pub use directions::Directions;
+pub use planar::Planar;
+pub use spatial::Spatial;
+pub use tension::PlanarTension;
