@@ -1,8 +1,8 @@
-//! The command line: `pendulum simulate | eval` and their options (clap derive).
+//! The command line: `pendulum simulate | eval | modes | steady` and their options (clap derive).
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Arg, Args, Parser, Subcommand, ValueEnum};
 use serde::{Deserialize, Serialize};
 
 use crate::spec::InitialSpec;
@@ -54,9 +54,10 @@ pub enum Command {
     Steady(SteadyArgs),
 }
 
-/// The chain of `pendulum modes` and `pendulum steady`.
+/// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`
+/// words the help of --masses and --gravity its own way, see [`Physics::run_help`]).
 #[derive(Debug, Args)]
-pub struct ChainArgs {
+pub struct ChainOptions {
     /// Number of links (default: the length of a --masses or --lengths list, else 3).
     #[arg(long, allow_negative_numbers = true)]
     pub n: Option<usize>,
@@ -76,7 +77,7 @@ pub struct ChainArgs {
 pub struct ModesArgs {
     /// The chain.
     #[command(flatten)]
-    pub chain: ChainArgs,
+    pub chain: ChainOptions,
     /// How many modes, lowest first (default: all, at most 6).
     #[arg(long, allow_negative_numbers = true)]
     pub count: Option<usize>,
@@ -90,7 +91,7 @@ pub struct ModesArgs {
 pub struct SteadyArgs {
     /// The chain.
     #[command(flatten)]
-    pub chain: ChainArgs,
+    pub chain: ChainOptions,
     /// Radius R of the pivot's horizontal circle, m (0: pivot fixed on the axis).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub radius: f64,
@@ -170,6 +171,9 @@ pub enum View {
 
 /// Options of `pendulum simulate`.
 #[derive(Debug, Args)]
+// `--from` conflicts with the group of every option of `Physics`. clap's derive leaves that
+// group empty because `Physics` flattens `ChainOptions`, so its members are given here.
+#[command(mut_group("Physics", |group| group.args(Physics::ids())))]
 pub struct SimulateArgs {
     /// Repeat the run recorded in this run.json exactly (only --out, --no-plots, --quiet,
     /// --view and --frames may be given with it).
@@ -197,23 +201,14 @@ pub struct SimulateArgs {
 
 /// Everything that defines a run (recorded in run.json).
 #[derive(Debug, Args)]
+#[command(mut_args(Physics::run_help))]
 pub struct Physics {
     /// Space dimension.
     #[arg(long, value_enum, default_value = "2")]
     pub dim: Dimension,
-    /// Number of links (default: the length of a --masses or --lengths list, else 3).
-    #[arg(long, allow_negative_numbers = true)]
-    pub n: Option<usize>,
-    /// Masses, kg: one value for every link, a comma list (one per link) or a file of
-    /// numbers.
-    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "1")]
-    pub masses: String,
-    /// Rod lengths, m: one value, a comma list or a file.
-    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0.5")]
-    pub lengths: String,
-    /// Gravitational acceleration g, m/s² (along −y in 2D, −z in 3D).
-    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
-    pub gravity: f64,
+    /// The chain: --n, --masses, --lengths, --gravity.
+    #[command(flatten)]
+    pub chain: ChainOptions,
     /// Damping λ_i, N·m·s: one value, a comma list or a file.
     #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE", default_value = "0")]
     pub damping: String,
@@ -263,6 +258,27 @@ pub struct Physics {
     /// Write a sample every k steps.
     #[arg(long, value_name = "K", default_value_t = 4, allow_negative_numbers = true)]
     pub every: usize,
+}
+
+impl Physics {
+    /// The help of a chain option where a run says more than `modes` and `steady`.
+    fn run_help(arg: Arg) -> Arg {
+        match arg.get_id().as_str() {
+            "masses" => arg.help(
+                "Masses, kg: one value for every link, a comma list (one per link) or a file of numbers",
+            ),
+            "gravity" => arg.help("Gravitational acceleration g, m/s² (along −y in 2D, −z in 3D)"),
+            _ => arg,
+        }
+    }
+
+    /// The ids of the options of a run, in their order.
+    fn ids() -> Vec<clap::Id> {
+        Self::augment_args(clap::Command::new("physics"))
+            .get_arguments()
+            .map(|arg| arg.get_id().clone())
+            .collect()
+    }
 }
 
 /// Model kind of `pendulum eval`.

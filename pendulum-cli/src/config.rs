@@ -93,9 +93,9 @@ impl RunConfig {
     /// Resolves the command line into a complete configuration, checking what the core
     /// does not check itself (counts, signs, combinations).
     pub fn from_args(p: &Physics, view: View, frames: usize) -> CliResult<Self> {
-        let masses = per_link("--masses", &p.masses)?;
-        let lengths = per_link("--lengths", &p.lengths)?;
-        let n = match p.n {
+        let masses = per_link("--masses", &p.chain.masses)?;
+        let lengths = per_link("--lengths", &p.chain.lengths)?;
+        let n = match p.chain.n {
             Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
             Some(n) => n,
             None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
@@ -141,7 +141,7 @@ impl RunConfig {
             dim: p.dim,
             masses,
             lengths,
-            gravity: p.gravity,
+            gravity: p.chain.gravity,
             damping,
             torque,
             drive,

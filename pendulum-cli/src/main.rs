@@ -1,16 +1,19 @@
 //! `pendulum`: simulate N-link pendulums and write what a person wants to look at
-//! (trajectory and energy CSVs, run.json, an energy plot and an animation), or evaluate
-//! a model's terms as JSON.
+//! (trajectory and energy CSVs, run.json, an energy plot and an animation), evaluate
+//! a model's terms as JSON, or find the normal modes and steady rotations of a chain.
 
 mod args;
+mod bessel;
+mod chain_args;
 mod config;
 mod error;
 mod eval;
 mod models;
+mod modes;
 mod plot;
-mod rotating;
 mod simulate;
 mod spec;
+mod steady;
 
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -43,8 +46,8 @@ fn main() -> ExitCode {
             simulate::simulate(args, demo)
         }
         Command::Eval(args) => eval::eval(args),
-        Command::Modes(args) => rotating::modes(args),
-        Command::Steady(args) => rotating::steady(args),
+        Command::Modes(args) => modes::modes(args),
+        Command::Steady(args) => steady::steady(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

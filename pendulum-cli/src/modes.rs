@@ -1,0 +1,118 @@
+//! `pendulum modes`: the normal modes of the chain hanging at rest (table, modes.csv and
+//! the mode shapes in modes.png).
+
+use std::io::Write;
+use std::path::Path;
+
+use nalgebra::Dyn;
+use pendulum_core::{Chain, normal_modes, sign_changes};
+use plotters::prelude::*;
+
+use crate::args::ModesArgs;
+use crate::bessel::bessel_j0_zero;
+use crate::chain_args::chain_of;
+use crate::error::{CliError, CliResult, io_failed};
+use crate::plot::{drawing_failed, fonts};
+
+/// Runs `pendulum modes`.
+pub fn modes(args: &ModesArgs) -> CliResult<()> {
+    let chain = chain_of(&args.chain)?;
+    let n = chain.links();
+    let count = args.count.unwrap_or(n.min(6));
+    if count == 0 || count > n {
+        return Err(CliError::usage(format!("--count must be between 1 and n = {n}, got {count}")));
+    }
+    let modes = normal_modes(&chain);
+    let total: f64 = chain.lengths().iter().sum();
+    let uniform = chain.masses().iter().all(|&m| m == chain.masses()[0])
+        && chain.lengths().iter().all(|&l| l == chain.lengths()[0]);
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+    })?;
+    let csv_path = args.out.join("modes.csv");
+    let file = std::fs::File::create(&csv_path).map_err(|e| io_failed("create", &csv_path, e))?;
+    let mut csv = std::io::BufWriter::new(file);
+    let mut header =
+        vec!["k".to_string(), "omega".into(), "frequency_hz".into(), "period".into(), "nodes".into()];
+    header.extend((1..=n).map(|i| format!("x{i}")));
+    let write_err = |e| io_failed("write", &csv_path, e);
+    writeln!(csv, "{}", header.join(",")).map_err(write_err)?;
+    let mut out = String::new();
+    let continuum = if uniform { "   Bernoulli (continuum)" } else { "" };
+    out.push_str(&format!(" k   omega (rad/s)     f (Hz)   period (s)  nodes{continuum}\n"));
+    let mut shapes = Vec::new();
+    for k in 0..count {
+        let omega = modes.frequencies[k];
+        let x = modes.displacements(&chain, k);
+        let nodes = 1 + sign_changes(&x);
+        let f = omega / (2.0 * std::f64::consts::PI);
+        let period = if omega > 0.0 { 1.0 / f } else { f64::INFINITY };
+        let mut line = format!("{:>2}  {omega:>14.6}  {f:>9.5}  {period:>11.5}  {nodes:>5}", k + 1);
+        if uniform {
+            let bernoulli = 0.5 * bessel_j0_zero(k + 1) * (chain.gravity() / total).sqrt();
+            line.push_str(&format!("   {bernoulli:>14.6}"));
+        }
+        out.push_str(&line);
+        out.push('\n');
+        let row: Vec<String> = [(k + 1) as f64, omega, f, period, nodes as f64]
+            .iter()
+            .chain(&x)
+            .map(|v| format!("{v:?}"))
+            .collect();
+        writeln!(csv, "{}", row.join(",")).map_err(write_err)?;
+        shapes.push((k + 1, omega, x));
+    }
+    csv.flush().map_err(write_err)?;
+    print!("{out}");
+    let png = args.out.join("modes.png");
+    plot_modes(&png, &chain, &shapes)?;
+    eprintln!("pendulum: {count} of {n} modes; files in {} (modes.csv, modes.png)", args.out.display());
+    Ok(())
+}
+
+/// Depths of the masses of a hanging chain, `z_i = −Σ_{j≤i} l_j` (m).
+fn hanging_depths(chain: &Chain<Dyn>) -> Vec<f64> {
+    let mut z = 0.0;
+    chain
+        .lengths()
+        .iter()
+        .map(|l| {
+            z -= l;
+            z
+        })
+        .collect()
+}
+
+/// One panel per mode: the chain displaced in its mode shape (horizontal displacement
+/// scaled to a quarter of the chain's length), the hanging chain in grey.
+fn plot_modes(path: &Path, chain: &Chain<Dyn>, shapes: &[(usize, f64, Vec<f64>)]) -> CliResult<()> {
+    fonts();
+    let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
+    let panels = shapes.len();
+    let root = BitMapBackend::new(path, (200 * panels as u32, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let total: f64 = chain.lengths().iter().sum();
+    let z = hanging_depths(chain);
+    for (area, (k, omega, x)) in root.split_evenly((1, panels)).iter().zip(shapes) {
+        let peak = x.iter().fold(0.0_f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+        let scale = 0.25 * total / peak;
+        let mut chart = ChartBuilder::on(area)
+            .caption(format!("mode {k}: ω = {omega:.3} rad/s"), ("sans-serif", 14))
+            .margin(6)
+            .build_cartesian_2d(-0.4 * total..0.4 * total, -1.05 * total..0.05 * total)
+            .map_err(|e| fail(&e))?;
+        let rest = std::iter::once((0.0, 0.0)).chain(z.iter().map(|&z| (0.0, z)));
+        chart
+            .draw_series(LineSeries::new(rest, RGBColor(200, 200, 200).stroke_width(1)))
+            .map_err(|e| fail(&e))?;
+        let points: Vec<(f64, f64)> =
+            std::iter::once((0.0, 0.0)).chain(x.iter().zip(&z).map(|(x, z)| (x * scale, *z))).collect();
+        chart
+            .draw_series(LineSeries::new(points.iter().copied(), BLACK.stroke_width(2)))
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(points[1..].iter().map(|&p| Circle::new(p, 3, BLUE.filled())))
+            .map_err(|e| fail(&e))?;
+    }
+    root.present().map_err(|e| fail(&e))
+}
