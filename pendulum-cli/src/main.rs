@@ -3,7 +3,6 @@
 //! a model's terms as JSON, or find the normal modes and steady rotations of a chain.
 
 mod args;
-mod bessel;
 mod chain_args;
 mod config;
 mod error;

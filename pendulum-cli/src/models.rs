@@ -1,19 +1,19 @@
 //! Which core model simulates which chain (one place to switch models), and the
-//! [`Simulation`] seam the run loop sees: a system, its initial state, and what one sample
-//! of it means (trajectory columns, positions, energy ledger).
+//! [`Simulation`] the run loop sees: a motion with its energy ledger, its initial state,
+//! and what one sample of it means ([`Motion`]: trajectory columns, positions).
 
-use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, OVector, U1, U2, U3, Vector2, Vector3};
+use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, U2, U3};
+use pendulum_core::energy::Powered;
 use pendulum_core::integrate::{
     Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System,
 };
+use pendulum_core::kinematics::Chart;
 use pendulum_core::{
-    Accounted, AccountedDirections, Chain, Circle, ConstantTorque, Directions, Drive, Fixed, Harmonic,
-    Ledger, Model, ModelAlloc, PlanarTension, Spatial,
+    Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Driven, FirstOrder, Fixed, Harmonic, Ledger,
+    Model, ModelAlloc, PlanarTension, Spatial,
 };
 
-use crate::args::{IntegratorKind, StageSolver};
-
-use crate::args::Dimension;
+use crate::args::{Dimension, IntegratorKind, StageSolver};
 use crate::config::{DriveConfig, RunConfig};
 use crate::error::{CliError, CliResult};
 
@@ -32,23 +32,6 @@ pub struct Sample {
     pub energy: f64,
     /// Work of drive and torques and the damped energy since t = 0, J.
     pub ledger: Ledger,
-}
-
-/// A chain set up to run: the integrators see [`system`](Simulation::system).
-pub trait Simulation {
-    /// The first-order system integrated.
-    type Sys: System<Dim = Dyn>;
-    /// The system.
-    fn system(&self) -> &Self::Sys;
-    /// The state at t = 0.
-    fn initial_state(&self) -> DVector<f64>;
-    /// Names of the trajectory's state columns (coordinates, then rates).
-    fn state_columns(&self) -> Vec<String>;
-    /// Reads a sample out of the state `x` at time `t`.
-    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample;
-    /// The integrator of this kind for the system (with a projection onto the
-    /// constraints where the system has them).
-    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_>;
 }
 
 /// Most sweeps of the fixed-point stage solve per step.
@@ -94,152 +77,146 @@ fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
     Box::new(Projected::new(plain_integrator(kind, solver, system)))
 }
 
-/// An angle model with a boxed pivot drive, constant torques and the energy ledger.
-type AccountedModel<M> = Accounted<M, Box<dyn Drive<<M as Model>::Space>>, ConstantTorque<<M as Model>::Dof>>;
-
-/// A chain model in angle coordinates with its drive, torques and energy ledger
-/// ([`Accounted`]): state `x = (q, q̇, W_drive, W_torque, E_damped)`.
-pub struct AngleSimulation<M: Model>
-where
-    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
-{
-    system: AccountedModel<M>,
-    x0: DVector<f64>,
+/// A chain's motion as `pendulum simulate` runs it: what the core's ledger needs
+/// ([`Powered`]) and what a run's files show of it.
+pub trait Motion: Powered + Sized {
+    /// Names of the trajectory's state columns (coordinates, then rates).
+    fn state_columns(&self) -> Vec<String>;
+    /// Pivot position at time `t` (m), z = 0 in 2D.
+    fn pivot(&self, t: f64) -> [f64; 3];
+    /// Mass positions in the inertial frame (m) of the motion's state `x` at time `t`.
+    fn masses(&self, t: f64, x: &[f64]) -> Vec<[f64; 3]>;
+    /// The integrator of this kind for the system (with a projection onto the
+    /// constraints where the motion has them).
+    fn integrator<'a>(
+        system: &'a Accounted<Self>,
+        kind: IntegratorKind,
+        solver: StageSolver,
+    ) -> Box<dyn Integrator<Accounted<Self>> + 'a>;
 }
 
-impl<M: Model<Links = Dyn, Dof = Dyn>> AngleSimulation<M>
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
-{
-    fn new(
-        model: M,
-        drive: Box<dyn Drive<M::Space>>,
-        torque: &[f64],
-        q: &[f64],
-        qd: &[f64],
-    ) -> CliResult<Self> {
-        let dof = model.dof();
-        let torque =
-            if torque.is_empty() { DVector::zeros(dof.0) } else { DVector::from_column_slice(torque) };
-        let (q, qd) = (DVector::from_column_slice(q), DVector::from_column_slice(qd));
-        model.check_configuration(&q).map_err(singular_start)?;
-        let system = Accounted::new(model, drive, ConstantTorque(torque));
-        let x0 = system.state(&q, &qd);
-        Ok(Self { system, x0 })
-    }
-}
+/// A model in angles with a boxed pivot drive and constant torques.
+type AngleMotion<M> =
+    FirstOrder<M, Driven<Box<dyn Drive<<M as Model>::Space>>, ConstantTorque<<M as Model>::Dof>>>;
 
-/// The error for a 3D start at the spherical-angle singularity.
-fn singular_start(e: pendulum_core::Error) -> CliError {
-    CliError::usage(format!(
-        "initial state: {e}. The 3D model in spherical angles cannot start with a link \
-         straight down or up; start tilted (--initial tilted:0.3) or from a file"
-    ))
-}
-
-impl<M: Model<Links = Dyn, Dof = Dyn>> Simulation for AngleSimulation<M>
+impl<M: Model<Links = Dyn, Dof = Dyn>> Motion for AngleMotion<M>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
-    type Sys = AccountedModel<M>;
-
-    fn system(&self) -> &Self::Sys {
-        &self.system
-    }
-
-    fn initial_state(&self) -> DVector<f64> {
-        self.x0.clone()
-    }
-
     fn state_columns(&self) -> Vec<String> {
-        let n = self.system.model().chain().links();
-        let names: &[&str] = if M::Space::dim() == 2 { &["theta"] } else { &["theta", "phi"] };
+        let n = self.model().chain().links();
         let mut columns = Vec::new();
         for prefix in ["", "d"] {
-            for name in names {
+            for name in M::Chart::COORDINATES {
                 columns.extend((1..=n).map(|i| format!("{prefix}{name}{i}")));
             }
         }
         columns
     }
 
-    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
-        let (q, _, ledger) = self.system.split(x);
-        let drive = self.system.inputs().drive();
-        let pivot = to3(&drive.position(t));
-        let chain = self.system.model().chain();
-        let masses = if M::Space::dim() == 2 {
-            planar_positions(chain.lengths().as_slice(), q.as_slice(), pivot)
-        } else {
-            spatial_positions(chain.lengths().as_slice(), q.as_slice(), pivot)
-        };
-        let dof = q.len();
-        Sample {
-            t,
-            state: x.as_slice()[..2 * dof].to_vec(),
-            pivot,
-            masses,
-            energy: self.system.energy(t, x),
-            ledger,
-        }
+    fn pivot(&self, t: f64) -> [f64; 3] {
+        to3(&self.inputs().drive().position(t))
     }
 
-    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_> {
-        plain_integrator(kind, solver, &self.system)
+    fn masses(&self, t: f64, x: &[f64]) -> Vec<[f64; 3]> {
+        let chain = self.model().chain();
+        let q = &x[..self.model().dof().value()];
+        let pivot = self.inputs().drive().position(t);
+        M::Chart::positions(chain.lengths().as_slice(), q, &pivot).iter().map(to3).collect()
+    }
+
+    fn integrator<'a>(
+        system: &'a Accounted<Self>,
+        kind: IntegratorKind,
+        solver: StageSolver,
+    ) -> Box<dyn Integrator<Accounted<Self>> + 'a> {
+        plain_integrator(kind, solver, system)
     }
 }
 
-/// A chain in unit link directions ([`Directions`], no coordinate singularity) with its
-/// energy ledger ([`AccountedDirections`]).
-pub struct DirectionsSimulation<S: DimName>
+impl<S: DimName> Motion for Directions<S, Box<dyn Drive<S>>>
 where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
-    system: AccountedDirections<S, Box<dyn Drive<S>>>,
-    x0: DVector<f64>,
-}
-
-impl<S: DimName> Simulation for DirectionsSimulation<S>
-where
-    DefaultAllocator: nalgebra::allocator::Allocator<S>,
-{
-    type Sys = AccountedDirections<S, Box<dyn Drive<S>>>;
-
-    fn system(&self) -> &Self::Sys {
-        &self.system
-    }
-
-    fn initial_state(&self) -> DVector<f64> {
-        self.x0.clone()
-    }
-
     fn state_columns(&self) -> Vec<String> {
-        let n = self.system.chain().links();
         let axes = ["x", "y", "z"];
         let mut columns = Vec::new();
         for name in ["u", "w"] {
-            for i in 1..=n {
+            for i in 1..=self.links() {
                 columns.extend(axes[..S::DIM].iter().map(|a| format!("{name}{i}_{a}")));
             }
         }
         columns
     }
 
-    fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
-        let motion = self.system.motion(x);
-        let chain = self.system.chain();
+    fn pivot(&self, t: f64) -> [f64; 3] {
+        to3(&self.drive().position(t))
+    }
+
+    fn masses(&self, t: f64, x: &[f64]) -> Vec<[f64; 3]> {
+        self.positions(t, &DVector::from_column_slice(x)).iter().map(to3).collect()
+    }
+
+    fn integrator<'a>(
+        system: &'a Accounted<Self>,
+        kind: IntegratorKind,
+        solver: StageSolver,
+    ) -> Box<dyn Integrator<Accounted<Self>> + 'a> {
+        projected_integrator(kind, solver, system)
+    }
+}
+
+/// A chain set up to run: its motion with the energy ledger ([`Accounted`]) and the state
+/// at t = 0.
+pub struct Simulation<P> {
+    system: Accounted<P>,
+    x0: DVector<f64>,
+}
+
+impl<P: Motion> Simulation<P> {
+    /// The motion from its state `motion` at t = 0, with an empty ledger.
+    fn new(motion: P, start: &[f64]) -> CliResult<Self> {
+        let system = Accounted::of(motion);
+        let x0 = system.start(start)?;
+        Ok(Self { system, x0 })
+    }
+
+    /// The first-order system integrated.
+    pub fn system(&self) -> &Accounted<P> {
+        &self.system
+    }
+
+    /// The state at t = 0.
+    pub fn initial_state(&self) -> DVector<f64> {
+        self.x0.clone()
+    }
+
+    /// Names of the trajectory's state columns (coordinates, then rates).
+    pub fn state_columns(&self) -> Vec<String> {
+        self.system.motion_system().state_columns()
+    }
+
+    /// Reads a sample out of the state `x` at time `t`.
+    pub fn sample(&self, t: f64, x: &DVector<f64>) -> Sample {
+        let motion = &x.as_slice()[..self.system.motion_len()];
+        let chain = self.system.motion_system();
         Sample {
             t,
-            state: motion.as_slice().to_vec(),
-            pivot: to3(&chain.drive().position(t)),
-            masses: chain.positions(t, &motion).iter().map(to3).collect(),
-            energy: chain.inertial_energy(t, &motion),
+            state: motion.to_vec(),
+            pivot: chain.pivot(t),
+            masses: chain.masses(t, motion),
+            energy: self.system.energy(t, x),
             ledger: self.system.ledger(x),
         }
     }
 
-    fn integrator(&self, kind: IntegratorKind, solver: StageSolver) -> Box<dyn Integrator<Self::Sys> + '_> {
-        projected_integrator(kind, solver, &self.system)
+    /// The integrator of this kind for the system.
+    pub fn integrator(
+        &self,
+        kind: IntegratorKind,
+        solver: StageSolver,
+    ) -> Box<dyn Integrator<Accounted<P>> + '_> {
+        P::integrator(&self.system, kind, solver)
     }
 }
 
@@ -249,36 +226,6 @@ where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
     [v[0], v[1], if S::dim() > 2 { v[2] } else { 0.0 }]
-}
-
-/// Planar mass positions `r_k = p + Σ_{j≤k} l_j (sin θ_j, −cos θ_j)` (m).
-pub fn planar_positions(lengths: &[f64], theta: &[f64], pivot: [f64; 3]) -> Vec<[f64; 3]> {
-    let mut r = pivot;
-    lengths
-        .iter()
-        .zip(theta)
-        .map(|(l, th)| {
-            let (s, c) = th.sin_cos();
-            r = [r[0] + l * s, r[1] - l * c, r[2]];
-            r
-        })
-        .collect()
-}
-
-/// Spatial mass positions `r_k = p + Σ_{j≤k} l_j (sin θ_j cos φ_j, sin θ_j sin φ_j,
-/// −cos θ_j)` (m), `q = (θ_1..θ_n, φ_1..φ_n)`.
-pub fn spatial_positions(lengths: &[f64], q: &[f64], pivot: [f64; 3]) -> Vec<[f64; 3]> {
-    let n = lengths.len();
-    let mut r = pivot;
-    (0..n)
-        .map(|i| {
-            let (st, ct) = q[i].sin_cos();
-            let (sp, cp) = q[n + i].sin_cos();
-            let l = lengths[i];
-            r = [r[0] + l * st * cp, r[1] + l * st * sp, r[2] - l * ct];
-            r
-        })
-        .collect()
 }
 
 /// The chain of a configuration, validated by the core.
@@ -298,83 +245,76 @@ pub fn spatial_model(chain: Chain<Dyn>) -> Spatial<Dyn> {
     Spatial::new(chain)
 }
 
-/// The 3D chain `pendulum simulate` integrates (the one place to change it): unit link
-/// directions, free of the spherical angles' singularity, started from spherical
-/// angles `q = (θ, φ)` and rates `q̇` (any angles, a hanging chain included).
-fn spatial_simulation(
-    chain: Chain<Dyn>,
-    drive: Box<dyn Drive<U3>>,
-    q: &[f64],
-    qd: &[f64],
-) -> CliResult<DirectionsSimulation<U3>> {
-    let directions = Directions::<U3>::new(chain).with_drive(drive);
-    let motion = directions.from_spherical(q, qd)?;
-    let system = AccountedDirections::new(directions);
-    let x0 = system.state(&motion)?;
-    Ok(DirectionsSimulation { system, x0 })
+/// The spaces a run's chain lives in, with what only one of them has.
+pub trait RunSpace: DimName
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<Self>,
+{
+    /// The circle drive in this space (3D only).
+    fn circle(radius: f64, omega: f64) -> CliResult<Box<dyn Drive<Self>>>;
 }
 
-/// The planar drive of a configuration.
-fn drive2(config: &DriveConfig) -> CliResult<Box<dyn Drive<U2>>> {
+impl RunSpace for U2 {
+    fn circle(_: f64, _: f64) -> CliResult<Box<dyn Drive<U2>>> {
+        Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only"))
+    }
+}
+
+impl RunSpace for U3 {
+    fn circle(radius: f64, omega: f64) -> CliResult<Box<dyn Drive<U3>>> {
+        Ok(Box::new(Circle::new(radius, omega)?))
+    }
+}
+
+/// The pivot drive of a configuration.
+fn drive<S: RunSpace>(config: &DriveConfig) -> CliResult<Box<dyn Drive<S>>>
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
     Ok(match config {
         DriveConfig::Fixed => Box::new(Fixed),
         DriveConfig::Harmonic { direction, amplitude, omega, phase } => {
-            let d = Vector2::from_iterator(direction.iter().copied());
+            let d = OVector::<f64, S>::from_iterator(direction.iter().copied());
             Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
         }
-        DriveConfig::Circle { .. } => {
-            return Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only"));
-        }
-    })
-}
-
-/// The spatial drive of a configuration.
-fn drive3(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
-    Ok(match config {
-        DriveConfig::Fixed => Box::new(Fixed),
-        DriveConfig::Harmonic { direction, amplitude, omega, phase } => {
-            let d = Vector3::from_iterator(direction.iter().copied());
-            Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
-        }
-        DriveConfig::Circle { radius, omega } => Box::new(Circle::new(*radius, *omega)?),
+        DriveConfig::Circle { radius, omega } => S::circle(*radius, *omega)?,
     })
 }
 
 /// The simulation of a configuration, one of the supported kinds.
 pub enum AnySimulation {
     /// 2D, angles.
-    Planar(AngleSimulation<PlanarTension<Dyn>>),
+    Planar(Simulation<AngleMotion<PlanarTension<Dyn>>>),
     /// 3D, unit link directions.
-    Spatial(DirectionsSimulation<U3>),
+    Spatial(Simulation<Directions<U3, Box<dyn Drive<U3>>>>),
 }
 
 /// Builds the simulation a configuration describes; errors name the bad parameter.
+///
+/// 2D chains run in angles (the one place to change it: [`planar_model`]); 3D chains in
+/// unit link directions, free of the spherical angles' singularity, started from
+/// spherical angles `q = (θ, φ)` and rates `q̇` (any angles, a hanging chain included).
 pub fn build(config: &RunConfig) -> CliResult<AnySimulation> {
     let chain = chain(config)?;
     let (q, qd) = (&config.initial.coordinates, &config.initial.rates);
     Ok(match config.dim {
-        Dimension::Two => AnySimulation::Planar(AngleSimulation::new(
-            planar_model(chain),
-            drive2(&config.drive)?,
-            &config.torque,
-            q,
-            qd,
-        )?),
-        Dimension::Three => AnySimulation::Spatial(spatial_simulation(chain, drive3(&config.drive)?, q, qd)?),
+        Dimension::Two => {
+            let model = planar_model(chain);
+            let dof = model.dof().value();
+            let torque = if config.torque.is_empty() {
+                DVector::zeros(dof)
+            } else {
+                DVector::from_column_slice(&config.torque)
+            };
+            let start: Vec<f64> = q.iter().chain(qd).copied().collect();
+            let motion =
+                FirstOrder::with_inputs(model, Driven::new(drive(&config.drive)?, ConstantTorque(torque)));
+            AnySimulation::Planar(Simulation::new(motion, &start)?)
+        }
+        Dimension::Three => {
+            let directions = Directions::<U3>::new(chain).with_drive(drive(&config.drive)?);
+            let start = directions.from_spherical(q, qd)?;
+            AnySimulation::Spatial(Simulation::new(directions, start.as_slice())?)
+        }
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn positions_follow_the_conventions() {
-        let r = planar_positions(&[1.0, 2.0], &[std::f64::consts::FRAC_PI_2, 0.0], [0.5, 0.0, 0.0]);
-        assert!((r[0][0] - 1.5).abs() < 1e-15 && r[0][1].abs() < 1e-15);
-        assert!((r[1][0] - 1.5).abs() < 1e-15 && (r[1][1] + 2.0).abs() < 1e-15);
-        let half = std::f64::consts::FRAC_PI_2;
-        let r = spatial_positions(&[1.0], &[half, half], [0.0; 3]);
-        assert!(r[0][0].abs() < 1e-15 && (r[0][1] - 1.0).abs() < 1e-15 && r[0][2].abs() < 1e-15);
-    }
 }

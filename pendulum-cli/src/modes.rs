@@ -5,11 +5,10 @@ use std::io::Write;
 use std::path::Path;
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, normal_modes, sign_changes};
+use pendulum_core::{Chain, bernoulli_frequency, normal_modes, sign_changes};
 use plotters::prelude::*;
 
 use crate::args::ModesArgs;
-use crate::bessel::bessel_j0_zero;
 use crate::chain_args::chain_of;
 use crate::error::{CliError, CliResult, io_failed};
 use crate::plot::{drawing_failed, fonts};
@@ -49,7 +48,7 @@ pub fn modes(args: &ModesArgs) -> CliResult<()> {
         let period = if omega > 0.0 { 1.0 / f } else { f64::INFINITY };
         let mut line = format!("{:>2}  {omega:>14.6}  {f:>9.5}  {period:>11.5}  {nodes:>5}", k + 1);
         if uniform {
-            let bernoulli = 0.5 * bessel_j0_zero(k + 1) * (chain.gravity() / total).sqrt();
+            let bernoulli = bernoulli_frequency(k + 1, chain.gravity(), total);
             line.push_str(&format!("   {bernoulli:>14.6}"));
         }
         out.push_str(&line);

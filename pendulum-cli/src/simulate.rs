@@ -14,7 +14,7 @@ use pendulum_core::trajectory;
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
 use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
-use crate::models::{AnySimulation, Sample, Simulation, build};
+use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
 use crate::plot::{self, Frame};
 
 /// Set by the Ctrl-C handler; the run stops at the next sample and writes its files.
@@ -106,7 +106,7 @@ impl Csv {
 
 /// Columns of the trajectory: t, the simulation's state columns, the pivot and every
 /// mass (x, y in 2D; x, y, z in 3D).
-fn trajectory_header<S: Simulation>(simulation: &S, dim: Dimension, n: usize) -> Vec<String> {
+fn trajectory_header<P: Motion>(simulation: &Simulation<P>, dim: Dimension, n: usize) -> Vec<String> {
     let axes: &[&str] = if dim == Dimension::Two { &["x", "y"] } else { &["x", "y", "z"] };
     let mut header = vec!["t".to_string()];
     header.extend(simulation.state_columns());
@@ -133,7 +133,7 @@ struct Kept {
 }
 
 /// Integrates, writes every output, prints the summary.
-fn execute<S: Simulation>(simulation: &S, config: &RunConfig, options: &Options) -> CliResult<()> {
+fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &Options) -> CliResult<()> {
     let out = &options.out;
     let n = config.links();
     let mut run_file = RunFile::new(config.clone());

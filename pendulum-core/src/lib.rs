@@ -43,8 +43,8 @@ pub mod trajectory;
 
 pub use analysis::{
     Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, Stability,
-    SteadyRotation, SteadyShape, linearise, normal_modes, relative_equilibrium, relative_spectrum,
-    sign_changes, stability,
+    SteadyRotation, SteadyShape, bernoulli_frequency, bessel_j0_zero, linearise, normal_modes,
+    relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
 pub use chain::Chain;
 pub use drive::{Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, TorqueAt};

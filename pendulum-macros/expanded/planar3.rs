@@ -81,6 +81,7 @@ const _: () = {
         type Links = Const<3>;
         type Dof = Const<3>;
         type Space = U2;
+        type Chart = ::pendulum_core::kinematics::PlanarAngles;
         fn chain(&self) -> &Chain<Const<3>> {
             &self.chain
         }

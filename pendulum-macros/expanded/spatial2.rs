@@ -67,6 +67,7 @@ const _: () = {
         type Links = Const<2>;
         type Dof = Const<4>;
         type Space = U3;
+        type Chart = ::pendulum_core::kinematics::SphericalAngles;
         fn chain(&self) -> &Chain<Const<2>> {
             &self.chain
         }

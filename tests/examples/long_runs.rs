@@ -21,13 +21,11 @@ use std::time::Instant;
 
 use nalgebra::{DVector, U2, U3, Vector3};
 use pendulum_core::integrate::{Constrained, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, State};
-use pendulum_core::{Canonical, Chain, Directions, KineticGradient, Model};
+use pendulum_core::{Canonical, Chain, Directions, Model};
 
 pendulum_macros::model! {
     struct Planar3 { kind: planar, links: 3 }
 }
-
-impl KineticGradient for Planar3 {}
 
 fn generated(steps: u64) {
     let (masses, lengths, g) = ([1.0, 0.7, 1.3], [1.0, 0.8, 0.6], 9.81);

@@ -8,8 +8,8 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, Dyn, OVector, U1, U2, U3, Vector2, Vector3};
 use pendulum_core::integrate::{GaussLegendre, GaussOptions, State, SystemAlloc};
 use pendulum_core::{
-    Accounted, Chain, Circle, ConstantTorque, Drive, FnDrive, Harmonic, Model, ModelAlloc, Planar, Spatial,
-    TorqueAt, trajectory,
+    Accounted, Chain, Circle, ConstantTorque, Drive, Driven, FirstOrder, FnDrive, Harmonic, Model,
+    ModelAlloc, Planar, Spatial, TorqueAt, trajectory,
 };
 use pendulum_tests::{random_chain, random_vector, rng};
 use rand::Rng;
@@ -107,7 +107,7 @@ impl Drive<U2> for Circle2D {
 /// checking the balance at every sample; returns the worst relative closure and the
 /// final balance.
 fn closure<M: Model, Dr: Drive<M::Space>, T: TorqueAt<M::Dof>>(
-    system: &Accounted<M, Dr, T>,
+    system: &Accounted<FirstOrder<M, Driven<Dr, T>>>,
     q: &[f64],
     qd: &[f64],
     t1: f64,

@@ -9,22 +9,19 @@
 //! the flow, so what is asserted is: at every step the state difference, relative to
 //! `max(‖x‖∞, 1)`, stays below 1e-13 (measured: 3e-16 to 3e-15, printed with
 //! `--nocapture`).
-//! The same holds in the canonical form ([`Canonical`]), where the generated models opt
-//! in to the closed-form kinetic gradient with an empty `impl KineticGradient`.
+//! The same holds in the canonical form ([`Canonical`]), whose kinetic gradient the
+//! generated models take from their chart (`Model::Chart`).
 
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{DefaultAllocator, DimMul, DimProd, Dyn, OVector, U1, U2};
 use pendulum_core::integrate::{GaussLegendre, GaussOptions, Integrator, State, System};
-use pendulum_core::{Canonical, Chain, FirstOrder, KineticGradient, ModelAlloc, Planar, Spatial};
+use pendulum_core::{Canonical, Chain, FirstOrder, Model, ModelAlloc, Planar, Spatial};
 
 pendulum_macros::model! {
     struct Planar3 { kind: planar, links: 3 }
     struct Spatial3 { kind: spatial, links: 3 }
 }
-
-impl KineticGradient for Planar3 {}
-impl KineticGradient for Spatial3 {}
 
 const MASSES: [f64; 3] = [1.0, 0.7, 1.3];
 const LENGTHS: [f64; 3] = [1.0, 0.8, 0.6];
@@ -68,7 +65,7 @@ fn worst_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
 }
 
 /// Velocity-form and canonical-form trajectories of one model from `(q, q̇)`.
-fn both_forms<M: KineticGradient + Clone>(model: &M, q: &[f64], qd: &[f64]) -> (Vec<Vec<f64>>, Vec<Vec<f64>>)
+fn both_forms<M: Model + Clone>(model: &M, q: &[f64], qd: &[f64]) -> (Vec<Vec<f64>>, Vec<Vec<f64>>)
 where
     M::Dof: DimMul<U2>,
     DimProd<M::Dof, U2>: DimMul<U2>,

@@ -1,15 +1,18 @@
 //! What the equations say about a chain beyond one trajectory: its normal modes about the
-//! hanging rest (`modes`), the undamped steady shapes turning rigidly about the vertical
+//! hanging rest (`modes`, with Bernoulli's continuum frequencies from the zeros of J0,
+//! `bessel`), the undamped steady shapes turning rigidly about the vertical
 //! as branches over the speed ω (`steady_branches`) and their stability (`stability`),
 //! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
 //! with their spectrum (`relative_equilibrium`).
 
+pub(crate) mod bessel;
 pub(crate) mod modes;
 pub(crate) mod relative_equilibrium;
 pub(crate) mod stability;
 pub(crate) mod steady_branches;
 
-pub use modes::{NormalModes, normal_modes, sign_changes};
+pub use bessel::bessel_j0_zero;
+pub use modes::{NormalModes, bernoulli_frequency, normal_modes, sign_changes};
 pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
 pub use stability::{Linearisation, Stability, linearise, stability};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};

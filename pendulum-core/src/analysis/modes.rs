@@ -28,6 +28,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, DimDiff, DimSub, OMatrix, OVector, U1, allocator::Allocator};
 
+use crate::analysis::bessel::bessel_j0_zero;
 use crate::chain::Chain;
 
 /// The normal modes of a chain hanging at rest.
@@ -144,6 +145,14 @@ pub fn sign_changes(values: &[f64]) -> usize {
         }
     }
     count
+}
+
+/// Bernoulli's frequency of mode `k` (k ≥ 1) of the uniform hanging chain of length `L` (m)
+/// in the continuum limit, `ω_k = (j_{0,k}/2) √(g/L)` (rad/s), `j_{0,k}` the k-th zero of
+/// the Bessel function J0 ([`bessel_j0_zero`]). A uniform chain of n links approaches it
+/// from below as n grows (`docs/rotating-chain.md`).
+pub fn bernoulli_frequency(k: usize, gravity: f64, length: f64) -> f64 {
+    0.5 * bessel_j0_zero(k) * (gravity / length).sqrt()
 }
 
 #[cfg(test)]

@@ -5,5 +5,5 @@
 pub(crate) mod ledger;
 pub(crate) mod power;
 
-pub use ledger::{Accounted, AccountedDirections, Balance, Ledger};
+pub use ledger::{Accounted, AccountedDirections, Balance, Ledger, Powered};
 pub use power::{Powers, inertial_energy, pivot_force, pivot_momentum, pivot_momentum_rate, powers};

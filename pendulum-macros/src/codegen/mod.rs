@@ -18,7 +18,7 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::parse::{Input, ModelDef};
-use crate::plan::{Plan, Sym};
+use crate::plan::{Kind, Plan, Sym};
 
 /// Everything `model!` emits for its input.
 pub fn expand(input: &Input) -> TokenStream {
@@ -104,10 +104,12 @@ fn associated_types(plan: &Plan) -> TokenStream {
     let n = index(plan.links);
     let dof = index(plan.dof());
     let space = space(plan);
+    let chart = chart(plan);
     quote! {
         type Links = Const<#n>;
         type Dof = Const<#dof>;
         type Space = #space;
+        type Chart = ::pendulum_core::kinematics::#chart;
     }
 }
 
@@ -119,6 +121,14 @@ fn ident(sym: Sym) -> Ident {
 /// `i` as an unsuffixed literal.
 fn index(i: usize) -> Literal {
     Literal::usize_unsuffixed(i)
+}
+
+/// The chart of the model's coordinates (`pendulum_core::kinematics`).
+fn chart(plan: &Plan) -> Ident {
+    match plan.kind {
+        Kind::Planar => format_ident!("PlanarAngles"),
+        Kind::Spatial => format_ident!("SphericalAngles"),
+    }
 }
 
 /// The pivot-acceleration type: `U2` planar, `U3` spatial.

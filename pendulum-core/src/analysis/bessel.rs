@@ -1,7 +1,5 @@
 //! The zeros `j_{0,k}` of the Bessel function J0, for Bernoulli's hanging-chain frequencies
 //! `ω_k = (j_{0,k} / 2) √(g/L)` (a uniform chain of length L, in the continuum limit).
-//!
-//! Self-contained: it depends on `std` only.
 
 /// The first ten positive zeros of the Bessel function J0 (Abramowitz & Stegun, table 9.5).
 const J0_ZEROS: [f64; 10] = [
