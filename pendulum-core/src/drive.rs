@@ -1,9 +1,9 @@
 //! Prescribed pivot motion `p(t)` and time-dependent torques `σ(t)`: the inputs of a
-//! driven chain, plugged into [`FirstOrder`](crate::FirstOrder) through [`Driven`].
+//! driven chain, plugged into [`FirstOrder`](crate::systems::FirstOrder) through [`Driven`].
 //!
 //! A driven pivot enters the equations of motion only through its acceleration `p̈(t)`
 //! (in the pivot's frame it acts as the time-dependent gravity `g⃗ − p̈(t)`, DESIGN.md);
-//! the energy accounting ([`Accounted`](crate::Accounted)) also needs `p(t)` and `ṗ(t)`.
+//! the energy accounting ([`Accounted`](crate::energy::Accounted)) also needs `p(t)` and `ṗ(t)`.
 //! Vectors live in the model's space: `(x, y)` with y up for planar models, `(x, y, z)`
 //! with z up for spatial ones.
 
@@ -18,7 +18,7 @@ use crate::model::{Inputs, InputsAt};
 /// `p̈(t)` (m/s²) in the model's space `S` (`U2` planar, `U3` spatial).
 ///
 /// The three must be consistent (`ṗ = dp/dt`, `p̈ = dṗ/dt`) for the energy balance of
-/// [`Accounted`](crate::Accounted) to close; the dynamics use `p̈` only. The built-in
+/// [`Accounted`](crate::energy::Accounted) to close; the dynamics use `p̈` only. The built-in
 /// drives are [`Fixed`], [`Harmonic`], [`Circle`] (spatial) and [`FnDrive`] (closures);
 /// implement the trait for any other motion. `&D` and `Box<D>` (also `Box<dyn Drive<S>>`,
 /// to choose a drive at run time) are drives when `D` is.

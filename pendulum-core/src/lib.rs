@@ -28,10 +28,10 @@
 //! document the project grew out of); where it is wrong the code follows the sympy derivation and
 //! `reference/ERRATA.md` says so.
 
-mod chain;
-mod drive;
-mod error;
-mod model;
+pub mod chain;
+pub mod drive;
+pub mod error;
+pub mod model;
 
 pub mod analysis;
 pub mod energy;

@@ -438,7 +438,7 @@ mod tests {
     fn spatial_inertial_energy_changes_at_the_power_of_drive_torque_and_damping() {
         let chain = Chain::<Dyn>::new(&[1.0, 0.7], &[0.5, 0.8], 9.81).unwrap();
         let model = Spatial::new(chain.with_damping(&[0.2, 0.3]).unwrap());
-        let drive = crate::Circle::new(0.1, 6.0).unwrap();
+        let drive = crate::drive::Circle::new(0.1, 6.0).unwrap();
         check_power_balance(
             model,
             drive,

@@ -182,7 +182,7 @@ mod tests {
     use crate::models::planar::Planar;
     use crate::systems::first_order::FirstOrder;
 
-    fn double_pendulum() -> FirstOrder<Planar, crate::Inputs<Dyn, U2>> {
+    fn double_pendulum() -> FirstOrder<Planar, crate::model::Inputs<Dyn, U2>> {
         FirstOrder::new(Planar::new(Chain::new(&[1.0, 0.7], &[1.0, 0.6], 9.81).unwrap()))
     }
 

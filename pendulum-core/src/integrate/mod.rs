@@ -2,7 +2,7 @@
 //! s = 1, 2, 3 stages, orders 2, 4, 6) and classical RK4 (explicit).
 //!
 //! The pieces are separate values:
-//! - the problem, a [`System`] (for a chain model, [`FirstOrder`](crate::FirstOrder));
+//! - the problem, a [`System`] (for a chain model, [`FirstOrder`](crate::systems::FirstOrder));
 //! - the solver, a [`GaussLegendre`] or [`Rk4`], which owns every buffer a step needs,
 //!   allocated once at construction from the system's dimension, and keeps [`Stats`];
 //! - the [`State`]: time, state vector and the round-off compensation of both.

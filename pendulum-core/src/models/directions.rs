@@ -28,7 +28,7 @@ use crate::models::rods::{Load, Rods, with_scratch};
 /// with gravity `g` along −y (planar) or −z (spatial) and the damping of the chain's
 /// Rayleigh function `D = ½ Σ λ_i |u̇_i|²` (the force pair `F_i = −λ_i w_i / l_i` on rod
 /// `i`; planar this is eq 26's `−λ_i θ̇_i`, spatial the same `λ` as the spherical models).
-/// The same physics as [`Planar`](crate::Planar) and [`Spatial`](crate::Spatial) (tests
+/// The same physics as [`Planar`](crate::models::Planar) and [`Spatial`](crate::models::Spatial) (tests
 /// compare them to round-off), without their coordinates: the spatial model in angles is
 /// singular where a link hangs straight down; this one is not.
 ///
@@ -321,7 +321,7 @@ impl<Dr> Directions<U2, Dr> {
     }
 
     /// The angle accelerations `θ̈_i = n_i · ü_i` (rad/s²; `n_i = (cos θ_i, sin θ_i)`,
-    /// since `ü_i = θ̈_i n_i − θ̇_i² u_i`) at `(t, x)`: what [`Planar`](crate::Planar)
+    /// since `ü_i = θ̈_i n_i − θ̇_i² u_i`) at `(t, x)`: what [`Planar`](crate::models::Planar)
     /// computes, by the O(n) route.
     pub fn angle_accelerations(&self, t: f64, x: &DVector<f64>) -> Result<DVector<f64>>
     where
@@ -374,7 +374,7 @@ impl<Dr> Directions<U3, Dr> {
     /// [`from_spherical`](Self::from_spherical)), `θ ∈ [0, π]`, `φ ∈ (−π, π]`.
     ///
     /// Errors: [`Error::SingularAngle`] for a link within
-    /// [`SINGULARITY_TOLERANCE`](crate::SINGULARITY_TOLERANCE) of the vertical, where `φ`
+    /// [`SINGULARITY_TOLERANCE`](crate::kinematics::SINGULARITY_TOLERANCE) of the vertical, where `φ`
     /// is undefined; a bad state.
     pub fn to_spherical(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DVector<f64>)> {
         self.check_state(x)?;
@@ -400,13 +400,13 @@ impl<Dr: Drive<U3>> Directions<U3, Dr> {
     /// θ̈ = e_θ·ü + φ̇² sin θ cos θ,   φ̈ = (e_φ·ü − 2 θ̇ φ̇ cos θ) / sin θ
     /// ```
     /// (differentiate `u̇ = θ̇ e_θ + φ̇ sin θ e_φ` once more). What the spherical model
-    /// [`Spatial`](crate::Spatial) computes, by an O(n) route; `cargo xtask verify`
+    /// [`Spatial`](crate::models::Spatial) computes, by an O(n) route; `cargo xtask verify`
     /// checks it against the sympy reference.
     ///
     /// The angles may be any (negative `θ` included) except at the vertical.
     ///
     /// Errors: [`Error::SingularAngle`] for `|sin θ_i|` below
-    /// [`SINGULARITY_TOLERANCE`](crate::SINGULARITY_TOLERANCE); those of
+    /// [`SINGULARITY_TOLERANCE`](crate::kinematics::SINGULARITY_TOLERANCE); those of
     /// [`from_spherical`](Self::from_spherical).
     pub fn spherical_accelerations(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
         let x = self.from_spherical(q, qd)?;

@@ -25,8 +25,8 @@ use crate::models::trig::sin_cos_into;
 /// solve: three loops over the links.
 ///
 /// Mass matrix, force terms and energies are [`Planar`]'s, so the model plugs into
-/// [`FirstOrder`](crate::FirstOrder), [`Canonical`](crate::Canonical) and
-/// [`Accounted`](crate::Accounted) unchanged. Evaluations allocate nothing after the
+/// [`FirstOrder`](crate::systems::FirstOrder), [`Canonical`](crate::systems::Canonical) and
+/// [`Accounted`](crate::energy::Accounted) unchanged. Evaluations allocate nothing after the
 /// first on a thread (the solve's buffers are per thread).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanarTension<L: Dim = Dyn>
@@ -84,12 +84,12 @@ where
         let n = chain.links();
         check_inputs(n, q, qd, inputs)?;
         if out.len() != n {
-            return Err(crate::Error::LengthMismatch { what: "out", expected: n, got: out.len() });
+            return Err(crate::error::Error::LengthMismatch { what: "out", expected: n, got: out.len() });
         }
         if let Some(t) = &tensions
             && t.len() != n
         {
-            return Err(crate::Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
+            return Err(crate::error::Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
         }
         let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
         let gravity = [0.0, -chain.gravity()];
@@ -127,7 +127,7 @@ where
                 }
             });
         });
-        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::Error::NotPositiveDefinite) }
+        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::error::Error::NotPositiveDefinite) }
     }
 }
 
@@ -196,8 +196,8 @@ where
         self.dense.potential_energy(q)
     }
 
-    /// `θ̈` by the O(n) tension solve (type docs). Errors: [`crate::Error::LengthMismatch`]
-    /// or [`crate::Error::NonFinite`] for bad inputs.
+    /// `θ̈` by the O(n) tension solve (type docs). Errors: [`crate::error::Error::LengthMismatch`]
+    /// or [`crate::error::Error::NonFinite`] for bad inputs.
     fn accelerations(
         &self,
         q: &OVector<f64, L>,
@@ -259,6 +259,6 @@ mod tests {
         let fast = PlanarTension::new(Chain::<Dyn>::uniform(2, 1.0, 1.0, 9.81).unwrap());
         let mut out = DVector::zeros(3);
         let err = fast.accelerations(&DVector::zeros(2), &DVector::zeros(2), &fast.zero_inputs(), &mut out);
-        assert_eq!(err, Err(crate::Error::LengthMismatch { what: "out", expected: 2, got: 3 }));
+        assert_eq!(err, Err(crate::error::Error::LengthMismatch { what: "out", expected: 2, got: 3 }));
     }
 }

@@ -22,7 +22,7 @@ type Pair<D> = (OVector<f64, D>, OVector<f64, D>);
 /// of dimension `2·dof`. Without torque, damping and drive these are Hamilton's equations
 /// of `H(q, p) = ½ pᵀ M(q)⁻¹ p + U(q)` (the document's section 1.1 `H = T + U`,
 /// `∂H/∂q|_p = −∂T/∂q|_q̇ + ∂U/∂q`), for which Gauss–Legendre methods are symplectic; in
-/// the velocity form [`FirstOrder`](crate::FirstOrder) (`x = (q, q̇)`) they are not. The
+/// the velocity form [`FirstOrder`](crate::systems::FirstOrder) (`x = (q, q̇)`) they are not. The
 /// momentum equation is Lagrange's `d/dt(∂T/∂q̇) − ∂T/∂q = Q − k − d`, so both forms
 /// describe the same motion; `docs/integrators.md` compares them on long runs.
 ///
@@ -127,7 +127,7 @@ where
 
     /// The Hamiltonian `H(q, p) = ½ pᵀ M(q)⁻¹ p + U(q) = T + U` (J), relative to the pivot,
     /// evaluated as [`Model::energy`] of `(q, M⁻¹ p)` so that it is the same function of
-    /// the motion as [`FirstOrder::energy`](crate::FirstOrder::energy).
+    /// the motion as [`FirstOrder::energy`](crate::systems::FirstOrder::energy).
     pub fn energy(&self, x: &OVector<f64, DimProd<M::Dof, U2>>) -> Result<f64> {
         let (q, qd) = self.to_velocities(x)?;
         Ok(self.model.energy(&q, &qd))

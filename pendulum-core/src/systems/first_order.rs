@@ -81,7 +81,7 @@ where
 }
 
 /// The state `x = (q, r)` of a chain with `dof` coordinates, `r` being the rates `q̇`
-/// ([`FirstOrder`]) or the momenta `p` ([`Canonical`](crate::Canonical)).
+/// ([`FirstOrder`]) or the momenta `p` ([`Canonical`](crate::systems::Canonical)).
 pub(crate) fn stack<D: Dim + DimMul<U2>>(
     dof: D,
     q: &OVector<f64, D>,
