@@ -2,7 +2,7 @@
 //! driven chain, plugged into [`FirstOrder`](crate::systems::FirstOrder) through [`Driven`].
 //!
 //! A driven pivot enters the equations of motion only through its acceleration `p̈(t)`
-//! (in the pivot's frame it acts as the time-dependent gravity `g⃗ − p̈(t)`, DESIGN.md);
+//! (in the pivot's frame it acts as the time-dependent gravity `g⃗ − p̈(t)`, `docs/conventions.md`);
 //! the energy accounting ([`Accounted`](crate::energy::Accounted)) also needs `p(t)` and `ṗ(t)`.
 //! Vectors live in the model's space: `(x, y)` with y up for planar models, `(x, y, z)`
 //! with z up for spatial ones.

@@ -27,7 +27,7 @@ impl<L: Dim, D: Dim, S: DimName, A> ModelAlloc<L, D, S> for A where
 /// `torque` holds the generalized forces `σ` conjugate to each coordinate (N·m; eq 26),
 /// `pivot_acceleration` the pivot's acceleration `p̈` (m/s²) in the model's space
 /// (2 components planar, 3 spatial). A driven pivot enters the equations only through
-/// `p̈` (DESIGN.md).
+/// `p̈` (`docs/conventions.md`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Inputs<D: Dim, S: DimName>
 where
