@@ -64,6 +64,21 @@ pub trait Chart: Copy + Default + std::fmt::Debug + Send + Sync + 'static {
     where
         DefaultAllocator: Allocator<L>;
 
+    /// The kinetic energy relative to the pivot, `T = ½ Σ_k m_k |v_k|²` with
+    /// `v_k = Σ_{j≤k} l_j u̇_j` (J; eq 11 planar, eq 48 as derived spatial): O(n).
+    fn kinetic_energy<L: Dim>(chain: &Chain<L>, q: &[f64], qd: &[f64]) -> f64
+    where
+        DefaultAllocator: Allocator<L> + Allocator<Self::Space>,
+    {
+        let mut v = OVector::<f64, Self::Space>::zeros();
+        let mut t = 0.0;
+        for k in 0..chain.links() {
+            v += Self::link_velocity(q, qd, k) * chain.lengths()[k];
+            t += 0.5 * chain.masses()[k] * v.norm_squared();
+        }
+        t
+    }
+
     /// Positions of the masses `r_k = p + Σ_{i≤k} l_i u_i` (m), pivot at `p`, mass 1
     /// (nearest the pivot) first.
     fn positions(

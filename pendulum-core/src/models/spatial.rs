@@ -7,7 +7,7 @@ use nalgebra::{
 use crate::chain::Chain;
 use crate::error::Result;
 use crate::kinematics::SphericalLink;
-use crate::kinematics::{SphericalAngles, check_polar_angle};
+use crate::kinematics::{Chart, SphericalAngles, check_polar_angle};
 use crate::model::Model;
 
 /// A spatial chain in spherical angles: `θ_i` from the −z axis, `φ_i` the azimuth from
@@ -160,17 +160,9 @@ where
         }
     }
 
-    /// `T = ½ Σ_k m_k |v_k|²` with `v_k = Σ_{j≤k} l_j u̇_j` (eq 48 as derived).
+    /// `T = ½ Σ_k m_k |v_k|²` with `v_k = Σ_{j≤k} l_j u̇_j` (eq 48 as derived), from the chart.
     fn kinetic_energy(&self, q: &OVector<f64, Self::Dof>, qd: &OVector<f64, Self::Dof>) -> f64 {
-        let c = &self.chain;
-        let n = c.links();
-        let mut v = Vector3::zeros();
-        let mut t = 0.0;
-        for (k, f) in self.frames(q).iter().enumerate() {
-            v += f.velocity(qd[k], qd[n + k]) * c.lengths()[k];
-            t += 0.5 * c.masses()[k] * v.norm_squared();
-        }
-        t
+        SphericalAngles::kinetic_energy(&self.chain, q.as_slice(), qd.as_slice())
     }
 
     /// `U = −Σ_i M_i g l_i cos θ_i` (eq 12, unchanged in 3D).

@@ -4,7 +4,7 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allo
 
 use crate::chain::Chain;
 use crate::error::Result;
-use crate::kinematics::PlanarAngles;
+use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, check_inputs};
 use crate::models::planar::Planar;
@@ -188,8 +188,9 @@ where
         self.dense.generalized_forces(q, qd, torque, out)
     }
 
+    /// `T = ½ Σ_k m_k |v_k|²` by the chart's O(n) sum (the dense model's eq 11 is O(n²)).
     fn kinetic_energy(&self, q: &OVector<f64, L>, qd: &OVector<f64, L>) -> f64 {
-        self.dense.kinetic_energy(q, qd)
+        PlanarAngles::kinetic_energy(self.chain(), q.as_slice(), qd.as_slice())
     }
 
     fn potential_energy(&self, q: &OVector<f64, L>) -> f64 {
@@ -232,6 +233,17 @@ mod tests {
         fast.accelerations(&q, &qd, &inputs, &mut a).unwrap();
         fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
         assert_relative_eq!(a, b, epsilon = 1e-12, max_relative = 1e-12);
+    }
+
+    /// The O(n) kinetic energy (sum over masses) equals the dense double sum (eq 11).
+    #[test]
+    fn kinetic_energy_matches_the_dense_double_sum() {
+        let chain = Chain::<Dyn>::new(&[1.0, 0.3, 2.0, 0.6, 1.7], &[0.7, 1.2, 0.4, 0.9, 0.3], 9.81).unwrap();
+        let fast = PlanarTension::new(chain);
+        let q = DVector::from_vec(vec![0.4, -2.0, 2.9, 1.0, -0.3]);
+        let qd = DVector::from_vec(vec![1.1, -0.3, 4.0, -2.2, 0.8]);
+        let (t, dense) = (fast.kinetic_energy(&q, &qd), fast.dense().kinetic_energy(&q, &qd));
+        assert!(dense > 1.0 && (t - dense).abs() < 1e-14 * dense, "{t} vs {dense}");
     }
 
     #[test]
