@@ -2,17 +2,18 @@
 //! plots, run.json and the summary line.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, IsTerminal, Write};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
-use crate::config::{Outcome, RunConfig, RunFile};
+use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
 use crate::plot::{self, Frame};
@@ -150,7 +151,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     let mut energy_csv = Csv::create(out.join("energy.csv"), &header)?;
 
     let dims = if config.dim == Dimension::Two { 2 } else { 3 };
-    let progress = progress_bar(total_steps, options.quiet);
+    let mut progress = Progress::new(total_steps, config.end, options.quiet);
     let system = simulation.system();
     let mut solver = simulation.integrator(config.integrator, config.solver);
     let mut state = State::new(0.0, simulation.initial_state());
@@ -168,14 +169,14 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
             }
             keep(&mut kept, &sample, h0, sample_count.is_multiple_of(frame_stride));
             sample_count += 1;
-            progress.set_position((t / config.end * total_steps as f64).round() as u64);
+            progress.at(t, (t / config.end * total_steps as f64).round() as u64);
             if INTERRUPTED.load(Ordering::SeqCst) {
                 ControlFlow::Break(())
             } else {
                 ControlFlow::Continue(())
             }
         });
-    progress.finish_and_clear();
+    progress.finish();
     // The last sample always goes into the animation.
     if let Some(last) = kept.last.take()
         && kept.frames.last().is_none_or(|f| f.t != last.t)
@@ -231,27 +232,88 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
         );
     }
     match result {
+        Ok(s) if s.stopped_early => Err(CliError::interrupted(format!(
+            "interrupted: the run was cut at t = {} s of {} s; files in {} hold what was computed \
+             (run.json says \"interrupted\")",
+            state.t(),
+            config.end,
+            out.display()
+        ))),
         Ok(_) => Ok(()),
         Err(e) => Err(CliError::failed(format!(
             "the run stopped at t = {} s: {e}{}; files hold what was computed",
             state.t(),
-            stage_solve_hint(&e, config.solver)
+            stage_solve_hint(&e, config)
         ))),
     }
 }
 
-/// Advice for a failed Gauss–Legendre stage solve, empty for other errors.
-fn stage_solve_hint(e: &pendulum_core::Error, solver: StageSolver) -> &'static str {
-    let stage_failure = matches!(e, pendulum_core::Error::StepFailed { source, .. }
-        if matches!(**source, pendulum_core::Error::StageSolveFailed { .. }));
-    match (stage_failure, solver) {
-        (false, _) => "",
-        (true, StageSolver::FixedPoint) => {
-            " (the fixed-point stage solve converges only for steps shorter than about the \
-             chain's fastest period: use a smaller --step, --solver newton or --integrator rk4)"
-        }
-        (true, StageSolver::Newton) => " (use a smaller --step, or --integrator rk4)",
+/// Advice for a failed step: a stage solve that did not converge (or a step that blew
+/// up) usually means the step is too long for the chain's fastest mode or the drive;
+/// names both and suggests a step. Empty for other errors.
+fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
+    let pendulum_core::Error::StepFailed { source, .. } = e else { return String::new() };
+    let stage_failure = matches!(**source, pendulum_core::Error::StageSolveFailed { .. });
+    let blew_up = matches!(**source, pendulum_core::Error::NonFinite { .. });
+    if !stage_failure && !blew_up {
+        return String::new();
     }
+    let (fastest, drive) = (fastest_mode(config), drive_frequency(config));
+    let suggested = suggested_step(fastest, drive);
+    let cause = match drive {
+        Some(w) => format!(
+            "the step --step {} is likely too long for the chain's fastest mode (about {fastest:.3e} rad/s) \
+             or the drive ({w} rad/s)",
+            config.step
+        ),
+        None => format!(
+            "the step --step {} is likely too long for the chain's fastest mode (about {fastest:.3e} rad/s)",
+            config.step
+        ),
+    };
+    let other = match (stage_failure, config.solver) {
+        (true, StageSolver::FixedPoint) => ", --solver newton or --integrator rk4",
+        (true, StageSolver::Newton) | (false, _) => " or --integrator rk4",
+    };
+    format!(" ({cause}: try --step {suggested:.1e}{other})")
+}
+
+/// An estimate of the chain's fastest angular frequency (rad/s): the largest
+/// `√(2 (T_i/l_i + T_{i+1}/l_{i+1}) / m_i)` with the tensions of the hanging chain
+/// `T_i = M_i (g + a_drive)` (`M_i` the tail mass, `a_drive` the drive's largest
+/// acceleration), a Gershgorin bound of the tension-stiffness matrix that is exact for
+/// the uniform chain's `2n √(g/L)` at large n.
+fn fastest_mode(config: &RunConfig) -> f64 {
+    let n = config.links();
+    let accel = match &config.drive {
+        DriveConfig::Fixed => 0.0,
+        DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
+        DriveConfig::Circle { radius, omega } => radius * omega * omega,
+    };
+    let g = config.gravity + accel;
+    let mut tail = vec![0.0; n + 1];
+    for i in (0..n).rev() {
+        tail[i] = tail[i + 1] + config.masses[i];
+    }
+    let stiffness = |i: usize| if i < n { tail[i] * g / config.lengths[i] } else { 0.0 };
+    (0..n).map(|i| (2.0 * (stiffness(i) + stiffness(i + 1)) / config.masses[i]).sqrt()).fold(0.0, f64::max)
+}
+
+/// The drive's angular frequency (rad/s), if it has one.
+fn drive_frequency(config: &RunConfig) -> Option<f64> {
+    match &config.drive {
+        DriveConfig::Fixed => None,
+        DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
+    }
+}
+
+/// A step that resolves both: `h = 0.5 / ω_fastest`, at most a fortieth of the drive period.
+fn suggested_step(fastest: f64, drive: Option<f64>) -> f64 {
+    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
+    if let Some(w) = drive.filter(|w| *w > 0.0) {
+        h = h.min(std::f64::consts::TAU / w / 40.0);
+    }
+    h
 }
 
 /// The steps a failed run completed (the failed step's number).
@@ -303,16 +365,54 @@ fn keep(kept: &mut Kept, s: &Sample, h0: f64, frame: bool) {
     kept.last = Some(current);
 }
 
-/// A progress bar for runs of 2000 steps or more, drawn only on a terminal.
-fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
-    if quiet || steps < 2000 {
-        return ProgressBar::hidden();
+/// How often a run without a terminal reports how far it is.
+const PLAIN_PROGRESS_EVERY: Duration = Duration::from_secs(5);
+
+/// Progress of a run of 2000 steps or more: a bar on a terminal; without one (a pipe, a
+/// log file, CI), a plain line every [`PLAIN_PROGRESS_EVERY`] instead.
+struct Progress {
+    bar: ProgressBar,
+    /// Plain lines: `(run end t1, when the last line was printed)`.
+    plain: Option<(f64, Instant)>,
+    started: Instant,
+}
+
+impl Progress {
+    fn new(steps: u64, end: f64, quiet: bool) -> Self {
+        let started = Instant::now();
+        if quiet || steps < 2000 {
+            return Self { bar: ProgressBar::hidden(), plain: None, started };
+        }
+        if !std::io::stderr().is_terminal() {
+            return Self { bar: ProgressBar::hidden(), plain: Some((end, started)), started };
+        }
+        let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
+        if let Ok(style) =
+            ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}")
+        {
+            bar.set_style(style);
+        }
+        Self { bar, plain: None, started }
     }
-    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}")
-    {
-        bar.set_style(style);
+
+    /// The run reached time `t` (s), step `step`.
+    fn at(&mut self, t: f64, step: u64) {
+        self.bar.set_position(step);
+        if let Some((end, last)) = &mut self.plain
+            && last.elapsed() >= PLAIN_PROGRESS_EVERY
+        {
+            *last = Instant::now();
+            let fraction = (t / *end).clamp(0.0, 1.0);
+            let elapsed = self.started.elapsed().as_secs_f64();
+            let eta = if fraction > 0.0 { elapsed * (1.0 - fraction) / fraction } else { f64::NAN };
+            eprintln!(
+                "pendulum: t = {t:.3} s of {end} s ({:.0} %), {elapsed:.0} s elapsed, about {eta:.0} s to go",
+                100.0 * fraction
+            );
+        }
     }
-    bar
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
 }
