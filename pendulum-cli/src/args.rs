@@ -247,9 +247,10 @@ pub struct Physics {
     /// End time, s (the run starts at t = 0).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub end: f64,
-    /// Initial state: hanging, horizontal, tilted:ANGLE (rad, every link, toward +x) or a
-    /// file of numbers: 2D θ_1..θ_n then θ̇_1..θ̇_n; 3D θ_1..θ_n, φ_1..φ_n,
-    /// θ̇_1..θ̇_n, φ̇_1..φ̇_n.
+    /// Initial state: hanging, horizontal, tilted:ANGLE (rad, every link, toward +x), a
+    /// previous run's final state (its directory or its final.json: continue exactly
+    /// where it ended, 3D in unit directions), or a file of numbers: 2D θ_1..θ_n then
+    /// θ̇_1..θ̇_n; 3D θ_1..θ_n, φ_1..φ_n, θ̇_1..θ̇_n, φ̇_1..φ̇_n.
     #[arg(long, value_name = "SPEC", default_value = "tilted:1.0")]
     pub initial: InitialSpec,
     /// 3D only: initial azimuthal rate φ̇ of every link, rad/s (a conical swing).

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::args::{Dimension, DriveKind, IntegratorKind, Physics, StageSolver, View};
 use crate::error::{CliError, CliResult, io_failed};
+use crate::final_state::FinalState;
 use crate::spec::{InitialSpec, expand, per_link, read_numbers};
 
 /// The pivot's motion, with every parameter.
@@ -46,6 +47,11 @@ pub struct InitialConfig {
     pub coordinates: Vec<f64>,
     /// Rates `q̇` at t = 0, rad/s, in the order of `coordinates`.
     pub rates: Vec<f64>,
+    /// 3D only, instead of angles (then `coordinates` and `rates` are empty): the exact
+    /// state in unit link directions `(u_1..u_n, w_1..w_n)` (1, 1/s), a previous run's
+    /// final state (`final.json`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub directions: Option<Vec<f64>>,
 }
 
 /// Every parameter of a simulation; with the program version, enough to repeat it.
@@ -169,11 +175,23 @@ impl RunConfig {
             Dimension::Two => n,
             Dimension::Three => 2 * n,
         };
+        let directions = self.initial.directions.as_ref();
+        if directions.is_some() && self.dim == Dimension::Two {
+            return Err(CliError::usage(
+                "initial state: a state in unit directions is for 3D runs (--dim 3)",
+            ));
+        }
+        let angles = if directions.is_some() { 0 } else { dof };
         let counts = [
             ("lengths", self.lengths.len(), n),
             ("damping", self.damping.len(), n),
-            ("initial coordinates", self.initial.coordinates.len(), dof),
-            ("initial rates", self.initial.rates.len(), dof),
+            ("initial coordinates", self.initial.coordinates.len(), angles),
+            ("initial rates", self.initial.rates.len(), angles),
+            (
+                "initial directions and rates",
+                directions.map_or(0, Vec::len),
+                if directions.is_some() { 6 * n } else { 0 },
+            ),
             ("torque", self.torque.len(), if self.dim == Dimension::Two { n } else { 0 }),
         ];
         for (what, got, expected) in counts {
@@ -181,7 +199,13 @@ impl RunConfig {
                 return Err(CliError::usage(format!("{what}: got {got} values, expected {expected}")));
             }
         }
-        if let Some(v) = self.initial.coordinates.iter().chain(&self.initial.rates).find(|v| !v.is_finite()) {
+        let initial = self
+            .initial
+            .coordinates
+            .iter()
+            .chain(&self.initial.rates)
+            .chain(directions.into_iter().flatten());
+        if let Some(v) = initial.copied().find(|v| !v.is_finite()) {
             return Err(CliError::usage(format!("initial state: {v} is not finite")));
         }
         if let Some(v) = self.torque.iter().find(|v| !v.is_finite()) {
@@ -241,6 +265,26 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
         InitialSpec::Hanging => straight(0.0),
         InitialSpec::Horizontal => straight(std::f64::consts::FRAC_PI_2),
         InitialSpec::Tilted(a) => straight(*a),
+        InitialSpec::File(path) if FinalState::names(path) => {
+            let state = FinalState::read_for(path, dim, n)?;
+            return Ok(match dim {
+                Dimension::Two => InitialConfig {
+                    spec: spec.to_string(),
+                    coordinates: state.coordinates,
+                    rates: state.rates,
+                    directions: None,
+                },
+                Dimension::Three => {
+                    let directions = state.coordinates.into_iter().chain(state.rates).collect();
+                    InitialConfig {
+                        spec: spec.to_string(),
+                        coordinates: vec![],
+                        rates: vec![],
+                        directions: Some(directions),
+                    }
+                }
+            });
+        }
         InitialSpec::File(path) => {
             let values = read_numbers("--initial", path)?;
             if values.len() != 2 * dof {
@@ -259,7 +303,7 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
             (values[..dof].to_vec(), values[dof..].to_vec())
         }
     };
-    Ok(InitialConfig { spec: spec.to_string(), coordinates, rates })
+    Ok(InitialConfig { spec: spec.to_string(), coordinates, rates, directions: None })
 }
 
 /// What `run.json` holds: the program and version that made it, the configuration and

@@ -7,6 +7,7 @@ mod chain_args;
 mod config;
 mod error;
 mod eval;
+mod final_state;
 mod models;
 mod modes;
 mod plot;

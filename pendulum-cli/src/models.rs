@@ -313,7 +313,15 @@ pub fn build(config: &RunConfig) -> CliResult<AnySimulation> {
         }
         Dimension::Three => {
             let directions = Directions::<U3>::new(chain).with_drive(drive(&config.drive)?);
-            let start = directions.from_spherical(q, qd)?;
+            let start = match &config.initial.directions {
+                // A previous run's final state, exactly.
+                Some(x) => {
+                    let x = DVector::from_column_slice(x);
+                    directions.check_state(&x)?;
+                    x
+                }
+                None => directions.from_spherical(q, qd)?,
+            };
             AnySimulation::Spatial(Simulation::new(directions, start.as_slice())?)
         }
     })

@@ -15,6 +15,7 @@ use pendulum_core::trajectory;
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
 use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
+use crate::final_state::FinalState;
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
 use crate::plot::{self, Frame};
 
@@ -203,6 +204,8 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
         plot::animation(&gif, &kept.frames, &kept.tip, &kept.times, config, delay_ms)?;
         images.extend([energy_png, gif]);
     }
+    let motion = &state.x().as_slice()[..system.motion_len()];
+    FinalState::new(config.dim, n, state.t(), motion).write(out)?;
     run_file.outcome = Some(Outcome {
         status: status.into(),
         t: state.t(),
@@ -227,7 +230,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
             images = if images.is_empty() {
                 ""
             } else {
-                " (trajectory.csv, energy.csv, run.json, energy.png, chain.gif)"
+                " (trajectory.csv, energy.csv, run.json, final.json, energy.png, chain.gif)"
             },
         );
     }

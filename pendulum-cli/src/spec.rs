@@ -115,7 +115,9 @@ impl std::str::FromStr for InitialSpec {
                     return Err("give the angle in rad: tilted:ANGLE, e.g. tilted:0.5".into());
                 }
                 let path = std::path::PathBuf::from(s);
-                if path.is_file() {
+                // A file of numbers, or a previous run's final state: `final.json` or the
+                // run directory holding it (read, and reported if missing, later).
+                if path.is_file() || path.is_dir() || s.ends_with(".json") {
                     Ok(Self::File(path))
                 } else {
                     Err(format!("'{s}' is not hanging, horizontal, tilted:ANGLE or an existing file"))

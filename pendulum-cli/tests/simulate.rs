@@ -373,7 +373,8 @@ fn a_run_that_fails_exits_1_with_valid_files_and_says_why() {
     // The likely cause, named, and a step to try that resolves the fastest mode: 30 links
     // of 2 cm hang with a fastest mode near 2·30·√(g/0.6) ≈ 240 rad/s.
     assert!(message.contains("likely too long for the chain's fastest mode"), "{message}");
-    let suggested: f64 = message.split("try --step ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
+    let suggested: f64 =
+        message.split("try --step ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
     assert!(suggested > 1e-3 && suggested < 3e-3, "{message}");
     let json = run_json(&dir.join("run"));
     assert_eq!(json["outcome"]["status"], "failed");
