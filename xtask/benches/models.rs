@@ -39,7 +39,7 @@ use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrat
 use pendulum_core::{Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial};
 use xtask::case::Params;
 use xtask::closed_form::DoublePendulum;
-use xtask::models::{
+use xtask::verify::models::{
     Planar1, Planar2, Planar3, Planar4, Planar5, Planar6, Planar7, Planar8, Spatial1, Spatial2, Spatial3,
     Spatial4, chain,
 };

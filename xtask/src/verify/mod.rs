@@ -3,11 +3,15 @@
 //! For every reference case and every seeded random state ([`crate::sample`]) the
 //! reference's equations are evaluated ([`Case::evaluate`]) and compared, entry by
 //! entry, with the generic model (`Planar<Dyn>`/`Spatial<Dyn>`) and the generated
-//! fixed-N model of that size ([`crate::models`]): mass matrix, velocity, gravity and
+//! fixed-N model of that size ([`models`]): mass matrix, velocity, gravity and
 //! pivot terms, generalized forces, kinetic and potential energy, and accelerations.
 //! The worst error per case, quantity and model is printed as a table; any error above
 //! [`BOUND`] fails the run, naming the case, state, quantity and entry. The O(n) routes
-//! (accelerations only) follow in their own table ([`crate::routes`]).
+//! (accelerations only) follow in their own table ([`routes`]).
+
+pub mod document;
+pub mod models;
+pub mod routes;
 
 use std::{fmt, time::Instant};
 
@@ -17,9 +21,9 @@ use pendulum_core::{Error, Inputs, Model, ModelAlloc};
 
 use crate::{
     case::{Case, Evaluated, Kind, Params, Point, load_all},
-    models::{self, ModelVisitor},
     sample,
 };
+use models::ModelVisitor;
 
 /// Largest error [`verify`](run) accepts, for every entry of every quantity.
 ///
@@ -883,13 +887,13 @@ pub fn run(options: &Options) -> Result<()> {
 
     // The O(n) routes (tension solve), accelerations only, at the same states.
     println!();
-    let routes = crate::routes::verify_cases(&cases, options.states, options.seed)
-        .and_then(|rows| crate::routes::report(&rows));
+    let routes =
+        routes::verify_cases(&cases, options.states, options.seed).and_then(|rows| routes::report(&rows));
 
     // The seed document's printed equations against the reference: prints its own
     // table, errors when reference/ERRATA.md no longer matches what it finds.
     println!();
-    let document = crate::document::run(&cases, options.states, options.seed);
+    let document = document::run(&cases, options.states, options.seed);
 
     if let Some(worst) = failures.first() {
         bail!(

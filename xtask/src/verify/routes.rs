@@ -12,8 +12,8 @@ use nalgebra::{DVector, U2, U3, Vector2, Vector3};
 use pendulum_core::{Directions, FnDrive, Inputs, Model, PlanarTension};
 
 use crate::case::{Case, Kind, Point};
-use crate::verify::{BOUND, Reference, acceleration_error};
-use crate::{models, sample};
+use crate::sample;
+use crate::verify::{BOUND, Reference, acceleration_error, models};
 
 /// The worst backward error of one route on one case, and the state it came from.
 #[derive(Debug, Clone, PartialEq)]
