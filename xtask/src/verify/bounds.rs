@@ -3,47 +3,24 @@
 
 use nalgebra::{DMatrix, DVector};
 
-/// Largest error [`verify`](run) accepts, for every entry of every quantity.
+/// Largest error [`verify`](super::run) accepts, for every entry of every quantity: the
+/// entry's `|x_impl − x_ref|` over its absolute scale ([`Scaled`]) floored by
+/// [`SCALE_FLOOR`], and for accelerations the backward error ([`acceleration_error`]).
 ///
-/// Errors are relative to each entry's absolute scale ([`Scaled`]: the entry evaluated
-/// with every sum replaced by the sum of the absolute values of its terms),
-/// floored as [`SCALE_FLOOR`] says. Evaluating an entry in floating point, whether as the
-/// reference's expanded polynomial or as a model's factored code, errs by about one unit
-/// of round-off (1.1e-16) per operation times that scale; the largest entries (planar
-/// n = 8, spatial n = 5) are sums of ~200 terms, so correct code stays below ~1e-13,
-/// and at most ~3e-12 where the floor applies (measured over 5000 states with the
-/// default seed: generated models ≤ 2e-15; generic ≤ 1.0e-13 where the floor does not
-/// apply, e.g. planar n = 5 `mass_matrix[4][3]`, and ≤ 1.3e-12 from the floor, spatial
-/// n = 1 velocity terms). A wrong or missing term, on the other hand, is a whole term:
-/// with masses and lengths drawn over two decades, a term's size relative to its entry's
-/// scale is at least ~(0.1/10)² = 1e-4 unless it happens to vanish at that state, which
-/// random states over the whole circle do not let happen at all 200 of them (the
-/// planted bugs of this module's tests measure 5e-3 to 20). `1e-10` sits two decades
-/// above round-off and six below a real discrepancy.
+/// Round-off of correct code stays decades below it, a wrong or missing term decades
+/// above: see `docs/verify.md`, "Why the bounds are what they are".
 ///
 /// [`Scaled`]: crate::expr::Scaled
 pub const BOUND: f64 = 1e-10;
 
-/// The floor of an entry's scale, as a fraction of its quantity's natural scale.
+/// The floor of an entry's scale, as a fraction of its quantity's natural scale `N`.
 ///
 /// An entry's error is `|x_impl − x_ref| / max(s, SCALE_FLOOR · N)`, `s` the entry's
 /// absolute scale and `N` the largest scale among the quantity's entries (for the
-/// velocity terms and the kinetic energy at least `‖S(M)‖_∞ ‖q̇‖²_∞`, see below).
-///
-/// The floor exists for terms the reference has cancelled symbolically but an
-/// implementation computes numerically. The generic spatial model computes the entry
-/// `M[θ_i][φ_i]`, identically zero, as the dot product `J_θ·J_φ` of two link
-/// Jacobians, and the velocity terms with `J_θ·u θ̇² = 0` included: each leaves round-off
-/// of about 1e-16 times the size of the cancelled terms, which the reference's scale of
-/// that entry does not contain (it is 0 for `M[θ_i][φ_i]`). So the floor must satisfy
-/// `BOUND · SCALE_FLOOR · N ≫ 1e-16 · N`, i.e. `SCALE_FLOOR ≫ 1e-6`; with 1e-12 every
-/// spatial case fails at ~5e-5. The cancelled terms are no larger than the quantity's
-/// natural scale `N`: mass-matrix terms are bounded by its largest entry, velocity terms
-/// `W_ij u̇_i·u̇_j`-like by `‖S(M)‖_∞ ‖q̇‖²_∞` (`S(M)` the entry scales of `M`), which is
-/// not always among the reference's velocity-term scales (one spatial link: the
-/// reference's `c_θ = −m l² sin θ cos θ φ̇²` has no `θ̇²` term, the model's round-off does).
-/// `1e-4` puts round-off at ≤ ~1e-12 and still flags any wrong term larger than
-/// `BOUND · SCALE_FLOOR = 1e-14` of the natural scale.
+/// velocity terms and the kinetic energy at least `‖S(M)‖_∞ ‖q̇‖²_∞`). The floor keeps the
+/// round-off of terms the reference cancels symbolically but a model computes (the zero
+/// `M[θ_i][φ_i]` of the generic spatial model) from counting as an error: see
+/// `docs/verify.md`, "Why the bounds are what they are".
 pub const SCALE_FLOOR: f64 = 1e-4;
 
 /// Whether `a` is worse than `b`: larger, or NaN.
@@ -87,22 +64,10 @@ pub(super) fn entry_errors(got: &[f64], want: &[f64], scales: &[f64], floor: f64
 /// ‖M a − rhs‖_∞ / (‖S(M)‖_∞ ‖a‖_∞ + ‖S(rhs)‖_∞)
 /// ```
 ///
-/// with `S(·)` the entry scales; returns the row of the largest residual, the error and
-/// that residual.
-///
-/// This is the smallest relative perturbation of `M` and `rhs` (relative to their
-/// round-off scales) for which `a` is exact (Rigal–Gaches). Comparing `a` with the
-/// reference's own solution instead (a forward error) would measure the conditioning of
-/// `M` as much as the model: with masses and lengths over two decades, and spatial
-/// `|sin θ|` down to 1e-3, `cond₂(M)` reaches ~1e6 planar and ~1e8–1e9 spatial at 200
-/// states, so two correct solvers may differ by 1e-8 relative and more. The backward error of a correct solve is a few units of
-/// round-off whatever the conditioning, while a wrong term in the model's right-hand
-/// side or a wrong solve leaves a residual of the size of that term.
-///
-/// The scales `S(M)`, `S(rhs) = S(Q) + S(c) + S(k) + S(d)` stand where the plain norms
-/// `‖M‖`, `‖rhs‖` would: `rhs = Q − c − k − d` often cancels, and a model's right-hand
-/// side errs by round-off of its terms, not of their small difference (with `‖rhs‖`,
-/// one planar link already reaches 4e-14 at 200 states, and the tail grows with more).
+/// with `S(·)` the entry scales, `S(rhs) = S(Q) + S(c) + S(k) + S(d)`: the smallest
+/// relative perturbation of `M` and `rhs` for which `a` is exact (Rigal–Gaches). Returns
+/// the row of the largest residual, the error and that residual. Why a backward error,
+/// and scales rather than norms: see `docs/verify.md`, "Why the bounds are what they are".
 pub fn acceleration_error(
     mass_scale: &DMatrix<f64>,
     rhs_scale: &DVector<f64>,
