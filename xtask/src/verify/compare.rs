@@ -1,5 +1,5 @@
 //! One model against the reference at one state: the worst entry of every quantity
-//! ([`check_model`]), and whether a spatial model reports the singularity at `θ_1 = 0`, `π`.
+//! (`check_model`), and whether a spatial model reports the singularity at `θ_1 = 0`, `π`.
 
 use anyhow::{Result, bail};
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, OMatrix, OVector, U1};

@@ -1,7 +1,7 @@
 //! `cargo xtask verify`: the models against the sympy reference at many random states.
 //!
 //! For every reference case and every seeded random state ([`crate::sample`]) the
-//! reference's equations are evaluated ([`reference`]) and compared, entry by entry
+//! reference's equations are evaluated (`reference`) and compared, entry by entry
 //! ([`compare`]), with the generic model (`Planar<Dyn>`/`Spatial<Dyn>`) and the generated
 //! fixed-N model of that size ([`models`]): mass matrix, velocity, gravity and pivot terms,
 //! generalized forces, kinetic and potential energy, and accelerations. The worst error
