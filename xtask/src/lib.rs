@@ -5,11 +5,8 @@
 pub mod bench;
 pub mod case;
 pub mod closed_form;
-pub mod document;
 pub mod expr;
-pub mod models;
 pub mod regen;
-pub mod routes;
 pub mod sample;
 pub mod verify;
 

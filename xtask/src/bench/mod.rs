@@ -1,8 +1,8 @@
-//! `cargo xtask bench`: runs the criterion benchmarks (`xtask/benches/models.rs`) into a
-//! fresh directory, reads the medians and fastest samples back and writes `docs/bench.md`
-//! (tables, targets, machine, date) and `docs/bench.svg` (log–log plot). `--quick` is a
-//! smoke run, and a run filtered by criterion arguments is partial: both write their
-//! report under the target directory instead of `docs/`.
+//! `cargo xtask bench`: runs the criterion benchmarks (`pendulum-core/benches/models.rs`)
+//! into a fresh directory, reads the medians and fastest samples back and writes
+//! `docs/bench.md` (tables, targets, machine, date) and `docs/bench.svg` (log–log plot).
+//! `--quick` is a smoke run, and a run filtered by criterion arguments is partial: both
+//! write their report under the target directory instead of `docs/`.
 
 mod plot;
 mod report;
@@ -72,8 +72,9 @@ pub fn run(options: &Options) -> Result<()> {
     Ok(())
 }
 
-/// Runs `cargo bench --workspace --bench models` with criterion's output in `criterion`
-/// (emptied first, so the report never mixes runs).
+/// Runs `cargo bench --workspace --bench models` (pendulum-core's, the workspace's one
+/// bench of that name) with criterion's output in `criterion` (emptied first, so the
+/// report never mixes runs).
 fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     if criterion.exists() {
         std::fs::remove_dir_all(criterion).with_context(|| format!("emptying {}", criterion.display()))?;

@@ -274,7 +274,8 @@ pub fn markdown(results: &Results, fastest: &Results, info: &RunInfo, notes: &st
          the end are kept), `cargo xtask bench --quick` (smoke run, report under the target \
          directory), `cargo xtask bench --report-only` (rewrite from the last run's estimates).\n"
     );
-    let _ = writeln!(out, "What is timed (groups `<kind>_<operation>` in `xtask/benches/models.rs`):\n");
+    let _ =
+        writeln!(out, "What is timed (groups `<kind>_<operation>` in `pendulum-core/benches/models.rs`):\n");
     for (op, what) in OPERATIONS {
         let _ = writeln!(out, "- `{op}`: {what};");
     }

@@ -2,7 +2,7 @@
 //!
 //! Criterion writes `<dir>/<group>/<function>/<n>/new/{estimates,sample}.json` per
 //! benchmark; here group is `<kind>_<operation>`, function the implementation, `n` the
-//! number of links (`xtask/benches/models.rs`).
+//! number of links (`pendulum-core/benches/models.rs`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;

@@ -11,9 +11,11 @@ use anyhow::{Context, Result, bail};
 use nalgebra::{DVector, U2, U3, Vector2, Vector3};
 use pendulum_core::{Directions, FnDrive, Inputs, Model, PlanarTension};
 
+use super::bounds::{BOUND, acceleration_error};
+use super::models;
+use super::reference::Reference;
 use crate::case::{Case, Kind, Point};
-use crate::verify::{BOUND, Reference, acceleration_error};
-use crate::{models, sample};
+use crate::sample;
 
 /// The worst backward error of one route on one case, and the state it came from.
 #[derive(Debug, Clone, PartialEq)]

@@ -15,7 +15,7 @@
 //! and 16 for the accelerations only), `generic_fixed` (`Planar`/`Spatial<Const<n>>`),
 //! `generic_dyn` (`Planar`/`Spatial<Dyn>`, accelerations up to n = 256). The
 //! `<kind>_accelerations` groups also hold:
-//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`xtask::closed_form`);
+//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`xtask/src/closed_form.rs`);
 //!   `planar_input_checks/check_inputs/2` times the input validation it lacks;
 //! - `tension`: the O(n) `PlanarTension<Dyn>` (also its `gl2_step` for n ≤ 8);
 //! - `directions`: `System::rhs` of the O(n) `Directions` chain (2D and 3D);
@@ -32,19 +32,48 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use nalgebra::allocator::Allocator;
 use nalgebra::{
     Const, DVector, DefaultAllocator, Dim, DimMul, DimName, DimProd, Dyn, OMatrix, OVector, U1, U2, U3,
 };
 use pendulum_core::integrate::{GaussAlloc, GaussLegendre, GaussOptions, Integrator, State, System};
-use pendulum_core::{Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial};
-use xtask::case::Params;
-use xtask::closed_form::DoublePendulum;
-use xtask::models::{
-    Planar1, Planar2, Planar3, Planar4, Planar5, Planar6, Planar7, Planar8, Spatial1, Spatial2, Spatial3,
-    Spatial4, chain,
+use pendulum_core::{
+    Chain, Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial,
 };
 
+// The closed form is written once, in xtask, where its unit tests check it against
+// `Planar<Dyn>` (`cargo test -p xtask`; a benchmark target runs no unit tests). It uses
+// nothing of xtask, so it compiles here as it is.
+#[path = "../../xtask/src/closed_form.rs"]
+mod closed_form;
+
+use closed_form::DoublePendulum;
+
 pendulum_macros::model! {
+    /// Generated planar model, 1 link.
+    pub struct Planar1 { kind: planar, links: 1 }
+    /// Generated planar model, 2 links.
+    pub struct Planar2 { kind: planar, links: 2 }
+    /// Generated planar model, 3 links.
+    pub struct Planar3 { kind: planar, links: 3 }
+    /// Generated planar model, 4 links.
+    pub struct Planar4 { kind: planar, links: 4 }
+    /// Generated planar model, 5 links.
+    pub struct Planar5 { kind: planar, links: 5 }
+    /// Generated planar model, 6 links.
+    pub struct Planar6 { kind: planar, links: 6 }
+    /// Generated planar model, 7 links.
+    pub struct Planar7 { kind: planar, links: 7 }
+    /// Generated planar model, 8 links.
+    pub struct Planar8 { kind: planar, links: 8 }
+    /// Generated spatial model, 1 link.
+    pub struct Spatial1 { kind: spatial, links: 1 }
+    /// Generated spatial model, 2 links.
+    pub struct Spatial2 { kind: spatial, links: 2 }
+    /// Generated spatial model, 3 links.
+    pub struct Spatial3 { kind: spatial, links: 3 }
+    /// Generated spatial model, 4 links.
+    pub struct Spatial4 { kind: spatial, links: 4 }
     /// Generated planar model, 12 links: accelerations only, to locate the crossover.
     pub struct Planar12 { kind: planar, links: 12 }
     /// Generated planar model, 16 links: accelerations only, to locate the crossover.
@@ -80,14 +109,18 @@ where
     (q, qd)
 }
 
-/// The benchmarked chain's parameters: `n` links of slowly varying masses and lengths.
-fn params(n: usize) -> Params {
-    Params {
-        masses: (0..n).map(|i| 1.0 + 0.1 * (i % 10) as f64).collect(),
-        lengths: (0..n).map(|i| 0.5 + 0.05 * (i % 10) as f64).collect(),
-        gravity: 9.81,
-        damping: vec![0.01; n],
-    }
+/// The benchmarked chain of `n` links, with `L = Dyn` or `Const<n>`: masses
+/// `1 + 0.1 (i mod 10)` kg, lengths `0.5 + 0.05 (i mod 10)` m, g = 9.81 m/s², damping
+/// 0.01 N·m·s at every joint.
+fn chain<L: Dim>(n: usize) -> Chain<L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    let masses: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i % 10) as f64).collect();
+    let lengths: Vec<f64> = (0..n).map(|i| 0.5 + 0.05 * (i % 10) as f64).collect();
+    Chain::<L>::new(&masses, &lengths, 9.81)
+        .and_then(|c| c.with_damping(&vec![0.01; n]))
+        .expect("valid chain")
 }
 
 /// `out = Q − c − k − d`, the right-hand side of `M q̈ = …`, from the building blocks.
@@ -169,7 +202,7 @@ fn bench_directions<S: DimName>(
 ) where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
-    let system = Directions::<S>::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    let system = Directions::<S>::new(chain::<Dyn>(n));
     let dof = if S::DIM == 2 { n } else { 2 * n };
     let (q, qd) = state::<Dyn>(Dyn(dof));
     let x = to_state(&system, q.as_slice(), qd.as_slice()).expect("non-singular state");
@@ -188,7 +221,7 @@ fn bench_directions<S: DimName>(
 /// The O(n) routes at `n` links: `PlanarTension<Dyn>` accelerations (and, if `step`, its
 /// Gauss–Legendre step), `Directions` rhs planar and spatial (if `spatial`).
 fn bench_linear(c: &mut Criterion, n: usize, step: bool, spatial: bool) {
-    let tension = PlanarTension::new(chain::<Dyn>(&params(n)).expect("valid chain"));
+    let tension = PlanarTension::new(chain::<Dyn>(n));
     bench_accelerations(c, "planar", "tension", n, &tension);
     if step {
         bench_gl2_step(c, "planar", "tension", n, &tension);
@@ -252,9 +285,9 @@ fn bench_baseline(c: &mut Criterion, kind: &str, n: usize, dof: usize) {
 
 /// The closed-form double pendulum (eq 50, corrected): its accelerations.
 fn bench_closed_form(c: &mut Criterion) {
-    let p = params(2);
-    let model = DoublePendulum::new(p.masses[0], p.masses[1], p.lengths[0], p.lengths[1], p.gravity)
-        .expect("valid parameters");
+    let p = chain::<Const<2>>(2);
+    let (m, l) = (p.masses(), p.lengths());
+    let model = DoublePendulum::new(m[0], m[1], l[0], l[1], p.gravity()).expect("valid parameters");
     let (q, qd) = state(Const::<2>);
     let (q, qd) = ([q[0], q[1]], [qd[0], qd[1]]);
     c.benchmark_group("planar_accelerations").bench_function(BenchmarkId::new("closed_form", 2), |b| {
@@ -275,10 +308,9 @@ macro_rules! bench_sizes {
     ($c:expr, $kind:literal, $generic:ident, $dof_per_link:literal, $($n:literal => $generated:ident),* $(,)?) => {
         $(
             if wanted($n) {
-                let p = params($n);
-                bench_model($c, $kind, "generated", $n, &$generated::new(chain::<Const<$n>>(&p).expect("valid chain")));
-                bench_model($c, $kind, "generic_fixed", $n, &$generic::new(chain::<Const<$n>>(&p).expect("valid chain")));
-                bench_model($c, $kind, "generic_dyn", $n, &$generic::new(chain::<Dyn>(&p).expect("valid chain")));
+                bench_model($c, $kind, "generated", $n, &$generated::new(chain::<Const<$n>>($n)));
+                bench_model($c, $kind, "generic_fixed", $n, &$generic::new(chain::<Const<$n>>($n)));
+                bench_model($c, $kind, "generic_dyn", $n, &$generic::new(chain::<Dyn>($n)));
                 bench_baseline($c, $kind, $n, $dof_per_link * $n);
             }
         )*
@@ -302,40 +334,14 @@ fn small_chains(c: &mut Criterion) {
 /// (accelerations only).
 fn large_chains(c: &mut Criterion) {
     if !quick() {
-        let (p12, p16) = (params(12), params(16));
-        bench_accelerations(
-            c,
-            "planar",
-            "generated",
-            12,
-            &Planar12::new(chain::<Const<12>>(&p12).expect("valid chain")),
-        );
-        bench_accelerations(
-            c,
-            "planar",
-            "generated",
-            16,
-            &Planar16::new(chain::<Const<16>>(&p16).expect("valid chain")),
-        );
+        bench_accelerations(c, "planar", "generated", 12, &Planar12::new(chain::<Const<12>>(12)));
+        bench_accelerations(c, "planar", "generated", 16, &Planar16::new(chain::<Const<16>>(16)));
     }
     for &n in large_sizes() {
         bench_linear(c, n, false, true);
         if n <= DENSE_MAX {
-            let p = params(n);
-            bench_accelerations(
-                c,
-                "planar",
-                "generic_dyn",
-                n,
-                &Planar::new(chain::<Dyn>(&p).expect("valid chain")),
-            );
-            bench_accelerations(
-                c,
-                "spatial",
-                "generic_dyn",
-                n,
-                &Spatial::new(chain::<Dyn>(&p).expect("valid chain")),
-            );
+            bench_accelerations(c, "planar", "generic_dyn", n, &Planar::new(chain::<Dyn>(n)));
+            bench_accelerations(c, "spatial", "generic_dyn", n, &Spatial::new(chain::<Dyn>(n)));
         }
         bench_baseline(c, "planar", n, n);
         bench_baseline(c, "spatial", n, 2 * n);

@@ -1,0 +1,616 @@
+//! One model against the reference at one state: the worst entry of every quantity
+//! (`check_model`), and whether a spatial model reports the singularity at `θ_1 = 0`, `π`.
+
+use anyhow::{Result, bail};
+use nalgebra::{DVector, DefaultAllocator, Dim, DimName, OMatrix, OVector, U1};
+use pendulum_core::{Error, Inputs, Model, ModelAlloc};
+
+use super::bounds::{acceleration_error, entry_errors};
+use super::models::ModelVisitor;
+use super::reference::Reference;
+use crate::case::{Case, Point};
+
+/// The quantities compared, in table order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// `M(q)`, entry-wise.
+    MassMatrix,
+    /// `c(q, q̇)`.
+    VelocityTerms,
+    /// `k(q)`.
+    GravityTerms,
+    /// `d(q, p̈)`.
+    PivotTerms,
+    /// `Q(q, q̇, σ)`.
+    GeneralizedForces,
+    /// `T`.
+    KineticEnergy,
+    /// `U`.
+    PotentialEnergy,
+    /// `q̈`, by the backward error ([`acceleration_error`]).
+    Accelerations,
+}
+
+impl Quantity {
+    /// Every quantity, in table order.
+    pub const ALL: [Quantity; 8] = [
+        Quantity::MassMatrix,
+        Quantity::VelocityTerms,
+        Quantity::GravityTerms,
+        Quantity::PivotTerms,
+        Quantity::GeneralizedForces,
+        Quantity::KineticEnergy,
+        Quantity::PotentialEnergy,
+        Quantity::Accelerations,
+    ];
+
+    /// The name used in the case files and the table.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::MassMatrix => "mass_matrix",
+            Quantity::VelocityTerms => "velocity_terms",
+            Quantity::GravityTerms => "gravity_terms",
+            Quantity::PivotTerms => "pivot_terms",
+            Quantity::GeneralizedForces => "generalized_forces",
+            Quantity::KineticEnergy => "kinetic_energy",
+            Quantity::PotentialEnergy => "potential_energy",
+            Quantity::Accelerations => "accelerations",
+        }
+    }
+}
+
+/// One error measurement: the worst entry of one quantity at one state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The error: the entry's absolute difference relative to its (floored) scale, or
+    /// for accelerations the backward error, as compared with [`BOUND`](super::bounds::BOUND); infinite for a
+    /// non-finite value or a model error.
+    pub error: f64,
+    /// Which entry: `[i][j]`, `[i]`, or empty for a scalar.
+    pub entry: String,
+    /// The implementation's value and the reference's (residual and its scale for
+    /// accelerations), or the model's error message.
+    pub detail: String,
+}
+
+impl Measured {
+    fn zero() -> Self {
+        Self { error: 0.0, entry: String::new(), detail: String::new() }
+    }
+}
+
+/// `Ok` if a model reported the singularity, `Err` saying what it did instead.
+pub type Reported = Result<(), String>;
+
+/// A [`Point`] as the vectors of one model.
+struct ModelPoint<M: Model>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    q: OVector<f64, M::Dof>,
+    qd: OVector<f64, M::Dof>,
+    inputs: Inputs<M::Dof, M::Space>,
+}
+
+impl<M: Model> ModelPoint<M>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    /// `point`'s coordinates, rates and inputs for `model`.
+    fn new(model: &M, point: &Point) -> Self {
+        let vector =
+            |v: &[f64]| OVector::<f64, M::Dof>::from_iterator_generic(model.dof(), U1, v.iter().copied());
+        let pivot_acceleration = OVector::<f64, M::Space>::from_iterator_generic(
+            M::Space::name(),
+            U1,
+            point.pivot_acceleration.iter().copied(),
+        );
+        ModelPoint {
+            q: vector(&point.q),
+            qd: vector(&point.qd),
+            inputs: Inputs { torque: vector(&point.torque), pivot_acceleration },
+        }
+    }
+}
+
+/// Compares one model with the reference at one state: the worst entry of every
+/// quantity, in [`Quantity::ALL`] order.
+///
+/// Outputs are filled with NaN before each call, so an entry a model fails to write
+/// shows up as an infinite error. Errors if the model's dimensions do not fit the case.
+fn check_model<M: Model>(
+    case: &Case,
+    model: &M,
+    point: &Point,
+    reference: &Reference,
+) -> Result<Vec<Measured>>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+{
+    let dof = model.dof();
+    let n = case.dof();
+    if dof.value() != n || M::Space::dim() != case.kind.space() {
+        bail!(
+            "{}: the model has {} coordinates in {} dimensions, the case {n} in {}",
+            case.name,
+            dof.value(),
+            M::Space::dim(),
+            case.kind.space()
+        );
+    }
+    let nan_vector = || OVector::<f64, M::Dof>::from_element_generic(dof, U1, f64::NAN);
+    let ModelPoint { q, qd, inputs } = ModelPoint::new(model, point);
+    let (values, scales) = (&reference.values, &reference.scales);
+
+    let measure =
+        |quantity: Quantity, got: &[f64], want: &[f64], scale: &[f64], entry: &dyn Fn(usize) -> String| {
+            let floor = reference.floors[quantity as usize];
+            let (i, error) = entry_errors(got, want, scale, floor);
+            if error == 0.0 {
+                return Measured::zero();
+            }
+            Measured {
+                error,
+                entry: entry(i),
+                detail: format!(
+                    "implementation {:?}, reference {:?}, scale {:.3e}, floor {floor:.3e}",
+                    got[i], want[i], scale[i]
+                ),
+            }
+        };
+    let index = |i: usize| format!("[{i}]");
+    let mut out = Vec::with_capacity(Quantity::ALL.len());
+
+    let mut mass = OMatrix::<f64, M::Dof, M::Dof>::from_element_generic(dof, dof, f64::NAN);
+    model.mass_matrix(&q, &mut mass);
+    // Both are column-major.
+    out.push(measure(
+        Quantity::MassMatrix,
+        mass.as_slice(),
+        values.mass_matrix.as_slice(),
+        scales.mass_matrix.as_slice(),
+        &|k| format!("[{}][{}]", k % n, k / n),
+    ));
+
+    let mut v = nan_vector();
+    model.velocity_terms(&q, &qd, &mut v);
+    out.push(measure(
+        Quantity::VelocityTerms,
+        v.as_slice(),
+        values.velocity_terms.as_slice(),
+        scales.velocity_terms.as_slice(),
+        &index,
+    ));
+
+    let mut v = nan_vector();
+    model.gravity_terms(&q, &mut v);
+    out.push(measure(
+        Quantity::GravityTerms,
+        v.as_slice(),
+        values.gravity_terms.as_slice(),
+        scales.gravity_terms.as_slice(),
+        &index,
+    ));
+
+    let mut v = nan_vector();
+    model.pivot_terms(&q, &inputs.pivot_acceleration, &mut v);
+    out.push(measure(
+        Quantity::PivotTerms,
+        v.as_slice(),
+        values.pivot_terms.as_slice(),
+        scales.pivot_terms.as_slice(),
+        &index,
+    ));
+
+    let mut v = nan_vector();
+    model.generalized_forces(&q, &qd, &inputs.torque, &mut v);
+    out.push(measure(
+        Quantity::GeneralizedForces,
+        v.as_slice(),
+        values.generalized_forces.as_slice(),
+        scales.generalized_forces.as_slice(),
+        &index,
+    ));
+
+    let scalar = |_| String::new();
+    let t = model.kinetic_energy(&q, &qd);
+    out.push(measure(
+        Quantity::KineticEnergy,
+        &[t],
+        &[values.kinetic_energy],
+        &[scales.kinetic_energy],
+        &scalar,
+    ));
+    let u = model.potential_energy(&q);
+    out.push(measure(
+        Quantity::PotentialEnergy,
+        &[u],
+        &[values.potential_energy],
+        &[scales.potential_energy],
+        &scalar,
+    ));
+
+    let mut a = nan_vector();
+    out.push(match model.accelerations(&q, &qd, &inputs, &mut a) {
+        Err(e) => {
+            Measured { error: f64::INFINITY, entry: String::new(), detail: format!("the model failed: {e}") }
+        }
+        Ok(()) => {
+            let a = DVector::from_column_slice(a.as_slice());
+            let (row, error, residual) = acceleration_error(
+                &scales.mass_matrix,
+                &reference.rhs_scale,
+                &values.mass_matrix,
+                &reference.rhs,
+                &a,
+            );
+            if error == 0.0 {
+                Measured::zero()
+            } else {
+                Measured {
+                    error,
+                    entry: format!(" (residual row {row})"),
+                    detail: format!(
+                        "residual {residual:.3e} of M_ref a - rhs_ref; implementation a {:?}, reference a {}",
+                        a.as_slice(),
+                        values
+                            .mass_matrix
+                            .clone()
+                            .lu()
+                            .solve(&reference.rhs)
+                            .map_or_else(|| "(singular)".to_owned(), |r| format!("{:?}", r.as_slice()))
+                    ),
+                }
+            }
+        }
+    });
+    Ok(out)
+}
+
+/// [`check_model`] as a [`ModelVisitor`].
+pub(super) struct Check<'a> {
+    pub(super) case: &'a Case,
+    pub(super) point: &'a Point,
+    pub(super) reference: &'a Reference,
+}
+
+impl ModelVisitor for Check<'_> {
+    type Output = Result<Vec<Measured>>;
+
+    fn visit<M: Model>(self, model: &M) -> Self::Output
+    where
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    {
+        check_model(self.case, model, self.point, self.reference)
+    }
+}
+
+/// Whether accelerations at `point` fail with [`Error::SingularAngle`] for link 1.
+pub(super) struct CheckSingular<'a> {
+    pub(super) point: &'a Point,
+}
+
+impl ModelVisitor for CheckSingular<'_> {
+    type Output = Reported;
+
+    fn visit<M: Model>(self, model: &M) -> Self::Output
+    where
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    {
+        let ModelPoint { q, qd, inputs } = ModelPoint::new(model, self.point);
+        let mut a = q.clone();
+        match model.accelerations(&q, &qd, &inputs, &mut a) {
+            Err(Error::SingularAngle { link: 1, .. }) => Ok(()),
+            Err(e) => {
+                Err(format!("at theta_1 = {}: expected SingularAngle for link 1, got: {e}", self.point.q[0]))
+            }
+            Ok(()) => Err(format!(
+                "at theta_1 = {}: expected SingularAngle for link 1, got accelerations {:?}",
+                self.point.q[0],
+                a.as_slice()
+            )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{DMatrix, Dyn};
+    use pendulum_core::{Chain, Planar, Spatial};
+
+    use super::*;
+    use crate::case::{Kind, load_all};
+    use crate::sample;
+    use crate::verify::bounds::BOUND;
+    use crate::verify::{DEFAULT_SEED, fixtures::fixtures, models};
+
+    /// Bugs planted into a correct model, each of a kind the document or a hurried
+    /// implementation could make.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    enum Bug {
+        /// Planar velocity terms with the lower triangle's sign flipped (eq 23 as printed).
+        DocumentVelocitySign,
+        /// Gravity from the link's own mass instead of the tail mass.
+        OwnMassGravity,
+        /// Damping forgotten.
+        NoDamping,
+        /// Spatial φ damping without its `sin² θ`.
+        PhiDampingWithoutSin2,
+        /// Kinetic energy with a ½ on the cross terms too.
+        HalfCrossTerms,
+        /// Accelerations that forget the pivot terms (all building blocks correct).
+        AccelerationsWithoutPivot,
+        /// Mass matrix diagonal from the link's own mass instead of the tail mass.
+        OwnMassDiagonal,
+        /// Planar velocity terms weighted by `M_min(i,j)` instead of `M_max(i,j)`.
+        MinTailMass,
+        /// No bug at all.
+        None,
+    }
+
+    /// A correct model with one [`Bug`].
+    struct Mutant<M> {
+        inner: M,
+        bug: Bug,
+    }
+
+    impl<M> Mutant<M>
+    where
+        M: Model<Links = Dyn, Dof = Dyn>,
+        DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+    {
+        fn weight(&self, i: usize, j: usize) -> f64 {
+            let c = self.inner.chain();
+            c.tail_masses()[i.max(j)] * c.lengths()[i] * c.lengths()[j]
+        }
+    }
+
+    impl<M> Model for Mutant<M>
+    where
+        M: Model<Links = Dyn, Dof = Dyn>,
+        DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+    {
+        type Links = Dyn;
+        type Dof = Dyn;
+        type Space = M::Space;
+
+        fn chain(&self) -> &Chain<Dyn> {
+            self.inner.chain()
+        }
+        fn dof(&self) -> Dyn {
+            self.inner.dof()
+        }
+        fn mass_matrix(&self, q: &DVector<f64>, out: &mut DMatrix<f64>) {
+            self.inner.mass_matrix(q, out);
+            if self.bug == Bug::OwnMassDiagonal {
+                let c = self.chain();
+                for i in 0..c.links() {
+                    out[(i, i)] *= c.masses()[i] / c.tail_masses()[i];
+                }
+            }
+        }
+        fn velocity_terms(&self, q: &DVector<f64>, qd: &DVector<f64>, out: &mut DVector<f64>) {
+            self.inner.velocity_terms(q, qd, out);
+            if self.bug == Bug::DocumentVelocitySign {
+                for i in 0..out.len() {
+                    for j in 0..i {
+                        out[i] -= 2.0 * self.weight(i, j) * (q[i] - q[j]).sin() * qd[j] * qd[j];
+                    }
+                }
+            }
+            if self.bug == Bug::MinTailMass {
+                let c = self.chain();
+                for i in 0..out.len() {
+                    for j in 0..out.len() {
+                        let (tail, l) = (c.tail_masses(), c.lengths());
+                        let change = (tail[i.min(j)] - tail[i.max(j)]) * l[i] * l[j];
+                        out[i] += change * (q[i] - q[j]).sin() * qd[j] * qd[j];
+                    }
+                }
+            }
+        }
+        fn gravity_terms(&self, q: &DVector<f64>, out: &mut DVector<f64>) {
+            self.inner.gravity_terms(q, out);
+            if self.bug == Bug::OwnMassGravity {
+                let c = self.chain();
+                for i in 0..c.links() {
+                    out[i] *= c.masses()[i] / c.tail_masses()[i];
+                }
+            }
+        }
+        fn pivot_terms(&self, q: &DVector<f64>, a: &OVector<f64, M::Space>, out: &mut DVector<f64>) {
+            self.inner.pivot_terms(q, a, out);
+        }
+        fn generalized_forces(
+            &self,
+            q: &DVector<f64>,
+            qd: &DVector<f64>,
+            torque: &DVector<f64>,
+            out: &mut DVector<f64>,
+        ) {
+            self.inner.generalized_forces(q, qd, torque, out);
+            let n = self.chain().links();
+            match self.bug {
+                Bug::NoDamping => out.copy_from(torque),
+                Bug::PhiDampingWithoutSin2 => {
+                    for i in 0..n {
+                        out[n + i] = torque[n + i] - self.chain().damping()[i] * qd[n + i];
+                    }
+                }
+                _ => {}
+            }
+        }
+        fn kinetic_energy(&self, q: &DVector<f64>, qd: &DVector<f64>) -> f64 {
+            let t = self.inner.kinetic_energy(q, qd);
+            if self.bug != Bug::HalfCrossTerms {
+                return t;
+            }
+            let n = q.len();
+            let cross: f64 = (0..n)
+                .flat_map(|i| (0..i).map(move |j| (i, j)))
+                .map(|(i, j)| self.weight(i, j) * (q[i] - q[j]).cos() * qd[i] * qd[j])
+                .sum();
+            t - 0.5 * cross
+        }
+        fn potential_energy(&self, q: &DVector<f64>) -> f64 {
+            self.inner.potential_energy(q)
+        }
+        fn check_configuration(&self, q: &DVector<f64>) -> pendulum_core::Result<()> {
+            self.inner.check_configuration(q)
+        }
+        fn accelerations(
+            &self,
+            q: &DVector<f64>,
+            qd: &DVector<f64>,
+            inputs: &Inputs<Dyn, M::Space>,
+            out: &mut DVector<f64>,
+        ) -> pendulum_core::Result<()> {
+            let mut inputs = inputs.clone();
+            if self.bug == Bug::AccelerationsWithoutPivot {
+                inputs.pivot_acceleration.fill(0.0);
+            }
+            // The default method, on this model's (possibly buggy) building blocks.
+            let dof = self.dof();
+            let mut mass = DMatrix::zeros(dof.value(), dof.value());
+            self.mass_matrix(q, &mut mass);
+            let mut tmp = DVector::zeros(dof.value());
+            self.generalized_forces(q, qd, &inputs.torque, out);
+            self.velocity_terms(q, qd, &mut tmp);
+            *out -= &tmp;
+            self.gravity_terms(q, &mut tmp);
+            *out -= &tmp;
+            self.pivot_terms(q, &inputs.pivot_acceleration, &mut tmp);
+            *out -= &tmp;
+            self.check_configuration(q)?;
+            mass.cholesky().ok_or(Error::NotPositiveDefinite)?.solve_mut(out);
+            Ok(())
+        }
+    }
+
+    /// The worst error of a mutant of the generic model on each quantity of `case`.
+    fn mutant_errors(case: &Case, bug: Bug, states: usize) -> Vec<f64> {
+        let mut worst = vec![0.0f64; Quantity::ALL.len()];
+        for state in 0..states {
+            let (params, point) = sample::state(DEFAULT_SEED, case.kind, case.links, state);
+            let reference = Reference::new(case, &params, &point);
+            let chain = models::chain::<Dyn>(&params).unwrap();
+            let measured = match case.kind {
+                Kind::Planar => {
+                    check_model(case, &Mutant { inner: Planar::new(chain), bug }, &point, &reference)
+                }
+                Kind::Spatial => {
+                    check_model(case, &Mutant { inner: Spatial::new(chain), bug }, &point, &reference)
+                }
+            }
+            .unwrap();
+            for (w, m) in worst.iter_mut().zip(measured) {
+                *w = w.max(m.error);
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn planted_bugs_fail_the_bound_where_they_are() {
+        use Quantity::*;
+        let cases = fixtures();
+        let [planar1, planar2, spatial1] = [&cases[0], &cases[1], &cases[2]];
+        let committed = load_all(&crate::cases_dir()).unwrap();
+        let real = |name: &str| committed.iter().find(|c| c.name == name).unwrap();
+        let (planar3, planar8, spatial2, spatial4) =
+            (real("planar_n3"), real("planar_n8"), real("spatial_n2"), real("spatial_n4"));
+        let expectations: [(&Case, Bug, &[Quantity]); 21] = [
+            (planar2, Bug::DocumentVelocitySign, &[VelocityTerms, Accelerations]),
+            (planar2, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
+            (planar1, Bug::NoDamping, &[GeneralizedForces, Accelerations]),
+            (spatial1, Bug::NoDamping, &[GeneralizedForces, Accelerations]),
+            (spatial1, Bug::PhiDampingWithoutSin2, &[GeneralizedForces, Accelerations]),
+            (planar2, Bug::HalfCrossTerms, &[KineticEnergy]),
+            (spatial1, Bug::AccelerationsWithoutPivot, &[Accelerations]),
+            (planar2, Bug::OwnMassDiagonal, &[MassMatrix, Accelerations]),
+            (planar1, Bug::None, &[]),
+            (planar2, Bug::None, &[]),
+            (spatial1, Bug::None, &[]),
+            // The same against the committed sympy reference.
+            (planar3, Bug::DocumentVelocitySign, &[VelocityTerms, Accelerations]),
+            (planar8, Bug::DocumentVelocitySign, &[VelocityTerms, Accelerations]),
+            (planar8, Bug::MinTailMass, &[VelocityTerms, Accelerations]),
+            (planar8, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
+            (planar8, Bug::OwnMassDiagonal, &[MassMatrix, Accelerations]),
+            (spatial2, Bug::PhiDampingWithoutSin2, &[GeneralizedForces, Accelerations]),
+            (spatial4, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
+            (spatial4, Bug::AccelerationsWithoutPivot, &[Accelerations]),
+            (planar8, Bug::None, &[]),
+            (spatial4, Bug::None, &[]),
+        ];
+        for (case, bug, flagged) in expectations {
+            let errors = mutant_errors(case, bug, 20);
+            for (quantity, error) in Quantity::ALL.iter().zip(errors) {
+                if flagged.contains(quantity) {
+                    assert!(error > 1e4 * BOUND, "{} {bug:?}: {} only {error:e}", case.name, quantity.name());
+                } else {
+                    assert!(error < 1e-2 * BOUND, "{} {bug:?}: {} {error:e}", case.name, quantity.name());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_model_that_leaves_an_entry_unwritten_fails() {
+        // Zero-initialised outputs would hide a model that never writes the spatial φ
+        // gravity entries; NaN-filled ones expose it.
+        struct Lazy(Spatial<Dyn>);
+        impl Model for Lazy {
+            type Links = Dyn;
+            type Dof = Dyn;
+            type Space = nalgebra::U3;
+            fn chain(&self) -> &Chain<Dyn> {
+                self.0.chain()
+            }
+            fn dof(&self) -> Dyn {
+                self.0.dof()
+            }
+            fn mass_matrix(&self, q: &DVector<f64>, out: &mut DMatrix<f64>) {
+                self.0.mass_matrix(q, out)
+            }
+            fn velocity_terms(&self, q: &DVector<f64>, qd: &DVector<f64>, out: &mut DVector<f64>) {
+                self.0.velocity_terms(q, qd, out)
+            }
+            fn gravity_terms(&self, q: &DVector<f64>, out: &mut DVector<f64>) {
+                let n = self.chain().links();
+                let mut full = DVector::zeros(2 * n);
+                self.0.gravity_terms(q, &mut full);
+                out.rows_mut(0, n).copy_from(&full.rows(0, n));
+            }
+            fn pivot_terms(&self, q: &DVector<f64>, a: &OVector<f64, nalgebra::U3>, out: &mut DVector<f64>) {
+                self.0.pivot_terms(q, a, out)
+            }
+            fn generalized_forces(
+                &self,
+                q: &DVector<f64>,
+                qd: &DVector<f64>,
+                t: &DVector<f64>,
+                out: &mut DVector<f64>,
+            ) {
+                self.0.generalized_forces(q, qd, t, out)
+            }
+            fn kinetic_energy(&self, q: &DVector<f64>, qd: &DVector<f64>) -> f64 {
+                self.0.kinetic_energy(q, qd)
+            }
+            fn potential_energy(&self, q: &DVector<f64>) -> f64 {
+                self.0.potential_energy(q)
+            }
+        }
+        let case = &fixtures()[2];
+        let (params, point) = sample::state(1, case.kind, case.links, 0);
+        let reference = Reference::new(case, &params, &point);
+        let lazy = Lazy(Spatial::new(models::chain::<Dyn>(&params).unwrap()));
+        let measured = check_model(case, &lazy, &point, &reference).unwrap();
+        assert_eq!(measured[2].error, f64::INFINITY);
+        assert_eq!(measured[2].entry, "[1]");
+        // The wrong model for the case is an error, not a comparison.
+        let planar = Planar::new(models::chain::<Dyn>(&params).unwrap());
+        let message = check_model(case, &planar, &point, &reference).unwrap_err().to_string();
+        assert!(message.contains("1 coordinates in 2 dimensions, the case 2 in 3"), "{message}");
+    }
+}
