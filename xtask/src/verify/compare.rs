@@ -373,6 +373,7 @@ mod tests {
         type Links = Dyn;
         type Dof = Dyn;
         type Space = M::Space;
+        type Chart = M::Chart;
 
         fn chain(&self) -> &Chain<Dyn> {
             self.inner.chain()
@@ -564,6 +565,7 @@ mod tests {
             type Links = Dyn;
             type Dof = Dyn;
             type Space = nalgebra::U3;
+            type Chart = pendulum_core::kinematics::SphericalAngles;
             fn chain(&self) -> &Chain<Dyn> {
                 self.0.chain()
             }
