@@ -15,7 +15,7 @@
 //! and 16 for the accelerations only), `generic_fixed` (`Planar`/`Spatial<Const<n>>`),
 //! `generic_dyn` (`Planar`/`Spatial<Dyn>`, accelerations up to n = 256). The
 //! `<kind>_accelerations` groups also hold:
-//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`xtask/src/closed_form.rs`);
+//! - `closed_form`: planar n = 2, the document's eq 50 corrected (`pendulum_core::models::DoublePendulum`);
 //!   `planar_input_checks/check_inputs/2` times the input validation it lacks;
 //! - `tension`: the O(n) `PlanarTension<Dyn>` (also its `gl2_step` for n ≤ 8);
 //! - `directions`: `System::rhs` of the O(n) `Directions` chain (2D and 3D);
@@ -44,10 +44,8 @@ use pendulum_core::{
 // The closed form is written once, in xtask, where its unit tests check it against
 // `Planar<Dyn>` (`cargo test -p xtask`; a benchmark target runs no unit tests). It uses
 // nothing of xtask, so it compiles here as it is.
-#[path = "../../xtask/src/closed_form.rs"]
-mod closed_form;
 
-use closed_form::DoublePendulum;
+use pendulum_core::models::DoublePendulum;
 
 pendulum_macros::model! {
     /// Generated planar model, 1 link.

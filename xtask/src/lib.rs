@@ -4,7 +4,6 @@
 
 pub mod bench;
 pub mod case;
-pub mod closed_form;
 pub mod expr;
 pub mod regen;
 pub mod sample;
