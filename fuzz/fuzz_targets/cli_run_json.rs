@@ -13,6 +13,9 @@ mod config;
 #[path = "../../pendulum-cli/src/error.rs"]
 mod error;
 #[allow(dead_code)]
+#[path = "../../pendulum-cli/src/final_state.rs"]
+mod final_state;
+#[allow(dead_code)]
 #[path = "../../pendulum-cli/src/spec.rs"]
 mod spec;
 
