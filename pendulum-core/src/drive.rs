@@ -19,7 +19,8 @@ use crate::model::{Inputs, InputsAt};
 ///
 /// The three must be consistent (`ṗ = dp/dt`, `p̈ = dṗ/dt`) for the energy balance of
 /// [`Accounted`](crate::energy::Accounted) to close; the dynamics use `p̈` only. The built-in
-/// drives are [`Fixed`], [`Harmonic`], [`Circle`] (spatial) and [`FnDrive`] (closures);
+/// drives are [`Fixed`], [`Harmonic`], [`Circle`] and [`RampedCircle`] (spatial, both
+/// [`Turning`]) and [`FnDrive`] (closures);
 /// implement the trait for any other motion. `&D` and `Box<D>` (also `Box<dyn Drive<S>>`,
 /// to choose a drive at run time) are drives when `D` is.
 pub trait Drive<S: DimName>
@@ -240,6 +241,169 @@ impl Drive<U3> for Circle {
     }
 }
 
+/// A spatial pivot drive that turns about the vertical: the pivot on the horizontal circle
+/// of radius `R` about the z axis, at the azimuth `φ(t)` (the phase, rad, from +x,
+/// counter-clockwise seen from above):
+/// ```text
+/// p(t) = R (cos φ, sin φ, 0),   ṗ(t) = R φ̇ (−sin φ, cos φ, 0),
+/// p̈(t) = R φ̈ (−sin φ, cos φ, 0) − R φ̇² (cos φ, sin φ, 0)
+/// ```
+/// Implementations must move the pivot so; the frame turning with the pivot (the lab frame
+/// turned by `−φ(t)` about z, the pivot at `(R, 0, 0)`) is where the steady shapes of a
+/// whirled chain stand still ([`ShapeTracker`](crate::analysis::ShapeTracker) analyses
+/// them). [`Circle`] turns at a constant rate, [`RampedCircle`] ramps its rate; `&T` and
+/// `Box<T>` (also `Box<dyn Turning>`) turn when `T` does.
+pub trait Turning: Drive<U3> {
+    /// The pivot's azimuth `φ(t)`, rad (unwrapped: continuous in `t`, not reduced mod 2π).
+    fn phase(&self, t: f64) -> f64;
+    /// Its rate `φ̇(t)`, rad/s: the angular speed of the turning frame.
+    fn rate(&self, t: f64) -> f64;
+    /// The circle's radius `R`, m.
+    fn radius(&self) -> f64;
+}
+
+impl<T: Turning + ?Sized> Turning for &T {
+    fn phase(&self, t: f64) -> f64 {
+        (**self).phase(t)
+    }
+    fn rate(&self, t: f64) -> f64 {
+        (**self).rate(t)
+    }
+    fn radius(&self) -> f64 {
+        (**self).radius()
+    }
+}
+
+impl<T: Turning + ?Sized> Turning for Box<T> {
+    fn phase(&self, t: f64) -> f64 {
+        (**self).phase(t)
+    }
+    fn rate(&self, t: f64) -> f64 {
+        (**self).rate(t)
+    }
+    fn radius(&self) -> f64 {
+        (**self).radius()
+    }
+}
+
+/// `φ = ωt`, `φ̇ = ω`.
+impl Turning for Circle {
+    fn phase(&self, t: f64) -> f64 {
+        self.angular_frequency * t
+    }
+    fn rate(&self, _t: f64) -> f64 {
+        self.angular_frequency
+    }
+    fn radius(&self) -> f64 {
+        self.radius
+    }
+}
+
+/// The pivot on a horizontal circle of radius `R` (m) about the z axis with its angular
+/// speed ramped linearly from `ω0` to `ω1` (rad/s, either sign, either order: up, down,
+/// from or to rest) over `T` seconds from `t = 0`, then held at `ω1`:
+/// ```text
+/// φ̇(t) = ω0 + (ω1 − ω0) t / T,     φ(t) = ω0 t + (ω1 − ω0) t² / (2T)     (0 ≤ t < T)
+/// φ̇(t) = ω1,                      φ(t) = φ(T) + ω1 (t − T)             (t ≥ T)
+/// φ̇(t) = ω0,                      φ(t) = ω0 t                          (t < 0)
+/// ```
+/// with `φ(T) = (ω0 + ω1) T / 2` and `φ̈ = (ω1 − ω0)/T` during the ramp, 0 outside it;
+/// `p`, `ṗ`, `p̈` follow from `φ` as for every [`Turning`] drive. `φ`, `φ̇`, `p` and `ṗ` are
+/// continuous; `φ̈` and `p̈` jump at `t = 0` and `t = T` (taking there the value after the
+/// jump, which a run starting at `t = 0` needs). `ω0 = ω1` moves the pivot as
+/// [`Circle`]`(R, ω0)`.
+///
+/// A fixed-step integrator loses its order on the step across a jump of `p̈`: RK4 runs
+/// through the ramp are first order in `h` there (the energy balance of `Accounted` closes
+/// as `O(h·R|φ̈|)`, unit test), fourth order elsewhere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RampedCircle {
+    radius: f64,
+    initial_speed: f64,
+    final_speed: f64,
+    duration: f64,
+}
+
+impl RampedCircle {
+    /// Radius `R` (m), speed ramped from `ω0` to `ω1` (rad/s) over `T` (s).
+    ///
+    /// Errors: [`Error::InvalidDrive`] naming the value when `R` is negative or not finite
+    /// (`"radius"`), `ω0` or `ω1` is not finite (`"initial angular speed"`,
+    /// `"final angular speed"`), or `T` is not finite and positive (`"ramp duration"`).
+    pub fn new(radius: f64, initial_speed: f64, final_speed: f64, duration: f64) -> Result<Self> {
+        let radius = check_parameter("radius", radius, true)?;
+        let initial_speed = check_parameter("initial angular speed", initial_speed, false)?;
+        let final_speed = check_parameter("final angular speed", final_speed, false)?;
+        if !(duration.is_finite() && duration > 0.0) {
+            let requirement = "finite and positive";
+            return Err(Error::InvalidDrive { what: "ramp duration", requirement, value: duration });
+        }
+        Ok(Self { radius, initial_speed, final_speed, duration })
+    }
+
+    /// Radius `R`, m.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// The speed at the start of the ramp `ω0`, rad/s.
+    pub fn initial_speed(&self) -> f64 {
+        self.initial_speed
+    }
+
+    /// The speed from the end of the ramp on `ω1`, rad/s.
+    pub fn final_speed(&self) -> f64 {
+        self.final_speed
+    }
+
+    /// The ramp's duration `T`, s.
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// `(φ, φ̇, φ̈)` at `t` (rad, rad/s, rad/s²).
+    fn angle(&self, t: f64) -> (f64, f64, f64) {
+        let (w0, w1, duration) = (self.initial_speed, self.final_speed, self.duration);
+        let spin = (w1 - w0) / duration;
+        if t < 0.0 {
+            (w0 * t, w0, 0.0)
+        } else if t < duration {
+            (w0 * t + 0.5 * spin * t * t, w0 + spin * t, spin)
+        } else {
+            (0.5 * (w0 + w1) * duration + w1 * (t - duration), w1, 0.0)
+        }
+    }
+}
+
+impl Drive<U3> for RampedCircle {
+    fn position(&self, t: f64) -> Vector3<f64> {
+        let (s, c) = self.angle(t).0.sin_cos();
+        Vector3::new(c, s, 0.0) * self.radius
+    }
+    fn velocity(&self, t: f64) -> Vector3<f64> {
+        let (phi, rate, _) = self.angle(t);
+        let (s, c) = phi.sin_cos();
+        Vector3::new(-s, c, 0.0) * (self.radius * rate)
+    }
+    fn acceleration(&self, t: f64) -> Vector3<f64> {
+        let (phi, rate, spin) = self.angle(t);
+        let (s, c) = phi.sin_cos();
+        (Vector3::new(-s, c, 0.0) * spin - Vector3::new(c, s, 0.0) * (rate * rate)) * self.radius
+    }
+}
+
+impl Turning for RampedCircle {
+    fn phase(&self, t: f64) -> f64 {
+        self.angle(t).0
+    }
+    fn rate(&self, t: f64) -> f64 {
+        self.angle(t).1
+    }
+    fn radius(&self) -> f64 {
+        self.radius
+    }
+}
+
 /// A user-supplied pivot motion: three closures of time `t` (s) giving `p(t)` (m),
 /// `ṗ(t)` (m/s) and `p̈(t)` (m/s²).
 ///
@@ -380,85 +544,4 @@ where
 }
 
 #[cfg(test)]
-mod tests {
-    use nalgebra::{DVector, Dyn, U2, Vector2};
-
-    use super::*;
-
-    /// Central differences of p and ṗ match ṗ and p̈.
-    fn assert_consistent<S: DimName, D: Drive<S>>(drive: &D)
-    where
-        DefaultAllocator: Allocator<S>,
-    {
-        let eps = 1e-5;
-        for t in [0.0, 0.3, 1.7] {
-            let dp = (drive.position(t + eps) - drive.position(t - eps)) / (2.0 * eps);
-            let dv = (drive.velocity(t + eps) - drive.velocity(t - eps)) / (2.0 * eps);
-            let (v, a) = (drive.velocity(t), drive.acceleration(t));
-            assert!((&dp - &v).norm() < 1e-7 * (1.0 + v.norm()), "ṗ {v} vs {dp}");
-            assert!((&dv - &a).norm() < 1e-7 * (1.0 + a.norm()), "p̈ {a} vs {dv}");
-        }
-    }
-
-    #[test]
-    fn built_in_drives_are_consistent() {
-        assert_consistent::<U2, _>(&Harmonic::new(Vector2::new(3.0, 4.0), 0.2, 5.0, 0.4).unwrap());
-        assert_consistent(&Harmonic::new(Vector3::new(1.0, -1.0, 2.0), 0.1, 7.0, -1.0).unwrap());
-        assert_consistent(&Circle::new(0.3, -4.0).unwrap());
-        assert_consistent::<U3, _>(&Fixed);
-    }
-
-    #[test]
-    fn harmonic_normalizes_its_direction() {
-        let h = Harmonic::new(Vector2::new(3.0, 4.0), 2.0, 1.0, std::f64::consts::FRAC_PI_2).unwrap();
-        assert_eq!(h.direction(), &Vector2::new(0.6, 0.8));
-        assert!((h.position(0.0) - Vector2::new(1.2, 1.6)).norm() < 1e-15);
-        assert_eq!(Harmonic::<U3>::vertical(1.0, 1.0, 0.0).unwrap().direction(), &Vector3::z());
-    }
-
-    #[test]
-    fn bad_parameters_are_named() {
-        let err = Harmonic::new(Vector2::zeros(), 1.0, 1.0, 0.0).unwrap_err();
-        assert!(matches!(err, Error::InvalidDrive { what: "direction norm", .. }), "{err}");
-        let err = Harmonic::new(Vector2::new(f64::NAN, 1.0), 1.0, 1.0, 0.0).unwrap_err();
-        assert!(matches!(err, Error::InvalidDrive { what: "direction norm", .. }), "{err}");
-        assert_eq!(
-            Harmonic::new(Vector2::x(), -0.5, 1.0, 0.0),
-            Err(Error::InvalidDrive {
-                what: "amplitude",
-                requirement: "finite and non-negative",
-                value: -0.5
-            })
-        );
-        assert!(matches!(
-            Harmonic::new(Vector2::x(), 0.5, f64::INFINITY, 0.0),
-            Err(Error::InvalidDrive { what: "angular frequency", .. })
-        ));
-        assert!(matches!(
-            Harmonic::new(Vector2::x(), 0.5, 1.0, f64::NAN),
-            Err(Error::InvalidDrive { what: "phase", .. })
-        ));
-        let err = Circle::new(-1.0, 2.0).unwrap_err();
-        assert_eq!(err.to_string(), "drive radius must be finite and non-negative, got -1");
-        assert!(matches!(
-            Circle::new(1.0, f64::NAN),
-            Err(Error::InvalidDrive { what: "angular frequency", .. })
-        ));
-    }
-
-    #[test]
-    fn driven_inputs_carry_the_torque_and_the_pivot_acceleration() {
-        let drive = FnDrive::new(
-            |t: f64| Vector2::new(t * t, 0.0),
-            |t: f64| Vector2::new(2.0 * t, 0.0),
-            |_t: f64| Vector2::new(2.0, 0.0),
-        );
-        let torque = |t: f64| DVector::from_vec(vec![t, -t]);
-        let driven = Driven::new(drive, torque);
-        let inputs: Cow<'_, Inputs<Dyn, U2>> = driven.inputs_at(1.5);
-        assert_eq!(inputs.torque.as_slice(), &[1.5, -1.5]);
-        assert_eq!(inputs.pivot_acceleration, Vector2::new(2.0, 0.0));
-        let boxed: Box<dyn Drive<U2>> = Box::new(Fixed);
-        assert_eq!(boxed.velocity(3.0), Vector2::zeros());
-    }
-}
+mod tests;

@@ -46,8 +46,14 @@ pub use analysis::{
     SteadyRotation, SteadyShape, bernoulli_frequency, bessel_j0_zero, linearise, normal_modes,
     relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
+pub use analysis::{
+    NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,
+    nearest_steady, shape_report, whirl_shape,
+};
 pub use chain::Chain;
-pub use drive::{Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, TorqueAt};
+pub use drive::{
+    Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, RampedCircle, TorqueAt, Turning,
+};
 pub use energy::{
     Accounted, AccountedDirections, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum,
     pivot_momentum_rate, powers,

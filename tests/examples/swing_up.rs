@@ -7,30 +7,38 @@
 //! ```
 //!
 //! prints the sweep tables (Markdown) and writes `docs/data/swing-up.csv`. Two sweeps:
-//! the drive switched on at full speed ("sudden"), and its speed ramped linearly from 0
-//! over `RAMP` seconds then held ("ramp"); both run `DURATION` seconds in all. The chain is
-//! simulated in unit link directions (`Directions<U3, Circle>`, RK4 + projection), in
-//! the inertial frame, with the damping of the chain's Rayleigh function
-//! (`D = ½ Σ λ |u̇_i|²`, inertial rates). At the end the positions are turned into the
-//! frame rotating with the pivot (`p(t) = R (cos ωt, sin ωt, 0)`, so the pivot sits at
-//! `(R, 0, 0)`); the chain counts as settled when those positions changed by less than
-//! `1e-3 L` over the last `SETTLE_WINDOW` seconds. All forced steady shapes at the same ω
-//! are collected from the continuation branches (`SteadyRotation::solutions_at`), and the
-//! nearest to the final shape (largest distance between corresponding masses) is the
-//! matching one; the table reports both node counts, that distance, and the out-of-plane
-//! lag (the inertial damping's doing: the undamped steady shape is planar). Last, the
-//! exact damped relative equilibrium nearest the final shape (`relative_equilibrium`,
-//! Newton on the `Directions` model's own equations in the turning frame) gives the
-//! distance to the shape the damped chain should settle into, and the largest real part
-//! of its spectrum with the damping (`relative_spectrum`).
+//! the drive switched on at full speed ("sudden", `Circle`), and its speed ramped linearly
+//! from 0 over `RAMP` seconds then held ("ramp", `RampedCircle`); both run `DURATION`
+//! seconds in all. The chain is simulated in unit link directions (`Directions<U3, _>`,
+//! RK4 + projection), in the inertial frame, with the damping of the chain's Rayleigh
+//! function (`D = ½ Σ λ |u̇_i|²`, inertial rates), and every step is fed to a
+//! `ShapeTracker` (`pendulum-core/src/analysis/shape.rs`), which does the analysis: the
+//! positions in the frame rotating with the pivot (the pivot at `(R, 0, 0)`), the node
+//! count, whether the chain settled (no mass moved more than `1e-3 L` in that frame over
+//! the last `SETTLE_WINDOW` seconds, here as `ShapeOptions::periods`), and the exact damped
+//! relative equilibrium nearest the final shape (`relative_equilibrium`, Newton on the
+//! `Directions` model's own equations in the turning frame) with the largest real part of
+//! its damped spectrum (`relative_spectrum`). On top of that, all undamped forced steady
+//! shapes at the same ω are collected from the continuation branches
+//! (`SteadyRotation::solutions_at`), and the nearest to the final shape (largest distance
+//! between corresponding masses) is the matching one; the table reports both node counts,
+//! that distance, and the out-of-plane lag `max |y_i|` from the pivot's plane (the inertial
+//! damping's doing: the undamped steady shape is planar).
+//!
+//! A shortened run (no CSV written; the CSV printed instead) for checks:
+//!
+//! ```text
+//! SWING_UP_DURATION=60 SWING_UP_RAMP=20 SWING_UP_SPEEDS=0.9,1.6,3.2 \
+//!     cargo run --release -p pendulum-tests --example swing_up
+//! ```
 
-use std::{error::Error, fmt::Write as _, fs, path::PathBuf};
+use std::{error::Error, f64::consts::TAU, fmt::Write as _, fs, path::PathBuf};
 
 use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Branch, Chain, Circle, ContinuationOptions, Directions, Drive, FnDrive, SteadyRotation, SteadyShape,
-    normal_modes, relative_equilibrium, relative_spectrum, stability,
+    Branch, Chain, Circle, ContinuationOptions, Directions, RampedCircle, ShapeOptions, ShapeReport,
+    ShapeTracker, SteadyRotation, SteadyShape, Turning, normal_modes, stability,
 };
 
 const LINKS: usize = 20;
@@ -41,58 +49,36 @@ const GRAVITY: f64 = 9.81;
 const RADIUS: f64 = 0.02;
 /// Decay rate of the first mode at rest the damping is chosen for, 1/s.
 const FIRST_MODE_DECAY: f64 = 0.02;
-/// Simulated time per speed, s.
+/// Simulated time per speed, s (`SWING_UP_DURATION` overrides).
 const DURATION: f64 = 600.0;
 /// Settled: rotating-frame positions moved less than `1e-3 L` over this window, s.
 const SETTLE_WINDOW: f64 = 10.0;
 /// RK4 step, s.
 const STEP: f64 = 1e-3;
-/// Length of the linear speed ramp of the second sweep, s.
+/// Length of the linear speed ramp of the second sweep, s (`SWING_UP_RAMP` overrides).
 const RAMP: f64 = 200.0;
-
-/// Positions in the frame turned by `angle` about z (the pivot's phase).
-fn rotating_positions<Dr: Drive<U3>>(
-    model: &Directions<U3, Dr>,
-    t: f64,
-    x: &DVector<f64>,
-    angle: f64,
-) -> Vec<Vector3<f64>> {
-    let (s, c) = angle.sin_cos();
-    model
-        .positions(t, x)
-        .into_iter()
-        .map(|r| Vector3::new(c * r.x + s * r.y, -s * r.x + c * r.y, r.z))
-        .collect()
-}
+/// The speeds, in units of sqrt(g/L) (`SWING_UP_SPEEDS`, comma-separated, overrides).
+const SPEEDS: [f64; 15] = [0.5, 0.9, 1.1, 1.3, 1.6, 2.0, 2.4, 2.6, 2.9, 3.2, 3.6, 4.0, 4.4, 4.8, 5.2];
 
 /// Mass positions, m.
 type Shape = Vec<Vector3<f64>>;
 
-/// Integrate from hanging at rest for `DURATION`; the rotating-frame positions
-/// `SETTLE_WINDOW` before the end and at the end (`phase(t)` the pivot's phase).
-fn simulate<Dr: Drive<U3>>(
+/// Integrate from hanging at rest for `duration` s, every step fed to the shape analysis
+/// (settle window `SETTLE_WINDOW` seconds at the final speed `omega`); its report at the end.
+fn simulate<Dr: Turning>(
     model: &Directions<U3, Dr>,
-    phase: impl Fn(f64) -> f64,
-) -> Result<(Shape, Shape), Box<dyn Error>> {
+    omega: f64,
+    duration: f64,
+) -> Result<ShapeReport, Box<dyn Error>> {
+    let options = ShapeOptions { periods: SETTLE_WINDOW * omega.abs() / TAU, ..ShapeOptions::default() };
+    let mut tracker = ShapeTracker::new(model, options)?;
     let mut state = State::new(0.0, model.hanging());
     let mut solver = Projected::new(Rk4::new(model));
-    let steps = (DURATION / STEP).round() as usize;
-    let window = (SETTLE_WINDOW / STEP).round() as usize;
-    let mut before = Vec::new();
-    for k in 0..steps {
-        if k == steps - window {
-            before = rotating_positions(model, state.t(), state.x(), phase(state.t()));
-        }
+    for _ in 0..(duration / STEP).round() as usize {
         solver.step(model, &mut state, STEP)?;
+        tracker.push(state.t(), state.x())?;
     }
-    let last = rotating_positions(model, state.t(), state.x(), phase(state.t()));
-    Ok((before, last))
-}
-
-/// The pivot's phase when its angular speed ramps linearly from 0 to `omega` over `ramp`
-/// seconds and then holds: `φ = ω t² / (2 T)` for `t < T`, `ω (t − T/2)` after.
-fn ramp_phase(omega: f64, ramp: f64) -> impl Fn(f64) -> f64 + Copy {
-    move |t| if t < ramp { 0.5 * omega * t * t / ramp } else { omega * (t - 0.5 * ramp) }
+    Ok(tracker.report()?)
 }
 
 fn max_distance(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
@@ -124,41 +110,24 @@ fn run(
     chain: &Chain<Dyn>,
     branches: &[Branch],
     omega: f64,
+    duration: f64,
     ramp: Option<f64>,
 ) -> Result<Row, Box<dyn Error>> {
-    // The model with the steady circle: simulated directly, and used for the analysis.
-    let model = Directions::<U3>::new(chain.clone()).with_drive(Circle::new(RADIUS, omega)?);
-    let (before, last) = match ramp {
-        None => simulate(&model, |t| omega * t)?,
+    let plain = Directions::<U3>::new(chain.clone());
+    let report = match ramp {
+        None => simulate(&plain.with_drive(Circle::new(RADIUS, omega)?), omega, duration)?,
         Some(ramp) => {
-            let phase = ramp_phase(omega, ramp);
-            let rate = move |t: f64| if t < ramp { omega * t / ramp } else { omega };
-            let spin = move |t: f64| if t < ramp { omega / ramp } else { 0.0 };
-            let drive = FnDrive::new(
-                move |t: f64| {
-                    let (s, c) = phase(t).sin_cos();
-                    Vector3::new(c, s, 0.0) * RADIUS
-                },
-                move |t: f64| {
-                    let (s, c) = phase(t).sin_cos();
-                    Vector3::new(-s, c, 0.0) * (RADIUS * rate(t))
-                },
-                move |t: f64| {
-                    let (s, c) = phase(t).sin_cos();
-                    (Vector3::new(-s, c, 0.0) * spin(t) - Vector3::new(c, s, 0.0) * rate(t).powi(2)) * RADIUS
-                },
-            );
-            simulate(&Directions::<U3>::new(chain.clone()).with_drive(drive), phase)?
+            simulate(&plain.with_drive(RampedCircle::new(RADIUS, 0.0, omega, ramp)?), omega, duration)?
         }
     };
-    let drift = max_distance(&before, &last) / LENGTH;
-    let sim_x: Vec<f64> = last.iter().map(|r| r.x).collect();
-    let nodes_sim = 1 + pendulum_core::sign_changes(&sim_x);
+    let last: &Shape = &report.shape.positions;
+    let drift = report.settling.drift / LENGTH;
     let lag = last.iter().map(|r| r.y.abs()).fold(0.0, f64::max) / LENGTH;
-    let amplitude = sim_x.iter().fold(0.0_f64, |a, x| if x.abs() > a.abs() { *x } else { a }) / LENGTH;
+    let amplitude =
+        last.iter().map(|r| r.x).fold(0.0_f64, |a, x| if x.abs() > a.abs() { x } else { a }) / LENGTH;
     let problem = SteadyRotation::new(chain, RADIUS)?;
     let candidates = problem.solutions_at(branches, omega);
-    let steady_positions = |shape: &SteadyShape| -> Vec<Vector3<f64>> {
+    let steady_positions = |shape: &SteadyShape| -> Shape {
         let mut z = 0.0;
         shape
             .displacements
@@ -172,9 +141,9 @@ fn run(
     };
     let nearest = candidates
         .iter()
-        .map(|c| (max_distance(&steady_positions(c), &last) / LENGTH, c))
+        .map(|c| (max_distance(&steady_positions(c), last) / LENGTH, c))
         .min_by(|a, b| a.0.total_cmp(&b.0));
-    let in_plane = nearest.map(|(_, shape)| max_in_plane_distance(&steady_positions(shape), &last) / LENGTH);
+    let in_plane = nearest.map(|(_, shape)| max_in_plane_distance(&steady_positions(shape), last) / LENGTH);
     let (nodes_steady, distance, class) = match nearest {
         Some((d, shape)) => {
             let st = stability(&problem, shape, None)?;
@@ -187,53 +156,42 @@ fn run(
         }
         None => (None, None, "no steady shape on the branches".to_string()),
     };
-    let solutions = candidates.len();
-    // The exact damped relative equilibrium nearest the final shape (Newton on the
-    // Directions model's own equations in the turning frame) and its spectrum.
-    let mut previous = Vector3::new(RADIUS, 0.0, 0.0);
-    let guess: Vec<(f64, f64)> = last
-        .iter()
-        .zip(chain.lengths().iter())
-        .map(|(r, l)| {
-            let u = (r - previous) / *l;
-            previous = *r;
-            (u.x.atan2(-u.z), u.y.clamp(-1.0, 1.0).asin())
-        })
-        .collect();
-    let (damped_distance, damped_growth) = match relative_equilibrium(&model, &guess) {
-        Ok(eq) => {
-            let mut r = Vector3::new(RADIUS, 0.0, 0.0);
-            let positions: Vec<Vector3<f64>> = (0..LINKS)
-                .map(|i| {
-                    r += chain.lengths()[i] * eq.state.fixed_rows::<3>(3 * i).into_owned();
-                    r
-                })
-                .collect();
-            let growth =
-                relative_spectrum(&model, &eq)?.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
-            (Some(max_distance(&positions, &last) / LENGTH), Some(growth))
-        }
-        Err(_) => (None, None),
-    };
+    // The exact damped relative equilibrium nearest the final shape and its spectrum.
+    let damped = report.nearest.as_ref().ok();
     Ok(Row {
         omega,
-        settled: drift < 1e-3,
+        settled: report.settling.settled,
         drift,
-        nodes_sim,
+        nodes_sim: report.shape.nodes,
         nodes_steady,
         distance,
         in_plane,
         lag,
         amplitude,
         class,
-        solutions,
-        damped_distance,
-        damped_growth,
+        solutions: candidates.len(),
+        damped_distance: damped.map(|d| d.distance / LENGTH),
+        damped_growth: damped.map(|d| d.growth_rate),
     })
+}
+
+/// `name` from the environment, parsed, or `default`.
+fn setting<T: std::str::FromStr>(name: &str, default: T) -> Result<T, Box<dyn Error>> {
+    match std::env::var(name) {
+        Ok(v) => v.parse().map_err(|_| format!("{name}={v}: not a number").into()),
+        Err(_) => Ok(default),
+    }
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
     let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs");
+    let duration: f64 = setting("SWING_UP_DURATION", DURATION)?;
+    let ramp_length: f64 = setting("SWING_UP_RAMP", RAMP)?;
+    let fractions: Vec<f64> = match std::env::var("SWING_UP_SPEEDS") {
+        Ok(v) => v.split(',').map(str::parse).collect::<Result<_, _>>()?,
+        Err(_) => SPEEDS.to_vec(),
+    };
+    let shortened = duration != DURATION || ramp_length != RAMP || fractions != SPEEDS;
     let plain = Chain::<Dyn>::uniform(LINKS, MASS / LINKS as f64, LENGTH / LINKS as f64, GRAVITY)?;
     // Damping λ (same on every link) giving the first mode at rest the decay rate
     // ½ λ Σ_i v_i² = FIRST_MODE_DECAY (v mass-normalised, so vᵀ W v = 1).
@@ -244,7 +202,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let critical = SteadyRotation::new(&chain, 0.0)?.bifurcation_speeds(3)?;
     let scale = (GRAVITY / LENGTH).sqrt();
     println!(
-        "n = {LINKS}, L = {LENGTH} m, R = {RADIUS} m, λ = {damping:.3e} N·m·s per link, {DURATION} s per run, RK4 h = {STEP} s"
+        "n = {LINKS}, L = {LENGTH} m, R = {RADIUS} m, λ = {damping:.3e} N·m·s per link, {duration} s per run, RK4 h = {STEP} s"
     );
     println!(
         "critical speeds ω_k / sqrt(g/L): {:.4}, {:.4}, {:.4}",
@@ -267,19 +225,18 @@ fn main() -> Result<(), Box<dyn Error>> {
             branches.push(forced.continue_from(&start, false, omega_max, &opts)?);
         }
     }
-    let fractions = [0.5, 0.9, 1.1, 1.3, 1.6, 2.0, 2.4, 2.6, 2.9, 3.2, 3.6, 4.0, 4.4, 4.8, 5.2];
     let header = String::from(
         "| ω / sqrt(g/L) | ω (rad/s) | settled (drift / L) | nodes (sim) | steady shapes at ω | nodes (nearest) | distance / L | in-plane distance / L | out-of-plane lag / L | signed amplitude / L | nearest steady shape | damped steady: distance / L | damped steady: growth (1/s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
         "start,omega_rad_s,settled,drift_over_L,nodes_sim,steady_solutions,nodes_steady,distance_over_L,in_plane_distance_over_L,lag_over_L,amplitude_over_L,steady_class,damped_distance_over_L,damped_growth_rate_1_s\n",
     );
-    for ramp in [None, Some(RAMP)] {
+    for ramp in [None, Some(ramp_length)] {
         let start = ramp.map_or("sudden".to_string(), |t| format!("ramp {t} s"));
         let mut table = header.clone();
-        for f in fractions {
+        for &f in &fractions {
             let omega = f * scale;
-            let r = run(&chain, &branches, omega, ramp)?;
+            let r = run(&chain, &branches, omega, duration, ramp)?;
             let opt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.2e}"));
             let _ = writeln!(
                 table,
@@ -320,8 +277,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         println!("\nstart: {start}");
         print!("{table}");
     }
-    fs::create_dir_all(docs.join("data"))?;
-    fs::write(docs.join("data/swing-up.csv"), csv)?;
-    println!("wrote docs/data/swing-up.csv");
+    if shortened {
+        println!("\nshortened run, docs/data/swing-up.csv not written:\n{csv}");
+    } else {
+        fs::create_dir_all(docs.join("data"))?;
+        fs::write(docs.join("data/swing-up.csv"), csv)?;
+        println!("wrote docs/data/swing-up.csv");
+    }
     Ok(())
 }

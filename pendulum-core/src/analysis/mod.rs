@@ -3,16 +3,23 @@
 //! `bessel`), the undamped steady shapes turning rigidly about the vertical
 //! as branches over the speed ω (`steady_branches`) and their stability (`stability`),
 //! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
-//! with their spectrum (`relative_equilibrium`).
+//! with their spectrum (`relative_equilibrium`); the shape a whirled chain takes, seen in
+//! the frame turning with its pivot, whether it settled and the damped steady shape nearest
+//! it (`shape`).
 
 pub(crate) mod bessel;
 pub(crate) mod modes;
 pub(crate) mod relative_equilibrium;
+pub(crate) mod shape;
 pub(crate) mod stability;
 pub(crate) mod steady_branches;
 
 pub use bessel::bessel_j0_zero;
 pub use modes::{NormalModes, bernoulli_frequency, normal_modes, sign_changes};
 pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
+pub use shape::{
+    NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,
+    nearest_steady, shape_report, whirl_shape,
+};
 pub use stability::{Linearisation, Stability, linearise, stability};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};
