@@ -14,5 +14,5 @@ pub(crate) mod steady_branches;
 pub use bessel::bessel_j0_zero;
 pub use modes::{NormalModes, bernoulli_frequency, normal_modes, sign_changes};
 pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
-pub use stability::{Linearisation, Stability, linearise, stability};
+pub use stability::{Linearisation, Stability, Verdict, linearise, stability};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};
