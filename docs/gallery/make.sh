@@ -35,7 +35,7 @@ cp "$runs/damped/energy.png" "$gallery/damped-energy.png"
 # Normal modes of a uniform 12-link chain, and its steady rotating shapes.
 pendulum modes --n 12 --lengths 0.1 --count 4 --out "$runs/modes" > /dev/null
 cp "$runs/modes/modes.png" "$gallery/modes.png"
-pendulum steady --n 12 --lengths 0.1 --out "$runs/steady" > /dev/null
+pendulum steady --n 12 --lengths 0.1 --omega 5,10,15 --out "$runs/steady" > /dev/null
 cp "$runs/steady/branches.png" "$gallery/steady-branches.png"
 cp "$runs/steady/shapes.png" "$gallery/steady-shapes.png"
 ls -l "$gallery"

@@ -48,9 +48,16 @@ pub enum Command {
     /// modes.csv and modes.png (the mode shapes) in the output directory.
     Modes(ModesArgs),
     /// Steady rotation about the vertical: the branches of shapes that turn rigidly at
-    /// angular speed ω (leaving the vertical at the critical speeds for a fixed pivot, or
-    /// the forced branch for a pivot on a circle of radius R), as a table, branches.csv,
-    /// the branch diagram branches.png and the shapes at the largest speed, shapes.png.
+    /// angular speed ω, up to exactly --omega-max (fixed pivot: leaving the vertical at
+    /// the critical speeds; --radius R: a pivot on a circle), and every steady shape at
+    /// the speeds of --omega with its node count, tip radius and stability: tables,
+    /// branches.csv, shapes.csv, the branch diagram branches.png and shapes.png.
+    ///
+    /// Nodes = axis crossings + 1 (the pivot counted). Stability, of the 3D equations in
+    /// the turning frame: stable (index 0, a minimum of the amended potential),
+    /// gyroscopic (spectrally stable with an even index > 0: held by Coriolis forces,
+    /// destroyed by damping in the turning frame) or unstable (growth rate: the largest
+    /// real part of the eigenvalues, 1/s).
     Steady(SteadyArgs),
 }
 
@@ -95,13 +102,26 @@ pub struct SteadyArgs {
     /// Radius R of the pivot's horizontal circle, m (0: pivot fixed on the axis).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub radius: f64,
-    /// Largest angular speed to follow the branches to, rad/s (default: 1.5 × the
-    /// highest critical speed; with R > 0, 3 √(g/L)).
+    /// List every steady shape at these angular speeds, rad/s, ≥ 0, comma list: branch,
+    /// nodes (axis crossings + 1, the pivot counted), tip radius, stability (default: at
+    /// --omega-max).
+    #[arg(long, value_name = "W[,W…]", allow_hyphen_values = true)]
+    pub omega: Option<String>,
+    /// The exact end of the branches, rad/s (default, for either pivot: 1.25 × the third
+    /// critical speed of the chain on a fixed pivot, the highest if n < 3, rounded up to
+    /// three digits; at least the largest --omega).
     #[arg(long, allow_negative_numbers = true)]
     pub omega_max: Option<f64>,
-    /// Fixed pivot: how many branches, lowest critical speed first (default: min(n, 3)).
+    /// Fixed pivot: how many branches, lowest critical speed first (default: every one
+    /// leaving the vertical below --omega-max).
     #[arg(long, allow_negative_numbers = true)]
     pub branches: Option<usize>,
+    /// Damping λ_i, N·m·s (one value, a comma list or a file; all zero: none): adds the
+    /// damped stability of each listed shape. R = 0: damping of the link rates in the turning frame (the
+    /// shape is unchanged); R > 0: the chain's own damping of the inertial rates, the
+    /// damped steady shape being the 3D relative equilibrium on the circling pivot.
+    #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE")]
+    pub damping: Option<String>,
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR", default_value = "pendulum-steady")]
     pub out: PathBuf,

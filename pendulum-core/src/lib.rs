@@ -43,7 +43,7 @@ pub mod trajectory;
 
 pub use analysis::{
     Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, Stability,
-    SteadyRotation, SteadyShape, bernoulli_frequency, bessel_j0_zero, linearise, normal_modes,
+    SteadyRotation, SteadyShape, Verdict, bernoulli_frequency, bessel_j0_zero, linearise, normal_modes,
     relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
 pub use analysis::{

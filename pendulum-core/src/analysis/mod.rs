@@ -21,5 +21,5 @@ pub use shape::{
     NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,
     nearest_steady, shape_report, whirl_shape,
 };
-pub use stability::{Linearisation, Stability, linearise, stability};
+pub use stability::{Linearisation, Stability, Verdict, linearise, stability};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};

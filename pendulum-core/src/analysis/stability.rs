@@ -41,6 +41,11 @@
 //! asymptotically stable iff its index is 0, and unstable otherwise. Free steady rotation
 //! with `R = 0` has a symmetry (turning the whole shape about the axis), so `H` and the
 //! spectrum have an exact zero there; it is not counted.
+//!
+//! [`Verdict`] puts this in three classes, from a [`Stability`] ([`Verdict::of`]) or from
+//! any spectrum, e.g. the damped one of [`crate::relative_spectrum`]
+//! ([`Verdict::of_spectrum`]): stable (index 0), gyroscopic (spectrally stable, index > 0)
+//! or unstable with its growth rate `max Re λ` (1/s).
 
 use nalgebra::{Complex, DMatrix, DVector};
 
@@ -78,6 +83,105 @@ impl Stability {
     /// Stable with any small damping in the turning frame: index 0 (Kelvin–Tait–Chetaev).
     pub fn stable_with_damping(&self) -> bool {
         self.index == 0
+    }
+
+    /// The verdict in three classes ([`Verdict::of`]).
+    pub fn verdict(&self) -> Verdict {
+        Verdict::of(self)
+    }
+}
+
+/// The verdict on one steady shape in three classes (module docs, "What stable means").
+///
+/// Undamped: [`Stable`](Self::Stable) is spectral stability with index 0 (a minimum of
+/// the amended potential, stable by Lagrange–Dirichlet), [`Gyroscopic`](Self::Gyroscopic)
+/// spectral stability with an (even) index > 0, held by the Coriolis terms and destroyed by
+/// any damping in the turning frame (Kelvin–Tait–Chetaev), [`Unstable`](Self::Unstable) an
+/// eigenvalue with real part above the tolerance. Damped: every eigenvalue decays
+/// (`Stable`) or one does not (`Unstable`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Verdict {
+    /// Spectrally stable with index 0 (damped: every eigenvalue has `Re λ ≤` tolerance).
+    Stable,
+    /// Spectrally stable although the amended potential has `index` descent directions.
+    Gyroscopic {
+        /// The number of negative eigenvalues of `H` (in and out of the plane).
+        index: usize,
+    },
+    /// The largest real part of the eigenvalues, `growth_rate = max Re λ > ` tolerance, 1/s:
+    /// perturbations grow as `exp(growth_rate · t)`.
+    Unstable {
+        /// `max Re λ`, 1/s.
+        growth_rate: f64,
+    },
+}
+
+impl Verdict {
+    /// The verdict of [`stability`]'s result: `Unstable` unless spectrally stable, then
+    /// `Stable` at index 0 and `Gyroscopic` above.
+    pub fn of(stability: &Stability) -> Self {
+        if !stability.spectrally_stable {
+            Self::Unstable { growth_rate: stability.growth_rate }
+        } else if stability.index == 0 {
+            Self::Stable
+        } else {
+            Self::Gyroscopic { index: stability.index }
+        }
+    }
+
+    /// The verdict of a spectrum (1/s), e.g. [`crate::relative_spectrum`] of a
+    /// damped chain: `Unstable` when `g = max Re λ > tolerance` (1/s), otherwise
+    /// `Gyroscopic` if `index` (the index of `H`, when known) is positive, else `Stable`.
+    /// For a damped spectrum pass `index = None`: decay is then stability, whatever the
+    /// potential. An empty spectrum is `Stable`.
+    pub fn of_spectrum(eigenvalues: &[Complex<f64>], index: Option<usize>, tolerance: f64) -> Self {
+        let growth_rate = eigenvalues.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+        if growth_rate > tolerance {
+            Self::Unstable { growth_rate }
+        } else {
+            match index {
+                Some(index) if index > 0 => Self::Gyroscopic { index },
+                _ => Self::Stable,
+            }
+        }
+    }
+
+    /// One word: `"stable"`, `"gyroscopic"` or `"unstable"`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::Stable => "stable",
+            Self::Gyroscopic { .. } => "gyroscopic",
+            Self::Unstable { .. } => "unstable",
+        }
+    }
+
+    /// Spectrally (undamped) or asymptotically (damped) stable: `Stable` or `Gyroscopic`.
+    pub fn is_stable(&self) -> bool {
+        !matches!(self, Self::Unstable { .. })
+    }
+
+    /// The growth rate of an `Unstable` verdict, 1/s.
+    pub fn growth_rate(&self) -> Option<f64> {
+        match self {
+            Self::Unstable { growth_rate } => Some(*growth_rate),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    /// `stable`, `gyroscopic (index 2)`, `unstable (growth 0.0720 1/s)` (three significant
+    /// digits, exponent form below 1e-3 and from 1e4 on).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Stable => f.write_str("stable"),
+            Self::Gyroscopic { index } => write!(f, "gyroscopic (index {index})"),
+            Self::Unstable { growth_rate: g } if (1e-3..1e4).contains(g) => {
+                let decimals = (2 - g.log10().floor() as i32).max(0) as usize;
+                write!(f, "unstable (growth {g:.decimals$} 1/s)")
+            }
+            Self::Unstable { growth_rate } => write!(f, "unstable (growth {growth_rate:.2e} 1/s)"),
+        }
     }
 }
 
@@ -265,6 +369,91 @@ mod tests {
         let last = b2.points.last().unwrap();
         let st = stability(&p, last, None).unwrap();
         assert!(st.index > 0);
+    }
+
+    #[test]
+    fn verdicts_of_the_three_classes() {
+        // One node: stable; the vertical above ω_1: gyroscopic, index 2; damped: unstable.
+        let p = SteadyRotation::new(&Chain::<Dyn>::new(&[1.0], &[1.0], 9.81).unwrap(), 0.0).unwrap();
+        let conical = p.solve(5.0, &DVector::from_element(1, 1.0)).unwrap();
+        assert_eq!(stability(&p, &conical, None).unwrap().verdict(), Verdict::Stable);
+        let chain = Chain::<Dyn>::uniform(3, 1.0, 0.3, 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, 0.0).unwrap();
+        let vertical = p.shape(1.2 * normal_modes(&chain).frequencies[0], DVector::zeros(3));
+        let st = stability(&p, &vertical, None).unwrap();
+        assert_eq!(Verdict::of(&st), Verdict::Gyroscopic { index: 2 });
+        let damped = stability(&p, &vertical, Some(&[0.01; 3])).unwrap();
+        let verdict = damped.verdict();
+        assert_eq!(verdict, Verdict::Unstable { growth_rate: damped.growth_rate });
+        assert!(verdict.growth_rate().unwrap() > 0.0 && !verdict.is_stable());
+        assert_eq!(verdict.label(), "unstable");
+    }
+
+    #[test]
+    fn odd_index_is_unstable_with_a_real_eigenvalue() {
+        // A link on a circling pivot, well above its resonance: the large shape out of
+        // phase with the pivot (x < 0) is stiff in the plane but has one direction of
+        // descent out of it (H_ψψ = l(g cos θ + ω² sin θ x) − ω² l² < 0): index 1.
+        let (radius, omega) = (0.1, 10.0);
+        let p = SteadyRotation::new(&Chain::<Dyn>::new(&[1.0], &[0.5], 9.81).unwrap(), radius).unwrap();
+        // g sin θ = ω² cos θ (R + l sin θ): three roots at this ω, the large negative one
+        // near −1.3 rad.
+        let opposite = p.solve(omega, &DVector::from_element(1, -1.3)).unwrap();
+        assert!(opposite.displacements[0] < -0.3, "{:?}", opposite.displacements);
+        let st = stability(&p, &opposite, None).unwrap();
+        assert_eq!(st.index, 1);
+        let Verdict::Unstable { growth_rate } = st.verdict() else { panic!("{:?}", st.verdict()) };
+        let real =
+            st.eigenvalues.iter().find(|z| z.im.abs() < 1e-9 && z.re > 0.0).expect("a real eigenvalue");
+        assert_relative_eq!(real.re, growth_rate, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn verdicts_of_spectra() {
+        let z = |re: f64, im: f64| Complex::new(re, im);
+        let centre = [z(0.0, 2.0), z(0.0, -2.0), z(1e-10, 5.0), z(1e-10, -5.0)];
+        assert_eq!(Verdict::of_spectrum(&centre, None, 1e-8), Verdict::Stable);
+        assert_eq!(Verdict::of_spectrum(&centre, Some(0), 1e-8), Verdict::Stable);
+        assert_eq!(Verdict::of_spectrum(&centre, Some(2), 1e-8), Verdict::Gyroscopic { index: 2 });
+        let quadruple = [z(0.14, 9.0), z(0.14, -9.0), z(-0.14, 9.0), z(-0.14, -9.0)];
+        assert_eq!(Verdict::of_spectrum(&quadruple, Some(2), 1e-8), Verdict::Unstable { growth_rate: 0.14 });
+        let decaying = [z(-0.02, 3.0), z(-0.02, -3.0), z(-0.5, 0.0)];
+        assert_eq!(Verdict::of_spectrum(&decaying, None, 1e-8), Verdict::Stable);
+        assert_eq!(Verdict::of_spectrum(&[], None, 1e-8), Verdict::Stable);
+        assert_eq!(Verdict::Gyroscopic { index: 4 }.to_string(), "gyroscopic (index 4)");
+        assert_eq!(Verdict::Unstable { growth_rate: 0.072 }.to_string(), "unstable (growth 0.0720 1/s)");
+        assert_eq!(Verdict::Unstable { growth_rate: 3.714 }.to_string(), "unstable (growth 3.71 1/s)");
+        assert_eq!(Verdict::Unstable { growth_rate: 2.5e-5 }.to_string(), "unstable (growth 2.50e-5 1/s)");
+        assert!(Verdict::Gyroscopic { index: 4 }.is_stable() && Verdict::Stable.growth_rate().is_none());
+    }
+
+    #[test]
+    fn the_damped_forced_shape_decays_by_its_spectrum() {
+        // The in-phase one-node shape of a damped chain on a circling pivot: its relative
+        // equilibrium's spectrum decays, the verdict is stable; undamped, the same route
+        // gives the verdict of `stability`.
+        use crate::analysis::relative_equilibrium::{relative_equilibrium, relative_spectrum};
+        use crate::drive::Circle;
+        use crate::models::directions::Directions;
+        use nalgebra::U3;
+        let (radius, omega) = (0.03, 4.0);
+        let chain = Chain::<Dyn>::uniform(3, 0.5, 0.3, 9.81).unwrap();
+        let p = SteadyRotation::new(&chain, radius).unwrap();
+        let shape = p.solve(omega, &DVector::from_element(3, 0.5)).unwrap();
+        let undamped = stability(&p, &shape, None).unwrap();
+        assert_eq!(undamped.verdict(), Verdict::Stable);
+        let guess: Vec<(f64, f64)> = shape.theta.iter().map(|&t| (t, 0.0)).collect();
+        for damping in [0.0, 0.02] {
+            let c = chain.clone().with_damping(&[damping; 3]).unwrap();
+            let model = Directions::<U3>::new(c).with_drive(Circle::new(radius, omega).unwrap());
+            let eq = relative_equilibrium(&model, &guess).unwrap();
+            let spectrum = relative_spectrum(&model, &eq).unwrap();
+            let largest = spectrum.iter().map(|z| z.norm()).fold(0.0, f64::max);
+            let verdict = Verdict::of_spectrum(&spectrum, (damping == 0.0).then_some(0), 1e-6 * largest);
+            assert_eq!(verdict, Verdict::Stable, "λ = {damping}");
+            let growth = spectrum.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+            assert!(if damping > 0.0 { growth < -1e-3 } else { growth.abs() < 1e-6 * largest }, "{growth}");
+        }
     }
 
     #[test]

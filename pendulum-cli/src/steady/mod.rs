@@ -1,0 +1,205 @@
+//! `pendulum steady`: the chain turning steadily about the vertical. The branches of
+//! steady shapes up to exactly `--omega-max` (`branches`), every shape at the speeds of
+//! `--omega` with its node count and stability (`shapes`), printed (`table`), written as
+//! branches.csv and shapes.csv (`csv`) and drawn as branches.png and shapes.png (`plots`).
+//!
+//! Node count: `1 + ` the sign changes of `x_1 … x_n` ([`SteadyShape::nodes`]: the axis
+//! crossings plus the pivot, the seed's convention); the vertical itself (on the axis, no
+//! crossing to count) is given none. Stability: [`Verdict`] of the undamped 3D
+//! linearisation in the turning frame ([`stability`]); damped, see [`shapes`].
+
+mod branches;
+mod csv;
+mod plots;
+mod shapes;
+mod table;
+
+use pendulum_core::{SteadyRotation, SteadyShape, Verdict, stability};
+
+use crate::args::SteadyArgs;
+use crate::chain_args::chain_of;
+use crate::error::{CliError, CliResult};
+use crate::spec::{expand, per_link};
+
+/// Margin of the default `--omega-max` over the third critical speed (below the fourth for
+/// uniform chains: ω_4/ω_3 = 1.37 at n = 12, 1.36 in the continuum).
+const DEFAULT_MARGIN: f64 = 1.25;
+
+/// Runs `pendulum steady`.
+pub fn steady(args: &SteadyArgs) -> CliResult<()> {
+    let chain = chain_of(&args.chain)?;
+    let n = chain.links();
+    let problem = SteadyRotation::new(&chain, args.radius)?;
+    if args.radius != 0.0 && args.branches.is_some() {
+        return Err(CliError::usage("--branches applies to a fixed pivot (--radius 0) only"));
+    }
+    let listed = args.omega.as_deref().map(parse_speeds).transpose()?;
+    let damping = match &args.damping {
+        Some(spec) => {
+            let d = expand("--damping", per_link("--damping", spec)?, n)?;
+            // Validated by the chain (finite, non-negative, named by link).
+            chain.clone().with_damping(&d).map_err(|e| CliError::from(e).context("--damping"))?;
+            d.iter().any(|&v| v > 0.0).then_some(d)
+        }
+        None => None,
+    };
+    let free = SteadyRotation::new(&chain, 0.0)?;
+    let omega_max = match args.omega_max {
+        Some(w) => {
+            check_omega_max(w)?;
+            if let Some(&above) = listed.iter().flatten().find(|&&v| v > w) {
+                return Err(CliError::usage(format!(
+                    "--omega: {above} rad/s is above --omega-max = {w} rad/s (the branches end there)"
+                )));
+            }
+            w
+        }
+        None => {
+            let speeds = free.bifurcation_speeds(n.min(3))?;
+            let default = round_up(DEFAULT_MARGIN * speeds[speeds.len() - 1]);
+            listed.iter().flatten().fold(default, |a, &b| a.max(b))
+        }
+    };
+    let family = branches::follow(&problem, &free, omega_max, args.branches)?;
+    let speeds = listed.unwrap_or_else(|| vec![omega_max]);
+    let found = shapes::at(&problem, &chain, &family, &speeds, damping.as_deref())?;
+
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+    })?;
+    csv::branches(&args.out.join("branches.csv"), &family, n)?;
+    csv::shapes(&args.out.join("shapes.csv"), &found, n, damping.is_some())?;
+    table::branches(&family, &problem, omega_max);
+    table::shapes(&found, args.radius, damping.is_some());
+    plots::branches(&args.out.join("branches.png"), &family, &found, omega_max, args.radius)?;
+    plots::shapes(&args.out.join("shapes.png"), &chain, args.radius, &found, &speeds)?;
+    let count = family.branches.len();
+    eprintln!(
+        "pendulum: {count} branch{} up to ω = {omega_max} rad/s, {} shape{} at {} speed{}; files in {} \
+         (branches.csv, shapes.csv, branches.png, shapes.png)",
+        if count == 1 { "" } else { "es" },
+        found.len(),
+        if found.len() == 1 { "" } else { "s" },
+        speeds.len(),
+        if speeds.len() == 1 { "" } else { "s" },
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Parses `--omega`: a comma list of finite, non-negative speeds (rad/s), at least one,
+/// no empty entry. Errors name the list and the entry.
+fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
+    let tokens: Vec<&str> = list.split(',').map(str::trim).collect();
+    if tokens.iter().all(|t| t.is_empty()) {
+        return Err(CliError::usage(format!(
+            "--omega: '{list}' lists no speed (give one or more in rad/s, e.g. --omega 5,10)"
+        )));
+    }
+    tokens
+        .iter()
+        .map(|&token| {
+            let bad = |why: &str| CliError::usage(format!("--omega: '{list}' has {why}"));
+            if token.is_empty() {
+                return Err(bad("an empty entry"));
+            }
+            match token.parse::<f64>() {
+                Ok(v) if !v.is_finite() => Err(bad(&format!("a non-finite entry {token}"))),
+                Ok(v) if v < 0.0 => Err(bad(&format!("a negative entry {token} (speeds are ≥ 0 rad/s)"))),
+                Ok(v) => Ok(v),
+                Err(_) => Err(bad(&format!("a bad entry '{token}' (not a number)"))),
+            }
+        })
+        .collect()
+}
+
+fn check_omega_max(omega_max: f64) -> CliResult<()> {
+    if omega_max.is_finite() && omega_max > 0.0 {
+        Ok(())
+    } else {
+        Err(CliError::usage(format!("--omega-max must be finite and positive, got {omega_max}")))
+    }
+}
+
+/// `x > 0` rounded up to three significant digits (`15.2268 → 15.3`), the nearest `f64`
+/// to that decimal.
+fn round_up(x: f64) -> f64 {
+    let decimals = 2 - x.log10().floor() as i32;
+    let scale = 10f64.powi(decimals);
+    let up = (x * scale * (1.0 - 1e-15)).ceil();
+    if decimals >= 0 { (up / scale).max(x) } else { (up * 10f64.powi(-decimals)).max(x) }
+}
+
+/// A rate (1/s) to three significant digits, in exponent form below 1e-3 and from 1e4 on.
+fn rate(g: f64) -> String {
+    let magnitude = g.abs();
+    if (1e-3..1e4).contains(&magnitude) {
+        let decimals = (2 - magnitude.log10().floor() as i32).max(0) as usize;
+        format!("{g:.decimals$}")
+    } else {
+        format!("{g:.2e}")
+    }
+}
+
+/// The node count of a shape, `None` for the vertical (every mass on the axis).
+fn nodes(shape: &SteadyShape) -> Option<usize> {
+    (shape.amplitude() > 0.0).then(|| shape.nodes())
+}
+
+/// `"1 node"`, `"3 nodes"`.
+fn nodes_name(k: usize) -> String {
+    format!("{k} node{}", if k == 1 { "" } else { "s" })
+}
+
+/// The undamped verdict of one shape and the numbers behind it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judged {
+    /// Stable, gyroscopic (index) or unstable (growth rate).
+    pub verdict: Verdict,
+    /// Negative eigenvalues of the amended potential's Hessian `H`, in and out of the plane.
+    pub index: usize,
+    /// Largest real part of the eigenvalues, 1/s (round-off when not unstable; without the
+    /// rotational symmetry's zeros for a fixed pivot).
+    pub growth_rate: f64,
+}
+
+/// [`stability`] of `shape`, undamped, as a [`Judged`].
+fn judge(problem: &SteadyRotation, shape: &SteadyShape) -> CliResult<Judged> {
+    let st = stability(problem, shape, None).map_err(|e| {
+        CliError::failed(format!("stability of the steady shape at ω = {} rad/s: {e}", shape.omega))
+    })?;
+    Ok(Judged { verdict: st.verdict(), index: st.index, growth_rate: st.growth_rate })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_numbers() {
+        assert_eq!(round_up(15.22677880957823), 15.3);
+        assert_eq!(round_up(15.3), 15.3);
+        assert_eq!(round_up(0.012341), 0.0124);
+        assert_eq!(round_up(1234.5), 1240.0);
+        assert_eq!(rate(3.714), "3.71");
+        assert_eq!(rate(-0.0196), "-0.0196");
+        assert_eq!(rate(2.5e-9), "2.50e-9");
+    }
+
+    #[test]
+    fn speed_lists() {
+        assert_eq!(parse_speeds("5, 10,15").unwrap(), vec![5.0, 10.0, 15.0]);
+        assert_eq!(parse_speeds("0").unwrap(), vec![0.0]);
+        let message = |s: &str| parse_speeds(s).unwrap_err().to_string();
+        assert_eq!(message(""), "--omega: '' lists no speed (give one or more in rad/s, e.g. --omega 5,10)");
+        assert_eq!(
+            message(","),
+            "--omega: ',' lists no speed (give one or more in rad/s, e.g. --omega 5,10)"
+        );
+        assert_eq!(message("5,,6"), "--omega: '5,,6' has an empty entry");
+        assert_eq!(message("5,inf"), "--omega: '5,inf' has a non-finite entry inf");
+        assert_eq!(message("NaN"), "--omega: 'NaN' has a non-finite entry NaN");
+        assert_eq!(message("-2"), "--omega: '-2' has a negative entry -2 (speeds are ≥ 0 rad/s)");
+        assert_eq!(message("3,x"), "--omega: '3,x' has a bad entry 'x' (not a number)");
+    }
+}
