@@ -254,6 +254,13 @@ pub struct Physics {
     /// Circle drive: radius R, m.
     #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
     pub radius: f64,
+    /// Circle drive: ramp the speed linearly from --ramp-from to --omega over this many
+    /// seconds, then hold --omega (a speed ramp up or down), s.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub ramp_time: Option<f64>,
+    /// Circle drive with --ramp-time: the speed at t = 0, rad/s [default: 0].
+    #[arg(long, value_name = "OMEGA0", allow_negative_numbers = true)]
+    pub ramp_from: Option<f64>,
     /// Time integrator. 3D chains are integrated in unit link directions with a
     /// projection onto the rod constraints after every step.
     #[arg(long, value_enum, default_value = "gl2")]

@@ -35,6 +35,18 @@ pub enum DriveConfig {
         /// Angular frequency `ω`, rad/s.
         omega: f64,
     },
+    /// A circle whose speed ramps linearly from `ω0` to `ω` over `duration`, then holds
+    /// `ω` (3D only): `p = R (cos φ, sin φ, 0)`, `φ̇` ramping (`pendulum_core::RampedCircle`).
+    RampedCircle {
+        /// Radius `R`, m.
+        radius: f64,
+        /// Speed at t = 0, rad/s.
+        initial_omega: f64,
+        /// Speed from `duration` on, rad/s.
+        omega: f64,
+        /// Duration of the ramp, s.
+        duration: f64,
+    },
 }
 
 /// The initial state: what was asked for and the resolved numbers.
@@ -134,8 +146,22 @@ impl RunConfig {
                 };
                 DriveConfig::Harmonic { direction, amplitude: p.amplitude, omega: p.omega, phase: p.phase }
             }
-            DriveKind::Circle => DriveConfig::Circle { radius: p.radius, omega: p.omega },
+            DriveKind::Circle => match p.ramp_time {
+                None => DriveConfig::Circle { radius: p.radius, omega: p.omega },
+                Some(duration) => DriveConfig::RampedCircle {
+                    radius: p.radius,
+                    initial_omega: p.ramp_from.unwrap_or(0.0),
+                    omega: p.omega,
+                    duration,
+                },
+            },
         };
+        if (p.ramp_time.is_some() || p.ramp_from.is_some()) && p.drive != DriveKind::Circle {
+            return Err(CliError::usage("--ramp-time and --ramp-from apply to --drive circle only"));
+        }
+        if p.ramp_from.is_some() && p.ramp_time.is_none() {
+            return Err(CliError::usage("--ramp-from needs --ramp-time (the ramp's duration, s)"));
+        }
         if p.direction.is_some() && p.drive != DriveKind::Harmonic {
             return Err(CliError::usage("--direction applies to --drive harmonic only"));
         }

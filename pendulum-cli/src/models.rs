@@ -10,7 +10,7 @@ use pendulum_core::integrate::{
 use pendulum_core::kinematics::Chart;
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Driven, FirstOrder, Fixed, Harmonic, Ledger,
-    Model, ModelAlloc, PlanarTension, Spatial,
+    Model, ModelAlloc, PlanarTension, RampedCircle, Spatial, Turning,
 };
 
 use crate::args::{Dimension, IntegratorKind, StageSolver};
@@ -250,20 +250,35 @@ pub trait RunSpace: DimName
 where
     DefaultAllocator: nalgebra::allocator::Allocator<Self>,
 {
-    /// The circle drive in this space (3D only).
-    fn circle(radius: f64, omega: f64) -> CliResult<Box<dyn Drive<Self>>>;
+    /// The circle drive, steady or ramped, in this space (3D only).
+    fn circle(config: &DriveConfig) -> CliResult<Box<dyn Drive<Self>>>;
 }
 
 impl RunSpace for U2 {
-    fn circle(_: f64, _: f64) -> CliResult<Box<dyn Drive<U2>>> {
+    fn circle(_: &DriveConfig) -> CliResult<Box<dyn Drive<U2>>> {
         Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only"))
     }
 }
 
 impl RunSpace for U3 {
-    fn circle(radius: f64, omega: f64) -> CliResult<Box<dyn Drive<U3>>> {
-        Ok(Box::new(Circle::new(radius, omega)?))
+    fn circle(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
+        match turning_drive(config)? {
+            Some(turning) => Ok(Box::new(turning)),
+            None => Err(CliError::usage("not a circle drive")),
+        }
     }
+}
+
+/// The drive of a configuration as a [`Turning`] one (the pivot circling the vertical
+/// axis: circle, steady or ramped), or `None` for other drives.
+pub fn turning_drive(config: &DriveConfig) -> CliResult<Option<Box<dyn Turning>>> {
+    Ok(match *config {
+        DriveConfig::Circle { radius, omega } => Some(Box::new(Circle::new(radius, omega)?)),
+        DriveConfig::RampedCircle { radius, initial_omega, omega, duration } => {
+            Some(Box::new(RampedCircle::new(radius, initial_omega, omega, duration)?))
+        }
+        DriveConfig::Fixed | DriveConfig::Harmonic { .. } => None,
+    })
 }
 
 /// The pivot drive of a configuration.
@@ -277,7 +292,7 @@ where
             let d = OVector::<f64, S>::from_iterator(direction.iter().copied());
             Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
         }
-        DriveConfig::Circle { radius, omega } => S::circle(*radius, *omega)?,
+        DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. } => S::circle(config)?,
     })
 }
 

@@ -112,7 +112,7 @@ fn extent(config: &RunConfig) -> f64 {
     let travel = match config.drive {
         DriveConfig::Fixed => 0.0,
         DriveConfig::Harmonic { amplitude, .. } => amplitude,
-        DriveConfig::Circle { radius, .. } => radius,
+        DriveConfig::Circle { radius, .. } | DriveConfig::RampedCircle { radius, .. } => radius,
     };
     1.08 * (reach + travel)
 }

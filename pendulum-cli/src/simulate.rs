@@ -292,6 +292,9 @@ fn fastest_mode(config: &RunConfig) -> f64 {
         DriveConfig::Fixed => 0.0,
         DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
         DriveConfig::Circle { radius, omega } => radius * omega * omega,
+        DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
+            radius * initial_omega.abs().max(omega.abs()).powi(2)
+        }
     };
     let g = config.gravity + accel;
     let mut tail = vec![0.0; n + 1];
@@ -307,6 +310,7 @@ fn drive_frequency(config: &RunConfig) -> Option<f64> {
     match &config.drive {
         DriveConfig::Fixed => None,
         DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
+        DriveConfig::RampedCircle { initial_omega, omega, .. } => Some(initial_omega.abs().max(omega.abs())),
     }
 }
 
