@@ -52,6 +52,12 @@ pub enum Command {
     /// the forced branch for a pivot on a circle of radius R), as a table, branches.csv,
     /// the branch diagram branches.png and the shapes at the largest speed, shapes.png.
     Steady(SteadyArgs),
+    /// Draw a run's animation again from its run.json and trajectory.csv, without
+    /// simulating: another view (side, top, or co-rotating with a pivot that circles the
+    /// vertical axis), time window, playback speed, size or frame count. Writes
+    /// RUN_DIR/chain.gif (or --out FILE): axes in m, a scale bar, the rotation axis of a
+    /// circling pivot and the tip's trail, in a viewport that fits the motion.
+    Render(crate::render::RenderArgs),
 }
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`

@@ -10,6 +10,7 @@ mod eval;
 mod models;
 mod modes;
 mod plot;
+mod render;
 mod simulate;
 mod spec;
 mod steady;
@@ -47,6 +48,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => eval::eval(args),
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
+        Command::Render(args) => render::render(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
