@@ -1,11 +1,16 @@
 #!/bin/sh
 # Regenerates the gallery images in docs/gallery with the `pendulum` command, exactly as
 # the README shows them. Run from anywhere: sh docs/gallery/make.sh
+# (PENDULUM=path/to/pendulum sh docs/gallery/make.sh uses that binary instead).
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 cd "$root"
-cargo build --release -q -p pendulum-cli
-pendulum() { cargo run --release -q -p pendulum-cli -- "$@"; }
+if [ -n "${PENDULUM:-}" ]; then
+    pendulum() { "$PENDULUM" "$@"; }
+else
+    cargo build --release -q -p pendulum-cli
+    pendulum() { cargo run --release -q -p pendulum-cli -- "$@"; }
+fi
 runs="$(mktemp -d)"
 trap 'rm -rf "$runs"' EXIT
 gallery=docs/gallery
@@ -16,18 +21,20 @@ cp "$runs/triple/chain.gif" "$gallery/triple.gif"
 cp "$runs/triple/energy.png" "$gallery/triple-energy.png"
 
 # Kapitza's pendulum: released near the top, held upright by a fast vertical drive
-# (a²ω² = 16 m²/s² > 2gl = 3.9 m²/s²).
+# (a²ω² = 16 m²/s² > 2gl = 3.9 m²/s²). Its first half second (one slow swing about the
+# top) drawn again at 8 frames per drive period, in slow motion.
 pendulum simulate --n 1 --lengths 0.2 --initial tilted:2.9 --drive harmonic --amplitude 0.02 \
-    --omega 200 --step 0.0005 --end 4 --frames 80 --out "$runs/kapitza" --quiet
-cp "$runs/kapitza/chain.gif" "$gallery/kapitza.gif"
+    --omega 200 --step 0.0005 --end 4 --out "$runs/kapitza" --quiet
+pendulum render "$runs/kapitza" --from 0 --to 0.5 --frames 251 --out "$gallery/kapitza.gif" --quiet
 cp "$runs/kapitza/energy.png" "$gallery/kapitza-energy.png"
 
-# A hanging 12-link chain whirled by its pivot on a horizontal circle (3D), side and top.
+# A hanging 12-link chain whirled by its pivot on a horizontal circle (3D): the side view
+# simulate draws, then the same run drawn again from above and turning with the pivot.
 pendulum simulate --dim 3 --n 12 --lengths 0.1 --initial hanging --drive circle --radius 0.08 \
     --omega 5 --step 0.001 --end 10 --every 10 --frames 100 --out "$runs/whirl" --quiet
 cp "$runs/whirl/chain.gif" "$gallery/whirl-side.gif"
-pendulum simulate --from "$runs/whirl/run.json" --view xy --frames 100 --out "$runs/whirl-top" --quiet
-cp "$runs/whirl-top/chain.gif" "$gallery/whirl-top.gif"
+pendulum render "$runs/whirl" --view top --out "$gallery/whirl-top.gif" --quiet
+pendulum render "$runs/whirl" --view co-rotating --out "$gallery/whirl-co-rotating.gif" --quiet
 
 # A damped double pendulum: the energy falls by exactly the dissipated energy.
 pendulum simulate --n 2 --damping 0.05 --initial horizontal --end 20 --out "$runs/damped" --quiet

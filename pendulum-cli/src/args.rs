@@ -59,6 +59,12 @@ pub enum Command {
     /// destroyed by damping in the turning frame) or unstable (growth rate: the largest
     /// real part of the eigenvalues, 1/s).
     Steady(SteadyArgs),
+    /// Draw a run's animation again from its run.json and trajectory.csv, without
+    /// simulating: another view (side, top, or co-rotating with a pivot that circles the
+    /// vertical axis), time window, playback speed, size or frame count. Writes
+    /// RUN_DIR/chain.gif (or --out FILE): axes in m, a scale bar, the rotation axis of a
+    /// circling pivot and the tip's trail, in a viewport that fits the motion.
+    Render(crate::render::RenderArgs),
 }
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`

@@ -11,6 +11,7 @@ mod final_state;
 mod models;
 mod modes;
 mod plot;
+mod render;
 mod simulate;
 mod spec;
 mod steady;
@@ -48,6 +49,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => eval::eval(args),
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
+        Command::Render(args) => render::render(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

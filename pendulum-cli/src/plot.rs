@@ -1,5 +1,5 @@
-//! Pictures of a run with plotters: the energy plot (PNG) and the animation of the chain
-//! (animated GIF; 3D chains drawn in a chosen plane, with the trace of the tip).
+//! Pictures of a run with plotters: the energy plot (PNG), and the embedded font every
+//! plot's labels use (the animation is drawn by [`crate::render`]).
 //!
 //! Labels use the Ubuntu Light font embedded in the binary (`epaint_default_fonts`),
 //! registered with plotters' `ab_glyph` backend: no font file is needed at run time.
@@ -10,20 +10,7 @@ use std::sync::Once;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
-use crate::args::{Dimension, View};
-use crate::config::{DriveConfig, RunConfig};
 use crate::error::{CliError, CliResult};
-
-/// The chain at one instant: pivot and mass positions (m), inertial frame.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frame {
-    /// Time, s.
-    pub t: f64,
-    /// Pivot position.
-    pub pivot: [f64; 3],
-    /// Mass positions, mass 1 first.
-    pub masses: Vec<[f64; 3]>,
-}
 
 /// Registers the embedded font once.
 pub fn fonts() {
@@ -94,86 +81,4 @@ pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], sca
         .draw()
         .map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))
-}
-
-/// The 2D point a 3D position is drawn at.
-fn project(r: &[f64; 3], dim: Dimension, view: View) -> (f64, f64) {
-    match (dim, view) {
-        (Dimension::Two, _) | (Dimension::Three, View::Xy) => (r[0], r[1]),
-        (Dimension::Three, View::Xz) => (r[0], r[2]),
-        (Dimension::Three, View::Yz) => (r[1], r[2]),
-    }
-}
-
-/// Half the width of the drawn square (m): the chain's reach plus the pivot's travel,
-/// with a margin.
-fn extent(config: &RunConfig) -> f64 {
-    let reach: f64 = config.lengths.iter().sum();
-    let travel = match config.drive {
-        DriveConfig::Fixed => 0.0,
-        DriveConfig::Harmonic { amplitude, .. } => amplitude,
-        DriveConfig::Circle { radius, .. } | DriveConfig::RampedCircle { radius, .. } => radius,
-    };
-    1.08 * (reach + travel)
-}
-
-/// Draws the animation: one GIF frame per [`Frame`], `delay_ms` apart; rods in black,
-/// masses as dots, the pivot as a square, and the trace of the tip over the preceding
-/// samples (`tip` at `times`, the last 300 samples) in orange.
-pub fn animation(
-    path: &Path,
-    frames: &[Frame],
-    tip: &[[f64; 3]],
-    times: &[f64],
-    config: &RunConfig,
-    delay_ms: u32,
-) -> CliResult<()> {
-    fonts();
-    let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
-    let (dim, view) = (config.dim, config.view);
-    let size = 360;
-    let root = BitMapBackend::gif(path, (size, size), delay_ms).map_err(|e| fail(&e))?.into_drawing_area();
-    let r = extent(config);
-    let n = config.links();
-    let dot = if n > 20 {
-        2
-    } else if n > 8 {
-        3
-    } else {
-        5
-    };
-    let plane = match (dim, view) {
-        (Dimension::Two, _) => "x-y plane",
-        (Dimension::Three, View::Xz) => "x-z plane",
-        (Dimension::Three, View::Yz) => "y-z plane",
-        (Dimension::Three, View::Xy) => "x-y plane (top view)",
-    };
-    for frame in frames {
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let mut chart =
-            ChartBuilder::on(&root).margin(8).build_cartesian_2d(-r..r, -r..r).map_err(|e| fail(&e))?;
-        let end = times.partition_point(|&t| t <= frame.t);
-        let start = end.saturating_sub(300);
-        let trace = tip[start..end].iter().map(|p| project(p, dim, view));
-        chart
-            .draw_series(LineSeries::new(trace, RGBColor(255, 150, 40).stroke_width(2)))
-            .map_err(|e| fail(&e))?;
-        let points: Vec<(f64, f64)> =
-            std::iter::once(&frame.pivot).chain(&frame.masses).map(|p| project(p, dim, view)).collect();
-        chart
-            .draw_series(LineSeries::new(points.iter().copied(), BLACK.stroke_width(2)))
-            .map_err(|e| fail(&e))?;
-        chart
-            .draw_series(points[1..].iter().map(|&p| Circle::new(p, dot, BLUE.filled())))
-            .map_err(|e| fail(&e))?;
-        let (px, py) = points[0];
-        let h = r * 0.02;
-        chart
-            .draw_series(std::iter::once(Rectangle::new([(px - h, py - h), (px + h, py + h)], RED.filled())))
-            .map_err(|e| fail(&e))?;
-        let label = format!("t = {:.2} s   {plane}", frame.t);
-        root.draw(&Text::new(label, (10, 8), ("sans-serif", 15).into_font())).map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))?;
-    }
-    Ok(())
 }

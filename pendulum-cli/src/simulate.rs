@@ -17,7 +17,8 @@ use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
-use crate::plot::{self, Frame};
+use crate::plot;
+use crate::render;
 
 /// Set by the Ctrl-C handler; the run stops at the next sample and writes its files.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -128,10 +129,6 @@ struct Kept {
     energy: Vec<f64>,
     /// `H_in(0) + W_drive + W_torque − E_damped`: the energy the ledger predicts.
     predicted: Vec<f64>,
-    tip: Vec<[f64; 3]>,
-    frames: Vec<Frame>,
-    /// The latest sample as a frame.
-    last: Option<Frame>,
 }
 
 /// Integrates, writes every output, prints the summary.
@@ -143,8 +140,6 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     run_file.write_atomic(&run_json)?;
 
     let (total_steps, _) = trajectory::plan(0.0, config.end, config.step)?;
-    let expected_samples = total_steps / config.every as u64 + 2;
-    let frame_stride = expected_samples.div_ceil(config.frames as u64).max(1);
 
     let mut trajectory_csv =
         Csv::create(out.join("trajectory.csv"), &trajectory_header(simulation, config.dim, n))?;
@@ -168,7 +163,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
                 write_error = Some(e);
                 return ControlFlow::Break(());
             }
-            keep(&mut kept, &sample, h0, sample_count.is_multiple_of(frame_stride));
+            keep(&mut kept, &sample, h0);
             sample_count += 1;
             progress.at(t, (t / config.end * total_steps as f64).round() as u64);
             if INTERRUPTED.load(Ordering::SeqCst) {
@@ -178,12 +173,6 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
             }
         });
     progress.finish();
-    // The last sample always goes into the animation.
-    if let Some(last) = kept.last.take()
-        && kept.frames.last().is_none_or(|f| f.t != last.t)
-    {
-        kept.frames.push(last);
-    }
     trajectory_csv.finish()?;
     energy_csv.finish()?;
     if let Some(e) = write_error {
@@ -199,9 +188,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     if options.plots && !kept.times.is_empty() {
         let energy_png = out.join("energy.png");
         plot::energy(&energy_png, &kept.times, &kept.energy, &kept.predicted, energy_scale(config))?;
-        let gif = out.join("chain.gif");
-        let delay_ms = frame_delay_ms(config, frame_stride);
-        plot::animation(&gif, &kept.frames, &kept.tip, &kept.times, config, delay_ms)?;
+        let gif = render::chain_gif(out, config, state.t(), options.quiet)?;
         images.extend([energy_png, gif]);
     }
     let motion = &state.x().as_slice()[..system.motion_len()];
@@ -343,13 +330,6 @@ fn energy_scale(config: &RunConfig) -> f64 {
     scale
 }
 
-/// Delay between animation frames (ms): real time, at least 20 ms (GIF viewers ignore
-/// shorter delays).
-fn frame_delay_ms(config: &RunConfig, frame_stride: u64) -> u32 {
-    let frame_time = config.step * config.every as f64 * frame_stride as f64;
-    ((frame_time * 1000.0).round() as u32).max(20)
-}
-
 /// Writes one sample: a trajectory row (positions with `dims` components) and an
 /// energy row with the balance residual `H − H0 − (W_drive + W_torque − E_damped)`.
 fn write_sample(trajectory: &mut Csv, energy: &mut Csv, s: &Sample, h0: f64, dims: usize) -> CliResult<()> {
@@ -360,16 +340,10 @@ fn write_sample(trajectory: &mut Csv, energy: &mut Csv, s: &Sample, h0: f64, dim
     energy.row([s.t, s.energy, l.drive, l.torque, l.damped, residual])
 }
 
-fn keep(kept: &mut Kept, s: &Sample, h0: f64, frame: bool) {
+fn keep(kept: &mut Kept, s: &Sample, h0: f64) {
     kept.times.push(s.t);
     kept.energy.push(s.energy);
     kept.predicted.push(h0 + s.ledger.net());
-    kept.tip.push(*s.masses.last().expect("a chain has at least one mass"));
-    let current = Frame { t: s.t, pivot: s.pivot, masses: s.masses.clone() };
-    if frame {
-        kept.frames.push(current.clone());
-    }
-    kept.last = Some(current);
 }
 
 /// How often a run without a terminal reports how far it is.
