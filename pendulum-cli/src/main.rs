@@ -15,6 +15,7 @@ mod render;
 mod simulate;
 mod spec;
 mod steady;
+mod whirl;
 
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;

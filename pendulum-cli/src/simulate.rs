@@ -19,6 +19,7 @@ use crate::final_state::FinalState;
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
 use crate::plot;
 use crate::render;
+use crate::whirl::Whirl;
 
 /// Set by the Ctrl-C handler; the run stops at the next sample and writes its files.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -152,6 +153,8 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     let mut solver = simulation.integrator(config.integrator, config.solver);
     let mut state = State::new(0.0, simulation.initial_state());
     let mut kept = Kept::default();
+    let whirl = Whirl::of(config)?;
+    let mut tracker = whirl.as_ref().map(Whirl::tracker).transpose()?;
     let mut write_error = None;
     let mut initial_energy = None;
     let mut sample_count: u64 = 0;
@@ -164,6 +167,12 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
                 return ControlFlow::Break(());
             }
             keep(&mut kept, &sample, h0);
+            if let Some(tracker) = &mut tracker
+                && let Err(e) = tracker.push(t, &sample.state)
+            {
+                write_error = Some(e);
+                return ControlFlow::Break(());
+            }
             sample_count += 1;
             progress.at(t, (t / config.end * total_steps as f64).round() as u64);
             if INTERRUPTED.load(Ordering::SeqCst) {
@@ -193,6 +202,10 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     }
     let motion = &state.x().as_slice()[..system.motion_len()];
     FinalState::new(config.dim, n, state.t(), motion).write(out)?;
+    // A whirled chain: its shape in the turning frame, in the user's terms (stdout).
+    if let Some(tracker) = &tracker {
+        tracker.finish(out, options.plots)?;
+    }
     run_file.outcome = Some(Outcome {
         status: status.into(),
         t: state.t(),
@@ -217,7 +230,11 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
             images = if images.is_empty() {
                 ""
             } else {
-                " (trajectory.csv, energy.csv, run.json, final.json, energy.png, chain.gif)"
+                if tracker.is_some() {
+                    " (trajectory.csv, energy.csv, run.json, final.json, shape.json, energy.png, chain.gif, shape.png)"
+                } else {
+                    " (trajectory.csv, energy.csv, run.json, final.json, energy.png, chain.gif)"
+                }
             },
         );
     }

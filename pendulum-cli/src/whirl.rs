@@ -1,0 +1,262 @@
+//! What `pendulum simulate` says about a whirled chain (3D, pivot circling the vertical,
+//! steady or ramped): the shape analysis of `pendulum_core::analysis` in the user's terms —
+//! one summary line, `shape.json` and `shape.png`.
+
+use std::path::Path;
+
+use nalgebra::{DVector, U3};
+use pendulum_core::{Directions, ShapeOptions, ShapeReport, ShapeTracker, Turning, WhirlShape};
+use plotters::prelude::*;
+use serde_json::json;
+
+use crate::args::Dimension;
+use crate::config::RunConfig;
+use crate::error::{CliError, CliResult, io_failed};
+use crate::models::{chain, turning_drive};
+use crate::plot::{drawing_failed, fonts};
+
+/// The chain of a whirled run with its turning drive, for the shape analysis.
+pub struct Whirl {
+    model: Directions<U3, Box<dyn Turning>>,
+}
+
+impl Whirl {
+    /// The whirl of a configuration: `Some` for a 3D chain whose pivot circles the
+    /// vertical (`--drive circle`, steady or ramped).
+    pub fn of(config: &RunConfig) -> CliResult<Option<Self>> {
+        if config.dim != Dimension::Three {
+            return Ok(None);
+        }
+        let Some(drive) = turning_drive(&config.drive)? else { return Ok(None) };
+        Ok(Some(Self { model: Directions::<U3>::new(chain(config)?).with_drive(drive) }))
+    }
+
+    /// A tracker of the co-rotating shape with the default options (settled: drift
+    /// ≤ 1e-3 L over the last 5 drive periods).
+    pub fn tracker(&self) -> CliResult<Tracker<'_>> {
+        Ok(Tracker(ShapeTracker::new(&self.model, ShapeOptions::default())?))
+    }
+}
+
+/// Follows the shape along a run, sample by sample (bounded memory).
+pub struct Tracker<'a>(ShapeTracker<'a, Box<dyn Turning>>);
+
+impl Tracker<'_> {
+    /// Takes the sample `(t, x)` of the chain's state `x = (u, w)`.
+    pub fn push(&mut self, t: f64, x: &[f64]) -> CliResult<()> {
+        self.0
+            .push(t, &DVector::from_column_slice(x))
+            .map_err(|e| CliError::failed(format!("shape analysis: {e}")))
+    }
+
+    /// The report at the latest sample, its summary line printed to stdout, `shape.json`
+    /// and (with `plots`) `shape.png` written into `out`.
+    pub fn finish(&self, out: &Path, plots: bool) -> CliResult<ShapeReport> {
+        let report = self.0.report().map_err(|e| CliError::failed(format!("shape analysis: {e}")))?;
+        println!("{}", summary(&report));
+        write_json(&out.join("shape.json"), &report)?;
+        if plots {
+            plot(&out.join("shape.png"), &report)?;
+        }
+        Ok(report)
+    }
+}
+
+/// `1 node`, `2 nodes`.
+fn plural(count: usize, noun: &str) -> String {
+    if count == 1 { format!("1 {noun}") } else { format!("{count} {noun}s") }
+}
+
+/// `stable`, or `unstable` with the growth rate, of the nearest steady shape.
+fn stability(growth_rate: f64, stable: bool) -> String {
+    if stable {
+        format!("stable (largest growth rate {growth_rate:.2e} 1/s)")
+    } else {
+        format!("unstable (growth rate {growth_rate:.3e} 1/s)")
+    }
+}
+
+/// The one line a user came for: nodes, tip radius, settled, and the nearest steady
+/// shape with its stability.
+pub fn summary(r: &ShapeReport) -> String {
+    let s = &r.shape;
+    let settled = if r.settling.settled {
+        format!(
+            "settled (drift {:.1e} m ≤ {:.1e} m over the last {:.3} s)",
+            r.settling.drift, r.settling.threshold, r.settling.window
+        )
+    } else if !r.settling.covered {
+        format!("not settled (the run is shorter than the {:.3} s window)", r.settling.window)
+    } else {
+        format!(
+            "not settled (drift {:.1e} m > {:.1e} m over the last {:.3} s)",
+            r.settling.drift, r.settling.threshold, r.settling.window
+        )
+    };
+    let nearest = match &r.nearest {
+        Ok(n) => format!(
+            "nearest steady shape {:.1e} m away: {}, {}",
+            n.distance,
+            plural(n.shape.nodes, "node"),
+            stability(n.growth_rate, n.stable)
+        ),
+        Err(e) => format!("no steady shape found nearby ({e})"),
+    };
+    format!(
+        "shape at t = {:.4} s, ω = {:.6} rad/s: {} ({}; the pivot counts as a node), \
+         tip radius {:.4e} m, {settled}; {nearest}",
+        r.t,
+        r.omega,
+        plural(s.nodes, "node"),
+        plural(s.axis_crossings, "axis crossing"),
+        s.tip_radius
+    )
+}
+
+fn shape_json(s: &WhirlShape) -> serde_json::Value {
+    json!({
+        "nodes": s.nodes,
+        "axis_crossings": s.axis_crossings,
+        "tip_radius": s.tip_radius,
+        "plane_azimuth": s.plane_azimuth,
+        "out_of_plane": s.out_of_plane,
+        "radial": s.radial,
+        "depth": s.depth,
+        "positions": s.positions.iter().map(|r| [r.x, r.y, r.z]).collect::<Vec<_>>(),
+    })
+}
+
+fn write_json(path: &Path, r: &ShapeReport) -> CliResult<()> {
+    let nearest = match &r.nearest {
+        Ok(n) => json!({
+            "found": true,
+            "omega": n.omega,
+            "distance": n.distance,
+            "nodes": n.shape.nodes,
+            "stable": n.stable,
+            "growth_rate": n.growth_rate,
+            "shape": shape_json(&n.shape),
+        }),
+        Err(e) => json!({ "found": false, "reason": e.to_string() }),
+    };
+    let value = json!({
+        "conventions": "co-rotating frame: the pivot at (R, 0, 0), the rotation axis along z (m); \
+                        nodes = axis_crossings + 1 (the pivot counts as a node); radial = signed distance \
+                        from the axis in the fitted plane, depth below the pivot (m); growth_rate in 1/s",
+        "t": r.t,
+        "omega": r.omega,
+        "radius": r.radius,
+        "nodes": r.shape.nodes,
+        "axis_crossings": r.shape.axis_crossings,
+        "tip_radius": r.shape.tip_radius,
+        "settled": r.settling.settled,
+        "drift": r.settling.drift,
+        "drift_threshold": r.settling.threshold,
+        "window": r.settling.window,
+        "window_covered": r.settling.covered,
+        "shape": shape_json(&r.shape),
+        "nearest": nearest,
+    });
+    let text = serde_json::to_string_pretty(&value).map_err(|e| CliError::failed(e.to_string()))?;
+    std::fs::write(path, text + "\n").map_err(|e| io_failed("write", path, e))
+}
+
+/// Where the signed radial coordinate changes sign between masses `i` and `i + 1`: the
+/// axis crossings, linearly interpolated, as (radial, height) = (0, −depth).
+fn crossings(s: &WhirlShape) -> Vec<(f64, f64)> {
+    (1..s.radial.len())
+        .filter(|&i| s.radial[i - 1] * s.radial[i] < 0.0)
+        .map(|i| {
+            let (a, b) = (s.radial[i - 1], s.radial[i]);
+            let f = a / (a - b);
+            (0.0, -(s.depth[i - 1] + f * (s.depth[i] - s.depth[i - 1])))
+        })
+        .collect()
+}
+
+/// `shape.png`: the final shape in its plane, seen in the turning frame — the signed
+/// distance from the rotation axis (horizontal, stretched to show the shape) against the
+/// depth below the pivot; the axis, the nodes (the pivot and the axis crossings), and the
+/// nearest damped steady shape overlaid.
+fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
+    fonts();
+    let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
+    let root = BitMapBackend::new(path, (720, 900)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let s = &r.shape;
+    // The pivot in the plane: (R cos α, 0) in (radial, depth).
+    let pivot = (r.radius * s.plane_azimuth.cos(), 0.0);
+    let curve = |w: &WhirlShape| -> Vec<(f64, f64)> {
+        std::iter::once(pivot).chain(w.radial.iter().zip(&w.depth).map(|(x, d)| (*x, -*d))).collect()
+    };
+    let chain_points = curve(s);
+    let steady_points = r.nearest.as_ref().ok().map(|n| curve(&n.shape));
+    let all = chain_points.iter().chain(steady_points.iter().flatten());
+    let width = all.clone().map(|p| p.0.abs()).fold(r.radius.abs(), f64::max).max(1e-6) * 1.15;
+    let depth = all.map(|p| -p.1).fold(0.0, f64::max).max(1e-6);
+    let settled = if r.settling.settled { "settled" } else { "not settled" };
+    let stable = match &r.nearest {
+        Ok(n) if n.stable => "nearest steady shape stable",
+        Ok(_) => "nearest steady shape unstable",
+        Err(_) => "no steady shape found",
+    };
+    let caption = format!("ω = {:.3} rad/s: {}, {settled}; {stable}", r.omega, plural(s.nodes, "node"));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(-width..width, (-1.04 * depth)..(0.04 * depth))
+        .map_err(|e| fail(&e))?;
+    let stretch = (depth / (2.0 * width)) * (720.0 - 78.0) / (900.0 - 100.0);
+    chart
+        .configure_mesh()
+        .x_desc(format!(
+            "signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}"
+        ))
+        .y_desc("height relative to the pivot (m)")
+        .light_line_style(BLACK.mix(0.03))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    let axis = ShapeStyle::from(&BLACK.mix(0.6)).stroke_width(1);
+    chart
+        .draw_series(DashedLineSeries::new(vec![(0.0, 0.04 * depth), (0.0, -1.04 * depth)], 8, 6, axis))
+        .map_err(|e| fail(&e))?
+        .label("rotation axis")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], axis));
+    let blue = RGBColor(31, 90, 180);
+    chart
+        .draw_series(LineSeries::new(chain_points.clone(), blue.stroke_width(2)))
+        .map_err(|e| fail(&e))?
+        .label(format!("the chain at t = {:.2} s", r.t))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2)));
+    chart
+        .draw_series(chain_points.iter().skip(1).map(|p| Circle::new(*p, 2, blue.filled())))
+        .map_err(|e| fail(&e))?;
+    if let Some(points) = steady_points {
+        let orange = RGBColor(230, 120, 20);
+        chart
+            .draw_series(DashedLineSeries::new(points, 10, 5, orange.mix(0.9).stroke_width(3)))
+            .map_err(|e| fail(&e))?
+            .label("nearest damped steady shape")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], orange.mix(0.9).stroke_width(3))
+            });
+    }
+    let nodes: Vec<(f64, f64)> = std::iter::once(pivot).chain(crossings(s)).collect();
+    chart
+        .draw_series(nodes.iter().map(|p| Circle::new(*p, 7, RED.stroke_width(2))))
+        .map_err(|e| fail(&e))?
+        .label(format!("nodes: the pivot and {}", plural(s.axis_crossings, "axis crossing")))
+        .legend(|(x, y)| Circle::new((x + 10, y), 6, RED.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    root.present().map_err(|e| fail(&e))
+}
