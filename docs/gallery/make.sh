@@ -45,4 +45,20 @@ cp "$runs/modes/modes.png" "$gallery/modes.png"
 pendulum steady --n 12 --lengths 0.1 --omega 5,10,15 --out "$runs/steady" > /dev/null
 cp "$runs/steady/branches.png" "$gallery/steady-branches.png"
 cp "$runs/steady/shapes.png" "$gallery/steady-shapes.png"
+# Whirl a chain (README "Whirl a chain"): 100 links, L = 1 m, M = 1 kg, hanging at rest,
+# the pivot on a 2 cm circle, light damping. A sudden start at 3, 6 and 11 rad/s.
+whirl="--dim 3 --n 100 --masses 0.01 --lengths 0.01 --damping 3e-4 --initial hanging \
+    --drive circle --radius 0.02 --integrator rk4 --step 0.001 --every 100"
+for w in 3 6 11; do
+    pendulum simulate $whirl --omega "$w" --end 150 --out "$runs/whirl-$w" --quiet > "$runs/whirl-$w.txt"
+    cp "$runs/whirl-$w/shape.png" "$gallery/whirl-$w-shape.png"
+done
+# The same chain at 5 rad/s: sudden start, and the speed ramped up from 0 over 150 s.
+pendulum simulate $whirl --omega 5 --end 400 --out "$runs/sudden-5" --quiet > "$runs/sudden-5.txt"
+cp "$runs/sudden-5/shape.png" "$gallery/whirl-5-sudden-shape.png"
+pendulum simulate $whirl --omega 5 --ramp-time 150 --end 400 --out "$runs/ramp-5" --quiet > "$runs/ramp-5.txt"
+cp "$runs/ramp-5/shape.png" "$gallery/whirl-5-ramp-shape.png"
+pendulum render "$runs/ramp-5" --view co-rotating --from 0 --to 250 --speed 10 --frames 250 \
+    --out "$gallery/whirl-5-ramp-co-rotating.gif" --quiet
+cat "$runs"/whirl-3.txt "$runs"/whirl-6.txt "$runs"/whirl-11.txt "$runs"/sudden-5.txt "$runs"/ramp-5.txt
 ls -l "$gallery"

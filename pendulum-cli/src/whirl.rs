@@ -211,9 +211,11 @@ fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
     let stretch = (depth / (2.0 * width)) * (720.0 - 78.0) / (900.0 - 100.0);
     chart
         .configure_mesh()
-        .x_desc(format!(
-            "signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}"
-        ))
+        .x_desc(if stretch >= 1.5 {
+            format!("signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}")
+        } else {
+            "signed distance from the rotation axis in the shape's plane (m)".to_string()
+        })
         .y_desc("height relative to the pivot (m)")
         .light_line_style(BLACK.mix(0.03))
         .label_style(("sans-serif", 13))
