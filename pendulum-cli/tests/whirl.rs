@@ -204,10 +204,10 @@ fn a_written_2d_sample_costs_time_linear_in_n() {
             })
             .fold(f64::INFINITY, f64::min)
     };
-    let (small, large) = (time(20_000), time(80_000));
+    let (small, large) = (time(25_000), time(100_000));
     assert!(
         large / small < 8.0,
-        "n = 20000: {small:.3} s, n = 80000: {large:.3} s: ratio {:.1}",
+        "n = 25000: {small:.3} s, n = 100000: {large:.3} s: ratio {:.1}",
         large / small
     );
 }
