@@ -47,12 +47,6 @@ pub struct SphericalLink {
     pub d_phi: Vector3<f64>,
     /// `e_φ = (−sin φ, cos φ, 0)`, the unit azimuthal vector.
     pub e_phi: Vector3<f64>,
-    /// `∂²u/∂θ² = −u`.
-    pub d_theta2: Vector3<f64>,
-    /// `∂²u/∂φ²`.
-    pub d_phi2: Vector3<f64>,
-    /// `∂²u/∂θ∂φ`.
-    pub d_theta_phi: Vector3<f64>,
     /// `sin θ`.
     pub sin_theta: f64,
     /// `cos θ`.
@@ -69,12 +63,33 @@ impl SphericalLink {
             d_theta: Vector3::new(ct * cp, ct * sp, st),
             d_phi: Vector3::new(-st * sp, st * cp, 0.0),
             e_phi: Vector3::new(-sp, cp, 0.0),
-            d_theta2: Vector3::new(-st * cp, -st * sp, ct),
-            d_phi2: Vector3::new(-st * cp, -st * sp, 0.0),
-            d_theta_phi: Vector3::new(-ct * sp, ct * cp, 0.0),
             sin_theta: st,
             cos_theta: ct,
         }
+    }
+
+    /// `∂²u/∂θ² = −u` (computed when asked: the O(n²) loops of the models use only the
+    /// first derivatives).
+    pub fn d_theta2(&self) -> Vector3<f64> {
+        let (st, ct, sp, cp) = self.scalars();
+        Vector3::new(-st * cp, -st * sp, ct)
+    }
+
+    /// `∂²u/∂φ² = −sin θ (cos φ, sin φ, 0)`.
+    pub fn d_phi2(&self) -> Vector3<f64> {
+        let (st, _, sp, cp) = self.scalars();
+        Vector3::new(-st * cp, -st * sp, 0.0)
+    }
+
+    /// `∂²u/∂θ∂φ = cos θ e_φ`.
+    pub fn d_theta_phi(&self) -> Vector3<f64> {
+        let (_, ct, sp, cp) = self.scalars();
+        Vector3::new(-ct * sp, ct * cp, 0.0)
+    }
+
+    /// `(sin θ, cos θ, sin φ, cos φ)`, from the stored vectors (`e_φ = (−sin φ, cos φ, 0)`).
+    fn scalars(&self) -> (f64, f64, f64, f64) {
+        (self.sin_theta, self.cos_theta, -self.e_phi.x, self.e_phi.y)
     }
 
     /// Link `i` of the chain's `q = (θ_1…θ_n, φ_1…φ_n)`.
@@ -89,9 +104,9 @@ impl SphericalLink {
 
     /// `ü` at `q̈ = 0`: the part of the acceleration quadratic in the rates (1/s²).
     pub fn centripetal(&self, theta_dot: f64, phi_dot: f64) -> Vector3<f64> {
-        self.d_theta2 * (theta_dot * theta_dot)
-            + self.d_phi2 * (phi_dot * phi_dot)
-            + self.d_theta_phi * (2.0 * theta_dot * phi_dot)
+        self.d_theta2() * (theta_dot * theta_dot)
+            + self.d_phi2() * (phi_dot * phi_dot)
+            + self.d_theta_phi() * (2.0 * theta_dot * phi_dot)
     }
 
     /// `ü = ∂u/∂θ θ̈ + ∂u/∂φ φ̈ +` [`centripetal`](Self::centripetal) (1/s²).
@@ -102,10 +117,8 @@ impl SphericalLink {
     /// `∂u̇/∂θ = ∂²u/∂θ² θ̇ + ∂²u/∂θ∂φ φ̇` and `∂u̇/∂φ = ∂²u/∂θ∂φ θ̇ + ∂²u/∂φ² φ̇`: how the
     /// link's velocity changes with its angles at fixed rates.
     pub fn velocity_gradient(&self, theta_dot: f64, phi_dot: f64) -> (Vector3<f64>, Vector3<f64>) {
-        (
-            self.d_theta2 * theta_dot + self.d_theta_phi * phi_dot,
-            self.d_theta_phi * theta_dot + self.d_phi2 * phi_dot,
-        )
+        let (d_theta_phi, d_phi2) = (self.d_theta_phi(), self.d_phi2());
+        (self.d_theta2() * theta_dot + d_theta_phi * phi_dot, d_theta_phi * theta_dot + d_phi2 * phi_dot)
     }
 
     /// The angle rates `(θ̇, φ̇) = (e_θ·w, e_φ·w / sin θ)` (rad/s) of a link rate `w = u̇`
