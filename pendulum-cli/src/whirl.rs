@@ -212,7 +212,9 @@ fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
     chart
         .configure_mesh()
         .x_desc(if stretch >= 1.5 {
-            format!("signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}")
+            format!(
+                "signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}"
+            )
         } else {
             "signed distance from the rotation axis in the shape's plane (m)".to_string()
         })
