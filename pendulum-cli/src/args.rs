@@ -65,6 +65,18 @@ pub enum Command {
     /// RUN_DIR/chain.gif (or --out FILE): axes in m, a scale bar, the rotation axis of a
     /// circling pivot and the tip's trail, in a viewport that fits the motion.
     Render(crate::render::RenderArgs),
+    /// Which shape a whirled 3D chain chooses: for every speed ω of --omega (a list or
+    /// A:B:N) and every --kind of start (sudden, ramp-up, ramp-down), run the chain from
+    /// hanging at rest (ramp-down: from the previous point's end) with its pivot on a
+    /// horizontal circle of --radius R, RK4 + projection, and report the shape it ends in:
+    /// nodes, axis crossings, tip radius, settled, the nearest damped steady shape and its
+    /// stability. Points run in parallel (--jobs).
+    ///
+    /// Writes sweep.csv (a row per point and kind), sweep.json (every parameter and the
+    /// results so far: repeat with --from) and sweep.png (the node count and tip radius
+    /// chosen against ω over the steady branch diagram of `pendulum steady --radius R`),
+    /// and prints a table. Ctrl-C stops: finished points are kept, the files stay valid.
+    Sweep(Box<crate::sweep::SweepArgs>),
 }
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`

@@ -15,6 +15,7 @@ mod render;
 mod simulate;
 mod spec;
 mod steady;
+mod sweep;
 mod whirl;
 
 use std::process::ExitCode;
@@ -51,6 +52,7 @@ fn main() -> ExitCode {
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
         Command::Render(args) => render::render(args),
+        Command::Sweep(args) => sweep::sweep(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

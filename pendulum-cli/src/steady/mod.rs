@@ -8,9 +8,9 @@
 //! crossing to count) is given none. Stability: [`Verdict`] of the undamped 3D
 //! linearisation in the turning frame ([`stability`]); damped, see [`shapes`].
 
-mod branches;
+pub(crate) mod branches;
 mod csv;
-mod plots;
+pub(crate) mod plots;
 mod shapes;
 mod table;
 
@@ -123,7 +123,7 @@ fn check_omega_max(omega_max: f64) -> CliResult<()> {
 
 /// `x > 0` rounded up to three significant digits (`15.2268 → 15.3`), the nearest `f64`
 /// to that decimal.
-fn round_up(x: f64) -> f64 {
+pub(crate) fn round_up(x: f64) -> f64 {
     let decimals = 2 - x.log10().floor() as i32;
     let scale = 10f64.powi(decimals);
     let up = (x * scale * (1.0 - 1e-15)).ceil();

@@ -20,12 +20,12 @@ use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 use pendulum_core::{Chain, Verdict};
 
-type Chart<'a> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+pub(crate) type Chart<'a> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-const GREY: RGBColor = RGBColor(140, 140, 140);
+pub(crate) const GREY: RGBColor = RGBColor(140, 140, 140);
 
 /// The colour of a node count (`None`: the vertical).
-fn colour(nodes: Option<usize>) -> RGBColor {
+pub(crate) fn colour(nodes: Option<usize>) -> RGBColor {
     const PALETTE: [RGBColor; 6] = [
         RGBColor(0, 90, 181),
         RGBColor(220, 50, 32),
@@ -64,7 +64,7 @@ fn draw_line(
 
 /// How a line or mark is drawn in a key.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Stroke {
+pub(crate) enum Stroke {
     /// Thick solid: stable.
     Thick,
     /// Thin solid: gyroscopic.
@@ -89,7 +89,7 @@ fn stroke_of(verdict: &Verdict) -> Stroke {
 
 /// Draws a key on `area`: one entry per line, 20 px apart from `top`, a sample of the line
 /// or mark then the text.
-fn draw_key(
+pub(crate) fn draw_key(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     top: i32,
     entries: &[(String, RGBColor, Stroke)],
@@ -135,13 +135,7 @@ fn draw_branches(
     let root = BitMapBackend::new(path, (1060, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     let (plot, key) = root.split_horizontally(820);
-    let tip = |x: &[f64]| *x.last().unwrap_or(&0.0);
-    let reach = family
-        .branches
-        .iter()
-        .flat_map(|b| b.branch.points.iter().map(|p| tip(&p.displacements).abs()))
-        .fold(radius.abs(), f64::max)
-        .max(1e-3);
+    let reach = reach(family, radius);
     let caption = if radius == 0.0 {
         "steady rotation on a fixed pivot: the free end's distance from the axis".to_string()
     } else {
@@ -176,8 +170,46 @@ fn draw_branches(
             ))
             .map_err(|e| fail(&e))?;
     }
+    let counts = draw_family(&mut chart, family, radius)?;
+    for f in found {
+        let c = colour(f.nodes);
+        let at = (f.shape.omega, tip(&f.shape.displacements));
+        let style = if f.judged.verdict.is_stable() { c.filled() } else { c.stroke_width(2) };
+        chart.draw_series([Circle::new(at, 5, style)]).map_err(|e| fail(&e))?;
+    }
+    let mut entries = family_key(counts, radius);
+    if !found.is_empty() {
+        entries.push((String::new(), BLACK, Stroke::Text));
+        entries.push(("shape at a listed ω".into(), DARK, Stroke::Dot));
+        entries.push(("the same, unstable".into(), DARK, Stroke::Ring));
+    }
+    draw_key(&key, 60, &entries)?;
+    root.present().map_err(|e| fail(&e))
+}
+
+/// The free end's signed distance from the axis, `x_n` (m), of a shape's displacements.
+fn tip(x: &[f64]) -> f64 {
+    *x.last().unwrap_or(&0.0)
+}
+
+/// The largest `|x_n|` on the branches of `family` (at least `|radius|` and 1 mm), m: the
+/// half-height the branch diagram needs.
+pub(crate) fn reach(family: &Family, radius: f64) -> f64 {
+    family
+        .branches
+        .iter()
+        .flat_map(|b| b.branch.points.iter().map(|p| tip(&p.displacements).abs()))
+        .fold(radius.abs(), f64::max)
+        .max(1e-3)
+}
+
+/// Draws the branches of `family` on `chart` (ω in rad/s across, `x_n` in m up) as the
+/// branch diagram shows them (module docs; for a fixed pivot also the vertical and the
+/// faint mirror branches); returns the node counts drawn, ascending, once each.
+/// `pendulum sweep` draws the chain's choices over the same lines.
+pub(crate) fn draw_family(chart: &mut Chart<'_>, family: &Family, radius: f64) -> Result<Vec<usize>, String> {
     for (from, to, judged) in &family.vertical {
-        draw_line(&mut chart, vec![(*from, 0.0), (*to, 0.0)], GREY, &judged.verdict)?;
+        draw_line(chart, vec![(*from, 0.0), (*to, 0.0)], GREY, &judged.verdict)?;
     }
     let mut counts: Vec<usize> = Vec::new();
     for labelled in &family.branches {
@@ -198,21 +230,24 @@ fn draw_branches(
                 points[start..=last].iter().map(|p| (p.omega, tip(&p.displacements))).collect();
             let c = colour(nodes(start));
             if radius == 0.0 {
-                draw_line(&mut chart, run.iter().map(|&(w, x)| (w, -x)).collect(), faint(c), verdict(start))?;
+                draw_line(chart, run.iter().map(|&(w, x)| (w, -x)).collect(), faint(c), verdict(start))?;
             }
-            draw_line(&mut chart, run, c, verdict(start))?;
+            draw_line(chart, run, c, verdict(start))?;
             counts.extend(nodes(start));
             start = i;
         }
     }
-    for f in found {
-        let c = colour(f.nodes);
-        let at = (f.shape.omega, tip(&f.shape.displacements));
-        let style = if f.judged.verdict.is_stable() { c.filled() } else { c.stroke_width(2) };
-        chart.draw_series([Circle::new(at, 5, style)]).map_err(|e| fail(&e))?;
-    }
     counts.sort_unstable();
     counts.dedup();
+    Ok(counts)
+}
+
+/// The grey of the key's samples of line styles.
+pub(crate) const DARK: RGBColor = RGBColor(60, 60, 60);
+
+/// The key of the branch lines: colour by node count (`counts`, from [`draw_family`]; for
+/// a fixed pivot the vertical and the mirror branches), line by stability.
+pub(crate) fn family_key(counts: Vec<usize>, radius: f64) -> Vec<(String, RGBColor, Stroke)> {
     let mut entries: Vec<(String, RGBColor, Stroke)> =
         vec![("colour: node count".into(), BLACK, Stroke::Text)];
     entries.extend(counts.into_iter().map(|k| (nodes_name(k), colour(Some(k)), Stroke::Thick)));
@@ -220,19 +255,12 @@ fn draw_branches(
         entries.push(("vertical (on the axis)".into(), GREY, Stroke::Thick));
         entries.push(("faint: mirror image (−θ)".into(), faint(colour(Some(1))), Stroke::Thick));
     }
-    let dark = RGBColor(60, 60, 60);
     entries.push((String::new(), BLACK, Stroke::Text));
     entries.push(("line: stability".into(), BLACK, Stroke::Text));
-    entries.push(("stable (index 0)".into(), dark, Stroke::Thick));
-    entries.push(("gyroscopic (index > 0)".into(), dark, Stroke::Thin));
-    entries.push(("unstable".into(), dark, Stroke::Dashed));
-    if !found.is_empty() {
-        entries.push((String::new(), BLACK, Stroke::Text));
-        entries.push(("shape at a listed ω".into(), dark, Stroke::Dot));
-        entries.push(("the same, unstable".into(), dark, Stroke::Ring));
-    }
-    draw_key(&key, 60, &entries)?;
-    root.present().map_err(|e| fail(&e))
+    entries.push(("stable (index 0)".into(), DARK, Stroke::Thick));
+    entries.push(("gyroscopic (index > 0)".into(), DARK, Stroke::Thin));
+    entries.push(("unstable".into(), DARK, Stroke::Dashed));
+    entries
 }
 
 /// Most panels in shapes.png.

@@ -1,0 +1,530 @@
+//! The resolved parameters of a sweep ([`SweepConfig`], from the command line or a
+//! sweep.json), their checks and defaults (duration from the damping, step from the
+//! chain's fastest mode), the `--omega` list or range, and sweep.json itself
+//! ([`SweepFile`]: the parameters, derived numbers and every point's result so far).
+
+use std::io::Write;
+use std::path::Path;
+
+use nalgebra::Dyn;
+use pendulum_core::{Chain, SteadyRotation, normal_modes};
+use serde::{Deserialize, Serialize};
+
+use super::runs::Point;
+use super::{SweepKind, SweepPhysics};
+use crate::error::{CliError, CliResult, io_failed};
+use crate::spec::{expand, per_link};
+use crate::steady::round_up;
+
+/// The shape analysis is fed every this many steps (`pendulum simulate`'s default
+/// `--every`, so a point and the same `simulate` run report the same).
+pub const FEED_EVERY: usize = 4;
+
+/// Settle window of the shape analysis, drive periods (`ShapeOptions` default).
+const SETTLE_PERIODS: f64 = 5.0;
+
+/// Settled: drift at most this times the chain's length (`ShapeOptions` default).
+const SETTLE_TOLERANCE: f64 = 1e-3;
+
+/// Default duration: this many decay times of the first mode at rest (600 s for the
+/// chain of `docs/rotating-chain.md` §4, whose first mode decays at 0.02 1/s).
+const DECAY_TIMES: f64 = 12.0;
+
+/// Default duration of an undamped sweep: this many periods of the first mode at rest.
+const UNDAMPED_PERIODS: f64 = 200.0;
+
+/// Most steps of one point.
+const MAX_STEPS: f64 = 1e8;
+
+/// Every parameter of a sweep; with the program version, enough to repeat it exactly.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepConfig {
+    /// Masses `m_i`, kg, one per link.
+    pub masses: Vec<f64>,
+    /// Rod lengths `l_i`, m.
+    pub lengths: Vec<f64>,
+    /// Gravity `g`, m/s² (along −z).
+    pub gravity: f64,
+    /// Damping `λ_i`, N·m·s.
+    pub damping: Vec<f64>,
+    /// Radius `R` of the pivot's circle, m.
+    pub radius: f64,
+    /// `--omega` as given.
+    pub omega_spec: String,
+    /// Whether `--omega` was in units of `√(g/L)`.
+    pub scaled: bool,
+    /// The speeds, rad/s, in the order given.
+    pub omegas: Vec<f64>,
+    /// The kinds of experiment, in the order given, each once.
+    pub kinds: Vec<SweepKind>,
+    /// Simulated time of every point, s.
+    pub duration: f64,
+    /// Length of the ramps, s (`None` without a ramp kind).
+    pub ramp_time: Option<f64>,
+    /// RK4 step, s (every run takes `⌈duration / step⌉` equal steps).
+    pub step: f64,
+    /// The shape analysis is fed every this many steps.
+    pub feed_every: usize,
+    /// Settle window, drive periods.
+    pub settle_periods: f64,
+    /// Settled when the drift is at most this times the chain's length.
+    pub settle_tolerance: f64,
+}
+
+impl SweepConfig {
+    /// Number of links.
+    pub fn links(&self) -> usize {
+        self.masses.len()
+    }
+
+    /// The chain's length `L = Σ l_i`, m.
+    pub fn length(&self) -> f64 {
+        self.lengths.iter().sum()
+    }
+
+    /// `√(g/L)`, rad/s: the unit of `--scaled` speeds.
+    pub fn reference_speed(&self) -> f64 {
+        (self.gravity / self.length()).sqrt()
+    }
+
+    /// The chain without damping (the steady shapes).
+    pub fn chain(&self) -> CliResult<Chain<Dyn>> {
+        Ok(Chain::<Dyn>::new(&self.masses, &self.lengths, self.gravity)?)
+    }
+
+    /// The damped chain of the runs.
+    pub fn damped_chain(&self) -> CliResult<Chain<Dyn>> {
+        self.chain()?.with_damping(&self.damping).map_err(|e| CliError::from(e).context("--damping"))
+    }
+
+    /// Resolves the command line into a complete configuration.
+    pub fn from_args(p: &SweepPhysics) -> CliResult<Self> {
+        if let Some(dim) = &p.dim {
+            return Err(CliError::usage(format!(
+                "--dim {dim}: not an option of pendulum sweep: sweeps are 3D (the pivot circles the vertical axis)"
+            )));
+        }
+        let masses = per_link("--masses", &p.chain.masses)?;
+        let lengths = per_link("--lengths", &p.chain.lengths)?;
+        let n = match p.chain.n {
+            Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
+            Some(n) => n,
+            None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
+        };
+        let masses = expand("--masses", masses, n)?;
+        let lengths = expand("--lengths", lengths, n)?;
+        let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
+        if !(p.chain.gravity.is_finite() && p.chain.gravity > 0.0) {
+            return Err(CliError::usage(format!(
+                "--gravity must be finite and positive for a sweep (the chain starts hanging at rest), got {}",
+                p.chain.gravity
+            )));
+        }
+        // The chain's own checks (positive masses and lengths, damping ≥ 0), named by link.
+        let chain = Chain::<Dyn>::new(&masses, &lengths, p.chain.gravity)?;
+        let damped =
+            chain.clone().with_damping(&damping).map_err(|e| CliError::from(e).context("--damping"))?;
+        check_radius(p.radius)?;
+        let spec = p.omega.clone().unwrap_or_default();
+        let listed = parse_omegas(&spec, p.scaled)?;
+        let scale = (p.chain.gravity / lengths.iter().sum::<f64>()).sqrt();
+        let omegas: Vec<f64> = if p.scaled { listed.iter().map(|w| w * scale).collect() } else { listed };
+        let mut kinds = Vec::new();
+        for &k in &p.kind {
+            if !kinds.contains(&k) {
+                kinds.push(k);
+            }
+        }
+        if let Some(d) = p.duration {
+            check_duration(d)?;
+        }
+        let duration = match p.duration {
+            Some(d) => d,
+            None => default_duration(&damped),
+        };
+        let ramps = kinds.iter().any(|&k| k != SweepKind::Sudden);
+        let ramp_time = match (p.ramp_time, ramps) {
+            (Some(t), true) => Some(t),
+            (None, true) => Some(round_up(duration / 3.0)),
+            (Some(_), false) => {
+                return Err(CliError::usage(
+                    "--ramp-time applies to the kinds ramp-up and ramp-down only (--kind sudden has no ramp)",
+                ));
+            }
+            (None, false) => None,
+        };
+        let fastest_drive = omegas.iter().copied().fold(0.0, f64::max);
+        let step = match p.step {
+            Some(h) => h,
+            None => default_step(&damped, p.radius, fastest_drive),
+        };
+        let config = Self {
+            masses,
+            lengths,
+            gravity: p.chain.gravity,
+            damping,
+            radius: p.radius,
+            omega_spec: spec,
+            scaled: p.scaled,
+            omegas,
+            kinds,
+            duration,
+            ramp_time,
+            step,
+            feed_every: FEED_EVERY,
+            settle_periods: SETTLE_PERIODS,
+            settle_tolerance: SETTLE_TOLERANCE,
+        };
+        config.check()?;
+        Ok(config)
+    }
+
+    /// Checks what building the chain and the drives does not: counts, signs, times.
+    pub fn check(&self) -> CliResult<()> {
+        let n = self.links();
+        if n == 0 {
+            return Err(CliError::usage("masses: a chain needs at least 1 link, got 0"));
+        }
+        for (what, got) in [("lengths", self.lengths.len()), ("damping", self.damping.len())] {
+            if got != n {
+                return Err(CliError::usage(format!("{what}: got {got} values, expected {n}")));
+            }
+        }
+        if !(self.gravity.is_finite() && self.gravity > 0.0) {
+            return Err(CliError::usage(format!(
+                "gravity must be finite and positive for a sweep, got {}",
+                self.gravity
+            )));
+        }
+        self.damped_chain()?;
+        check_radius(self.radius)?;
+        if self.omegas.is_empty() {
+            return Err(CliError::usage("--omega: no speed to sweep"));
+        }
+        if let Some(w) = self.omegas.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
+            return Err(CliError::usage(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
+        }
+        if self.kinds.is_empty() {
+            return Err(CliError::usage("--kind: no kind of experiment given"));
+        }
+        check_duration(self.duration)?;
+        let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
+        match (self.ramp_time, ramps) {
+            (Some(t), true) => {
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(CliError::usage(format!(
+                        "--ramp-time must be finite and positive, got {t} (s)"
+                    )));
+                }
+                if t >= self.duration {
+                    return Err(CliError::usage(format!(
+                        "--ramp-time {t} s must be shorter than --duration {} s (the speed is held at ω after the ramp)",
+                        self.duration
+                    )));
+                }
+            }
+            (None, true) => return Err(CliError::usage("ramp_time: the ramp kinds need a ramp time")),
+            (Some(_), false) => return Err(CliError::usage("ramp_time: given without a ramp kind")),
+            (None, false) => {}
+        }
+        if !(self.step.is_finite() && self.step > 0.0) {
+            return Err(CliError::usage(format!("--step must be finite and positive, got {}", self.step)));
+        }
+        let steps = (self.duration / self.step).ceil();
+        if steps > MAX_STEPS {
+            return Err(CliError::usage(format!(
+                "--duration {} s with --step {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
+                self.duration, self.step
+            )));
+        }
+        if self.feed_every == 0 {
+            return Err(CliError::usage("feed_every must be at least 1 step, got 0"));
+        }
+        if !(self.settle_periods.is_finite() && self.settle_periods > 0.0) {
+            return Err(CliError::usage(format!(
+                "settle_periods must be finite and positive, got {}",
+                self.settle_periods
+            )));
+        }
+        if !(self.settle_tolerance.is_finite() && self.settle_tolerance >= 0.0) {
+            return Err(CliError::usage(format!(
+                "settle_tolerance must be finite and non-negative, got {}",
+                self.settle_tolerance
+            )));
+        }
+        Ok(())
+    }
+
+    /// Numbers derived from the parameters, for the reader (not read back).
+    pub fn derived(&self) -> CliResult<Derived> {
+        let chain = self.damped_chain()?;
+        let free = SteadyRotation::new(&chain, 0.0)?;
+        let critical = free.bifurcation_speeds(self.links().min(4))?;
+        let (steps, _) = pendulum_core::trajectory::plan(0.0, self.duration, self.step)?;
+        Ok(Derived {
+            length: self.length(),
+            reference_speed: self.reference_speed(),
+            first_mode_decay_rate: first_mode_decay(&chain),
+            critical_speeds: critical,
+            steps_per_point: steps,
+        })
+    }
+}
+
+/// Numbers a reader of sweep.json wants beside the parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Derived {
+    /// The chain's length `L`, m.
+    pub length: f64,
+    /// `√(g/L)`, rad/s.
+    pub reference_speed: f64,
+    /// Decay rate of the first mode at rest, `σ = ½ Σ λ_i v_i²`, 1/s.
+    pub first_mode_decay_rate: f64,
+    /// The lowest critical speeds of the chain on a fixed pivot, rad/s.
+    pub critical_speeds: Vec<f64>,
+    /// Steps of every run.
+    pub steps_per_point: u64,
+}
+
+/// `x` to six significant digits, in the shortest form (`1`, `0.02`, `0.00056237`): for
+/// titles and tables, where `1.0000000000000002 m` would be noise.
+pub fn short(x: f64) -> String {
+    format!("{x:.5e}").parse::<f64>().map_or_else(|_| x.to_string(), |v| v.to_string())
+}
+
+fn check_radius(radius: f64) -> CliResult<()> {
+    if radius.is_finite() && radius > 0.0 {
+        Ok(())
+    } else {
+        Err(CliError::usage(format!(
+            "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
+        )))
+    }
+}
+
+fn check_duration(duration: f64) -> CliResult<()> {
+    if duration.is_finite() && duration > 0.0 {
+        Ok(())
+    } else {
+        Err(CliError::usage(format!("--duration must be finite and positive, got {duration} (s)")))
+    }
+}
+
+/// Parses `--omega`: a comma list of speeds or `A:B:N`, every speed finite and ≥ 0 (in
+/// rad/s, or in units of √(g/L) when `scaled`). Errors name the value.
+pub fn parse_omegas(spec: &str, scaled: bool) -> CliResult<Vec<f64>> {
+    let unit = if scaled { "√(g/L)" } else { "rad/s" };
+    let bad = |why: String| CliError::usage(format!("--omega: '{spec}' {why}"));
+    let number = |token: &str, what: &str| -> CliResult<f64> {
+        let token = token.trim();
+        match token.parse::<f64>() {
+            Ok(v) if !v.is_finite() => Err(bad(format!("has a non-finite {what} {token}"))),
+            Ok(v) if v < 0.0 => Err(bad(format!("has a negative {what} {token} (speeds are ≥ 0 {unit})"))),
+            Ok(v) => Ok(v),
+            Err(_) if token.is_empty() => Err(bad(format!("has an empty {what}"))),
+            Err(_) => Err(bad(format!("has a bad {what} '{token}' (not a number)"))),
+        }
+    };
+    if spec.trim().is_empty() || spec.split(',').all(|t| t.trim().is_empty()) {
+        return Err(bad(format!(
+            "lists no speed (give W1,W2,… or A:B:N in {unit}, e.g. --omega 2,4 or --omega 1:5:9)"
+        )));
+    }
+    if spec.contains(':') {
+        let parts: Vec<&str> = spec.split(':').collect();
+        if parts.len() != 3 || spec.contains(',') {
+            return Err(bad("is not a range A:B:N (start, end, number of points)".into()));
+        }
+        let (a, b) = (number(parts[0], "start")?, number(parts[1], "end")?);
+        let count = parts[2].trim();
+        let n: usize = match count.parse::<i64>() {
+            Ok(n) if n < 1 => return Err(bad(format!("asks for {n} points (N must be at least 1)"))),
+            Ok(n) => n as usize,
+            Err(_) => {
+                return Err(bad(format!("has a bad number of points '{count}' (N: a whole number ≥ 1)")));
+            }
+        };
+        if n == 1 {
+            return Ok(vec![a]);
+        }
+        return Ok((0..n)
+            .map(|k| if k == n - 1 { b } else { a + (b - a) * k as f64 / (n - 1) as f64 })
+            .collect());
+    }
+    spec.split(',').map(|token| number(token, "entry")).collect()
+}
+
+/// `σ = ½ Σ λ_i v_i²`, 1/s: the decay rate of the first mode of the hanging chain under
+/// the chain's damping, `v` its mass-normalised shape in link angles.
+pub fn first_mode_decay(chain: &Chain<Dyn>) -> f64 {
+    let modes = normal_modes(chain);
+    let v = modes.shapes.column(0);
+    0.5 * chain.damping().iter().zip(v.iter()).map(|(l, v)| l * v * v).sum::<f64>()
+}
+
+/// [`DECAY_TIMES`] decay times of the first mode, rounded up to three digits; undamped,
+/// [`UNDAMPED_PERIODS`] periods of that mode.
+fn default_duration(chain: &Chain<Dyn>) -> f64 {
+    let decay = first_mode_decay(chain);
+    if decay > 0.0 {
+        round_up(DECAY_TIMES / decay)
+    } else {
+        let omega_1 = normal_modes(chain).frequencies[0];
+        round_up(UNDAMPED_PERIODS * std::f64::consts::TAU / omega_1)
+    }
+}
+
+/// The step `pendulum simulate` suggests for this chain on a circle of `radius` turning at
+/// up to `omega` (rad/s), `0.5 / ω_fastest`, at most a fortieth of the drive period, and
+/// here also at most `1 / ν_fastest` (RK4 is stable to `h ν ≈ 2.8` on decaying modes);
+/// rounded down to two digits. `ω_fastest` is the largest
+/// `√(2 (T_i/l_i + T_{i+1}/l_{i+1}) / m_i)`, the tensions of the hanging chain
+/// `T_i = M_i (g + R ω²)` (`M_i` the tail mass): a Gershgorin bound of the
+/// tension-stiffness matrix, `2n √(g/L)` for a long uniform chain; `ν_fastest`, the same
+/// bound of the damping's, the largest `2 (λ_i/l_i² + λ_{i+1}/l_{i+1}²) / m_i`.
+fn default_step(chain: &Chain<Dyn>, radius: f64, omega: f64) -> f64 {
+    let g = chain.gravity() + radius * omega * omega;
+    let (m, l, tail) = (chain.masses(), chain.lengths(), chain.tail_masses());
+    let n = chain.links();
+    let stiffness = |i: usize| if i < n { tail[i] * g / l[i] } else { 0.0 };
+    let fastest = (0..n).map(|i| (2.0 * (stiffness(i) + stiffness(i + 1)) / m[i]).sqrt()).fold(0.0, f64::max);
+    let damping = |i: usize| if i < n { chain.damping()[i] / (l[i] * l[i]) } else { 0.0 };
+    let decay = (0..n).map(|i| 2.0 * (damping(i) + damping(i + 1)) / m[i]).fold(0.0, f64::max);
+    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
+    if decay > 0.0 {
+        h = h.min(1.0 / decay);
+    }
+    if omega > 0.0 {
+        h = h.min(std::f64::consts::TAU / omega / 40.0);
+    }
+    let unit = 10f64.powi(h.log10().floor() as i32 - 1);
+    (h / unit).floor() * unit
+}
+
+/// What sweep.json holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    /// Always `"pendulum"`.
+    pub program: String,
+    /// Always `"sweep"`.
+    pub command: String,
+    /// The `pendulum-cli` version that wrote the file.
+    pub version: String,
+    /// Units and conventions of the numbers.
+    pub conventions: String,
+    /// Every parameter of the sweep.
+    pub config: SweepConfig,
+    /// Numbers derived from them (not read back).
+    pub derived: Derived,
+    /// `"running"`, `"completed"`, `"interrupted"` or `"failed"`.
+    pub status: String,
+    /// Every point and kind: its status and, once run, its result.
+    pub points: Vec<Point>,
+}
+
+const CONVENTIONS: &str = "SI units: ω in rad/s (omega_scaled: ω / √(g/L), L the chain's length), lengths in m, \
+times in s, growth rates in 1/s. Each point: a 3D chain in unit link directions, RK4 + projection, its pivot on the \
+horizontal circle of radius R about the z axis; the shape in the frame turning with the pivot (pivot at (R, 0, 0)): \
+nodes = axis crossings + 1 (the pivot counts as a node), tip radius = the free end's distance from the axis \
+(tip_signed: + on the pivot's side), settled = drift ≤ settle_tolerance · L over the last settle_periods drive \
+periods; nearest = the damped steady shape (relative equilibrium) nearest the final shape, its distance, nodes \
+and growth rate (stable: below 1e-6 |ω|).";
+
+impl SweepFile {
+    /// A sweep.json of this program's version.
+    pub fn new(config: SweepConfig, derived: Derived, points: Vec<Point>) -> Self {
+        Self {
+            program: "pendulum".into(),
+            command: "sweep".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            conventions: CONVENTIONS.into(),
+            config,
+            derived,
+            status: "running".into(),
+            points,
+        }
+    }
+
+    /// Reads and checks a sweep.json; errors name the file and the problem.
+    pub fn read(path: &Path) -> CliResult<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::usage(format!("--from: cannot read {}: {e}", path.display())))?;
+        let not_sweep = |why: String| {
+            CliError::usage(format!(
+                "--from: {} is not a sweep.json of pendulum sweep: {why}",
+                path.display()
+            ))
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| not_sweep(format!("not JSON ({e})")))?;
+        let field = |name: &str| value.get(name).and_then(|v| v.as_str()).map(str::to_owned);
+        match (field("program"), field("command")) {
+            (Some(p), _) if p != "pendulum" => return Err(not_sweep(format!("written by '{p}'"))),
+            (Some(_), Some(c)) if c != "sweep" => return Err(not_sweep(format!("written by pendulum {c}"))),
+            (Some(_), None) if value.get("config").is_some_and(|c| c.get("dim").is_some()) => {
+                return Err(not_sweep(
+                    "a run.json of pendulum simulate (repeat it with pendulum simulate --from)".into(),
+                ));
+            }
+            (None, _) | (Some(_), None) => return Err(not_sweep("no \"command\": \"sweep\" in it".into())),
+            _ => {}
+        }
+        let file: Self = serde_json::from_value(value).map_err(|e| not_sweep(e.to_string()))?;
+        file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
+        Ok(file)
+    }
+
+    /// Writes the file atomically: to `sweep.json.tmp` beside it, then renamed over `path`.
+    pub fn write_atomic(&self, path: &Path) -> CliResult<()> {
+        let tmp = path.with_extension("json.tmp");
+        let text = serde_json::to_string_pretty(self).map_err(|e| CliError::failed(e.to_string()))?;
+        let mut f = std::fs::File::create(&tmp).map_err(|e| io_failed("create", &tmp, e))?;
+        f.write_all(text.as_bytes())
+            .and_then(|()| f.write_all(b"\n"))
+            .map_err(|e| io_failed("write", &tmp, e))?;
+        f.sync_all().map_err(|e| io_failed("sync", &tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| io_failed("rename into", path, e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speed_lists_and_ranges() {
+        assert_eq!(parse_omegas("1, 2,3", false).unwrap(), vec![1.0, 2.0, 3.0]);
+        assert_eq!(parse_omegas("1:3:5", false).unwrap(), vec![1.0, 1.5, 2.0, 2.5, 3.0]);
+        assert_eq!(parse_omegas("4:2:3", false).unwrap(), vec![4.0, 3.0, 2.0]);
+        assert_eq!(parse_omegas("2:9:1", false).unwrap(), vec![2.0]);
+        let range = parse_omegas("0.5:5:24", true).unwrap();
+        assert_eq!((range.len(), range[0], range[23]), (24, 0.5, 5.0));
+        let message = |s: &str| parse_omegas(s, false).unwrap_err().to_string();
+        assert!(message("").contains("lists no speed"), "{}", message(""));
+        assert_eq!(message("1,,2"), "--omega: '1,,2' has an empty entry");
+        assert_eq!(message("1,-2"), "--omega: '1,-2' has a negative entry -2 (speeds are ≥ 0 rad/s)");
+        assert_eq!(message("inf"), "--omega: 'inf' has a non-finite entry inf");
+        assert_eq!(message("1:2"), "--omega: '1:2' is not a range A:B:N (start, end, number of points)");
+        assert_eq!(message("1:2:0"), "--omega: '1:2:0' asks for 0 points (N must be at least 1)");
+        assert_eq!(message("1:x:3"), "--omega: '1:x:3' has a bad end 'x' (not a number)");
+        assert_eq!(
+            message("1:2:2.5"),
+            "--omega: '1:2:2.5' has a bad number of points '2.5' (N: a whole number ≥ 1)"
+        );
+    }
+
+    #[test]
+    fn the_default_step_resolves_the_fastest_mode() {
+        // n = 20, L = 1 m: ω_fastest ≈ 2n √(g/L) = 125 rad/s; the drive adds R ω² to g.
+        let chain = Chain::<Dyn>::uniform(20, 0.05, 0.05, 9.81).unwrap();
+        let h = default_step(&chain, 0.02, 15.66);
+        assert!((3.0e-3..4.1e-3).contains(&h), "{h}");
+        assert_eq!(h, (h * 1e4).round() / 1e4);
+        // Heavy damping (λ / (m l²) = 8000 1/s) shortens it.
+        let damped = chain.with_damping(&[1.0; 20]).unwrap();
+        assert!(default_step(&damped, 0.02, 15.66) <= 1.0 / 32000.0);
+    }
+}

@@ -1,0 +1,554 @@
+//! The runs of a sweep: one point (a chain from hanging at rest, or from the previous
+//! point's end, its pivot circling at a speed switched on or ramped; RK4 + projection; the
+//! shape analysis fed every few steps and its report at the end), and their scheduling on
+//! a rayon pool — sudden and ramp-up points independent, the ramp-down points one chain
+//! in decreasing ω — with a line per finished point on stderr, sweep.json rewritten after
+//! each, and Ctrl-C honoured between samples.
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+use nalgebra::{DVector, Dyn, U3};
+use pendulum_core::integrate::{Projected, Rk4, State};
+use pendulum_core::{Chain, Directions, ShapeOptions, ShapeReport, ShapeTracker, trajectory};
+use serde::{Deserialize, Serialize};
+
+use super::SweepKind;
+use super::config::{Derived, SweepConfig, SweepFile};
+use crate::config::DriveConfig;
+use crate::error::{CliError, CliResult};
+use crate::models::turning_drive;
+use crate::simulate::INTERRUPTED;
+
+/// Where a point stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Status {
+    /// Not started yet.
+    Pending,
+    /// Ran to the end; its result is there.
+    Completed,
+    /// Cut by Ctrl-C; no result.
+    Interrupted,
+    /// Never started (Ctrl-C, or an earlier ramp-down point did not finish).
+    NotRun,
+    /// A step or the analysis failed; the error says why.
+    Failed,
+}
+
+impl Status {
+    /// The name in the files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pending => "pending",
+            Self::Completed => "completed",
+            Self::Interrupted => "interrupted",
+            Self::NotRun => "not-run",
+            Self::Failed => "failed",
+        }
+    }
+}
+
+/// One point of the sweep: a speed and a kind, how it starts, and its result once run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Point {
+    /// How it is started.
+    pub kind: SweepKind,
+    /// The speed held at the end, rad/s.
+    pub omega: f64,
+    /// `ω / √(g/L)`.
+    pub omega_scaled: f64,
+    /// The speed the ramp starts from, rad/s (`None`: switched on at ω).
+    pub ramp_from: Option<f64>,
+    /// The state it starts from.
+    pub start: String,
+    /// Where it stands.
+    pub status: Status,
+    /// Why it failed or was not run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// What the shape analysis said at the end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub result: Option<Outcome>,
+}
+
+/// The shape analysis at the end of a point's run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outcome {
+    /// The time reached, s.
+    pub t: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Axis crossings + 1 (the pivot counts as a node).
+    pub nodes: usize,
+    /// Crossings of the rotation axis below the pivot.
+    pub axis_crossings: usize,
+    /// The free end's distance from the axis, m.
+    pub tip_radius: f64,
+    /// The same, + on the pivot's side of the axis, − opposite (signed radial coordinate
+    /// of the free end in the shape's plane), m.
+    pub tip_signed: f64,
+    /// Azimuth of the shape's plane behind (−) or ahead of the pivot, rad.
+    pub plane_azimuth: f64,
+    /// Largest distance of a mass from that plane, m.
+    pub out_of_plane: f64,
+    /// Whether the chain settled (drift ≤ threshold over the window).
+    pub settled: bool,
+    /// Largest displacement of a mass over the last window, m.
+    pub drift: f64,
+    /// The settled threshold, m.
+    pub drift_threshold: f64,
+    /// The window, s.
+    pub window: f64,
+    /// The damped steady shape nearest the final shape, if Newton found one.
+    pub nearest: Option<Nearest>,
+    /// Why no steady shape was found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nearest_error: Option<String>,
+    /// Wall-clock time of the run and its analysis, s.
+    pub wall_seconds: f64,
+}
+
+/// The damped steady shape nearest a point's final shape.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Nearest {
+    /// Largest distance between corresponding masses, m.
+    pub distance: f64,
+    /// Its node count.
+    pub nodes: usize,
+    /// Its tip radius, m.
+    pub tip_radius: f64,
+    /// Every damped mode decays (growth rate below 1e-6 |ω|).
+    pub stable: bool,
+    /// Largest real part of its damped spectrum, 1/s.
+    pub growth_rate: f64,
+}
+
+impl Outcome {
+    fn of(report: &ShapeReport, steps: u64, wall_seconds: f64) -> Self {
+        let (shape, settling) = (&report.shape, &report.settling);
+        let (nearest, nearest_error) = match &report.nearest {
+            Ok(n) => (
+                Some(Nearest {
+                    distance: n.distance,
+                    nodes: n.shape.nodes,
+                    tip_radius: n.shape.tip_radius,
+                    stable: n.stable,
+                    growth_rate: n.growth_rate,
+                }),
+                None,
+            ),
+            Err(e) => (None, Some(e.to_string())),
+        };
+        Self {
+            t: report.t,
+            steps,
+            nodes: shape.nodes,
+            axis_crossings: shape.axis_crossings,
+            tip_radius: shape.tip_radius,
+            tip_signed: shape.tip_radius.copysign(*shape.radial.last().unwrap_or(&0.0)),
+            plane_azimuth: shape.plane_azimuth,
+            out_of_plane: shape.out_of_plane,
+            settled: settling.settled,
+            drift: settling.drift,
+            drift_threshold: settling.threshold,
+            window: settling.window,
+            nearest,
+            nearest_error,
+            wall_seconds,
+        }
+    }
+}
+
+/// Why a run did not finish.
+enum Stop {
+    /// Ctrl-C.
+    Interrupted,
+    /// A step or the analysis failed.
+    Failed(String),
+}
+
+/// A sweep set up to run: its configuration and points, where to write, how many threads.
+pub struct Sweep {
+    config: SweepConfig,
+    derived: Derived,
+    chain: Chain<Dyn>,
+    out: PathBuf,
+    jobs: usize,
+    quiet: bool,
+    /// Every point and kind, in the order of the files.
+    points: Vec<Point>,
+    /// The independent points (sudden, ramp-up), indices into `points`.
+    singles: Vec<usize>,
+    /// The ramp-down points in the order they run (decreasing ω).
+    down: Vec<usize>,
+    started: Instant,
+}
+
+impl Sweep {
+    /// The points of `config`: per kind (in the order given) sudden and ramp-up at the
+    /// speeds in the order given, ramp-down in decreasing ω.
+    pub fn new(config: SweepConfig, out: PathBuf, jobs: usize, quiet: bool) -> CliResult<Self> {
+        let derived = config.derived()?;
+        let chain = config.damped_chain()?;
+        let scale = config.reference_speed();
+        let point = |kind, omega: f64, ramp_from, start: String| Point {
+            kind,
+            omega,
+            omega_scaled: omega / scale,
+            ramp_from,
+            start,
+            status: Status::Pending,
+            error: None,
+            result: None,
+        };
+        let hanging = || "hanging at rest".to_string();
+        let (mut points, mut singles, mut down) = (Vec::new(), Vec::new(), Vec::new());
+        for &kind in &config.kinds {
+            match kind {
+                SweepKind::Sudden | SweepKind::RampUp => {
+                    for &w in &config.omegas {
+                        singles.push(points.len());
+                        let from = (kind == SweepKind::RampUp).then_some(0.0);
+                        points.push(point(kind, w, from, hanging()));
+                    }
+                }
+                SweepKind::RampDown => {
+                    let mut order = config.omegas.clone();
+                    order.sort_by(|a, b| b.total_cmp(a));
+                    let mut previous: Option<f64> = None;
+                    for &w in &order {
+                        down.push(points.len());
+                        let start = match previous {
+                            None => hanging(),
+                            Some(p) => format!("the final state of the ramp-down point at ω = {p} rad/s"),
+                        };
+                        points.push(point(kind, w, Some(previous.unwrap_or(0.0)), start));
+                        previous = Some(w);
+                    }
+                }
+            }
+        }
+        Ok(Self { config, derived, chain, out, jobs, quiet, points, singles, down, started: Instant::now() })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SweepConfig {
+        &self.config
+    }
+
+    fn file(&self, points: &[Point]) -> SweepFile {
+        SweepFile::new(self.config.clone(), self.derived.clone(), points.to_vec())
+    }
+
+    /// Runs every point on `jobs` threads, sweep.json written before and rewritten after
+    /// each point; returns the points, each completed, interrupted, not run or failed.
+    pub fn run(&self) -> CliResult<Vec<Point>> {
+        let json = self.out.join("sweep.json");
+        self.file(&self.points).write_atomic(&json)?;
+        let c = &self.config;
+        if !self.quiet {
+            let (speeds, kinds) = (c.omegas.len(), c.kinds.len());
+            eprintln!(
+                "pendulum: sweep of {speeds} speed{} × {kinds} kind{} = {} runs of {} s each \
+                 (RK4 + projection, h = {} s, {} steps) on {} thread{}{}",
+                if speeds == 1 { "" } else { "s" },
+                if kinds == 1 { "" } else { "s" },
+                self.points.len(),
+                c.duration,
+                c.step,
+                self.derived.steps_per_point,
+                self.jobs,
+                if self.jobs == 1 { "" } else { "s" },
+                if self.down.is_empty() { "" } else { "; the ramp-down points run one after the other" },
+            );
+        }
+        let shared = Mutex::new(Shared { points: self.points.clone(), finished: 0, error: None });
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.jobs)
+            .build()
+            .map_err(|e| CliError::failed(format!("cannot start {} threads: {e}", self.jobs)))?;
+        pool.scope_fifo(|s| {
+            // The sequential chain first: it is the longest task.
+            if !self.down.is_empty() {
+                s.spawn_fifo(|_| self.run_down(&shared));
+            }
+            for &i in &self.singles {
+                let shared = &shared;
+                s.spawn_fifo(move |_| {
+                    if INTERRUPTED.load(Ordering::SeqCst) {
+                        return;
+                    }
+                    let p = &self.points[i];
+                    let drive = match p.ramp_from {
+                        None => DriveConfig::Circle { radius: c.radius, omega: p.omega },
+                        Some(from) => self.ramp(from, p.omega),
+                    };
+                    let ended = self.run_point(&drive, None).map(|(outcome, _)| outcome);
+                    self.record(shared, i, ended);
+                });
+            }
+        });
+        let mut shared = shared.into_inner().map_err(|_| CliError::failed("a run panicked"))?;
+        for p in &mut shared.points {
+            if p.status == Status::Pending {
+                p.status = Status::NotRun;
+            }
+        }
+        if let Some(e) = shared.error {
+            return Err(e);
+        }
+        self.file(&shared.points).write_atomic(&json)?;
+        Ok(shared.points)
+    }
+
+    /// The ramp from `from` to `omega` (rad/s) over the ramp time.
+    fn ramp(&self, from: f64, omega: f64) -> DriveConfig {
+        let c = &self.config;
+        DriveConfig::RampedCircle {
+            radius: c.radius,
+            initial_omega: from,
+            omega,
+            duration: c.ramp_time.unwrap_or(c.duration / 3.0),
+        }
+    }
+
+    /// The ramp-down points, each from the previous one's final state.
+    fn run_down(&self, shared: &Mutex<Shared>) {
+        let mut previous: Option<(f64, DVector<f64>)> = None;
+        for &i in &self.down {
+            if INTERRUPTED.load(Ordering::SeqCst) {
+                return;
+            }
+            let omega = self.points[i].omega;
+            let (from, start) = match &previous {
+                None => (0.0, None),
+                Some((w, x)) => (*w, Some(x.clone())),
+            };
+            match self.run_point(&self.ramp(from, omega), start) {
+                Ok((outcome, last)) => {
+                    self.record(shared, i, Ok(outcome));
+                    previous = Some((omega, last));
+                }
+                Err(stop) => {
+                    let failed = matches!(stop, Stop::Failed(_));
+                    self.record(shared, i, Err(stop));
+                    if failed {
+                        let mut s = shared.lock().unwrap_or_else(|e| e.into_inner());
+                        for &j in &self.down {
+                            if s.points[j].status == Status::Pending {
+                                s.points[j].error = Some("an earlier ramp-down point failed".into());
+                            }
+                        }
+                    }
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Runs one point with `drive` from `start` (default: hanging at rest); returns the
+    /// outcome and the final state turned about the axis so that the pivot is at phase 0
+    /// (the next ramp-down point's start: its drive starts there).
+    fn run_point(
+        &self,
+        drive: &DriveConfig,
+        start: Option<DVector<f64>>,
+    ) -> Result<(Outcome, DVector<f64>), Stop> {
+        let clock = Instant::now();
+        let c = &self.config;
+        let failed = |e: &dyn std::fmt::Display| Stop::Failed(e.to_string());
+        let turning =
+            turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
+        let model = Directions::<U3>::new(self.chain.clone()).with_drive(turning);
+        let x0 = match start {
+            Some(x) => x,
+            None => model.hanging(),
+        };
+        let options = ShapeOptions {
+            periods: c.settle_periods,
+            tolerance: c.settle_tolerance,
+            ..ShapeOptions::default()
+        };
+        let mut tracker = ShapeTracker::new(&model, options).map_err(|e| failed(&e))?;
+        let mut solver = Projected::new(Rk4::new(&model));
+        let mut state = State::new(0.0, x0);
+        let mut push_error = None;
+        let summary =
+            trajectory::run(&mut solver, &model, &mut state, c.duration, c.step, c.feed_every, |t, x| {
+                if let Err(e) = tracker.push(t, x) {
+                    push_error = Some(e);
+                    return ControlFlow::Break(());
+                }
+                if INTERRUPTED.load(Ordering::Relaxed) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })
+            .map_err(|e| failed(&e))?;
+        if let Some(e) = push_error {
+            return Err(Stop::Failed(format!("shape analysis: {e}")));
+        }
+        if summary.stopped_early {
+            return Err(Stop::Interrupted);
+        }
+        let report = tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
+        let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64());
+        let phase = model.drive().phase(state.t());
+        Ok((outcome, turned(state.x(), -phase)))
+    }
+
+    /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
+    fn record(&self, shared: &Mutex<Shared>, i: usize, ended: Result<Outcome, Stop>) {
+        let mut s = shared.lock().unwrap_or_else(|e| e.into_inner());
+        let point = &mut s.points[i];
+        match ended {
+            Ok(outcome) => {
+                point.status = Status::Completed;
+                point.result = Some(outcome);
+            }
+            Err(Stop::Interrupted) => point.status = Status::Interrupted,
+            Err(Stop::Failed(e)) => {
+                point.status = Status::Failed;
+                point.error = Some(e);
+            }
+        }
+        s.finished += 1;
+        if !self.quiet {
+            let elapsed = self.started.elapsed().as_secs_f64();
+            eprintln!(
+                "pendulum: [{}/{}] {} ({elapsed:.0} s elapsed)",
+                s.finished,
+                self.points.len(),
+                progress_line(&s.points[i])
+            );
+        }
+        if s.error.is_none()
+            && let Err(e) = self.file(&s.points).write_atomic(&self.out.join("sweep.json"))
+        {
+            s.error = Some(e);
+        }
+    }
+
+    /// After the files are written: the final sweep.json, the closing line, and the
+    /// error for an interrupted (exit 130) or failed (exit 1) sweep.
+    pub fn conclude(&self, points: &[Point]) -> CliResult<()> {
+        let count = |s: Status| points.iter().filter(|p| p.status == s).count();
+        let (done, failed) = (count(Status::Completed), count(Status::Failed));
+        let cut = count(Status::Interrupted) + count(Status::NotRun);
+        let interrupted = cut > 0 && INTERRUPTED.load(Ordering::SeqCst);
+        let mut file = self.file(points);
+        file.status = if interrupted {
+            "interrupted"
+        } else if failed > 0 {
+            "failed"
+        } else {
+            "completed"
+        }
+        .into();
+        file.write_atomic(&self.out.join("sweep.json"))?;
+        let total = points.len();
+        let dir = self.out.display();
+        if !self.quiet {
+            eprintln!(
+                "pendulum: {done} of {total} points done in {:.1} s on {} thread{}; files in {dir} \
+                 (sweep.csv, sweep.json, sweep.png)",
+                self.started.elapsed().as_secs_f64(),
+                self.jobs,
+                if self.jobs == 1 { "" } else { "s" }
+            );
+        }
+        if interrupted {
+            return Err(CliError::interrupted(format!(
+                "interrupted: {done} of {total} points finished; {dir} holds them (sweep.csv, sweep.json, \
+                 sweep.png; the {cut} unfinished are marked interrupted or not-run)"
+            )));
+        }
+        if let Some(p) = points.iter().find(|p| p.status == Status::Failed) {
+            return Err(CliError::failed(format!(
+                "{failed} of {total} points failed (first: {} at ω = {} rad/s: {}); files in {dir} hold the others",
+                p.kind.name(),
+                p.omega,
+                p.error.as_deref().unwrap_or("unknown error")
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// What the threads share.
+struct Shared {
+    points: Vec<Point>,
+    finished: usize,
+    /// The first failure to write sweep.json.
+    error: Option<CliError>,
+}
+
+/// The state `x = (u_1..u_n, w_1..w_n)` turned by `angle` (rad) about the z axis.
+fn turned(x: &DVector<f64>, angle: f64) -> DVector<f64> {
+    let (s, c) = angle.sin_cos();
+    let mut y = x.clone();
+    for k in 0..x.len() / 3 {
+        let (a, b) = (x[3 * k], x[3 * k + 1]);
+        y[3 * k] = c * a - s * b;
+        y[3 * k + 1] = s * a + c * b;
+    }
+    y
+}
+
+/// `1 node`, `3 nodes`.
+pub fn nodes_name(k: usize) -> String {
+    format!("{k} node{}", if k == 1 { "" } else { "s" })
+}
+
+/// One line about a finished point: kind, speed, nodes, tip radius, settled, nearest.
+fn progress_line(p: &Point) -> String {
+    let head = format!("{} ω = {:.4} rad/s ({:.3} √(g/L))", p.kind.name(), p.omega, p.omega_scaled);
+    match (&p.result, p.status) {
+        (Some(r), _) => {
+            let settled = if r.settled { "settled" } else { "not settled" };
+            let nearest = match &r.nearest {
+                Some(n) => format!(
+                    "nearest steady shape {:.1e} m away, {}, {}",
+                    n.distance,
+                    nodes_name(n.nodes),
+                    if n.stable { "stable" } else { "unstable" }
+                ),
+                None => "no steady shape found nearby".into(),
+            };
+            format!(
+                "{head}: {}, tip radius {:.4} m, {settled} (drift {:.1e} m); {nearest}; {:.1} s",
+                nodes_name(r.nodes),
+                r.tip_radius,
+                r.drift,
+                r.wall_seconds
+            )
+        }
+        (None, status) => match &p.error {
+            Some(e) => format!("{head}: {}: {e}", status.name()),
+            None => format!("{head}: {}", status.name()),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turning_a_state_turns_every_vector_about_z() {
+        let x = DVector::from_vec(vec![1.0, 0.0, -1.0, 0.0, 2.0, 0.5]);
+        let y = turned(&x, std::f64::consts::FRAC_PI_2);
+        let expected = [0.0, 1.0, -1.0, -2.0, 0.0, 0.5];
+        for (a, b) in y.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-15, "{y:?}");
+        }
+    }
+}
