@@ -60,5 +60,11 @@ pendulum simulate $whirl --omega 5 --ramp-time 150 --end 400 --out "$runs/ramp-5
 cp "$runs/ramp-5/shape.png" "$gallery/whirl-5-ramp-shape.png"
 pendulum render "$runs/ramp-5" --view co-rotating --from 0 --to 250 --speed 10 --frames 250 \
     --out "$gallery/whirl-5-ramp-co-rotating.gif" --quiet
+# The chain's choice against ω: 20 links, 24 speeds, three kinds of experiment (about 20 s
+# with 2 cores).
+pendulum sweep --n 20 --lengths 0.05 --masses 0.05 --radius 0.02 --damping 5.6237e-4 \
+    --omega 0.5:5:24 --scaled --kind sudden,ramp-up,ramp-down --duration 600 --ramp-time 200 \
+    --out "$runs/sweep" --quiet > "$runs/sweep.txt"
+cp "$runs/sweep/sweep.png" "$gallery/sweep.png"
 cat "$runs"/whirl-3.txt "$runs"/whirl-6.txt "$runs"/whirl-11.txt "$runs"/sudden-5.txt "$runs"/ramp-5.txt
 ls -l "$gallery"

@@ -294,7 +294,9 @@ pub struct Physics {
     pub end: f64,
     /// Initial state: hanging, horizontal, tilted:ANGLE (rad, every link, toward +x), a
     /// previous run's final state (its directory or its final.json: continue exactly
-    /// where it ended, 3D in unit directions), or a file of numbers: 2D θ_1..θ_n then
+    /// where it ended, 3D in unit directions; with a circling pivot, whose phase restarts
+    /// at 0, turned about the vertical to keep its place relative to the pivot), or a
+    /// file of numbers: 2D θ_1..θ_n then
     /// θ̇_1..θ̇_n; 3D θ_1..θ_n, φ_1..φ_n, θ̇_1..θ̇_n, φ̇_1..φ̇_n.
     #[arg(long, value_name = "SPEC", default_value = "tilted:1.0")]
     pub initial: InitialSpec,

@@ -301,7 +301,7 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
                     directions: None,
                 },
                 Dimension::Three => {
-                    let directions = state.coordinates.into_iter().chain(state.rates).collect();
+                    let directions = state.start();
                     InitialConfig {
                         spec: spec.to_string(),
                         coordinates: vec![],

@@ -36,12 +36,18 @@ pub struct FinalState {
     pub coordinates: Vec<f64>,
     /// 2D `θ̇_1..θ̇_n`; 3D `w_1..w_n`.
     pub rates: Vec<f64>,
+    /// 3D with a pivot circling the vertical (circle drive, steady or ramped): its azimuth
+    /// `φ` at `t`, rad. A run that continues from this state starts its drive at phase 0,
+    /// so it turns the state by `−φ` about the vertical: the chain keeps its place relative
+    /// to the pivot.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pivot_phase: Option<f64>,
 }
 
 impl FinalState {
     /// The final state of a run of `links` links in `dim` at time `t`, from the motion's
     /// state (coordinates, then rates).
-    pub fn new(dim: Dimension, links: usize, t: f64, motion: &[f64]) -> Self {
+    pub fn new(dim: Dimension, links: usize, t: f64, motion: &[f64], pivot_phase: Option<f64>) -> Self {
         let half = motion.len() / 2;
         Self {
             program: "pendulum".into(),
@@ -52,6 +58,17 @@ impl FinalState {
             representation: representation(dim).into(),
             coordinates: motion[..half].to_vec(),
             rates: motion[half..].to_vec(),
+            pivot_phase,
+        }
+    }
+
+    /// The state a continuing run starts from: coordinates then rates, in 3D turned by
+    /// `−pivot_phase` about the vertical when the pivot circled ([`turned_about_vertical`]).
+    pub fn start(&self) -> Vec<f64> {
+        let state: Vec<f64> = self.coordinates.iter().chain(&self.rates).copied().collect();
+        match (self.dim, self.pivot_phase) {
+            (Dimension::Three, Some(phase)) => turned_about_vertical(&state, -phase),
+            _ => state,
         }
     }
 
@@ -109,6 +126,19 @@ impl FinalState {
             .and_then(|()| f.write_all(b"\n"))
             .map_err(|e| io_failed("write", &path, e))
     }
+}
+
+/// A 3D state `(u_1..u_n, w_1..w_n)` (3 components each) turned by `angle` (rad) about
+/// the vertical z axis.
+pub fn turned_about_vertical(x: &[f64], angle: f64) -> Vec<f64> {
+    let (s, c) = angle.sin_cos();
+    let mut y = x.to_vec();
+    for k in 0..x.len() / 3 {
+        let (a, b) = (x[3 * k], x[3 * k + 1]);
+        y[3 * k] = c * a - s * b;
+        y[3 * k + 1] = s * a + c * b;
+    }
+    y
 }
 
 fn representation(dim: Dimension) -> &'static str {

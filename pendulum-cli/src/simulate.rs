@@ -201,7 +201,8 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
         images.extend([energy_png, gif]);
     }
     let motion = &state.x().as_slice()[..system.motion_len()];
-    FinalState::new(config.dim, n, state.t(), motion).write(out)?;
+    let phase = whirl.as_ref().map(|w| w.phase(state.t()));
+    FinalState::new(config.dim, n, state.t(), motion, phase).write(out)?;
     // A whirled chain: its shape in the turning frame, in the user's terms (stdout).
     if let Some(tracker) = &tracker {
         tracker.finish(out, options.plots)?;

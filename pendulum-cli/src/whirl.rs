@@ -31,6 +31,11 @@ impl Whirl {
         Ok(Some(Self { model: Directions::<U3>::new(chain(config)?).with_drive(drive) }))
     }
 
+    /// The circling pivot's azimuth at `t`, rad.
+    pub fn phase(&self, t: f64) -> f64 {
+        self.model.drive().phase(t)
+    }
+
     /// A tracker of the co-rotating shape with the default options (settled: drift
     /// ≤ 1e-3 L over the last 5 drive periods).
     pub fn tracker(&self) -> CliResult<Tracker<'_>> {

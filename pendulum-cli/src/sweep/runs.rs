@@ -20,6 +20,7 @@ use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
 use crate::config::DriveConfig;
 use crate::error::{CliError, CliResult};
+use crate::final_state::turned_about_vertical;
 use crate::models::turning_drive;
 use crate::simulate::INTERRUPTED;
 
@@ -402,7 +403,7 @@ impl Sweep {
         let report = tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
         let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64());
         let phase = model.drive().phase(state.t());
-        Ok((outcome, turned(state.x(), -phase)))
+        Ok((outcome, DVector::from_vec(turned_about_vertical(state.x().as_slice(), -phase))))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
@@ -489,18 +490,6 @@ struct Shared {
     finished: usize,
     /// The first failure to write sweep.json.
     error: Option<CliError>,
-}
-
-/// The state `x = (u_1..u_n, w_1..w_n)` turned by `angle` (rad) about the z axis.
-fn turned(x: &DVector<f64>, angle: f64) -> DVector<f64> {
-    let (s, c) = angle.sin_cos();
-    let mut y = x.clone();
-    for k in 0..x.len() / 3 {
-        let (a, b) = (x[3 * k], x[3 * k + 1]);
-        y[3 * k] = c * a - s * b;
-        y[3 * k + 1] = s * a + c * b;
-    }
-    y
 }
 
 /// `1 node`, `3 nodes`.
