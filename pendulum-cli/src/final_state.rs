@@ -2,13 +2,13 @@
 //! (`--initial RUN_DIR` or `--initial RUN_DIR/final.json`) and continue, ramp down or
 //! sweep on.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use crate::args::Dimension;
-use crate::error::{CliError, CliResult, io_failed};
+use crate::config::write_json_atomic;
+use crate::error::{CliError, CliResult};
 
 /// The file name a run writes its final state to.
 pub const FILE_NAME: &str = "final.json";
@@ -119,12 +119,7 @@ impl FinalState {
 
     /// Writes the file into `dir`.
     pub fn write(&self, dir: &Path) -> CliResult<()> {
-        let path = dir.join(FILE_NAME);
-        let text = serde_json::to_string_pretty(self).map_err(|e| CliError::failed(e.to_string()))?;
-        let mut f = std::fs::File::create(&path).map_err(|e| io_failed("create", &path, e))?;
-        f.write_all(text.as_bytes())
-            .and_then(|()| f.write_all(b"\n"))
-            .map_err(|e| io_failed("write", &path, e))
+        write_json_atomic(&dir.join(FILE_NAME), self)
     }
 }
 
@@ -143,4 +138,19 @@ pub fn turned_about_vertical(x: &[f64], angle: f64) -> Vec<f64> {
 
 fn representation(dim: Dimension) -> &'static str {
     if dim == Dimension::Two { "angles" } else { "directions" }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turning_a_state_turns_every_vector_about_z() {
+        let x = [1.0, 0.0, -1.0, 0.0, 2.0, 0.5];
+        let y = turned_about_vertical(&x, std::f64::consts::FRAC_PI_2);
+        let expected = [0.0, 1.0, -1.0, -2.0, 0.0, 0.5];
+        for (a, b) in y.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-15, "{y:?}");
+        }
+    }
 }

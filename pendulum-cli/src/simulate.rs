@@ -10,13 +10,13 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_core::integrate::State;
-use pendulum_core::trajectory;
+use pendulum_core::{fastest_frequency_bound, trajectory};
 
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
 use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
-use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
+use crate::models::{AnySimulation, Motion, Sample, Simulation, build, chain};
 use crate::plot;
 use crate::render;
 use crate::whirl::Whirl;
@@ -286,13 +286,10 @@ fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
     format!(" ({cause}: try --step {suggested:.1e}{other})")
 }
 
-/// An estimate of the chain's fastest angular frequency (rad/s): the largest
-/// `√(2 (T_i/l_i + T_{i+1}/l_{i+1}) / m_i)` with the tensions of the hanging chain
-/// `T_i = M_i (g + a_drive)` (`M_i` the tail mass, `a_drive` the drive's largest
-/// acceleration), a Gershgorin bound of the tension-stiffness matrix that is exact for
-/// the uniform chain's `2n √(g/L)` at large n.
+/// The chain's fastest angular frequency (rad/s), [`fastest_frequency_bound`] with the
+/// drive's largest acceleration added to gravity; `0` if the chain is invalid (the run
+/// would not have started).
 fn fastest_mode(config: &RunConfig) -> f64 {
-    let n = config.links();
     let accel = match &config.drive {
         DriveConfig::Fixed => 0.0,
         DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
@@ -301,13 +298,7 @@ fn fastest_mode(config: &RunConfig) -> f64 {
             radius * initial_omega.abs().max(omega.abs()).powi(2)
         }
     };
-    let g = config.gravity + accel;
-    let mut tail = vec![0.0; n + 1];
-    for i in (0..n).rev() {
-        tail[i] = tail[i + 1] + config.masses[i];
-    }
-    let stiffness = |i: usize| if i < n { tail[i] * g / config.lengths[i] } else { 0.0 };
-    (0..n).map(|i| (2.0 * (stiffness(i) + stiffness(i + 1)) / config.masses[i]).sqrt()).fold(0.0, f64::max)
+    chain(config).map_or(0.0, |c| fastest_frequency_bound(&c, config.gravity + accel))
 }
 
 /// The drive's angular frequency (rad/s), if it has one.

@@ -10,8 +10,8 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use crate::args::Dimension;
-use crate::config::RunConfig;
-use crate::error::{CliError, CliResult, io_failed};
+use crate::config::{RunConfig, write_json_atomic};
+use crate::error::{CliError, CliResult};
 use crate::models::{chain, turning_drive};
 use crate::plot::{drawing_failed, fonts};
 
@@ -162,8 +162,7 @@ fn write_json(path: &Path, r: &ShapeReport) -> CliResult<()> {
         "shape": shape_json(&r.shape),
         "nearest": nearest,
     });
-    let text = serde_json::to_string_pretty(&value).map_err(|e| CliError::failed(e.to_string()))?;
-    std::fs::write(path, text + "\n").map_err(|e| io_failed("write", path, e))
+    write_json_atomic(path, &value)
 }
 
 /// Where the signed radial coordinate changes sign between masses `i` and `i + 1`: the

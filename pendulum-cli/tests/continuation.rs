@@ -99,20 +99,46 @@ fn a_whirl_continues_where_it_was_relative_to_its_pivot() {
     // the vertical, so the shape in the turning frame carries on: 1 s + 1 s against 2 s.
     let dir = scratch("continuation-whirl");
     let chain = ["simulate", "--dim", "3", "--n", "4", "--initial", "tilted:0.3", "--drive", "circle"];
-    let run = ["--radius", "0.05", "--omega", "4", "--integrator", "rk4", "--step", "0.002", "--no-plots", "--quiet"];
+    let run = [
+        "--radius",
+        "0.05",
+        "--omega",
+        "4",
+        "--integrator",
+        "rk4",
+        "--step",
+        "0.002",
+        "--no-plots",
+        "--quiet",
+    ];
     for (extra, out) in [(&["--end", "2"][..], "whole"), (&["--end", "1"][..], "first")] {
         let o = run_in(&dir, &[&chain[..], &run[..], extra, &["--out", out]].concat());
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let phase = final_state(&dir.join("first"))["pivot_phase"].as_f64().unwrap();
     assert!((phase - 4.0).abs() < 1e-12, "φ(1 s) = {phase}");
-    let rest = ["simulate", "--dim", "3", "--n", "4", "--initial", "first", "--drive", "circle", "--end", "1", "--out", "second"];
+    let rest = [
+        "simulate",
+        "--dim",
+        "3",
+        "--n",
+        "4",
+        "--initial",
+        "first",
+        "--drive",
+        "circle",
+        "--end",
+        "1",
+        "--out",
+        "second",
+    ];
     let o = run_in(&dir, &[&rest[..], &run[..]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
     let shape = |run: &str| -> Vec<f64> {
         let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join(run).join("shape.json")).unwrap()).unwrap();
-        v["shape"]["positions"].as_array().unwrap().iter().flat_map(|p| numbers_of(p)).collect()
+            serde_json::from_str(&std::fs::read_to_string(dir.join(run).join("shape.json")).unwrap())
+                .unwrap();
+        v["shape"]["positions"].as_array().unwrap().iter().flat_map(numbers_of).collect()
     };
     let (a, b) = (shape("whole"), shape("second"));
     let worst = a.iter().zip(&b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);

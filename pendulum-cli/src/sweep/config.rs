@@ -3,16 +3,16 @@
 //! chain's fastest mode), the `--omega` list or range, and sweep.json itself
 //! ([`SweepFile`]: the parameters, derived numbers and every point's result so far).
 
-use std::io::Write;
 use std::path::Path;
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, SteadyRotation, normal_modes};
+use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, fastest_frequency_bound, normal_modes};
 use serde::{Deserialize, Serialize};
 
 use super::runs::Point;
 use super::{SweepKind, SweepPhysics};
-use crate::error::{CliError, CliResult, io_failed};
+use crate::config::write_json_atomic;
+use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
 use crate::steady::round_up;
 
@@ -379,19 +379,11 @@ fn default_duration(chain: &Chain<Dyn>) -> f64 {
 /// The step `pendulum simulate` suggests for this chain on a circle of `radius` turning at
 /// up to `omega` (rad/s), `0.5 / ω_fastest`, at most a fortieth of the drive period, and
 /// here also at most `1 / ν_fastest` (RK4 is stable to `h ν ≈ 2.8` on decaying modes);
-/// rounded down to two digits. `ω_fastest` is the largest
-/// `√(2 (T_i/l_i + T_{i+1}/l_{i+1}) / m_i)`, the tensions of the hanging chain
-/// `T_i = M_i (g + R ω²)` (`M_i` the tail mass): a Gershgorin bound of the
-/// tension-stiffness matrix, `2n √(g/L)` for a long uniform chain; `ν_fastest`, the same
-/// bound of the damping's, the largest `2 (λ_i/l_i² + λ_{i+1}/l_{i+1}²) / m_i`.
+/// rounded down to two digits; `ω_fastest` with `g_eff = g + R ω²`
+/// ([`fastest_frequency_bound`]), `ν_fastest` [`fastest_decay_bound`].
 fn default_step(chain: &Chain<Dyn>, radius: f64, omega: f64) -> f64 {
-    let g = chain.gravity() + radius * omega * omega;
-    let (m, l, tail) = (chain.masses(), chain.lengths(), chain.tail_masses());
-    let n = chain.links();
-    let stiffness = |i: usize| if i < n { tail[i] * g / l[i] } else { 0.0 };
-    let fastest = (0..n).map(|i| (2.0 * (stiffness(i) + stiffness(i + 1)) / m[i]).sqrt()).fold(0.0, f64::max);
-    let damping = |i: usize| if i < n { chain.damping()[i] / (l[i] * l[i]) } else { 0.0 };
-    let decay = (0..n).map(|i| 2.0 * (damping(i) + damping(i + 1)) / m[i]).fold(0.0, f64::max);
+    let fastest = fastest_frequency_bound(chain, chain.gravity() + radius * omega * omega);
+    let decay = fastest_decay_bound(chain);
     let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
     if decay > 0.0 {
         h = h.min(1.0 / decay);
@@ -477,16 +469,9 @@ impl SweepFile {
         Ok(file)
     }
 
-    /// Writes the file atomically: to `sweep.json.tmp` beside it, then renamed over `path`.
+    /// Writes the file atomically ([`write_json_atomic`]).
     pub fn write_atomic(&self, path: &Path) -> CliResult<()> {
-        let tmp = path.with_extension("json.tmp");
-        let text = serde_json::to_string_pretty(self).map_err(|e| CliError::failed(e.to_string()))?;
-        let mut f = std::fs::File::create(&tmp).map_err(|e| io_failed("create", &tmp, e))?;
-        f.write_all(text.as_bytes())
-            .and_then(|()| f.write_all(b"\n"))
-            .map_err(|e| io_failed("write", &tmp, e))?;
-        f.sync_all().map_err(|e| io_failed("sync", &tmp, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| io_failed("rename into", path, e))
+        write_json_atomic(path, self)
     }
 }
 

@@ -526,18 +526,3 @@ fn progress_line(p: &Point) -> String {
         },
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn turning_a_state_turns_every_vector_about_z() {
-        let x = DVector::from_vec(vec![1.0, 0.0, -1.0, 0.0, 2.0, 0.5]);
-        let y = turned(&x, std::f64::consts::FRAC_PI_2);
-        let expected = [0.0, 1.0, -1.0, -2.0, 0.0, 0.5];
-        for (a, b) in y.iter().zip(expected) {
-            assert!((a - b).abs() < 1e-15, "{y:?}");
-        }
-    }
-}

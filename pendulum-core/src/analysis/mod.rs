@@ -15,7 +15,10 @@ pub(crate) mod stability;
 pub(crate) mod steady_branches;
 
 pub use bessel::bessel_j0_zero;
-pub use modes::{NormalModes, bernoulli_frequency, normal_modes, sign_changes};
+pub use modes::{
+    NormalModes, bernoulli_frequency, fastest_decay_bound, fastest_frequency_bound, normal_modes,
+    sign_changes,
+};
 pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
 pub use shape::{
     NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,

@@ -155,6 +155,34 @@ pub fn bernoulli_frequency(k: usize, gravity: f64, length: f64) -> f64 {
     0.5 * bessel_j0_zero(k) * (gravity / length).sqrt()
 }
 
+/// An estimate of a chain's fastest angular frequency (rad/s) about the hanging rest under
+/// the effective gravity `g_eff` (m/s²: `g` plus what a drive adds, e.g. `R ω²` on a
+/// circle): the largest `√(2 (T_i/l_i + T_{i+1}/l_{i+1}) / m_i)` with the hanging tensions
+/// `T_i = M_i g_eff` (`M_i` the tail mass, eq 10; `T_{n+1} = 0`), a Gershgorin bound of the
+/// tension-stiffness matrix; `2n √(g/L)` for a long uniform chain. What limits an
+/// explicit step (RK4: `h ω ≲ 2.8`) and a fixed-point stage solve (`h ω ≲ 1`).
+pub fn fastest_frequency_bound<L: Dim>(chain: &Chain<L>, effective_gravity: f64) -> f64
+where
+    DefaultAllocator: Allocator<L>,
+{
+    let (m, l, tail) = (chain.masses(), chain.lengths(), chain.tail_masses());
+    let n = chain.links();
+    let stiffness = |i: usize| if i < n { tail[i] * effective_gravity / l[i] } else { 0.0 };
+    (0..n).map(|i| (2.0 * (stiffness(i) + stiffness(i + 1)) / m[i]).sqrt()).fold(0.0, f64::max)
+}
+
+/// The same bound for the damping (1/s): the largest `2 (λ_i/l_i² + λ_{i+1}/l_{i+1}²) / m_i`,
+/// the fastest decay rate; RK4 is stable to `h ν ≈ 2.8` on decaying modes.
+pub fn fastest_decay_bound<L: Dim>(chain: &Chain<L>) -> f64
+where
+    DefaultAllocator: Allocator<L>,
+{
+    let (m, l, lambda) = (chain.masses(), chain.lengths(), chain.damping());
+    let n = chain.links();
+    let damping = |i: usize| if i < n { lambda[i] / (l[i] * l[i]) } else { 0.0 };
+    (0..n).map(|i| 2.0 * (damping(i) + damping(i + 1)) / m[i]).fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
