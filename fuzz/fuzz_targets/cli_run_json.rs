@@ -16,6 +16,9 @@ mod error;
 #[path = "../../pendulum-cli/src/final_state.rs"]
 mod final_state;
 #[allow(dead_code)]
+#[path = "../../pendulum-cli/src/json_file.rs"]
+mod json_file;
+#[allow(dead_code)]
 #[path = "../../pendulum-cli/src/spec.rs"]
 mod spec;
 

@@ -1,14 +1,14 @@
 //! The resolved parameters of a run: built from the command line, written to `run.json`
 //! (atomically) and read back by `pendulum simulate --from run.json`.
 
-use std::io::Write;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use crate::args::{Dimension, DriveKind, IntegratorKind, Physics, StageSolver, View};
-use crate::error::{CliError, CliResult, io_failed};
+use crate::error::{CliError, CliResult};
 use crate::final_state::FinalState;
+use crate::json_file::write_json_atomic;
 use crate::spec::{InitialSpec, expand, per_link, read_numbers};
 
 /// The pivot's motion, with every parameter.
@@ -389,21 +389,8 @@ impl RunFile {
         Ok(file)
     }
 
-    /// Writes the file atomically ([`write_json_atomic`]).
+    /// Writes the file atomically ([`write_json_atomic`](crate::json_file::write_json_atomic)).
     pub fn write_atomic(&self, path: &Path) -> CliResult<()> {
         write_json_atomic(path, self)
     }
-}
-
-/// Writes `value` as pretty JSON atomically: to `NAME.json.tmp` beside `path`, flushed and
-/// synced, then renamed over `path`, so a reader sees the old or the new file, never half.
-pub fn write_json_atomic<T: Serialize + ?Sized>(path: &Path, value: &T) -> CliResult<()> {
-    let tmp = path.with_extension("json.tmp");
-    let text = serde_json::to_string_pretty(value).map_err(|e| CliError::failed(e.to_string()))?;
-    let mut f = std::fs::File::create(&tmp).map_err(|e| io_failed("create", &tmp, e))?;
-    f.write_all(text.as_bytes())
-        .and_then(|()| f.write_all(b"\n"))
-        .map_err(|e| io_failed("write", &tmp, e))?;
-    f.sync_all().map_err(|e| io_failed("sync", &tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| io_failed("rename into", path, e))
 }

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::args::Dimension;
-use crate::config::write_json_atomic;
 use crate::error::{CliError, CliResult};
+use crate::json_file::write_json_atomic;
 
 /// The file name a run writes its final state to.
 pub const FILE_NAME: &str = "final.json";

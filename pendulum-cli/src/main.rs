@@ -4,10 +4,13 @@
 
 mod args;
 mod chain_args;
+mod cli;
 mod config;
 mod error;
 mod eval;
 mod final_state;
+mod interrupt;
+mod json_file;
 mod models;
 mod modes;
 mod plot;
@@ -19,12 +22,11 @@ mod sweep;
 mod whirl;
 
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
 
 use clap::Parser;
 use clap::error::ErrorKind;
 
-use args::{Cli, Command};
+use cli::{Cli, Command};
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -43,7 +45,7 @@ fn main() -> ExitCode {
     };
     let result = match &cli.command {
         Command::Simulate(args) => {
-            install_interrupt_handler();
+            interrupt::install_handler();
             // `pendulum simulate` alone: the demo.
             let demo = std::env::args_os().len() == 2;
             simulate::simulate(args, demo)
@@ -72,17 +74,4 @@ fn one_line(text: &str) -> String {
         .filter(|l| !l.is_empty())
         .collect();
     if lines.is_empty() { "error: invalid arguments".into() } else { lines.join(" ") }
-}
-
-/// Ctrl-C once: the run stops at its next sample and writes valid files. Twice: exit at
-/// once (status 130).
-fn install_interrupt_handler() {
-    let installed = ctrlc::set_handler(|| {
-        if simulate::INTERRUPTED.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    });
-    if let Err(e) = installed {
-        eprintln!("pendulum: warning: Ctrl-C will end the run without writing files ({e})");
-    }
 }

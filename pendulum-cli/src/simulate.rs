@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::{BufWriter, IsTerminal, Write};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -16,13 +16,11 @@ use crate::args::{Dimension, SimulateArgs, StageSolver, View};
 use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
+use crate::interrupt::INTERRUPTED;
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build, chain};
 use crate::plot;
 use crate::render;
 use crate::whirl::Whirl;
-
-/// Set by the Ctrl-C handler; the run stops at the next sample and writes its files.
-pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Runs `pendulum simulate`.
 pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {

@@ -10,8 +10,9 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use crate::args::Dimension;
-use crate::config::{RunConfig, write_json_atomic};
+use crate::config::RunConfig;
 use crate::error::{CliError, CliResult};
+use crate::json_file::write_json_atomic;
 use crate::models::{chain, turning_drive};
 use crate::plot::{drawing_failed, fonts};
 

@@ -9,10 +9,10 @@ use nalgebra::Dyn;
 use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, fastest_frequency_bound, normal_modes};
 use serde::{Deserialize, Serialize};
 
-use super::runs::Point;
+use super::point::Point;
 use super::{SweepKind, SweepPhysics};
-use crate::config::write_json_atomic;
 use crate::error::{CliError, CliResult};
+use crate::json_file::write_json_atomic;
 use crate::spec::{expand, per_link};
 use crate::steady::round_up;
 
@@ -469,7 +469,7 @@ impl SweepFile {
         Ok(file)
     }
 
-    /// Writes the file atomically ([`write_json_atomic`]).
+    /// Writes the file atomically ([`write_json_atomic`](crate::json_file::write_json_atomic)).
     pub fn write_atomic(&self, path: &Path) -> CliResult<()> {
         write_json_atomic(path, self)
     }

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::config::{SweepConfig, short};
-use super::runs::{Point, Status};
+use super::point::{Point, Status};
 use crate::error::{CliResult, io_failed};
 
 /// The columns of sweep.csv.

@@ -13,6 +13,7 @@
 mod config;
 mod csv;
 mod plot;
+mod point;
 mod runs;
 
 use std::path::PathBuf;
@@ -160,7 +161,7 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
-    crate::install_interrupt_handler();
+    crate::interrupt::install_handler();
     let sweep = runs::Sweep::new(config, args.out.clone(), jobs, args.quiet)?;
     let points = sweep.run()?;
     let config = sweep.config();

@@ -15,7 +15,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::SweepKind;
 use super::config::{SweepConfig, short};
-use super::runs::{Outcome, Point};
+use super::point::{Outcome, Point};
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 use crate::steady::branches::{Family, follow};
