@@ -215,7 +215,8 @@ fn animate(job: &Job) -> CliResult<Done> {
     let mut row = trajectory.row();
     let (_, step) = pendulum_core::trajectory::plan(0.0, config.end, config.step)?;
     let sample = step * config.every as f64;
-    let period = drive_period(&config.drive);
+    // In the co-rotating view the drive stands still: nothing to alias.
+    let period = if co_rotating { None } else { drive_period(&config.drive) };
     let reach: f64 = config.lengths.iter().sum();
     let slack = 1e-9 * config.end.max(1.0);
     let not_circling = |why: String| {
