@@ -7,6 +7,9 @@
 #[path = "../../pendulum-cli/src/args.rs"]
 mod args;
 #[allow(dead_code)]
+#[path = "../../pendulum-cli/src/chain_args.rs"]
+mod chain_args;
+#[allow(dead_code)]
 #[path = "../../pendulum-cli/src/config.rs"]
 mod config;
 #[allow(dead_code)]

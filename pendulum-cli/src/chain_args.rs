@@ -1,4 +1,5 @@
-//! The chain of `pendulum modes` and `pendulum steady`, built from the shared chain options.
+//! The chain the shared chain options describe (`--n --masses --lengths --gravity`), for
+//! every command that takes them.
 
 use nalgebra::Dyn;
 use pendulum_core::Chain;
@@ -9,6 +10,13 @@ use crate::spec::{expand, per_link};
 
 /// The chain the shared chain options describe (default 3 links).
 pub fn chain_of(options: &ChainOptions) -> CliResult<Chain<Dyn>> {
+    let (masses, lengths) = per_link_values(options)?;
+    Ok(Chain::<Dyn>::new(&masses, &lengths, options.gravity)?)
+}
+
+/// The masses and lengths of the shared chain options, one per link: `--n`, else the
+/// length of a `--masses` or `--lengths` list, else 3 links. Errors name the option.
+pub fn per_link_values(options: &ChainOptions) -> CliResult<(Vec<f64>, Vec<f64>)> {
     let masses = per_link("--masses", &options.masses)?;
     let lengths = per_link("--lengths", &options.lengths)?;
     let n = match options.n {
@@ -16,7 +24,5 @@ pub fn chain_of(options: &ChainOptions) -> CliResult<Chain<Dyn>> {
         Some(n) => n,
         None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
     };
-    let masses = expand("--masses", masses, n)?;
-    let lengths = expand("--lengths", lengths, n)?;
-    Ok(Chain::<Dyn>::new(&masses, &lengths, options.gravity)?)
+    Ok((expand("--masses", masses, n)?, expand("--lengths", lengths, n)?))
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::args::{Dimension, DriveKind, IntegratorKind, Physics, StageSolver, View};
+use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::final_state::FinalState;
 use crate::json_file::write_json_atomic;
@@ -111,15 +112,8 @@ impl RunConfig {
     /// Resolves the command line into a complete configuration, checking what the core
     /// does not check itself (counts, signs, combinations).
     pub fn from_args(p: &Physics, view: View, frames: usize) -> CliResult<Self> {
-        let masses = per_link("--masses", &p.chain.masses)?;
-        let lengths = per_link("--lengths", &p.chain.lengths)?;
-        let n = match p.chain.n {
-            Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
-            Some(n) => n,
-            None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
-        };
-        let masses = expand("--masses", masses, n)?;
-        let lengths = expand("--lengths", lengths, n)?;
+        let (masses, lengths) = per_link_values(&p.chain)?;
+        let n = masses.len();
         let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
         let torque = match (&p.torque, p.dim) {
             (None, Dimension::Two) => vec![0.0; n],

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::point::Point;
 use super::{SweepKind, SweepPhysics};
+use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::json_file::write_json_atomic;
 use crate::spec::{expand, per_link};
@@ -105,15 +106,8 @@ impl SweepConfig {
                 "--dim {dim}: not an option of pendulum sweep: sweeps are 3D (the pivot circles the vertical axis)"
             )));
         }
-        let masses = per_link("--masses", &p.chain.masses)?;
-        let lengths = per_link("--lengths", &p.chain.lengths)?;
-        let n = match p.chain.n {
-            Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
-            Some(n) => n,
-            None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
-        };
-        let masses = expand("--masses", masses, n)?;
-        let lengths = expand("--lengths", lengths, n)?;
+        let (masses, lengths) = per_link_values(&p.chain)?;
+        let n = masses.len();
         let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
         if !(p.chain.gravity.is_finite() && p.chain.gravity > 0.0) {
             return Err(CliError::usage(format!(
