@@ -20,3 +20,15 @@ pub fn write_json_atomic<T: Serialize + ?Sized>(path: &Path, value: &T) -> CliRe
     f.sync_all().map_err(|e| io_failed("sync", &tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| io_failed("rename into", path, e))
 }
+
+/// A warning on stderr when `path`, read to repeat a run, was written by another version
+/// of the program (`version`): the results may differ.
+pub fn warn_other_version(path: &Path, version: &str) {
+    if version != env!("CARGO_PKG_VERSION") {
+        eprintln!(
+            "pendulum: warning: {} was written by pendulum {version}, this is {}; results may differ",
+            path.display(),
+            env!("CARGO_PKG_VERSION")
+        );
+    }
+}

@@ -17,6 +17,7 @@ use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
 use crate::interrupt::INTERRUPTED;
+use crate::json_file::warn_other_version;
 use crate::models::{AnySimulation, Motion, Sample, Simulation, build, chain};
 use crate::plot;
 use crate::render;
@@ -27,13 +28,8 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
     let mut config = match &args.from {
         Some(path) => {
             let file = RunFile::read(path)?;
-            if file.version != env!("CARGO_PKG_VERSION") && !args.quiet {
-                eprintln!(
-                    "pendulum: warning: {} was written by pendulum {}, this is {}; results may differ",
-                    path.display(),
-                    file.version,
-                    env!("CARGO_PKG_VERSION")
-                );
+            if !args.quiet {
+                warn_other_version(path, &file.version);
             }
             file.config
         }

@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::args::ChainOptions;
 use crate::error::{CliError, CliResult};
+use crate::json_file::warn_other_version;
 
 use config::{SweepConfig, SweepFile};
 
@@ -141,13 +142,8 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
     let config = match &args.from {
         Some(path) => {
             let file = SweepFile::read(path)?;
-            if file.version != env!("CARGO_PKG_VERSION") && !args.quiet {
-                eprintln!(
-                    "pendulum: warning: {} was written by pendulum {}, this is {}; results may differ",
-                    path.display(),
-                    file.version,
-                    env!("CARGO_PKG_VERSION")
-                );
+            if !args.quiet {
+                warn_other_version(path, &file.version);
             }
             file.config
         }
