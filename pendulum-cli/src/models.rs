@@ -263,7 +263,8 @@ impl RunSpace for U2 {
 impl RunSpace for U3 {
     fn circle(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
         match turning_drive(config)? {
-            Some(turning) => Ok(Box::new(turning)),
+            // Upcast: the same box, not a box of a box (the drive is called at every step).
+            Some(turning) => Ok(turning),
             None => Err(CliError::usage("not a circle drive")),
         }
     }

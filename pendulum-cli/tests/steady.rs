@@ -5,54 +5,16 @@
 
 mod common;
 
-use std::path::Path;
-
 use nalgebra::{DVector, Dyn, U3};
 use pendulum_core::{
     Chain, Circle, Directions, SteadyRotation, Verdict, relative_equilibrium, relative_spectrum, stability,
 };
 
-use common::{run_in, scratch, stderr};
+use common::{Table, run_in, scratch, stderr};
 
-/// A CSV file with text columns: header and fields; panics on a ragged row.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Self {
-        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(text.ends_with('\n'), "{} does not end with a newline", path.display());
-        let mut lines = text.lines();
-        let header: Vec<String> = lines.next().expect("a header").split(',').map(String::from).collect();
-        let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(String::from).collect()).collect();
-        for (i, row) in rows.iter().enumerate() {
-            assert_eq!(row.len(), header.len(), "{} row {i}", path.display());
-        }
-        Self { header, rows }
-    }
-
-    fn index(&self, name: &str) -> usize {
-        self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"))
-    }
-
-    fn text(&self, name: &str) -> Vec<String> {
-        let j = self.index(name);
-        self.rows.iter().map(|r| r[j].clone()).collect()
-    }
-
-    fn column(&self, name: &str) -> Vec<f64> {
-        self.text(name)
-            .iter()
-            .map(|v| v.parse().unwrap_or_else(|_| panic!("{name}: bad number {v}")))
-            .collect()
-    }
-
-    /// `theta1..n` of row `i`.
-    fn theta(&self, i: usize, n: usize) -> DVector<f64> {
-        DVector::from_fn(n, |k, _| self.rows[i][self.index(&format!("theta{}", k + 1))].parse().unwrap())
-    }
+/// `theta1..n` of row `i` of a shapes or branches table.
+fn theta(table: &Table, i: usize, n: usize) -> DVector<f64> {
+    DVector::from_fn(n, |k, _| table.rows[i][table.index(&format!("theta{}", k + 1))].parse().unwrap())
 }
 
 /// Runs `pendulum steady args… --out s` in a fresh directory; returns it and stdout.
@@ -214,28 +176,28 @@ fn check_listed_shapes(name: &str, radius: f64) -> f64 {
         for &(a, b) in &pairs {
             let (wa, wb) = (branches.column("omega")[a], branches.column("omega")[b]);
             let s = if wb == wa { 1.0 } else { (w - wa) / (wb - wa) };
-            let guess = branches.theta(a, n) * (1.0 - s) + branches.theta(b, n) * s;
+            let guess = theta(&branches, a, n) * (1.0 - s) + theta(&branches, b, n) * s;
             let direct = problem.solve(w, &guess).unwrap();
             // The listed shape of the same branch nearest the direct solve.
             let b_no = branches.column("branch")[a];
             let distance = rows
                 .iter()
                 .filter(|&&i| branch[i] == b_no)
-                .map(|&i| (shapes.theta(i, n) - &direct.theta).amax())
+                .map(|&i| (theta(&shapes, i, n) - &direct.theta).amax())
                 .fold(f64::INFINITY, f64::min);
             assert!(distance < 1e-9, "{name} ω = {w}: branch {b_no} differs by {distance:e} rad");
             worst = worst.max(distance);
             if w == speeds[3] {
                 // At --omega-max the listed shape is the branch's own last point.
-                let end = branches.theta(if branches.column("omega")[a] == w { a } else { b }, n);
+                let end = theta(&branches, if branches.column("omega")[a] == w { a } else { b }, n);
                 let at_end =
-                    rows.iter().map(|&i| (shapes.theta(i, n) - &end).amax()).fold(f64::INFINITY, f64::min);
+                    rows.iter().map(|&i| (theta(&shapes, i, n) - &end).amax()).fold(f64::INFINITY, f64::min);
                 assert!(at_end < 1e-9, "{name}: {at_end:e} rad from the end of branch {b_no}");
                 worst = worst.max(at_end);
             }
         }
         for &i in &rows {
-            let residual = problem.residual(&shapes.theta(i, n), w * w).norm();
+            let residual = problem.residual(&theta(&shapes, i, n), w * w).norm();
             assert!(residual < 1e-10 * 9.81 * 4.0, "{name} ω = {w}: residual {residual:e}");
         }
     }
@@ -276,7 +238,7 @@ fn listed_shapes_at_continuation_points_are_those_points() {
         for &i in &picks {
             let distance = (0..w.len())
                 .filter(|&r| w[r] == omega[i] && b[r] == branch[i])
-                .map(|r| (shapes.theta(r, 5) - branches.theta(i, 5)).amax())
+                .map(|r| (theta(&shapes, r, 5) - theta(&branches, i, 5)).amax())
                 .fold(f64::INFINITY, f64::min);
             assert!(
                 distance < 1e-9,
@@ -315,7 +277,7 @@ fn listed_stability_is_that_of_the_core() {
         let (omega, nodes) = (shapes.column("omega"), shapes.column("nodes"));
         let mut labels = Vec::new();
         for i in 0..shapes.rows.len() {
-            let shape = problem.shape(omega[i], shapes.theta(i, n));
+            let shape = problem.shape(omega[i], theta(&shapes, i, n));
             let st = stability(&problem, &shape, None).unwrap();
             let (label, index, growth) = verdict_of_row(&shapes, i);
             assert_eq!(label, st.verdict().label(), "{name} row {i}");

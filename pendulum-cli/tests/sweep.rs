@@ -7,51 +7,20 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{run_in, scratch, stderr};
+use common::{Table, run_in, scratch, stderr};
 
 /// The chain of every test: 6 links of 0.1 m and 0.1 kg (L = 0.6 m, √(g/L) = 4.04 rad/s,
 /// critical speeds 4.7, 10.9 rad/s), damped so the first mode decays at ≈ 0.3 1/s.
 const CHAIN: [&str; 8] = ["--n", "6", "--lengths", "0.1", "--masses", "0.1", "--damping", "0.01"];
 
-/// sweep.csv as text fields: header and rows; panics on a ragged row.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Self {
-        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(text.ends_with('\n'), "{} does not end with a newline", path.display());
-        let mut lines = text.lines();
-        let header: Vec<String> = lines.next().expect("a header").split(',').map(String::from).collect();
-        let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(String::from).collect()).collect();
-        for (i, row) in rows.iter().enumerate() {
-            assert_eq!(row.len(), header.len(), "{} row {i}", path.display());
-        }
-        Self { header, rows }
-    }
-
-    fn text(&self, name: &str) -> Vec<String> {
-        let j = self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
-        self.rows.iter().map(|r| r[j].clone()).collect()
-    }
-
-    fn column(&self, name: &str) -> Vec<f64> {
-        self.text(name)
-            .iter()
-            .map(|v| v.parse().unwrap_or_else(|_| panic!("{name}: bad number '{v}'")))
-            .collect()
-    }
-
-    /// Every field but the wall-clock time, row by row.
-    fn without_wall_time(&self) -> Vec<Vec<String>> {
-        let wall = self.header.iter().position(|h| h == "wall_s").expect("a wall_s column");
-        self.rows
-            .iter()
-            .map(|r| r.iter().enumerate().filter(|(j, _)| *j != wall).map(|(_, v)| v.clone()).collect())
-            .collect()
-    }
+/// Every field of a sweep.csv but the wall-clock time, row by row.
+fn without_wall_time(table: &Table) -> Vec<Vec<String>> {
+    let wall = table.index("wall_s");
+    table
+        .rows
+        .iter()
+        .map(|r| r.iter().enumerate().filter(|(j, _)| *j != wall).map(|(_, v)| v.clone()).collect())
+        .collect()
 }
 
 /// Runs `pendulum sweep args… --out NAME` in `dir`; asserts success, returns the directory.
@@ -103,7 +72,7 @@ fn a_row_per_point_and_kind_with_the_node_counts_of_simulate() {
     assert_eq!(csv.column("nodes"), [1.0, 2.0, 2.0, 1.0, 2.0, 2.0, 2.0, 2.0, 1.0]);
     assert_eq!(csv.column("nodes"), csv.column("nearest_nodes"));
     // The first ramp-down point is the ramp-up run at the top speed.
-    let rows = csv.without_wall_time();
+    let rows = without_wall_time(&csv);
     assert_eq!(rows[5][1..], rows[6][1..]);
     // The same points run by `pendulum simulate`: the same trajectory, the same report.
     let json = json(&out.join("sweep.json"));
@@ -153,7 +122,7 @@ fn from_sweep_json_and_any_number_of_jobs_give_the_same_numbers() {
     assert_eq!(reference.text("kind")[4..], ["ramp-down"; 4]);
     assert_eq!(reference.column("omega_rad_s")[4..], [12.0, 9.0, 6.0, 3.0]);
     for other in [&two, &from] {
-        assert_eq!(Table::read(&other.join("sweep.csv")).without_wall_time(), reference.without_wall_time());
+        assert_eq!(without_wall_time(&Table::read(&other.join("sweep.csv"))), without_wall_time(&reference));
         assert_eq!(json(&other.join("sweep.json"))["config"], json(&one.join("sweep.json"))["config"]);
     }
 }

@@ -69,3 +69,43 @@ impl Csv {
 pub fn run_json(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
 }
+
+/// A CSV file with text columns (sweep.csv, branches.csv, shapes.csv): header and fields;
+/// panics (failing the test) on a ragged row or a missing final newline.
+pub struct Table {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Self {
+        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(text.ends_with('\n'), "{} does not end with a newline", path.display());
+        let mut lines = text.lines();
+        let header: Vec<String> = lines.next().expect("a header").split(',').map(String::from).collect();
+        let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(String::from).collect()).collect();
+        for (i, row) in rows.iter().enumerate() {
+            assert_eq!(row.len(), header.len(), "{} row {i}", path.display());
+        }
+        Self { header, rows }
+    }
+
+    /// The index of column `name`.
+    pub fn index(&self, name: &str) -> usize {
+        self.header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"))
+    }
+
+    /// Column `name` as text.
+    pub fn text(&self, name: &str) -> Vec<String> {
+        let j = self.index(name);
+        self.rows.iter().map(|r| r[j].clone()).collect()
+    }
+
+    /// Column `name` as numbers.
+    pub fn column(&self, name: &str) -> Vec<f64> {
+        self.text(name)
+            .iter()
+            .map(|v| v.parse().unwrap_or_else(|_| panic!("{name}: bad number '{v}'")))
+            .collect()
+    }
+}
