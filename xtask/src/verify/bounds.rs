@@ -1,11 +1,12 @@
 //! The error measures of `verify` and their bound: an entry's error relative to its
-//! floored absolute scale, and the backward error of accelerations.
+//! floored absolute scale, and the componentwise backward error of accelerations.
 
 use nalgebra::{DMatrix, DVector};
 
 /// Largest error [`verify`](super::run) accepts, for every entry of every quantity: the
 /// entry's `|x_impl − x_ref|` over its absolute scale ([`Scaled`]) floored by
-/// [`SCALE_FLOOR`], and for accelerations the backward error ([`acceleration_error`]).
+/// [`SCALE_FLOOR`], and for accelerations the componentwise backward error
+/// ([`acceleration_error`]).
 ///
 /// Round-off of correct code stays decades below it, a wrong or missing term decades
 /// above: see `docs/verify.md`, "Why the bounds are what they are".
@@ -58,16 +59,19 @@ pub(super) fn entry_errors(got: &[f64], want: &[f64], scales: &[f64], floor: f64
     worst
 }
 
-/// The backward error of accelerations `a` for the reference system `M a = rhs`,
+/// The componentwise backward error of accelerations `a` for the reference system
+/// `M a = rhs`, row by row (Oettli–Prager),
 ///
 /// ```text
-/// ‖M a − rhs‖_∞ / (‖S(M)‖_∞ ‖a‖_∞ + ‖S(rhs)‖_∞)
+/// max_i |M a − rhs|_i / (S(M) |a| + S(rhs))_i
 /// ```
 ///
 /// with `S(·)` the entry scales, `S(rhs) = S(Q) + S(c) + S(k) + S(d)`: the smallest
-/// relative perturbation of `M` and `rhs` for which `a` is exact (Rigal–Gaches). Returns
-/// the row of the largest residual, the error and that residual. Why a backward error,
-/// and scales rather than norms: see `docs/verify.md`, "Why the bounds are what they are".
+/// relative perturbation of every entry of `M` and `rhs` (relative to its own scale) for
+/// which `a` is exact. Each row is measured against its own scale, so an error confined
+/// to a light or short link's row is not diluted by the heavy links' rows. Returns the
+/// worst row, its error and its residual. Why a backward error, and scales rather than
+/// values: see `docs/verify.md`, "Why the bounds are what they are".
 pub fn acceleration_error(
     mass_scale: &DMatrix<f64>,
     rhs_scale: &DVector<f64>,
@@ -76,13 +80,15 @@ pub fn acceleration_error(
     a: &DVector<f64>,
 ) -> (usize, f64, f64) {
     let residual = mass_matrix * a - rhs;
-    let scale = row_sum_norm(mass_scale) * a.amax() + rhs_scale.amax();
-    let (row, largest) = residual
-        .iter()
-        .map(|r| r.abs())
-        .enumerate()
-        .fold((0, 0.0), |(i, m), (j, r)| if worse(r, m) { (j, r) } else { (i, m) });
-    (row, ratio(largest, scale), largest)
+    let scale = mass_scale * a.abs() + rhs_scale;
+    let mut worst = (0, 0.0, 0.0);
+    for (i, (r, s)) in residual.iter().zip(scale.iter()).enumerate() {
+        let error = ratio(r.abs(), *s);
+        if worse(error, worst.1) {
+            worst = (i, error, r.abs());
+        }
+    }
+    worst
 }
 
 #[cfg(test)]
@@ -101,7 +107,7 @@ mod tests {
     }
 
     #[test]
-    fn acceleration_error_is_the_relative_residual() {
+    fn acceleration_error_is_the_worst_relative_row_residual() {
         let m = DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 3.0]);
         let rhs = DVector::from_vec(vec![1.0, 2.0]);
         let rhs_scale = DVector::from_vec(vec![3.0, 2.0]);
@@ -109,10 +115,29 @@ mod tests {
         assert!(acceleration_error(&m, &rhs_scale, &m, &rhs, &exact).1 < 1e-16);
         let wrong = &exact + DVector::from_vec(vec![0.0, 0.1]);
         let (row, error, residual) = acceleration_error(&m, &rhs_scale, &m, &rhs, &wrong);
+        // Residual (0.1, 0.3); row scales (2|a_0| + |a_1| + 3, |a_0| + 3|a_1| + 2).
         assert_eq!(row, 1);
         assert!((residual - 0.3).abs() < 1e-15);
-        assert!((error - 0.3 / (4.0 * wrong.amax() + 3.0)).abs() < 1e-15);
+        assert!((error - 0.3 / (wrong[0].abs() + 3.0 * wrong[1].abs() + 2.0)).abs() < 1e-15);
         let nan = DVector::from_vec(vec![f64::NAN, 0.0]);
         assert_eq!(acceleration_error(&m, &rhs_scale, &m, &rhs, &nan).1, f64::INFINITY);
+    }
+
+    #[test]
+    fn a_light_row_is_measured_against_its_own_scale() {
+        // A heavy and a light link: the light row's scale is 1e-6 of the heavy one's.
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 1e-6, 1e-6, 1e-6]);
+        let rhs = DVector::from_vec(vec![1.0, 2e-6]);
+        let exact = m.clone().lu().solve(&rhs).unwrap();
+        let mut wrong = exact.clone();
+        wrong[1] *= 1.0 + 1e-6;
+        let rhs_scale = rhs.abs();
+        let (row, error, _) = acceleration_error(&m.abs(), &rhs_scale, &m, &rhs, &wrong);
+        assert_eq!(row, 1);
+        // The light row's own relative residual, ~1e-6 / 4; a normwise measure
+        // (‖r‖_∞ / (‖M‖_∞ ‖a‖_∞ + ‖rhs‖_∞)) would report ~1e-12.
+        assert!(error > 1e-7, "{error:e}");
+        let normwise = (&m * &wrong - &rhs).amax() / (row_sum_norm(&m) * wrong.amax() + rhs.amax());
+        assert!(normwise < 1e-11, "{normwise:e}");
     }
 }

@@ -316,7 +316,7 @@ impl ModelVisitor for CheckSingular<'_> {
 #[cfg(test)]
 mod tests {
     use nalgebra::{DMatrix, Dyn};
-    use pendulum_core::{Chain, Planar, Spatial};
+    use pendulum_core::{Chain, Planar, Spatial, kinematics::Chart};
 
     use super::*;
     use crate::case::{Kind, load_all};
@@ -344,6 +344,25 @@ mod tests {
         OwnMassDiagonal,
         /// Planar velocity terms weighted by `M_min(i,j)` instead of `M_max(i,j)`.
         MinTailMass,
+        /// Pivot terms from the link's own mass instead of the tail mass.
+        OwnMassPivot,
+        /// Pivot terms with the vertical pivot acceleration's sign flipped (up and down
+        /// confused).
+        PivotVerticalSign,
+        /// Potential energy from the link's own mass instead of the tail mass.
+        OwnMassPotential,
+        /// Spatial `M[φ_i][φ_i] = W_ii l_i²`, without its `sin² θ_i`.
+        PhiInertiaWithoutSin2,
+        /// Spatial `M[θ_i][φ_i]`, identically zero, as `W_ii l_i² sin θ_i cos θ_i sin 2φ_i`:
+        /// `∂u/∂φ` with the wrong sign in x. The reference's scale of this entry is 0, so
+        /// only the scale floor measures it.
+        ThetaPhiNotCancelled,
+        /// Spatial `c_φ_i` with the Coriolis term `2 W_ii l_i² sin θ_i cos θ_i θ̇_i φ̇_i`
+        /// at half its size (the factor 2 of `d/dt sin² θ` forgotten).
+        PhiCoriolisFactorOne,
+        /// The last coordinate's acceleration off by this relative amount (all building
+        /// blocks correct).
+        LastAccelerationOff(f64),
         /// No bug at all.
         None,
     }
@@ -362,6 +381,13 @@ mod tests {
         fn weight(&self, i: usize, j: usize) -> f64 {
             let c = self.inner.chain();
             c.tail_masses()[i.max(j)] * c.lengths()[i] * c.lengths()[j]
+        }
+
+        /// `m_i / W_ii` of the link of coordinate `a` (θ_i or φ_i).
+        fn own_mass_share(&self, a: usize) -> f64 {
+            let c = self.inner.chain();
+            let i = a % c.links();
+            c.masses()[i] / c.tail_masses()[i]
         }
     }
 
@@ -383,11 +409,26 @@ mod tests {
         }
         fn mass_matrix(&self, q: &DVector<f64>, out: &mut DMatrix<f64>) {
             self.inner.mass_matrix(q, out);
-            if self.bug == Bug::OwnMassDiagonal {
-                let c = self.chain();
-                for i in 0..c.links() {
-                    out[(i, i)] *= c.masses()[i] / c.tail_masses()[i];
+            let n = self.chain().links();
+            match self.bug {
+                Bug::OwnMassDiagonal => {
+                    for i in 0..n {
+                        out[(i, i)] *= self.own_mass_share(i);
+                    }
                 }
+                Bug::PhiInertiaWithoutSin2 => {
+                    for i in 0..n {
+                        out[(n + i, n + i)] = self.weight(i, i);
+                    }
+                }
+                Bug::ThetaPhiNotCancelled => {
+                    for i in 0..n {
+                        let slip = self.weight(i, i) * q[i].sin() * q[i].cos() * (2.0 * q[n + i]).sin();
+                        out[(i, n + i)] = slip;
+                        out[(n + i, i)] = slip;
+                    }
+                }
+                _ => {}
             }
         }
         fn velocity_terms(&self, q: &DVector<f64>, qd: &DVector<f64>, out: &mut DVector<f64>) {
@@ -397,6 +438,12 @@ mod tests {
                     for j in 0..i {
                         out[i] -= 2.0 * self.weight(i, j) * (q[i] - q[j]).sin() * qd[j] * qd[j];
                     }
+                }
+            }
+            if self.bug == Bug::PhiCoriolisFactorOne {
+                let n = self.chain().links();
+                for i in 0..n {
+                    out[n + i] -= self.weight(i, i) * q[i].sin() * q[i].cos() * qd[i] * qd[n + i];
                 }
             }
             if self.bug == Bug::MinTailMass {
@@ -420,7 +467,17 @@ mod tests {
             }
         }
         fn pivot_terms(&self, q: &DVector<f64>, a: &OVector<f64, M::Space>, out: &mut DVector<f64>) {
-            self.inner.pivot_terms(q, a, out);
+            let mut a = a.clone();
+            if self.bug == Bug::PivotVerticalSign {
+                let up = a.len() - 1;
+                a[up] = -a[up];
+            }
+            self.inner.pivot_terms(q, &a, out);
+            if self.bug == Bug::OwnMassPivot {
+                for k in 0..out.len() {
+                    out[k] *= self.own_mass_share(k);
+                }
+            }
         }
         fn generalized_forces(
             &self,
@@ -454,7 +511,19 @@ mod tests {
             t - 0.5 * cross
         }
         fn potential_energy(&self, q: &DVector<f64>) -> f64 {
-            self.inner.potential_energy(q)
+            let u = self.inner.potential_energy(q);
+            if self.bug != Bug::OwnMassPotential {
+                return u;
+            }
+            // U = Σ_i W_ii g l_i u_i · up; the slip puts m_i where W_ii belongs.
+            let c = self.chain();
+            let excess: f64 = (0..c.links())
+                .map(|i| {
+                    let u_i = <M::Chart as Chart>::direction(q.as_slice(), i);
+                    (c.tail_masses()[i] - c.masses()[i]) * c.gravity() * c.lengths()[i] * u_i[u_i.len() - 1]
+                })
+                .sum();
+            u - excess
         }
         fn check_configuration(&self, q: &DVector<f64>) -> pendulum_core::Result<()> {
             self.inner.check_configuration(q)
@@ -484,6 +553,9 @@ mod tests {
             *out -= &tmp;
             self.check_configuration(q)?;
             mass.cholesky().ok_or(Error::NotPositiveDefinite)?.solve_mut(out);
+            if let Bug::LastAccelerationOff(relative) = self.bug {
+                out[dof.value() - 1] *= 1.0 + relative;
+            }
             Ok(())
         }
     }
@@ -520,7 +592,7 @@ mod tests {
         let real = |name: &str| committed.iter().find(|c| c.name == name).unwrap();
         let (planar3, planar8, spatial2, spatial4) =
             (real("planar_n3"), real("planar_n8"), real("spatial_n2"), real("spatial_n4"));
-        let expectations: [(&Case, Bug, &[Quantity]); 21] = [
+        let expectations: [(&Case, Bug, &[Quantity]); 36] = [
             (planar2, Bug::DocumentVelocitySign, &[VelocityTerms, Accelerations]),
             (planar2, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
             (planar1, Bug::NoDamping, &[GeneralizedForces, Accelerations]),
@@ -541,6 +613,23 @@ mod tests {
             (spatial2, Bug::PhiDampingWithoutSin2, &[GeneralizedForces, Accelerations]),
             (spatial4, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
             (spatial4, Bug::AccelerationsWithoutPivot, &[Accelerations]),
+            // Where the scale floors act: pivot terms, potential energy, the spatial
+            // mass matrix (the zero M[θ_i][φ_i]) and velocity terms.
+            (planar2, Bug::OwnMassPivot, &[PivotTerms, Accelerations]),
+            (planar8, Bug::OwnMassPivot, &[PivotTerms, Accelerations]),
+            (spatial4, Bug::OwnMassPivot, &[PivotTerms, Accelerations]),
+            (planar1, Bug::PivotVerticalSign, &[PivotTerms, Accelerations]),
+            (spatial1, Bug::PivotVerticalSign, &[PivotTerms, Accelerations]),
+            (planar2, Bug::OwnMassPotential, &[PotentialEnergy]),
+            (planar8, Bug::OwnMassPotential, &[PotentialEnergy]),
+            (spatial4, Bug::OwnMassPotential, &[PotentialEnergy]),
+            (spatial1, Bug::PhiInertiaWithoutSin2, &[MassMatrix, Accelerations]),
+            (spatial4, Bug::PhiInertiaWithoutSin2, &[MassMatrix, Accelerations]),
+            (spatial1, Bug::ThetaPhiNotCancelled, &[MassMatrix, Accelerations]),
+            (spatial4, Bug::ThetaPhiNotCancelled, &[MassMatrix, Accelerations]),
+            (spatial1, Bug::PhiCoriolisFactorOne, &[VelocityTerms, Accelerations]),
+            (spatial2, Bug::PhiCoriolisFactorOne, &[VelocityTerms, Accelerations]),
+            (spatial4, Bug::PhiCoriolisFactorOne, &[VelocityTerms, Accelerations]),
             (planar8, Bug::None, &[]),
             (spatial4, Bug::None, &[]),
         ];
@@ -554,6 +643,55 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The componentwise and the normwise backward error of the accelerations of a
+    /// planar n = 8 chain whose last mass is 1e-3 of the others, at 20 states, with the
+    /// last link's q̈ off by `relative`.
+    fn light_tail_errors(relative: f64) -> Vec<(f64, f64)> {
+        let committed = load_all(&crate::cases_dir()).unwrap();
+        let case = committed.iter().find(|c| c.name == "planar_n8").unwrap();
+        (0..20)
+            .map(|state| {
+                let (mut params, point) = sample::state(DEFAULT_SEED, case.kind, case.links, state);
+                params.masses = vec![1.0; 8];
+                params.masses[7] = 1e-3;
+                let reference = Reference::new(case, &params, &point);
+                let chain = models::chain::<Dyn>(&params).unwrap();
+                let mutant = Mutant { inner: Planar::new(chain), bug: Bug::LastAccelerationOff(relative) };
+                let measured = check_model(case, &mutant, &point, &reference).unwrap();
+                for (quantity, m) in Quantity::ALL.iter().zip(&measured) {
+                    if *quantity != Quantity::Accelerations {
+                        assert!(m.error < 1e-2 * BOUND, "{}: {:e}", quantity.name(), m.error);
+                    }
+                }
+                let accelerations = &measured[Quantity::Accelerations as usize];
+                assert!(accelerations.entry.contains("row 7"), "{accelerations:?}");
+                // The normwise backward error verify used before, of the same residual:
+                // ‖M a − rhs‖_∞ / (‖S(M)‖_∞ ‖a‖_∞ + ‖S(rhs)‖_∞).
+                let ModelPoint { q, qd, inputs } = ModelPoint::new(&mutant, &point);
+                let mut a = DVector::zeros(8);
+                mutant.accelerations(&q, &qd, &inputs, &mut a).unwrap();
+                let residual = &reference.values.mass_matrix * &a - &reference.rhs;
+                let normwise = residual.amax()
+                    / (crate::verify::bounds::row_sum_norm(&reference.scales.mass_matrix) * a.amax()
+                        + reference.rhs_scale.amax());
+                (accelerations.error, normwise)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_small_error_in_a_light_tail_links_acceleration_fails() {
+        // 1e-6 relative: every state fails now; the normwise measure passed most of them.
+        let errors = light_tail_errors(1e-6);
+        assert!(errors.iter().all(|&(componentwise, _)| componentwise > 100.0 * BOUND), "{errors:?}");
+        let passed_before = errors.iter().filter(|&&(_, normwise)| normwise < BOUND).count();
+        assert!(passed_before >= 15, "{errors:?}");
+        // 1e-8 relative: every state fails now; the normwise measure passed all of them.
+        let errors = light_tail_errors(1e-8);
+        assert!(errors.iter().all(|&(componentwise, _)| componentwise > BOUND), "{errors:?}");
+        assert!(errors.iter().all(|&(_, normwise)| normwise < 0.1 * BOUND), "{errors:?}");
     }
 
     #[test]

@@ -89,7 +89,7 @@ pub fn run(options: &Options) -> Result<()> {
     let (cases, report) = verify_all(options.states, options.seed, options.case.as_deref())?;
     println!(
         "verify: {} reference cases x {} random states (seed {:#x}); bound {BOUND:e} on the error \
-         relative to each entry's absolute scale, backward error for accelerations",
+         relative to each entry's absolute scale, componentwise backward error for accelerations",
         cases.len(),
         options.states,
         options.seed

@@ -106,7 +106,9 @@ pub fn verify_cases(cases: &[Case], states: usize, seed: u64) -> Result<Vec<Rout
 
 /// Prints the table of `rows` and errors if any is above [`BOUND`] (or NaN).
 pub fn report(rows: &[RouteRow]) -> Result<()> {
-    println!("O(n) routes, accelerations (backward error against the reference, bound {BOUND:e}):");
+    println!(
+        "O(n) routes, accelerations (componentwise backward error against the reference, bound {BOUND:e}):"
+    );
     println!("{:<12} {:<14} {:>10}  verdict", "case", "route", "worst");
     for row in rows {
         let ok = row.error <= BOUND;
