@@ -138,26 +138,92 @@ fn spatial_accelerations(
     out
 }
 
-/// Checks that `m` is symmetric and positive definite, and that `T = ½ q̇ᵀ M q̇`.
-fn check_mass_matrix(m: &DMatrix<f64>, qd: &DVector<f64>, kinetic: f64) -> Result<(), TestCaseError> {
+/// `T = ½ Σ_k m_k |v_k|²` from the masses' velocities `v_k = Σ_{i≤k} l_i u̇_i`, written
+/// here apart from the models (no tail masses, no weights `W_ij`): planar
+/// `u_i = (sin θ_i, −cos θ_i)`, spatial `u_i = (sin θ_i cos φ_i, sin θ_i sin φ_i, −cos θ_i)`.
+fn kinetic_energy_from_velocities(p: &Params, q: &[f64], qd: &[f64]) -> f64 {
+    let n = p.masses.len();
+    let spatial = q.len() == 2 * n;
+    let mut v = Vector3::zeros();
+    let mut t = 0.0;
+    for i in 0..n {
+        let (st, ct) = q[i].sin_cos();
+        let u_dot = if spatial {
+            let (sp, cp) = q[n + i].sin_cos();
+            let (td, pd) = (qd[i], qd[n + i]);
+            Vector3::new(ct * cp * td - st * sp * pd, ct * sp * td + st * cp * pd, st * td)
+        } else {
+            Vector3::new(ct * qd[i], st * qd[i], 0.0)
+        };
+        v += p.lengths[i] * u_dot;
+        t += 0.5 * p.masses[i] * v.norm_squared();
+    }
+    t
+}
+
+/// Checks that `m` is symmetric and positive definite, and that the model's `T` and
+/// `½ q̇ᵀ M q̇` both equal the kinetic energy of the masses' velocities
+/// ([`kinetic_energy_from_velocities`]).
+fn check_mass_matrix(
+    m: &DMatrix<f64>,
+    p: &Params,
+    q: &[f64],
+    qd: &[f64],
+    kinetic: f64,
+) -> Result<(), TestCaseError> {
     let scale = m.amax();
     let asymmetry = (m - m.transpose()).amax() / scale;
     prop_assert!(asymmetry < 1e-14, "asymmetry {asymmetry:e}");
     prop_assert!(m.clone().cholesky().is_some(), "not positive definite: {m}");
-    let quadratic = 0.5 * qd.dot(&(m * qd));
-    prop_assert!(
-        (quadratic - kinetic).abs() <= 1e-12 * (quadratic.abs() + scale),
-        "½q̇ᵀMq̇ = {quadratic}, T = {kinetic}"
-    );
+    let qd_v = dv(qd);
+    let quadratic = 0.5 * qd_v.dot(&(m * &qd_v));
+    let independent = kinetic_energy_from_velocities(p, q, qd);
+    let tolerance = 1e-12 * (independent.abs() + scale * qd_v.amax().powi(2));
+    prop_assert!((quadratic - independent).abs() <= tolerance, "½q̇ᵀMq̇ = {quadratic}, Σ½m v² = {independent}");
+    prop_assert!((kinetic - independent).abs() <= tolerance, "model T = {kinetic}, Σ½m v² = {independent}");
     Ok(())
 }
+
+/// `q̇ᵀ c(q, q̇) − ½ q̇ᵀ Ṁ q̇`, relative to `½ |q̇|ᵀ|Ṁ||q̇|`, with `Ṁ = Σ_a ∂M/∂q_a q̇_a` by a
+/// central difference of `mass` along q̇. Zero for the velocity terms of any Lagrangian
+/// `T = ½ q̇ᵀ M q̇`: `c = Ṁ q̇ − ∂T/∂q` and `q̇ᵀ ∂T/∂q = ½ q̇ᵀ Ṁ q̇`. A Coriolis or
+/// centrifugal term with a wrong factor breaks it.
+fn power_identity_defect(
+    mass: impl Fn(&DVector<f64>) -> DMatrix<f64>,
+    q: &[f64],
+    qd: &[f64],
+    c: &DVector<f64>,
+) -> f64 {
+    let (q, qd) = (dv(q), dv(qd));
+    let h = 1e-5 / (qd.amax() + 1.0);
+    let m_dot = (mass(&(&q + h * &qd)) - mass(&(&q - h * &qd))) / (2.0 * h);
+    let defect = qd.dot(c) - 0.5 * qd.dot(&(&m_dot * &qd));
+    let scale = 0.5 * qd.abs().dot(&(m_dot.abs() * qd.abs())) + 1e-300;
+    defect.abs() / scale
+}
+
+/// `M(q)` of `model`.
+fn mass_matrix<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, q: &DVector<f64>) -> DMatrix<f64>
+where
+    nalgebra::DefaultAllocator: pendulum_core::ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    let mut m = DMatrix::zeros(q.len(), q.len());
+    model.mass_matrix(q, &mut m);
+    m
+}
+
+/// Largest [`power_identity_defect`] of correct code: the central difference's error,
+/// `O(h²)` relative with `h ≤ 1e-5`, and its round-off `~1e-16 / h`.
+const POWER_IDENTITY_TOLERANCE: f64 = 1e-7;
 
 proptest! {
     #![proptest_config(Config { cases: CASES_CHEAP, ..Config::default() })]
 
-    /// M(q) symmetric positive definite and consistent with the kinetic energy, planar.
-    /// Catches: a wrong cos(θ_i − θ_j) entry or tail-mass weight (asymmetry, or T and M
-    /// disagreeing), a sign error making M indefinite at some angles.
+    /// M(q) symmetric positive definite, and M and the model's T both give the kinetic
+    /// energy of the masses' velocities computed here from scratch, planar. Catches: a
+    /// wrong cos(θ_i − θ_j) entry or tail-mass weight in M or in T (the two share
+    /// `Chain::weight`, so only the independent energy can tell), a sign error making M
+    /// indefinite at some angles.
     #[test]
     fn planar_mass_matrix_is_spd_and_gives_the_kinetic_energy(case in (1usize..=6).prop_flat_map(planar_case)) {
         let (p, q, qd, _, _) = case;
@@ -165,11 +231,11 @@ proptest! {
         let model = Planar::new(p.chain::<Dyn>());
         let mut m = DMatrix::zeros(n, n);
         model.mass_matrix(&dv(&q), &mut m);
-        check_mass_matrix(&m, &dv(&qd), model.kinetic_energy(&dv(&q), &dv(&qd)))?;
+        check_mass_matrix(&m, &p, &q, &qd, model.kinetic_energy(&dv(&q), &dv(&qd)))?;
     }
 
     /// The same for the spatial model off the singularity (its φ block scales with
-    /// sin θ_i sin θ_j: a wrong factor shows as asymmetry or indefiniteness).
+    /// sin θ_i sin θ_j: a wrong factor shows against the independent energy).
     #[test]
     fn spatial_mass_matrix_is_spd_and_gives_the_kinetic_energy(case in (1usize..=5).prop_flat_map(spatial_case)) {
         let (p, q, qd, _, _) = case;
@@ -177,7 +243,7 @@ proptest! {
         let model = Spatial::new(p.chain::<Dyn>());
         let mut m = DMatrix::zeros(2 * n, 2 * n);
         model.mass_matrix(&dv(&q), &mut m);
-        check_mass_matrix(&m, &dv(&qd), model.kinetic_energy(&dv(&q), &dv(&qd)))?;
+        check_mass_matrix(&m, &p, &q, &qd, model.kinetic_energy(&dv(&q), &dv(&qd)))?;
     }
 
     /// The unrolled generated models (`pendulum_macros::model!`) give the generic models'
@@ -291,9 +357,10 @@ proptest! {
     }
 
     /// Time rescaling t → t/σ: rates ×σ, g, pivot acceleration and torque/mass ×σ²,
-    /// damping ×σ gives accelerations ×σ². Catches: a velocity term of the wrong power
-    /// (θ̇ instead of θ̇², a missing factor 2 in Coriolis terms shows as a mismatch
-    /// only when gravity and velocities mix, which this does).
+    /// damping ×σ gives accelerations ×σ². Catches: a term of the wrong power in the
+    /// rates (θ̇ instead of θ̇², a damping term in θ̇²), gravity or a drive term that does
+    /// not scale with g or p̈. Not a wrong coefficient of a quadratic term (a Coriolis
+    /// factor 2 scales as σ² too): the power identity below catches that.
     #[test]
     fn time_rescaling_scales_accelerations_by_sigma_squared(
         case in (1usize..=6).prop_flat_map(spatial_case), sigma in 0.3f64..3.0
@@ -309,6 +376,28 @@ proptest! {
         let other = spatial_accelerations(&Spatial::new(scaled.chain::<Dyn>()), &q, &qd_s, &s_s, a_s);
         let err = relative(&other, &(base * sigma * sigma));
         prop_assert!(err < ROUTE_TOLERANCE, "{err:e}");
+    }
+
+    /// The velocity terms do no work beyond what the changing inertia takes:
+    /// `q̇ᵀ c = ½ q̇ᵀ Ṁ q̇` ([`power_identity_defect`]), planar and spatial. Catches: a
+    /// Coriolis or centrifugal term with a wrong factor or sign (e.g. the spatial
+    /// `2 W l² sin θ cos θ θ̇ φ̇` at half size: `a_halved_coriolis_term_breaks_the_power_identity`).
+    #[test]
+    fn velocity_terms_satisfy_the_power_identity(
+        planar in (1usize..=6).prop_flat_map(planar_case), spatial in (1usize..=5).prop_flat_map(spatial_case)
+    ) {
+        let (p, q, qd, _, _) = planar;
+        let model = Planar::new(p.chain::<Dyn>());
+        let mut c = DVector::zeros(q.len());
+        model.velocity_terms(&dv(&q), &dv(&qd), &mut c);
+        let defect = power_identity_defect(|q| mass_matrix(&model, q), &q, &qd, &c);
+        prop_assert!(defect < POWER_IDENTITY_TOLERANCE, "planar: {defect:e}");
+        let (p, q, qd, _, _) = spatial;
+        let model = Spatial::new(p.chain::<Dyn>());
+        let mut c = DVector::zeros(q.len());
+        model.velocity_terms(&dv(&q), &dv(&qd), &mut c);
+        let defect = power_identity_defect(|q| mass_matrix(&model, q), &q, &qd, &c);
+        prop_assert!(defect < POWER_IDENTITY_TOLERANCE, "spatial: {defect:e}");
     }
 
     /// Rotating the whole spatial chain about the vertical (φ_i → φ_i + α, pivot
@@ -409,4 +498,26 @@ proptest! {
         }
         prop_assert!(worst < 1e-6, "relative energy error {worst:e}");
     }
+}
+
+/// The power identity is not vacuous: the spatial velocity terms with the Coriolis term
+/// `2 W_ii l_i² sin θ_i cos θ_i θ̇_i φ̇_i` of `c_φ_i` at half size (a slip that time
+/// rescaling cannot see) break it by far more than its tolerance.
+#[test]
+fn a_halved_coriolis_term_breaks_the_power_identity() {
+    let p = Params { masses: vec![1.3, 0.4], lengths: vec![0.7, 1.9], gravity: 9.81, damping: vec![0.0; 2] };
+    let (q, qd) = (vec![0.9, 2.1, 0.3, -1.2], vec![1.5, -0.8, 2.2, 0.6]);
+    let model = Spatial::new(p.chain::<Dyn>());
+    let mut c = DVector::zeros(4);
+    model.velocity_terms(&dv(&q), &dv(&qd), &mut c);
+    let correct = power_identity_defect(|q| mass_matrix(&model, q), &q, &qd, &c);
+    assert!(correct < POWER_IDENTITY_TOLERANCE, "{correct:e}");
+    let n = 2;
+    let tail = [p.masses[0] + p.masses[1], p.masses[1]];
+    for i in 0..n {
+        let w = tail[i] * p.lengths[i] * p.lengths[i];
+        c[n + i] -= w * q[i].sin() * q[i].cos() * qd[i] * qd[n + i];
+    }
+    let wrong = power_identity_defect(|q| mass_matrix(&model, q), &q, &qd, &c);
+    assert!(wrong > 1e3 * POWER_IDENTITY_TOLERANCE, "{wrong:e}");
 }
