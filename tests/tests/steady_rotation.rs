@@ -2,7 +2,7 @@
 //! critical speeds, those of the heavy rotating string: `ω_k = (j_{0,k} / 2) sqrt(g / L)`.
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, ContinuationOptions, SteadyRotation, stability};
+use pendulum_core::{BranchEnd, Chain, ContinuationOptions, SteadyRotation, stability};
 
 const J0_ZEROS: [f64; 3] = [2.404825557695773, 5.520078110286311, 8.653727912911013];
 
@@ -36,7 +36,16 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
     let opts = ContinuationOptions::default();
     for k in 1..=3 {
         let branch = problem.branch(k, 1.6 * speeds[2], &opts).unwrap();
+        // The whole way to the speed asked for, not a branch of one vertical point.
+        assert_eq!(branch.end, BranchEnd::ReachedOmega, "k = {k}");
         let pts = &branch.points[1..];
+        assert!(pts.len() >= 10, "k = {k}: {} points", pts.len());
+        assert!(pts.last().unwrap().omega >= 1.6 * speeds[2], "k = {k}");
+        assert!(
+            pts.last().unwrap().amplitude() > 0.1,
+            "k = {k}: amplitude {}",
+            pts.last().unwrap().amplitude()
+        );
         assert!(pts.iter().all(|s| s.nodes() == k && s.omega > speeds[k - 1]), "k = {k}");
         // Amplitude grows with speed along the branch (no fold for the free chain).
         assert!(
@@ -46,9 +55,15 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
     }
     // Only the one-node branch is stable; the others have directions of descent of the
     // amended potential.
-    let top = problem.branch(1, 1.6 * speeds[2], &opts).unwrap();
-    let st = stability(&problem, top.points.last().unwrap(), None).unwrap();
-    assert!(st.spectrally_stable && st.index == 0);
+    for k in 1..=3 {
+        let branch = problem.branch(k, 1.6 * speeds[2], &opts).unwrap();
+        let st = stability(&problem, branch.points.last().unwrap(), None).unwrap();
+        if k == 1 {
+            assert!(st.spectrally_stable && st.index == 0, "k = 1: {st:?}");
+        } else {
+            assert!(st.index > 0, "k = {k}: index {}", st.index);
+        }
+    }
 }
 
 /// The spatial (θ, φ) model state of a steady shape at t = 0: polar angle `|θ_i|`,
@@ -134,7 +149,9 @@ fn rotating_frame_spectrum_matches_the_spatial_model_jacobian() {
         let theirs: Vec<_> = jac.complex_eigenvalues().iter().copied().collect();
         let scale = ours.eigenvalues.last().unwrap().norm();
         // Every eigenvalue away from the symmetry's zero pair has a partner within FD error.
-        for z in ours.eigenvalues.iter().filter(|z| z.norm() > 1e-3 * scale) {
+        let away: Vec<_> = ours.eigenvalues.iter().filter(|z| z.norm() > 1e-3 * scale).collect();
+        assert!(away.len() >= 18, "k = {k}: only {} eigenvalues compared", away.len());
+        for z in away {
             let d = theirs.iter().map(|w| (w - z).norm()).fold(f64::INFINITY, f64::min);
             assert!(d < 1e-5 * scale, "k = {k}: eigenvalue {z} has no spatial partner (nearest {d:e})");
         }

@@ -284,7 +284,7 @@ pub fn stability(
 mod tests {
     use super::*;
     use crate::analysis::modes::normal_modes;
-    use crate::analysis::steady_branches::ContinuationOptions;
+    use crate::analysis::steady_branches::{BranchEnd, ContinuationOptions};
     use crate::chain::Chain;
     use approx::assert_relative_eq;
     use nalgebra::Dyn;
@@ -365,10 +365,21 @@ mod tests {
             let st = stability(&p, s, None).unwrap();
             assert!(st.spectrally_stable && st.index == 0, "k=1 at ω = {}: {:?}", s.omega, st.growth_rate);
         }
+        assert!(b1.points.len() >= 10, "{} points", b1.points.len());
         let b2 = p.branch(2, 1.5 * speeds[1], &opts).unwrap();
+        // Not the vertical it starts from (also of index > 0 above ω_1): a two-node
+        // shape of finite size, at the speed asked for.
+        assert!(b2.points.len() >= 10, "{} points", b2.points.len());
         let last = b2.points.last().unwrap();
+        assert_eq!(b2.end, BranchEnd::ReachedOmega);
+        assert!(last.omega >= 1.5 * speeds[1], "ended at ω = {}", last.omega);
+        assert_eq!(last.nodes(), 2);
+        assert!(last.theta.amax() > 0.2, "{}", last.theta);
         let st = stability(&p, last, None).unwrap();
-        assert!(st.index > 0);
+        // Index 2 and a complex quartet with growth ~0.2/s: unstable, not merely of
+        // nonzero index.
+        assert_eq!(st.index, 2);
+        assert!(!st.spectrally_stable && st.growth_rate > 0.1, "{st:?}");
     }
 
     #[test]
