@@ -189,17 +189,26 @@ mod tests {
     use approx::assert_relative_eq;
     use nalgebra::{Const, DMatrix, Dyn};
 
-    /// `K v = ω² W v` and `vᵀ W v = 1` checked with the dense matrices.
+    /// `K v = ω² W v` and `vᵀ W v = 1` checked with dense matrices built here apart from
+    /// `Chain::weight` and the tail masses: `W = Jᵀ diag(m) J` with `J_ki = l_i` (i ≤ k),
+    /// the masses' horizontal displacements `x_k = Σ_{i≤k} l_i θ_i` to first order, and
+    /// `K_ii = ∂²U/∂θ_i²` at rest, `U = −g Σ_k m_k Σ_{i≤k} l_i cos θ_i`.
     fn check_eigenpairs<L>(chain: &Chain<L>, modes: &NormalModes<L>)
     where
         L: Dim,
         DefaultAllocator: Allocator<L> + Allocator<L, L>,
     {
         let n = chain.links();
-        let w = DMatrix::from_fn(n, n, |i, j| chain.weight(i, j));
-        let k = DMatrix::from_fn(n, n, |i, j| {
-            if i == j { chain.gravity() * chain.tail_masses()[i] * chain.lengths()[i] } else { 0.0 }
-        });
+        let (m, l, g) = (chain.masses(), chain.lengths(), chain.gravity());
+        let jacobian = DMatrix::from_fn(n, n, |k, i| if i <= k { l[i] } else { 0.0 });
+        let masses = DMatrix::from_fn(n, n, |a, b| if a == b { m[a] } else { 0.0 });
+        let w = jacobian.transpose() * masses * &jacobian;
+        let k =
+            DMatrix::from_fn(
+                n,
+                n,
+                |i, j| if i == j { g * l[i] * (i..n).map(|k| m[k]).sum::<f64>() } else { 0.0 },
+            );
         for c in 0..n {
             let v = nalgebra::DVector::from_fn(n, |i, _| modes.shapes[(i, c)]);
             let w2 = modes.frequencies[c].powi(2);

@@ -522,6 +522,77 @@ mod tests {
         }
     }
 
+    /// The worst relative residual of Newton's law for every mass and of the rigidity of
+    /// every rod, for the solution `(ü, T)` of `loads` with the pivot at rest — written
+    /// from the module docs' mechanics, apart from the tridiagonal system (`entries`)
+    /// the solve uses:
+    /// `m_i a_i = m_i g⃗ + F_i − F_{i+1} + T_{i+1} u_{i+1} − T_i u_i`, `a_i = a_{i−1} + l_i ü_i`,
+    /// `u_i · ü_i = −|u̇_i|²`.
+    fn mechanics_residual<const S: usize>(
+        rods: &Rods,
+        gravity: [f64; S],
+        loads: &[Load<S>],
+        solution: &Solution<S>,
+    ) -> (f64, f64) {
+        let (udd, tension) = solution;
+        let n = loads.len();
+        // a_i, and Σ_{j≤i} l_j |ü_j|: the scale of its round-off.
+        let (mut a, mut a_scale) = ([0.0; S], [0.0; S]);
+        let (mut newton, mut rigid) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            let m = 1.0 / rods.inverse_mass[i];
+            let u = loads[i].direction;
+            for k in 0..S {
+                a[k] += rods.length[i] * udd[i][k];
+                a_scale[k] += rods.length[i] * udd[i][k].abs();
+            }
+            for k in 0..S {
+                let mut terms = vec![m * gravity[k], loads[i].pair[k], -tension[i] * u[k], -m * a[k]];
+                if i + 1 < n {
+                    terms.push(-loads[i + 1].pair[k]);
+                    terms.push(tension[i + 1] * loads[i + 1].direction[k]);
+                }
+                let size: f64 = terms.iter().map(|t| t.abs()).sum::<f64>() + m * a_scale[k];
+                newton = newton.max(terms.iter().sum::<f64>().abs() / size);
+            }
+            let along = dot(&u, &udd[i]);
+            rigid = rigid.max(
+                (along + loads[i].rate_squared).abs()
+                    / (dot(&udd[i], &udd[i]).sqrt() + loads[i].rate_squared),
+            );
+        }
+        (newton, rigid)
+    }
+
+    #[test]
+    fn solutions_obey_newtons_law_and_keep_the_rods_rigid() {
+        // Planar chains over twelve and two decades, by both eliminations, and a 3D chain.
+        for (n, range, seed) in [(64, (-6.0, 6.0), 11), (1000, (-1.0, 1.0), 12)] {
+            let (rods, loads) = random_chain(n, range, seed);
+            for route in [Route::Solve, Route::Pivots] {
+                let (solution, _, _) = solve_as(&rods, [0.0, -9.81], &loads, route);
+                let (newton, rigid) = mechanics_residual(&rods, [0.0, -9.81], &loads, &solution);
+                assert!(newton < 1e-12 && rigid < 1e-12, "n = {n}: Newton {newton:e}, rigidity {rigid:e}");
+            }
+        }
+        let mut r = ChaCha8Rng::seed_from_u64(13);
+        let n = 200;
+        let masses: Vec<f64> = (0..n).map(|_| decades(&mut r, -1.0, 1.0)).collect();
+        let lengths: Vec<f64> = (0..n).map(|_| decades(&mut r, -1.0, 1.0)).collect();
+        let loads: Vec<Load<3>> = (0..n)
+            .map(|_| {
+                let (st, ct) = r.random_range(0.0..3.0f64).sin_cos();
+                let (sp, cp) = r.random_range(0.0..6.0f64).sin_cos();
+                let pair = [r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), r.random_range(-1.0..1.0)];
+                Load { direction: [st * cp, st * sp, -ct], rate_squared: r.random_range(0.0..4.0), pair }
+            })
+            .collect();
+        let rods = Rods::new(&masses, &lengths, &vec![0.0; n]);
+        let solution = solve(&rods, [0.0, 0.0, -9.81], &loads);
+        let (newton, rigid) = mechanics_residual(&rods, [0.0, 0.0, -9.81], &loads, &solution);
+        assert!(newton < 1e-12 && rigid < 1e-12, "3D: Newton {newton:e}, rigidity {rigid:e}");
+    }
+
     #[test]
     fn normalizer_is_the_power_of_two_into_one_to_two() {
         for x in [1.0, 1.5, 3.0, 0.75, 2f64.powi(700), 1.9 * 2f64.powi(-700), f64::MIN_POSITIVE] {
