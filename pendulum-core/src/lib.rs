@@ -43,9 +43,9 @@ pub mod trajectory;
 
 pub use analysis::{
     Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, Stability,
-    SteadyRotation, SteadyShape, Verdict, bernoulli_frequency, bessel_j0_zero, fastest_decay_bound,
-    fastest_frequency_bound, linearise, normal_modes, relative_equilibrium, relative_spectrum, sign_changes,
-    stability,
+    SteadyRotation, SteadyShape, Verdict, bernoulli_frequency, bessel_j0_zero, equal_link_frequencies,
+    fastest_decay_bound, fastest_frequency_bound, laguerre_zeros, linearise, normal_modes,
+    relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
 pub use analysis::{
     NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,

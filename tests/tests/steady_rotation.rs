@@ -1,8 +1,11 @@
 //! A uniform chain spun about the vertical leaves it in its k-node shape at Kolodner's
-//! critical speeds, those of the heavy rotating string: `ω_k = (j_{0,k} / 2) sqrt(g / L)`.
+//! critical speeds, those of the heavy rotating string: `ω_k = (j_{0,k} / 2) sqrt(g / L)`;
+//! at each n exactly at `√((g/l) x_k)`, `x_k` the zeros of the Laguerre polynomial L_n.
 
 use nalgebra::Dyn;
-use pendulum_core::{BranchEnd, Chain, ContinuationOptions, SteadyRotation, stability};
+use pendulum_core::{
+    BranchEnd, Chain, ContinuationOptions, SteadyRotation, equal_link_frequencies, stability,
+};
 
 const J0_ZEROS: [f64; 3] = [2.404825557695773, 5.520078110286311, 8.653727912911013];
 
@@ -24,6 +27,16 @@ fn bifurcation_speeds_match_kolodner_at_100_links() {
             err
         );
         assert!(err.abs() < 0.01, "k = {}: error {err}", k + 1);
+        // Exactly, at this n: the equal-link chain's ω_k = √((g/l) x_k), x_k the zeros
+        // of L_n (the linearised shape equations are the normal-mode eigenproblem).
+        // The 1 % bound would pass a tail mass off by one; this would not.
+        let exact = equal_link_frequencies(n, g, length / n as f64)[k];
+        assert!(
+            (speeds[k] - exact).abs() < 1e-10 * exact,
+            "k = {}: {} against Laguerre {exact}",
+            k + 1,
+            speeds[k]
+        );
     }
 }
 

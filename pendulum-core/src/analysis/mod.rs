@@ -1,6 +1,6 @@
 //! What the equations say about a chain beyond one trajectory: its normal modes about the
 //! hanging rest (`modes`, with Bernoulli's continuum frequencies from the zeros of J0,
-//! `bessel`), the undamped steady shapes turning rigidly about the vertical
+//! `bessel`, and the equal-link chain's exact ones from the zeros of L_n, `laguerre`), the undamped steady shapes turning rigidly about the vertical
 //! as branches over the speed ω (`steady_branches`) and their stability (`stability`),
 //! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
 //! with their spectrum (`relative_equilibrium`); the shape a whirled chain takes, seen in
@@ -8,6 +8,7 @@
 //! it (`shape`).
 
 pub(crate) mod bessel;
+pub(crate) mod laguerre;
 pub(crate) mod modes;
 pub(crate) mod relative_equilibrium;
 pub(crate) mod shape;
@@ -15,9 +16,10 @@ pub(crate) mod stability;
 pub(crate) mod steady_branches;
 
 pub use bessel::bessel_j0_zero;
+pub use laguerre::laguerre_zeros;
 pub use modes::{
-    NormalModes, bernoulli_frequency, fastest_decay_bound, fastest_frequency_bound, normal_modes,
-    sign_changes,
+    NormalModes, bernoulli_frequency, equal_link_frequencies, fastest_decay_bound, fastest_frequency_bound,
+    normal_modes, sign_changes,
 };
 pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
 pub use shape::{

@@ -29,6 +29,7 @@
 use nalgebra::{DefaultAllocator, Dim, DimDiff, DimSub, OMatrix, OVector, U1, allocator::Allocator};
 
 use crate::analysis::bessel::bessel_j0_zero;
+use crate::analysis::laguerre::laguerre_zeros;
 use crate::chain::Chain;
 
 /// The normal modes of a chain hanging at rest.
@@ -153,6 +154,16 @@ pub fn sign_changes(values: &[f64]) -> usize {
 /// from below as n grows (`docs/rotating-chain.md`).
 pub fn bernoulli_frequency(k: usize, gravity: f64, length: f64) -> f64 {
     0.5 * bessel_j0_zero(k) * (gravity / length).sqrt()
+}
+
+/// The exact angular frequencies (rad/s, ascending) of small oscillations of a chain of
+/// `n` equal masses on equal rods of length `l` (m) about the hanging rest:
+/// `ω_k = √((g/l) x_k)`, `x_k` the zeros of the Laguerre polynomial `L_n`
+/// ([`laguerre_zeros`]). Independent of the mass; they approach [`bernoulli_frequency`]
+/// with `L = n l` as n grows. Also the speeds at which the equal-link chain turning about
+/// the vertical leaves it (the linearised shape equations are the same eigenproblem).
+pub fn equal_link_frequencies(n: usize, gravity: f64, link_length: f64) -> Vec<f64> {
+    laguerre_zeros(n).into_iter().map(|x| (gravity / link_length * x).sqrt()).collect()
 }
 
 /// An estimate of a chain's fastest angular frequency (rad/s) about the hanging rest under
