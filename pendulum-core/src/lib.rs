@@ -69,4 +69,7 @@ pub use systems::{Canonical, FirstOrder};
 #[doc(hidden)]
 pub mod __private {
     pub use nalgebra;
+
+    pub use crate::models::rods::CONTINUANT_RANGE;
+    pub use crate::models::trig::sin_cos_into;
 }

@@ -11,7 +11,7 @@ use syn::ext::IdentExt;
 use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Generics, Ident, Lit, Token, Visibility, braced};
 
-use crate::plan::Kind;
+use crate::plan::{Algorithm, Kind};
 
 /// The most links a generated model may have.
 pub const MAX_LINKS: usize = 16;
@@ -34,6 +34,8 @@ pub struct ModelDef {
     pub kind: Kind,
     /// Number of links, `1..=MAX_LINKS`.
     pub links: usize,
+    /// The algorithm asked for with `algorithm: dense | tension`, if any.
+    pub algorithm: Option<Algorithm>,
 }
 
 /// Collects errors so that several mistakes are reported at once (serde's `Ctxt`).
@@ -107,20 +109,22 @@ impl ModelDef {
         braced!(content in input);
         let mut kind = None;
         let mut links = None;
+        let mut algorithm = None;
         let mut seen = BTreeSet::new();
         let mut ok = true;
         while !content.is_empty() {
             let field = Field::parse(&content)?;
             let name = field.name.to_string();
             let result = match name.as_str() {
-                "kind" | "links" if seen.contains(&name) => {
+                "kind" | "links" | "algorithm" if seen.contains(&name) => {
                     Err(syn::Error::new_spanned(&field.name, format!("duplicate field `{name}`")))
                 }
                 "kind" => field.kind().map(|k| kind = Some(k)),
                 "links" => field.links().map(|n| links = Some(n)),
+                "algorithm" => field.algorithm().map(|a| algorithm = Some(a)),
                 other => Err(syn::Error::new_spanned(
                     &field.name,
-                    format!("unknown field `{other}`, expected `kind` or `links`"),
+                    format!("unknown field `{other}`, expected `kind`, `links` or `algorithm`"),
                 )),
             };
             seen.insert(name);
@@ -148,7 +152,7 @@ impl ModelDef {
             ));
         }
         Ok(match (kind, links) {
-            (Some(kind), Some(links)) if ok => Some(ModelDef { attrs, vis, ident, kind, links }),
+            (Some(kind), Some(links)) if ok => Some(ModelDef { attrs, vis, ident, kind, links, algorithm }),
             _ => None,
         })
     }
@@ -203,6 +207,22 @@ impl Field {
             other => {
                 Err(syn::Error::new_spanned(&other, format!("`kind` must be {EXPECTED}, got `{other}`")))
             }
+        }
+    }
+
+    fn algorithm(&self) -> syn::Result<Algorithm> {
+        const EXPECTED: &str = "`dense` (mass matrix and L D Lᵀ) or `tension` (the O(n) rod-tension solve)";
+        match self.single(EXPECTED)? {
+            TokenTree::Ident(ident) if ident == "dense" => Ok(Algorithm::Dense),
+            TokenTree::Ident(ident) if ident == "tension" => Ok(Algorithm::Tension),
+            TokenTree::Ident(ident) => Err(syn::Error::new_spanned(
+                &ident,
+                format!("unknown algorithm `{ident}`, expected {EXPECTED}"),
+            )),
+            other => Err(syn::Error::new_spanned(
+                &other,
+                format!("`algorithm` must be {EXPECTED}, got `{}`", render(&other.clone().into())),
+            )),
         }
     }
 
@@ -265,7 +285,7 @@ mod tests {
             [
                 "unknown kind `circular`, expected `planar` or `spatial`",
                 "`links` must be between 1 and 16, got 40",
-                "unknown field `mass`, expected `kind` or `links`",
+                "unknown field `mass`, expected `kind`, `links` or `algorithm`",
                 "duplicate field `kind`",
                 "`links` must be an integer literal from 1 to 16, got `2.5`",
                 "missing field `links` in `C`, expected `links: N` with N from 1 to 16",
@@ -298,7 +318,7 @@ mod tests {
         assert_eq!(
             messages("struct A { type: planar, links: 1 }"),
             [
-                "unknown field `type`, expected `kind` or `links`",
+                "unknown field `type`, expected `kind`, `links` or `algorithm`",
                 "missing field `kind` in `A`, expected `kind: planar` or `kind: spatial`"
             ]
         );
@@ -321,6 +341,34 @@ mod tests {
         assert_eq!(
             messages("struct A { kind: planar, links: 1 + 2 }"),
             ["`links` must be an integer literal from 1 to 16, got `1 + 2`"]
+        );
+    }
+
+    #[test]
+    fn the_algorithm_is_optional_and_named_when_wrong() {
+        let input = parse(
+            "struct A { kind: planar, links: 3 } struct B { kind: planar, links: 3, algorithm: tension }
+             struct C { algorithm: dense, kind: spatial, links: 2 }",
+        )
+        .unwrap();
+        let algorithms: Vec<_> = input.models.iter().map(|m| m.algorithm).collect();
+        assert_eq!(algorithms, [None, Some(Algorithm::Tension), Some(Algorithm::Dense)]);
+        const EXPECTED: &str = "`dense` (mass matrix and L D Lᵀ) or `tension` (the O(n) rod-tension solve)";
+        assert_eq!(
+            messages("struct A { kind: planar, links: 3, algorithm: sparse }"),
+            [format!("unknown algorithm `sparse`, expected {EXPECTED}")]
+        );
+        assert_eq!(
+            messages("struct A { kind: planar, links: 3, algorithm: \"tension\" }"),
+            [format!("`algorithm` must be {EXPECTED}, got `\"tension\"`")]
+        );
+        assert_eq!(
+            messages("struct A { kind: planar, links: 3, algorithm: dense, algorithm: tension }"),
+            ["duplicate field `algorithm`"]
+        );
+        assert_eq!(
+            messages("struct A { kind: planar, links: 3, algorithm: }"),
+            [format!("missing value for `algorithm`, expected {EXPECTED}")]
         );
     }
 

@@ -32,6 +32,33 @@ pub enum Kind {
     Spatial,
 }
 
+/// How `accelerations` solves for `q̈`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Algorithm {
+    /// `M q̈ = Q − c − (k + d)` by an unrolled `L D Lᵀ` factorisation of the mass matrix:
+    /// O(n³), fastest for the smallest chains.
+    Dense,
+    /// The rod tensions' symmetric tridiagonal system, unrolled (the O(n) route of
+    /// `pendulum_core::PlanarTension` and `Directions`, in the model's angles).
+    Tension,
+}
+
+impl Algorithm {
+    /// The smallest `n` from which [`Algorithm::Tension`] is the default, per kind: the
+    /// crossover measured by `cargo xtask bench` (`docs/bench.md`, "Crossover").
+    pub const fn crossover(kind: Kind) -> usize {
+        match kind {
+            Kind::Planar => 4,
+            Kind::Spatial => 2,
+        }
+    }
+
+    /// The faster algorithm for `links` links of `kind`: dense below the crossover.
+    pub const fn default_for(kind: Kind, links: usize) -> Self {
+        if links >= Self::crossover(kind) { Algorithm::Tension } else { Algorithm::Dense }
+    }
+}
+
 /// An angle of the chain: the polar angle θ or the azimuth φ of link `i` (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Angle {

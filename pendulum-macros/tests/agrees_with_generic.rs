@@ -18,6 +18,20 @@ pendulum_macros::model! {
     pub struct Spatial3 { kind: spatial, links: 3 }
     pub struct Spatial4 { kind: spatial, links: 4 }
     pub struct Spatial16 { kind: spatial, links: 16 }
+    // Each algorithm at each size, whatever the default.
+    pub struct DensePlanar16 { kind: planar, links: 16, algorithm: dense }
+    pub struct TensionPlanar1 { kind: planar, links: 1, algorithm: tension }
+    pub struct TensionPlanar2 { kind: planar, links: 2, algorithm: tension }
+    pub struct TensionPlanar3 { kind: planar, links: 3, algorithm: tension }
+    pub struct DensePlanar8 { kind: planar, links: 8, algorithm: dense }
+    pub struct TensionPlanar8 { kind: planar, links: 8, algorithm: tension }
+    pub struct TensionPlanar16 { kind: planar, links: 16, algorithm: tension }
+    pub struct DenseSpatial3 { kind: spatial, links: 3, algorithm: dense }
+    pub struct DenseSpatial16 { kind: spatial, links: 16, algorithm: dense }
+    pub struct TensionSpatial1 { kind: spatial, links: 1, algorithm: tension }
+    pub struct TensionSpatial2 { kind: spatial, links: 2, algorithm: tension }
+    pub struct TensionSpatial3 { kind: spatial, links: 3, algorithm: tension }
+    pub struct TensionSpatial16 { kind: spatial, links: 16, algorithm: tension }
 }
 
 /// Round-off allowed, relative to each entry's scale.
@@ -235,6 +249,12 @@ fn planar_models_agree_with_the_generic_planar_model() {
     agree::<Planar4, _>(Planar::new, 4);
     agree::<Planar8, _>(Planar::new, 8);
     agree::<Planar16, _>(Planar::new, 16);
+    agree::<DensePlanar16, _>(Planar::new, 116);
+    agree::<TensionPlanar1, _>(Planar::new, 101);
+    agree::<TensionPlanar2, _>(Planar::new, 102);
+    agree::<TensionPlanar3, _>(Planar::new, 103);
+    agree::<TensionPlanar8, _>(Planar::new, 108);
+    agree::<TensionPlanar16, _>(Planar::new, 216);
 }
 
 #[test]
@@ -244,6 +264,11 @@ fn spatial_models_agree_with_the_generic_spatial_model() {
     agree::<Spatial3, _>(Spatial::new, 13);
     agree::<Spatial4, _>(Spatial::new, 14);
     agree::<Spatial16, _>(Spatial::new, 16);
+    agree::<DenseSpatial16, _>(Spatial::new, 316);
+    agree::<TensionSpatial1, _>(Spatial::new, 111);
+    agree::<TensionSpatial2, _>(Spatial::new, 112);
+    agree::<TensionSpatial3, _>(Spatial::new, 113);
+    agree::<TensionSpatial16, _>(Spatial::new, 416);
 }
 
 fn uniform<L: Dim>(n: usize) -> Chain<L>
@@ -255,7 +280,16 @@ where
 
 #[test]
 fn spatial_model_reports_the_singular_link() {
-    let model = Spatial3::new(uniform(3));
+    reports_the_singular_link(&Spatial3::new(uniform(3)));
+    reports_the_singular_link(&DenseSpatial3::new(uniform(3)));
+    reports_the_singular_link(&TensionSpatial3::new(uniform(3)));
+}
+
+fn reports_the_singular_link<
+    M: Model<Links = nalgebra::Const<3>, Dof = nalgebra::Const<6>, Space = nalgebra::U3>,
+>(
+    model: &M,
+) {
     let mut a = nalgebra::SVector::<f64, 6>::zeros();
     let qd = nalgebra::SVector::<f64, 6>::repeat(0.5);
     for link in 1..=3 {
@@ -395,7 +429,35 @@ fn every_non_finite_entry_is_named_even_where_it_is_multiplied_by_zero() {
     every_bad_entry_is_named(&Spatial2::new(still(2)), &spatial_still(2), &[0.0; 4], "spatial 2 still");
     every_bad_entry_is_named(&Spatial3::new(still(3)), &spatial_still(3), &[0.0; 6], "spatial 3 still");
     every_bad_entry_is_named(&Spatial3::new(moving(3)), &angles(6), &rates(6), "spatial 3");
+    // The tension route, which reads every entry through other operations.
+    every_bad_entry_is_named(&TensionPlanar3::new(still(3)), &[0.0; 3], &[0.0; 3], "tension planar 3 still");
+    every_bad_entry_is_named(&TensionPlanar16::new(moving(16)), &angles(16), &rates(16), "tension planar 16");
+    every_bad_entry_is_named(
+        &TensionSpatial2::new(still(2)),
+        &spatial_still(2),
+        &[0.0; 4],
+        "tension spatial 2 still",
+    );
+    every_bad_entry_is_named(&TensionSpatial3::new(moving(3)), &angles(6), &rates(6), "tension spatial 3");
+    every_bad_entry_is_named(&DenseSpatial3::new(moving(3)), &angles(6), &rates(6), "dense spatial 3");
     // A singular angle too: the input error comes first.
     let singular = [0.0, 0.5, 0.0, 0.0];
     every_bad_entry_is_named(&Spatial2::new(moving(2)), &singular, &rates(4), "spatial 2 singular");
+}
+
+#[test]
+fn extreme_mass_ratios_take_the_classical_pivots_and_still_agree() {
+    // Masses of 1e-150 kg: the continuants pass 2⁸⁰⁰ within two rods and the tension
+    // route redoes the elimination by pivots; the accelerations stay the dense ones.
+    let masses = [1e-150, 3e-150, 2e-150, 1e-150, 5e-151, 1e-150, 2e-150, 4e-150];
+    let chain = || {
+        Chain::<nalgebra::Const<8>>::new(&masses, &[1.0, 0.5, 2.0, 1.0, 0.3, 0.7, 1.1, 0.9], 9.81).unwrap()
+    };
+    let (dense, tension) = (DensePlanar8::new(chain()), TensionPlanar8::new(chain()));
+    let q = nalgebra::SVector::<f64, 8>::from_fn(|i, _| 0.4 * i as f64 - 1.0);
+    let qd = nalgebra::SVector::<f64, 8>::from_fn(|i, _| 0.3 - 0.1 * i as f64);
+    let (mut a, mut b) = (nalgebra::SVector::<f64, 8>::zeros(), nalgebra::SVector::<f64, 8>::zeros());
+    dense.accelerations(&q, &qd, &dense.zero_inputs(), &mut a).unwrap();
+    tension.accelerations(&q, &qd, &tension.zero_inputs(), &mut b).unwrap();
+    assert!((a - b).amax() < 1e-10 * a.amax(), "dense {a}, tension {b}");
 }

@@ -170,7 +170,7 @@ const BLOCK: usize = 16;
 /// patterns: `low ≤ bits(P_i) ≤ low + span`), far from overflow and from the subnormals
 /// where they would lose digits; otherwise the pivots are redone by
 /// [`Rods::eliminate_by_pivots`]. Negative, zero, infinite and NaN values fall outside too.
-const CONTINUANT_RANGE: (u64, u64) = {
+pub const CONTINUANT_RANGE: (u64, u64) = {
     let low = (1023 - 800) << 52; // 2⁻⁸⁰⁰
     let high = (1023 + 800) << 52; // 2⁸⁰⁰
     (low, high - low)

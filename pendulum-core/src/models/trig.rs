@@ -89,7 +89,7 @@ fn sin_cos_reduced(theta: f64) -> (f64, f64) {
 ///
 /// Vectorised polynomial kernel for `|θ_i| ≤ LIMIT` (module docs), `f64::sin_cos` for the
 /// others (NaN for a non-finite angle, as std).
-pub(crate) fn sin_cos_into(angles: &[f64], out: &mut [[f64; 2]]) {
+pub fn sin_cos_into(angles: &[f64], out: &mut [[f64; 2]]) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2, checked just above.

@@ -71,7 +71,7 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
 
 /// `fn failure` inside `accelerations`: the error of a failed evaluation, the input
 /// checks' first.
-fn failure(plan: &Plan) -> TokenStream {
+pub(super) fn failure(plan: &Plan) -> TokenStream {
     let dof = index(plan.dof());
     let space = space(plan);
     quote! {
@@ -223,7 +223,7 @@ fn minus_products(first: Option<TokenStream>, products: &[(Ident, Ident)]) -> Op
 /// `Σ (x − x)` over `values` as a balanced tree of additions (latency `log₂` of their
 /// number): `0.0` exactly when every value is finite, NaN otherwise (`x − x` is NaN for
 /// ±∞ and NaN). One subtraction and one addition per value, no branch per value.
-fn finite_probe(values: &[TokenStream]) -> TokenStream {
+pub(super) fn finite_probe(values: &[TokenStream]) -> TokenStream {
     match values {
         [] => quote!(0.0),
         [x] => quote!((#x - #x)),

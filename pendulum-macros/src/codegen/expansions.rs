@@ -9,10 +9,12 @@ use super::expand;
 use crate::parse::Input;
 
 /// Expansions committed under `pendulum-macros/expanded/` so reviewers read diffs of
-/// real generated code.
-const EXPANSIONS: [(&str, &str); 2] = [
-    ("planar3.rs", "pub struct Planar3 { kind: planar, links: 3 }"),
-    ("spatial2.rs", "pub struct Spatial2 { kind: spatial, links: 2 }"),
+/// real generated code: each algorithm at one small and one larger size.
+const EXPANSIONS: [(&str, &str); 4] = [
+    ("planar3.rs", "pub struct Planar3 { kind: planar, links: 3, algorithm: dense }"),
+    ("planar12.rs", "pub struct Planar12 { kind: planar, links: 12, algorithm: tension }"),
+    ("spatial2.rs", "pub struct Spatial2 { kind: spatial, links: 2, algorithm: dense }"),
+    ("spatial3.rs", "pub struct Spatial3 { kind: spatial, links: 3, algorithm: tension }"),
 ];
 
 fn rustfmt(code: &str) -> String {

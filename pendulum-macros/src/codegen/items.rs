@@ -5,9 +5,9 @@ use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
 use super::body::lets_from;
-use super::{ident, index};
+use super::{ident, index, tension};
 use crate::parse::ModelDef;
-use crate::plan::{Kind, Plan, Sym};
+use crate::plan::{Algorithm, Kind, Plan, Sym};
 
 /// What depends on the chain alone (the weights `W_ij`, the moments `M_i l_i`) and some
 /// method needs: computed once by `new`, stored as fields named like the symbols.
@@ -18,12 +18,13 @@ pub(super) fn stored(plan: &Plan) -> Vec<Sym> {
     plan.closure(method_roots).into_iter().filter(|s| s.is_stored()).collect()
 }
 
-/// `vis struct Name { chain, <stored>, inv0 }`, with the input's attributes and a generated
-/// doc paragraph.
-pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym]) -> TokenStream {
+/// `vis struct Name { chain, <stored>, <what the algorithm needs> }`, with the input's
+/// attributes and a generated doc paragraph: `inv0` for the dense route, the per-link
+/// constants of the tension solve ([`tension::stored`]) for the other.
+pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm: Algorithm) -> TokenStream {
     let ModelDef { attrs, vis, ident: name, .. } = def;
     let n = index(plan.links);
-    let doc = struct_doc(def, plan);
+    let doc = struct_doc(def, plan, algorithm);
     let stored_idents = stored.iter().map(|&s| ident(s));
     let stored_docs = stored.iter().map(|&s| {
         let what = match s {
@@ -33,6 +34,19 @@ pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym]) -> TokenS
         };
         quote!(#[doc = #what])
     });
+    let solver_fields = match algorithm {
+        Algorithm::Dense => quote! {
+            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not
+            /// positive (underflow), which makes every acceleration NaN and
+            /// `accelerations` fail as not positive definite.
+            inv0: ::core::primitive::f64,
+        },
+        Algorithm::Tension => {
+            let (fields, docs): (Vec<Ident>, Vec<String>) =
+                tension::stored(plan).into_iter().map(|(f, _, d)| (f, d)).unzip();
+            quote!(#(#[doc = #docs] #fields: ::core::primitive::f64,)*)
+        }
+    };
     quote! {
         #(#attrs)*
         #(#[doc = #doc])*
@@ -40,17 +54,14 @@ pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym]) -> TokenS
         #vis struct #name {
             chain: ::pendulum_core::Chain<::pendulum_core::__private::nalgebra::Const<#n>>,
             #(#stored_docs #stored_idents: ::core::primitive::f64,)*
-            /// `1/W_00`, kg⁻¹·m⁻², the first pivot's reciprocal; NaN when `W_00` is not
-            /// positive (underflow), which makes every acceleration NaN and
-            /// `accelerations` fail as not positive definite.
-            inv0: ::core::primitive::f64,
+            #solver_fields
         }
     }
 }
 
-/// The struct's generated doc lines: what it models and its coordinates, after an empty
-/// line when the input has doc comments of its own.
-fn struct_doc(def: &ModelDef, plan: &Plan) -> Vec<String> {
+/// The struct's generated doc lines: what it models, its coordinates and how it solves for
+/// the accelerations, after an empty line when the input has doc comments of its own.
+fn struct_doc(def: &ModelDef, plan: &Plan, algorithm: Algorithm) -> Vec<String> {
     let n = index(plan.links);
     let mut doc = Vec::new();
     if def.attrs.iter().any(|a| a.path().is_ident("doc")) {
@@ -66,11 +77,21 @@ fn struct_doc(def: &ModelDef, plan: &Plan) -> Vec<String> {
              coordinates `q = (θ_1 … θ_{n}, φ_1 … φ_{n})`, θ from −z and φ the azimuth from +x, rad."
         ),
     });
+    doc.push(String::new());
+    doc.push(match algorithm {
+        Algorithm::Dense => {
+            " Accelerations: the mass matrix factored as `L D Lᵀ`, unrolled (`algorithm: dense`).".into()
+        }
+        Algorithm::Tension => {
+            " Accelerations: the O(n) rod-tension solve, unrolled (`algorithm: tension`).".into()
+        }
+    });
     doc
 }
 
-/// `impl Name { vis fn new(chain) -> Self }`: computes the stored quantities and `1/W_00`.
-pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym]) -> TokenStream {
+/// `impl Name { vis fn new(chain) -> Self }`: computes the stored quantities and what the
+/// algorithm needs (`1/W_00`, or the tension solve's per-link constants).
+pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm: Algorithm) -> TokenStream {
     let ModelDef { vis, ident: name, .. } = def;
     let n = index(plan.links);
     let stored_idents = stored.iter().map(|&s| ident(s));
@@ -81,16 +102,32 @@ pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym]) -> TokenS
         &quote!(chain),
         false,
     );
-    // The first pivot of `accelerations`' factorisation is `M_00 = W_00`: its reciprocal too.
-    let w00 = ident(Sym::Weight(0, 0));
-    assert!(stored.contains(&Sym::Weight(0, 0)), "W_00 is stored");
+    let (solver_lets, solver_fields) = match algorithm {
+        Algorithm::Dense => {
+            // The first pivot of `accelerations`' factorisation is `M_00 = W_00`: its
+            // reciprocal too.
+            let w00 = ident(Sym::Weight(0, 0));
+            assert!(stored.contains(&Sym::Weight(0, 0)), "W_00 is stored");
+            (
+                quote!(let inv0 = if #w00 > 0.0 { 1.0 / #w00 } else { ::core::primitive::f64::NAN };),
+                quote!(inv0),
+            )
+        }
+        Algorithm::Tension => {
+            let inputs = tension::constructor_lets(plan);
+            let (fields, values): (Vec<Ident>, Vec<TokenStream>) =
+                tension::stored(plan).into_iter().map(|(f, v, _)| (f, v)).unzip();
+            // In a block of its own: its lets may share names with the stored symbols'.
+            (quote!(let (#(#fields,)*) = { #inputs (#(#values,)*) };), quote!(#(#fields),*))
+        }
+    };
     quote! {
         impl #name {
             /// The model of `chain`.
             #vis fn new(chain: Chain<Const<#n>>) -> Self {
                 #lets
-                let inv0 = if #w00 > 0.0 { 1.0 / #w00 } else { ::core::primitive::f64::NAN };
-                Self { chain, #(#stored_idents,)* inv0 }
+                #solver_lets
+                Self { chain, #(#stored_idents,)* #solver_fields }
             }
         }
     }

@@ -11,6 +11,7 @@ mod body;
 mod expansions;
 mod items;
 mod methods;
+mod tension;
 #[cfg(test)]
 mod tests;
 
@@ -18,7 +19,7 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::parse::{Input, ModelDef};
-use crate::plan::{Kind, Plan, Sym};
+use crate::plan::{Algorithm, Kind, Plan, Sym};
 
 /// Everything `model!` emits for its input.
 pub fn expand(input: &Input) -> TokenStream {
@@ -28,20 +29,21 @@ pub fn expand(input: &Input) -> TokenStream {
 /// One model: the struct, then its impls in a `const _` block that imports what they name.
 fn model(def: &ModelDef) -> TokenStream {
     let plan = Plan::new(def.kind, def.links);
+    let algorithm = def.algorithm.unwrap_or(Algorithm::default_for(def.kind, def.links));
     let stored = items::stored(&plan);
     let name = &def.ident;
     // A `#[cfg]` on the struct must also remove its impls.
     let cfgs = def.attrs.iter().filter(|a| a.path().is_ident("cfg"));
-    let struct_item = items::struct_item(def, &plan, &stored);
+    let struct_item = items::struct_item(def, &plan, &stored, algorithm);
     let imports = imports(&plan);
     // Every impl, in the order emitted: another trait impl is one more entry (its trait
     // imported in `imports`).
     let impls = [
-        items::constructor(def, &plan, &stored),
+        items::constructor(def, &plan, &stored, algorithm),
         items::debug_impl(name),
         items::partial_eq_impl(name),
         items::from_impl(name, &plan),
-        model_impl(name, &plan),
+        model_impl(name, &plan, algorithm),
     ];
     quote! {
         #struct_item
@@ -66,8 +68,9 @@ fn imports(plan: &Plan) -> TokenStream {
     }
 }
 
-/// `impl Model for Name`: the [associated types](associated_types), then the methods.
-fn model_impl(name: &Ident, plan: &Plan) -> TokenStream {
+/// `impl Model for Name`: the [associated types](associated_types), then the methods, with
+/// `accelerations` by the chosen [`Algorithm`].
+fn model_impl(name: &Ident, plan: &Plan, algorithm: Algorithm) -> TokenStream {
     let associated_types = associated_types(plan);
     let methods = [
         methods::chain_accessor(plan),
@@ -80,7 +83,10 @@ fn model_impl(name: &Ident, plan: &Plan) -> TokenStream {
         methods::energies(plan),
     ];
     let check_configuration = methods::check_configuration(plan);
-    let accelerations = accelerations::accelerations(plan);
+    let accelerations = match algorithm {
+        Algorithm::Dense => accelerations::accelerations(plan),
+        Algorithm::Tension => tension::accelerations(plan),
+    };
     // `mul_add` would be a slow libm call on targets without FMA, and would round
     // differently from the generic models. `x - x` is the finiteness probe
     // (NaN for ±∞ and NaN, 0 otherwise).

@@ -84,6 +84,24 @@ fn angle_uses(body: TokenStream, uses: &mut AngleUses) {
                     uses.checks.push((i, args[2].iter().map(ToString::to_string).collect()));
                 }
             }
+            // `let [s, c] = trig[i]`: the sine and cosine of `q[i]` from the vectorised
+            // kernel (`sin_cos_into(q.as_slice(), &mut trig)`).
+            TokenTree::Ident(t) if t == "trig" => {
+                let Some(TokenTree::Group(at)) = tokens.get(k + 1) else { continue };
+                if at.delimiter() != Delimiter::Bracket {
+                    continue;
+                }
+                let i = at.stream().to_string();
+                if let Some([TokenTree::Ident(l), TokenTree::Group(pair), TokenTree::Punct(eq)]) =
+                    k.checked_sub(3).map(|p| &tokens[p..k])
+                    && l == "let"
+                    && eq.as_char() == '='
+                    && let Some(s) = pair.stream().into_iter().next()
+                {
+                    uses.sine.insert(s.to_string(), i.clone());
+                }
+                uses.trig.push((i, "sin_cos_into".into()));
+            }
             TokenTree::Ident(_) => {
                 let Some(i) = q_index(&tokens[k..]) else { continue };
                 let Some(TokenTree::Ident(method)) = tokens.get(k + 3) else { continue };
@@ -147,20 +165,30 @@ fn expansion(item: &str) -> TokenStream {
 
 #[test]
 fn expansion_has_no_loops() {
-    let mut words = Vec::new();
-    idents(expansion("struct S3 { kind: spatial, links: 3 }"), &mut words);
-    for word in ["in", "while", "loop", "Vec", "vec", "Box", "iter", "collect"] {
-        assert!(!words.iter().any(|w| w == word), "the expansion contains `{word}`");
+    for item in [
+        "struct S3 { kind: spatial, links: 3 }",
+        "struct S3 { kind: spatial, links: 3, algorithm: dense }",
+        "struct S3 { kind: spatial, links: 3, algorithm: tension }",
+        "struct P9 { kind: planar, links: 9, algorithm: tension }",
+    ] {
+        let mut words = Vec::new();
+        idents(expansion(item), &mut words);
+        for word in ["in", "while", "loop", "Vec", "vec", "Box", "iter", "collect"] {
+            assert!(!words.iter().any(|w| w == word), "{item}: the expansion contains `{word}`");
+        }
     }
 }
 
 #[test]
 fn every_method_takes_each_angles_sine_and_cosine_once() {
-    for kind in ["planar", "spatial"] {
+    for (kind, algorithm) in
+        [("planar", "dense"), ("planar", "tension"), ("spatial", "dense"), ("spatial", "tension")]
+    {
         for links in [1, 2, 3, 5] {
-            let tokens = expansion(&format!("struct S {{ kind: {kind}, links: {links} }}"));
+            let tokens =
+                expansion(&format!("struct S {{ kind: {kind}, links: {links}, algorithm: {algorithm} }}"));
             let found = repeated_trig(tokens.clone());
-            assert!(found.is_empty(), "{kind} {links}: {found:#?}");
+            assert!(found.is_empty(), "{kind} {links} {algorithm}: {found:#?}");
             // The spatial checks: every link's, in both methods that make them.
             let mut all = Vec::new();
             methods(tokens, &mut all);
@@ -174,7 +202,7 @@ fn every_method_takes_each_angles_sine_and_cosine_once() {
                     }
                     _ => Vec::new(),
                 };
-                assert_eq!(checked, want, "{kind} {links}: {name}");
+                assert_eq!(checked, want, "{kind} {links} {algorithm}: {name}");
             }
         }
     }
