@@ -76,6 +76,102 @@ pendulum_macros::model! {
     pub struct Planar12 { kind: planar, links: 12 }
     /// Generated planar model, 16 links: accelerations only, to locate the crossover.
     pub struct Planar16 { kind: planar, links: 16 }
+    /// Generated planar model, 1 link, by the mass matrix.
+    pub struct PlanarDense1 { kind: planar, links: 1, algorithm: dense }
+    /// Generated planar model, 1 link, by the rod tensions.
+    pub struct PlanarTension1 { kind: planar, links: 1, algorithm: tension }
+    /// Generated planar model, 2 links, by the mass matrix.
+    pub struct PlanarDense2 { kind: planar, links: 2, algorithm: dense }
+    /// Generated planar model, 2 links, by the rod tensions.
+    pub struct PlanarTension2 { kind: planar, links: 2, algorithm: tension }
+    /// Generated planar model, 3 links, by the mass matrix.
+    pub struct PlanarDense3 { kind: planar, links: 3, algorithm: dense }
+    /// Generated planar model, 3 links, by the rod tensions.
+    pub struct PlanarTension3 { kind: planar, links: 3, algorithm: tension }
+    /// Generated planar model, 4 links, by the mass matrix.
+    pub struct PlanarDense4 { kind: planar, links: 4, algorithm: dense }
+    /// Generated planar model, 4 links, by the rod tensions.
+    pub struct PlanarTension4 { kind: planar, links: 4, algorithm: tension }
+    /// Generated planar model, 5 links, by the mass matrix.
+    pub struct PlanarDense5 { kind: planar, links: 5, algorithm: dense }
+    /// Generated planar model, 5 links, by the rod tensions.
+    pub struct PlanarTension5 { kind: planar, links: 5, algorithm: tension }
+    /// Generated planar model, 6 links, by the mass matrix.
+    pub struct PlanarDense6 { kind: planar, links: 6, algorithm: dense }
+    /// Generated planar model, 6 links, by the rod tensions.
+    pub struct PlanarTension6 { kind: planar, links: 6, algorithm: tension }
+    /// Generated planar model, 7 links, by the mass matrix.
+    pub struct PlanarDense7 { kind: planar, links: 7, algorithm: dense }
+    /// Generated planar model, 7 links, by the rod tensions.
+    pub struct PlanarTension7 { kind: planar, links: 7, algorithm: tension }
+    /// Generated planar model, 8 links, by the mass matrix.
+    pub struct PlanarDense8 { kind: planar, links: 8, algorithm: dense }
+    /// Generated planar model, 8 links, by the rod tensions.
+    pub struct PlanarTension8 { kind: planar, links: 8, algorithm: tension }
+    /// Generated planar model, 9 links, by the mass matrix.
+    pub struct PlanarDense9 { kind: planar, links: 9, algorithm: dense }
+    /// Generated planar model, 9 links, by the rod tensions.
+    pub struct PlanarTension9 { kind: planar, links: 9, algorithm: tension }
+    /// Generated planar model, 10 links, by the mass matrix.
+    pub struct PlanarDense10 { kind: planar, links: 10, algorithm: dense }
+    /// Generated planar model, 10 links, by the rod tensions.
+    pub struct PlanarTension10 { kind: planar, links: 10, algorithm: tension }
+    /// Generated planar model, 11 links, by the mass matrix.
+    pub struct PlanarDense11 { kind: planar, links: 11, algorithm: dense }
+    /// Generated planar model, 11 link, by the rod tensions.
+    pub struct PlanarTension11 { kind: planar, links: 11, algorithm: tension }
+    /// Generated planar model, 12 links, by the mass matrix.
+    pub struct PlanarDense12 { kind: planar, links: 12, algorithm: dense }
+    /// Generated planar model, 12 links, by the rod tensions.
+    pub struct PlanarTension12 { kind: planar, links: 12, algorithm: tension }
+    /// Generated planar model, 13 links, by the mass matrix.
+    pub struct PlanarDense13 { kind: planar, links: 13, algorithm: dense }
+    /// Generated planar model, 13 links, by the rod tensions.
+    pub struct PlanarTension13 { kind: planar, links: 13, algorithm: tension }
+    /// Generated planar model, 14 links, by the mass matrix.
+    pub struct PlanarDense14 { kind: planar, links: 14, algorithm: dense }
+    /// Generated planar model, 14 links, by the rod tensions.
+    pub struct PlanarTension14 { kind: planar, links: 14, algorithm: tension }
+    /// Generated planar model, 15 links, by the mass matrix.
+    pub struct PlanarDense15 { kind: planar, links: 15, algorithm: dense }
+    /// Generated planar model, 15 links, by the rod tensions.
+    pub struct PlanarTension15 { kind: planar, links: 15, algorithm: tension }
+    /// Generated planar model, 16 links, by the mass matrix.
+    pub struct PlanarDense16 { kind: planar, links: 16, algorithm: dense }
+    /// Generated planar model, 16 links, by the rod tensions.
+    pub struct PlanarTension16 { kind: planar, links: 16, algorithm: tension }
+    /// Generated spatial model, 1 link, by the mass matrix.
+    pub struct SpatialDense1 { kind: spatial, links: 1, algorithm: dense }
+    /// Generated spatial model, 1 link, by the rod tensions.
+    pub struct SpatialTension1 { kind: spatial, links: 1, algorithm: tension }
+    /// Generated spatial model, 2 links, by the mass matrix.
+    pub struct SpatialDense2 { kind: spatial, links: 2, algorithm: dense }
+    /// Generated spatial model, 2 links, by the rod tensions.
+    pub struct SpatialTension2 { kind: spatial, links: 2, algorithm: tension }
+    /// Generated spatial model, 3 links, by the mass matrix.
+    pub struct SpatialDense3 { kind: spatial, links: 3, algorithm: dense }
+    /// Generated spatial model, 3 links, by the rod tensions.
+    pub struct SpatialTension3 { kind: spatial, links: 3, algorithm: tension }
+    /// Generated spatial model, 4 links, by the mass matrix.
+    pub struct SpatialDense4 { kind: spatial, links: 4, algorithm: dense }
+    /// Generated spatial model, 4 links, by the rod tensions.
+    pub struct SpatialTension4 { kind: spatial, links: 4, algorithm: tension }
+    /// Generated spatial model, 5 links, by the mass matrix.
+    pub struct SpatialDense5 { kind: spatial, links: 5, algorithm: dense }
+    /// Generated spatial model, 5 links, by the rod tensions.
+    pub struct SpatialTension5 { kind: spatial, links: 5, algorithm: tension }
+    /// Generated spatial model, 6 links, by the mass matrix.
+    pub struct SpatialDense6 { kind: spatial, links: 6, algorithm: dense }
+    /// Generated spatial model, 6 links, by the rod tensions.
+    pub struct SpatialTension6 { kind: spatial, links: 6, algorithm: tension }
+    /// Generated spatial model, 7 links, by the mass matrix.
+    pub struct SpatialDense7 { kind: spatial, links: 7, algorithm: dense }
+    /// Generated spatial model, 7 links, by the rod tensions.
+    pub struct SpatialTension7 { kind: spatial, links: 7, algorithm: tension }
+    /// Generated spatial model, 8 links, by the mass matrix.
+    pub struct SpatialDense8 { kind: spatial, links: 8, algorithm: dense }
+    /// Generated spatial model, 8 links, by the rod tensions.
+    pub struct SpatialTension8 { kind: spatial, links: 8, algorithm: tension }
 }
 
 /// Whether this is the smoke run of `cargo xtask bench --quick` (few sizes).
@@ -346,12 +442,74 @@ fn large_chains(c: &mut Criterion) {
     }
 }
 
+/// Both algorithms of the generated models (`algorithm: dense | tension`) at every n they
+/// are made for here (planar 1..16, spatial 1..8), accelerations only, as
+/// `generated_dense` and `generated_tension`; beside them the O(n) routes at the sizes the
+/// other groups skip, and spatial `Directions` converted to the angles' q̈
+/// (`directions_angles`: `Directions::spherical_accelerations`, which builds the direction
+/// state from the angles and allocates its result).
+fn algorithms(c: &mut Criterion) {
+    macro_rules! both {
+        ($kind:literal, $($n:literal => $dense:ident, $tension:ident),* $(,)?) => {
+            $(
+                if wanted($n) {
+                    bench_accelerations(c, $kind, "generated_dense", $n, &$dense::new(chain::<Const<$n>>($n)));
+                    bench_accelerations(c, $kind, "generated_tension", $n, &$tension::new(chain::<Const<$n>>($n)));
+                }
+            )*
+        };
+    }
+    both!("planar",
+        1 => PlanarDense1, PlanarTension1, 2 => PlanarDense2, PlanarTension2,
+        3 => PlanarDense3, PlanarTension3, 4 => PlanarDense4, PlanarTension4,
+        5 => PlanarDense5, PlanarTension5, 6 => PlanarDense6, PlanarTension6,
+        7 => PlanarDense7, PlanarTension7, 8 => PlanarDense8, PlanarTension8,
+        9 => PlanarDense9, PlanarTension9, 10 => PlanarDense10, PlanarTension10,
+        11 => PlanarDense11, PlanarTension11, 12 => PlanarDense12, PlanarTension12,
+        13 => PlanarDense13, PlanarTension13, 14 => PlanarDense14, PlanarTension14,
+        15 => PlanarDense15, PlanarTension15, 16 => PlanarDense16, PlanarTension16,
+    );
+    both!("spatial",
+        1 => SpatialDense1, SpatialTension1, 2 => SpatialDense2, SpatialTension2,
+        3 => SpatialDense3, SpatialTension3, 4 => SpatialDense4, SpatialTension4,
+        5 => SpatialDense5, SpatialTension5, 6 => SpatialDense6, SpatialTension6,
+        7 => SpatialDense7, SpatialTension7, 8 => SpatialDense8, SpatialTension8,
+    );
+    if quick() {
+        return;
+    }
+    for n in [9, 10, 11, 13, 14, 15] {
+        let tension = PlanarTension::new(chain::<Dyn>(n));
+        bench_accelerations(c, "planar", "tension", n, &tension);
+        bench_directions::<U2>(c, "planar", n, |s, q, qd| s.from_angles(q, qd));
+    }
+    for n in 5..=8 {
+        bench_directions::<U3>(c, "spatial", n, |s, q, qd| s.from_spherical(q, qd));
+    }
+    for n in 1..=8 {
+        let system = Directions::<U3>::new(chain::<Dyn>(n));
+        let (q, qd) = state::<Dyn>(Dyn(2 * n));
+        c.benchmark_group("spatial_accelerations").bench_function(
+            BenchmarkId::new("directions_angles", n),
+            |b| {
+                b.iter(|| {
+                    black_box(
+                        system
+                            .spherical_accelerations(0.0, black_box(q.as_slice()), black_box(qd.as_slice()))
+                            .unwrap(),
+                    )
+                })
+            },
+        );
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default()
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_millis(700))
         .sample_size(40);
-    targets = small_chains, large_chains
+    targets = small_chains, large_chains, algorithms
 }
 criterion_main!(benches);

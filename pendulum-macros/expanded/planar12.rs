@@ -314,6 +314,10 @@ const _: () = {
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U2};
     use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
     impl Planar12 {
+        #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
+        #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
+        #[doc = r" `algorithm:` or by the default for this size."]
+        pub const ALGORITHM: &'static str = "tension";
         #[doc = r" The model of `chain`."]
         pub fn new(chain: Chain<Const<12>>) -> Self {
             let tail_masses = chain.tail_masses();

@@ -62,6 +62,10 @@ const _: () = {
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U3};
     use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
     impl Spatial3 {
+        #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
+        #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
+        #[doc = r" `algorithm:` or by the default for this size."]
+        pub const ALGORITHM: &'static str = "tension";
         #[doc = r" The model of `chain`."]
         pub fn new(chain: Chain<Const<3>>) -> Self {
             let tail_masses = chain.tail_masses();
@@ -561,8 +565,10 @@ const _: () = {
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
             let g = self.chain.gravity();
-            let mut trig = [[0.0f64; 2]; 6];
-            ::pendulum_core::__private::sin_cos_into(q.as_slice(), &mut trig);
+            let mut trig = [[0.0f64; 2]; 8];
+            let mut angles = [0.0f64; 8];
+            angles[..6].copy_from_slice(q.as_slice());
+            ::pendulum_core::__private::sin_cos_into(&angles, &mut trig);
             let pa_x = pivot[0];
             let pa_y = pivot[1];
             let pa_z = pivot[2];

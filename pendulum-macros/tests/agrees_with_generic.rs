@@ -356,6 +356,11 @@ fn generated_types_have_the_expected_shape_and_derives() {
     let spatial = Spatial3::new(chain);
     assert_eq!(spatial.dof(), nalgebra::Const::<6>);
     assert_eq!(spatial.zero_inputs().pivot_acceleration.len(), 3);
+    // The default algorithm by size (the crossover measured in docs/bench.md), and the
+    // one asked for.
+    assert_eq!([Planar1::ALGORITHM, Planar3::ALGORITHM, Planar4::ALGORITHM], ["dense", "dense", "tension"]);
+    assert_eq!([Spatial1::ALGORITHM, Spatial2::ALGORITHM], ["dense", "tension"]);
+    assert_eq!([DensePlanar16::ALGORITHM, TensionPlanar1::ALGORITHM], ["dense", "tension"]);
 }
 
 /// Sets entry `index` of `what` (`q`, `qd`, `torque` or `pivot_acceleration`) to `bad` in

@@ -121,8 +121,17 @@ pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
             (quote!(let (#(#fields,)*) = { #inputs (#(#values,)*) };), quote!(#(#fields),*))
         }
     };
+    let algorithm_name = match algorithm {
+        Algorithm::Dense => "dense",
+        Algorithm::Tension => "tension",
+    };
     quote! {
         impl #name {
+            /// How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as
+            /// `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by
+            /// `algorithm:` or by the default for this size.
+            #vis const ALGORITHM: &'static str = #algorithm_name;
+
             /// The model of `chain`.
             #vis fn new(chain: Chain<Const<#n>>) -> Self {
                 #lets

@@ -91,13 +91,25 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
 
     // Sines and cosines of every angle at once (a vectorised kernel), then the links'
     // directions, rates and force pairs.
-    let angles = index(plan.dof());
+    // Padded to a multiple of four angles, the kernel's width with AVX2: no scalar tail.
+    let padded = plan.dof().div_ceil(4) * 4;
+    let trig_call = if padded == plan.dof() {
+        quote!(::pendulum_core::__private::sin_cos_into(q.as_slice(), &mut trig);)
+    } else {
+        let (padded, dof) = (index(padded), index(plan.dof()));
+        quote! {
+            let mut angles = [0.0f64; #padded];
+            angles[..#dof].copy_from_slice(q.as_slice());
+            ::pendulum_core::__private::sin_cos_into(&angles, &mut trig);
+        }
+    };
+    let trig_len = index(padded);
     let mut body = quote! {
         let torque = &inputs.torque;
         let pivot = &inputs.pivot_acceleration;
         let g = self.chain.gravity();
-        let mut trig = [[0.0f64; 2]; #angles];
-        ::pendulum_core::__private::sin_cos_into(q.as_slice(), &mut trig);
+        let mut trig = [[0.0f64; 2]; #trig_len];
+        #trig_call
     };
     let components: &[&str] = if spatial { &["x", "y", "z"] } else { &["x", "y"] };
     let pivot_names: Vec<Ident> = components.iter().map(|c| format_ident!("pa_{c}")).collect();

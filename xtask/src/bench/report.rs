@@ -18,15 +18,47 @@ pub const OPERATIONS: [(&str, &str); 5] = [
 ];
 
 /// The implementations in table order (benchmark function name, label).
-pub const IMPLEMENTATIONS: [(&str, &str); 7] = [
+pub const IMPLEMENTATIONS: [(&str, &str); 10] = [
     ("generated", "generated"),
+    ("generated_dense", "generated, `algorithm: dense`"),
+    ("generated_tension", "generated, `algorithm: tension`"),
     ("generic_fixed", "generic `Const<n>`"),
     ("generic_dyn", "generic `Dyn`"),
     ("closed_form", "closed form (eq 50)"),
     ("tension", "O(n) `PlanarTension<Dyn>`"),
     ("directions", "O(n) `Directions` rhs"),
+    ("directions_angles", "O(n) `Directions` → (θ, φ) q̈"),
     ("baseline", "baseline"),
 ];
+
+/// The smallest n from which `model!` generates `algorithm: tension` by default, per kind
+/// (`pendulum_macros`' `Algorithm::crossover`; `default_algorithms_match_the_macro` checks
+/// the generated types agree).
+pub const GENERATED_CROSSOVER: [(&str, usize); 2] = [("planar", 4), ("spatial", 2)];
+
+/// The algorithm `model!` generates by default for `n` links of `kind`: `"dense"` or
+/// `"tension"`.
+pub fn default_algorithm(kind: &str, n: usize) -> &'static str {
+    let from = GENERATED_CROSSOVER.iter().find(|(k, _)| *k == kind).map_or(usize::MAX, |&(_, n)| n);
+    if n >= from { "tension" } else { "dense" }
+}
+
+/// The routes computing the same `q̈` in the same angles as the generated models, per kind
+/// (`Directions` rhs is another quantity, the first-order right-hand side in direction
+/// coordinates, and is listed beside them).
+pub const SAME_QUANTITY: [(&str, &[&str]); 2] = [
+    ("planar", &["generic_fixed", "generic_dyn", "closed_form", "tension"]),
+    ("spatial", &["generic_fixed", "generic_dyn", "directions_angles"]),
+];
+
+/// The O(n) route in the same coordinates that the generated models must beat by
+/// [`ALGORITHM_TARGET`], and from which n on.
+pub const LINEAR_SAME_QUANTITY: [(&str, &str, usize); 2] =
+    [("planar", "tension", 8), ("spatial", "directions_angles", 1)];
+
+/// Required speed-up of the generated models (default algorithm) over the O(n) route in
+/// the same coordinates ([`LINEAR_SAME_QUANTITY`]).
+pub const ALGORITHM_TARGET: f64 = 1.3;
 
 /// The generic dense route every speed-up is measured against.
 pub const GENERIC: &str = "generic_dyn";
@@ -109,6 +141,34 @@ pub struct Targets {
     pub closed_form_unchecked: Option<(f64, f64)>,
     /// Where each O(n) route of [`LINEAR`] overtakes the generated models.
     pub crossovers: Vec<Crossover>,
+    /// The generated models' two algorithms at every measured n (issue 20).
+    pub algorithms: Vec<AlgorithmRow>,
+}
+
+/// One size of one kind: the generated models' two algorithms and what they compete with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlgorithmRow {
+    /// Model kind.
+    pub kind: &'static str,
+    /// Links.
+    pub n: usize,
+    /// `algorithm: dense` time, ns.
+    pub dense: Option<f64>,
+    /// `algorithm: tension` time, ns.
+    pub tension: Option<f64>,
+    /// The fastest other route computing the same q̈ ([`SAME_QUANTITY`]): name and time.
+    pub best_other: Option<(&'static str, f64)>,
+    /// The O(n) route in the same coordinates ([`LINEAR_SAME_QUANTITY`]), ns.
+    pub linear: Option<f64>,
+    /// `Directions` rhs (another quantity), ns.
+    pub directions: Option<f64>,
+}
+
+impl AlgorithmRow {
+    /// The default algorithm's time.
+    pub fn generated(&self) -> Option<f64> {
+        if default_algorithm(self.kind, self.n) == "tension" { self.tension } else { self.dense }
+    }
 }
 
 /// Where an O(n) route overtakes another route (accelerations).
@@ -164,8 +224,115 @@ impl Targets {
             .into_iter()
             .map(|(kind, route)| Crossover::of(results, kind, route, "generated"))
             .collect();
-        Self { speedups, closed_form, closed_form_unchecked, crossovers }
+        let algorithms = KINDS
+            .into_iter()
+            .flat_map(|kind| {
+                let group = format!("{kind}_accelerations");
+                let mut sizes: Vec<usize> =
+                    results.series(&group, "generated_dense").into_iter().map(|(n, _)| n).collect();
+                sizes.dedup();
+                let others = SAME_QUANTITY.iter().find(|(k, _)| *k == kind).map_or(&[][..], |(_, o)| o);
+                let linear = LINEAR_SAME_QUANTITY.iter().find(|(k, _, _)| *k == kind).map(|&(_, r, _)| r);
+                sizes
+                    .into_iter()
+                    .map(|n| {
+                        let get = |name: &str| results.get(&group, name, n);
+                        let best_other = others
+                            .iter()
+                            .filter_map(|&o| Some((o, get(o)?)))
+                            .min_by(|a, b| a.1.total_cmp(&b.1));
+                        AlgorithmRow {
+                            kind,
+                            n,
+                            dense: get("generated_dense"),
+                            tension: get("generated_tension"),
+                            best_other,
+                            linear: linear.and_then(get),
+                            directions: get("directions"),
+                        }
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        Self { speedups, closed_form, closed_form_unchecked, crossovers, algorithms }
     }
+}
+
+/// The generated models' algorithms as markdown (issue 20): per kind and n, both
+/// algorithms, the default, and the checks against the other routes.
+fn algorithms_markdown(median: &Targets, fastest: &Targets) -> String {
+    let mut out = String::new();
+    if median.algorithms.is_empty() {
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "**Generated models: the algorithm at each n** (`model!`'s `algorithm: dense | tension`;          the default is `tension` from n = {} planar and n = {} spatial). Times are medians /          fastest samples; \"best other\" is the fastest other route computing the same q̈ in the          same angles ({}); the O(n) route in the same coordinates must be ≥ {ALGORITHM_TARGET}×          slower than the default (planar `PlanarTension<Dyn>` from n = 8; spatial          `Directions::spherical_accelerations`, which converts angles to directions and back and          allocates its result). `Directions` rhs, another quantity (the first-order right-hand          side in direction coordinates, no trigonometry), is listed for scale.\n",
+        GENERATED_CROSSOVER[0].1,
+        GENERATED_CROSSOVER[1].1,
+        SAME_QUANTITY.iter().map(|(k, o)| format!("{k}: {}", o.join(", "))).collect::<Vec<_>>().join("; ")
+    );
+    let _ = writeln!(
+        out,
+        "| model | n | dense | tension | faster | default | best other | default ≤ best other | O(n) same coords ÷ default | `Directions` rhs |\n|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let show = |t: Option<f64>| t.map_or("–".to_string(), time);
+    for (m, f) in median.algorithms.iter().zip(&fastest.algorithms) {
+        let faster = match (m.dense, m.tension) {
+            (Some(d), Some(t)) => {
+                if t < d {
+                    "tension"
+                } else {
+                    "dense"
+                }
+            }
+            _ => "–",
+        };
+        let default = default_algorithm(m.kind, m.n);
+        let other = |r: &AlgorithmRow| r.best_other.map(|(_, t)| t);
+        let beats = |r: &AlgorithmRow| match (r.generated(), other(r)) {
+            (Some(g), Some(o)) => {
+                if g <= o {
+                    "yes".to_string()
+                } else {
+                    format!("**no** ({:.2}×)", g / o)
+                }
+            }
+            _ => "–".to_string(),
+        };
+        let needed = LINEAR_SAME_QUANTITY
+            .iter()
+            .find(|(k, _, _)| *k == m.kind)
+            .is_some_and(|&(_, _, from)| m.n >= from);
+        let linear = |r: &AlgorithmRow| match (r.linear, r.generated()) {
+            (Some(l), Some(g)) => {
+                let v = l / g;
+                if needed && v < ALGORITHM_TARGET { format!("**{}**", ratio(v)) } else { ratio(v) }
+            }
+            _ => "–".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} / {} | {} / {} | {faster} | {default} | {} {} / {} | {} / {} | {} / {} | {} / {} |",
+            m.kind,
+            m.n,
+            show(m.dense),
+            show(f.dense),
+            show(m.tension),
+            show(f.tension),
+            m.best_other.map_or("–", |(name, _)| label(name)),
+            show(other(m)),
+            show(other(f)),
+            beats(m),
+            beats(f),
+            linear(m),
+            linear(f),
+            show(m.directions),
+            show(f.directions),
+        );
+    }
+    let _ = writeln!(out);
+    out
 }
 
 /// `"met"`, or by how much a ratio `r` misses: `at_least` targets need `r ≥ target`,
@@ -250,6 +417,7 @@ pub fn targets_markdown(median: &Targets, fastest: &Targets) -> String {
             list.join(", ")
         );
     }
+    out.push_str(&algorithms_markdown(median, fastest));
     out
 }
 
@@ -372,6 +540,7 @@ fn ratio_table(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::verify::models;
 
     fn results() -> Results {
         let mut r = Results::default();
@@ -437,5 +606,37 @@ mod tests {
         assert_eq!(time(7.25), "7.25 ns");
         assert_eq!(time(1234.0), "1.23 µs");
         assert_eq!(time(45_600_000.0), "45.6 ms");
+    }
+
+    #[test]
+    fn default_algorithms_match_the_macro() {
+        // The report's copy of the crossover against what `model!` generated.
+        let planar = [
+            models::Planar1::ALGORITHM,
+            models::Planar2::ALGORITHM,
+            models::Planar3::ALGORITHM,
+            models::Planar4::ALGORITHM,
+            models::Planar5::ALGORITHM,
+            models::Planar6::ALGORITHM,
+            models::Planar7::ALGORITHM,
+            models::Planar8::ALGORITHM,
+        ];
+        for (n, a) in planar.into_iter().enumerate() {
+            assert_eq!(a, default_algorithm("planar", n + 1), "planar n = {}", n + 1);
+        }
+        let spatial = [
+            models::Spatial1::ALGORITHM,
+            models::Spatial2::ALGORITHM,
+            models::Spatial3::ALGORITHM,
+            models::Spatial4::ALGORITHM,
+            models::Spatial5::ALGORITHM,
+        ];
+        for (n, a) in spatial.into_iter().enumerate() {
+            assert_eq!(a, default_algorithm("spatial", n + 1), "spatial n = {}", n + 1);
+        }
+        assert_eq!(
+            (models::PlanarDense8::ALGORITHM, models::SpatialTension1::ALGORITHM),
+            ("dense", "tension")
+        );
     }
 }

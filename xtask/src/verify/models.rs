@@ -1,6 +1,6 @@
 //! The models `verify` checks, behind one generic entry point: the generic
 //! `Planar<Dyn>`/`Spatial<Dyn>` and the fixed-N models `pendulum_macros::model!`
-//! generates.
+//! generates, with their default algorithm and with each algorithm named.
 //!
 //! Each model has its own type, so callers pass a [`ModelVisitor`] whose generic
 //! [`visit`](ModelVisitor::visit) runs on whichever concrete model the case needs.
@@ -38,6 +38,59 @@ pendulum_macros::model! {
     pub struct Spatial4 { kind: spatial, links: 4 }
     /// Generated spatial model, 5 links.
     pub struct Spatial5 { kind: spatial, links: 5 }
+    // Each algorithm at each size, whatever the default (the O(n) routes table).
+    /// Generated planar model, 1 link, by the mass matrix.
+    pub struct PlanarDense1 { kind: planar, links: 1, algorithm: dense }
+    /// Generated planar model, 1 link, by the rod tensions.
+    pub struct PlanarTension1 { kind: planar, links: 1, algorithm: tension }
+    /// Generated planar model, 2 links, by the mass matrix.
+    pub struct PlanarDense2 { kind: planar, links: 2, algorithm: dense }
+    /// Generated planar model, 2 links, by the rod tensions.
+    pub struct PlanarTension2 { kind: planar, links: 2, algorithm: tension }
+    /// Generated planar model, 3 links, by the mass matrix.
+    pub struct PlanarDense3 { kind: planar, links: 3, algorithm: dense }
+    /// Generated planar model, 3 links, by the rod tensions.
+    pub struct PlanarTension3 { kind: planar, links: 3, algorithm: tension }
+    /// Generated planar model, 4 links, by the mass matrix.
+    pub struct PlanarDense4 { kind: planar, links: 4, algorithm: dense }
+    /// Generated planar model, 4 links, by the rod tensions.
+    pub struct PlanarTension4 { kind: planar, links: 4, algorithm: tension }
+    /// Generated planar model, 5 links, by the mass matrix.
+    pub struct PlanarDense5 { kind: planar, links: 5, algorithm: dense }
+    /// Generated planar model, 5 links, by the rod tensions.
+    pub struct PlanarTension5 { kind: planar, links: 5, algorithm: tension }
+    /// Generated planar model, 6 links, by the mass matrix.
+    pub struct PlanarDense6 { kind: planar, links: 6, algorithm: dense }
+    /// Generated planar model, 6 links, by the rod tensions.
+    pub struct PlanarTension6 { kind: planar, links: 6, algorithm: tension }
+    /// Generated planar model, 7 links, by the mass matrix.
+    pub struct PlanarDense7 { kind: planar, links: 7, algorithm: dense }
+    /// Generated planar model, 7 links, by the rod tensions.
+    pub struct PlanarTension7 { kind: planar, links: 7, algorithm: tension }
+    /// Generated planar model, 8 links, by the mass matrix.
+    pub struct PlanarDense8 { kind: planar, links: 8, algorithm: dense }
+    /// Generated planar model, 8 links, by the rod tensions.
+    pub struct PlanarTension8 { kind: planar, links: 8, algorithm: tension }
+    /// Generated spatial model, 1 link, by the mass matrix.
+    pub struct SpatialDense1 { kind: spatial, links: 1, algorithm: dense }
+    /// Generated spatial model, 1 link, by the rod tensions.
+    pub struct SpatialTension1 { kind: spatial, links: 1, algorithm: tension }
+    /// Generated spatial model, 2 links, by the mass matrix.
+    pub struct SpatialDense2 { kind: spatial, links: 2, algorithm: dense }
+    /// Generated spatial model, 2 links, by the rod tensions.
+    pub struct SpatialTension2 { kind: spatial, links: 2, algorithm: tension }
+    /// Generated spatial model, 3 links, by the mass matrix.
+    pub struct SpatialDense3 { kind: spatial, links: 3, algorithm: dense }
+    /// Generated spatial model, 3 links, by the rod tensions.
+    pub struct SpatialTension3 { kind: spatial, links: 3, algorithm: tension }
+    /// Generated spatial model, 4 links, by the mass matrix.
+    pub struct SpatialDense4 { kind: spatial, links: 4, algorithm: dense }
+    /// Generated spatial model, 4 links, by the rod tensions.
+    pub struct SpatialTension4 { kind: spatial, links: 4, algorithm: tension }
+    /// Generated spatial model, 5 links, by the mass matrix.
+    pub struct SpatialDense5 { kind: spatial, links: 5, algorithm: dense }
+    /// Generated spatial model, 5 links, by the rod tensions.
+    pub struct SpatialTension5 { kind: spatial, links: 5, algorithm: tension }
 }
 
 /// Something to do with one model, whatever its concrete type.
@@ -104,5 +157,51 @@ pub fn with_generated<V: ModelVisitor>(
         Spatial 3 => Spatial3,
         Spatial 4 => Spatial4,
         Spatial 5 => Spatial5,
+    }
+}
+
+/// The generated algorithms, as named in `model!` (`algorithm: dense | tension`).
+pub const ALGORITHMS: [&str; 2] = ["dense", "tension"];
+
+/// Runs `visitor` on the generated model of `kind` with `links` links and `algorithm`
+/// (`"dense"` or `"tension"`) built from `params`, or returns `None` if no such model is
+/// generated.
+pub fn with_generated_algorithm<V: ModelVisitor>(
+    kind: Kind,
+    links: usize,
+    algorithm: &str,
+    params: &Params,
+    visitor: V,
+) -> Result<Option<V::Output>> {
+    /// One line per size: `Kind n => Dense, Tension`.
+    macro_rules! dispatch {
+        ($($kind:ident $n:literal => $dense:ty, $tension:ty),* $(,)?) => {{
+            $(
+                if (kind, links) == (Kind::$kind, $n) {
+                    let chain = chain::<nalgebra::Const<$n>>(params)?;
+                    return Ok(match algorithm {
+                        "dense" => Some(visitor.visit(&<$dense>::new(chain))),
+                        "tension" => Some(visitor.visit(&<$tension>::new(chain))),
+                        _ => None,
+                    });
+                }
+            )*
+            Ok(None)
+        }};
+    }
+    dispatch! {
+        Planar 1 => PlanarDense1, PlanarTension1,
+        Planar 2 => PlanarDense2, PlanarTension2,
+        Planar 3 => PlanarDense3, PlanarTension3,
+        Planar 4 => PlanarDense4, PlanarTension4,
+        Planar 5 => PlanarDense5, PlanarTension5,
+        Planar 6 => PlanarDense6, PlanarTension6,
+        Planar 7 => PlanarDense7, PlanarTension7,
+        Planar 8 => PlanarDense8, PlanarTension8,
+        Spatial 1 => SpatialDense1, SpatialTension1,
+        Spatial 2 => SpatialDense2, SpatialTension2,
+        Spatial 3 => SpatialDense3, SpatialTension3,
+        Spatial 4 => SpatialDense4, SpatialTension4,
+        Spatial 5 => SpatialDense5, SpatialTension5,
     }
 }

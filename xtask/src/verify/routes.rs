@@ -1,5 +1,6 @@
 //! The O(n) routes against the sympy reference: `PlanarTension` (planar angles, rod
-//! tensions) and `Directions` (unit link directions, planar and spatial) at the same
+//! tensions), `Directions` (unit link directions, planar and spatial) and the generated
+//! models with each algorithm (`algorithm: dense`, `algorithm: tension`) at the same
 //! seeded random states as the dense models.
 //!
 //! They compute accelerations only (mass matrix and force terms are the dense models'),
@@ -8,8 +9,8 @@
 //! `Directions` takes no torques: its states have `σ = 0` (the reference is evaluated so).
 
 use anyhow::{Context, Result, bail};
-use nalgebra::{DVector, U2, U3, Vector2, Vector3};
-use pendulum_core::{Directions, FnDrive, Inputs, Model, PlanarTension};
+use nalgebra::{DVector, DefaultAllocator, DimName, U1, U2, U3, Vector2, Vector3};
+use pendulum_core::{Directions, FnDrive, Inputs, Model, ModelAlloc, PlanarTension};
 
 use super::bounds::{BOUND, acceleration_error};
 use super::models;
@@ -22,7 +23,7 @@ use crate::sample;
 pub struct RouteRow {
     /// Reference case name.
     pub case: String,
-    /// `"PlanarTension"` or `"Directions"`.
+    /// `"PlanarTension"`, `"Directions"`, `"generated dense"` or `"generated tension"`.
     pub route: &'static str,
     /// Worst backward error over the states.
     pub error: f64,
@@ -42,6 +43,33 @@ fn backward_error(case: &Case, params: &crate::case::Params, point: &Point, a: &
     );
     error
 }
+
+/// The accelerations of a model at a point, as a [`models::ModelVisitor`].
+struct Accelerations<'a>(&'a Point);
+
+impl models::ModelVisitor for Accelerations<'_> {
+    type Output = pendulum_core::Result<DVector<f64>>;
+
+    fn visit<M: Model>(self, model: &M) -> Self::Output
+    where
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    {
+        let point = self.0;
+        let vector = |v: &[f64]| OVectorOf::<M>::from_iterator_generic(model.dof(), U1, v.iter().copied());
+        let pivot_acceleration = nalgebra::OVector::<f64, M::Space>::from_iterator_generic(
+            M::Space::name(),
+            U1,
+            point.pivot_acceleration.iter().copied(),
+        );
+        let inputs = Inputs { torque: vector(&point.torque), pivot_acceleration };
+        let mut a = vector(&point.q);
+        model.accelerations(&vector(&point.q), &vector(&point.qd), &inputs, &mut a)?;
+        Ok(DVector::from_column_slice(a.as_slice()))
+    }
+}
+
+/// A model's vector of coordinates.
+type OVectorOf<M> = nalgebra::OVector<f64, <M as Model>::Dof>;
 
 /// `point` with its torques set to zero.
 fn without_torque(point: &Point) -> Point {
@@ -64,6 +92,19 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
         let (params, point) = sample::state(seed, case.kind, case.links, state);
         let chain = models::chain::<nalgebra::Dyn>(&params)?;
         let context = || format!("{} state {state}", case.name);
+        for (algorithm, route) in models::ALGORITHMS.into_iter().zip(["generated dense", "generated tension"])
+        {
+            if let Some(a) = models::with_generated_algorithm(
+                case.kind,
+                case.links,
+                algorithm,
+                &params,
+                Accelerations(&point),
+            )? {
+                let a = a.with_context(context)?;
+                record(route, backward_error(case, &params, &point, &a), state);
+            }
+        }
         match case.kind {
             Kind::Planar => {
                 let model = PlanarTension::new(chain.clone());
@@ -107,13 +148,14 @@ pub fn verify_cases(cases: &[Case], states: usize, seed: u64) -> Result<Vec<Rout
 /// Prints the table of `rows` and errors if any is above [`BOUND`] (or NaN).
 pub fn report(rows: &[RouteRow]) -> Result<()> {
     println!(
-        "O(n) routes, accelerations (componentwise backward error against the reference, bound {BOUND:e}):"
+        "O(n) routes and each generated algorithm, accelerations (componentwise backward error \
+         against the reference, bound {BOUND:e}):"
     );
-    println!("{:<12} {:<14} {:>10}  verdict", "case", "route", "worst");
+    println!("{:<12} {:<17} {:>10}  verdict", "case", "route", "worst");
     for row in rows {
         let ok = row.error <= BOUND;
         println!(
-            "{:<12} {:<14} {:>10.1e}  {}",
+            "{:<12} {:<17} {:>10.1e}  {}",
             row.case,
             row.route,
             row.error,
@@ -143,7 +185,7 @@ mod tests {
         let rows = verify_cases(&cases, 20, 0x5eed).unwrap();
         assert_eq!(
             rows.len(),
-            cases.iter().map(|c| if c.kind == Kind::Planar { 2 } else { 1 }).sum::<usize>()
+            cases.iter().map(|c| if c.kind == Kind::Planar { 4 } else { 3 }).sum::<usize>()
         );
         report(&rows).unwrap();
     }
