@@ -1897,63 +1897,6 @@ const _: () = {
                     Ok(()) => error,
                 }
             }
-            #[doc = r" The elimination by classical pivots, for chains whose continuants leave"]
-            #[doc = r" `CONTINUANT_RANGE`: factors `c_i / D_{i−1}` and scaled right-hand sides `e_i / D_i`."]
-            #[cold]
-            #[inline(never)]
-            fn pivots(diagonal: [f64; 12], off: [f64; 12], rhs: [f64; 12]) -> ([f64; 12], [f64; 12]) {
-                let ip0 = 1.0 / diagonal[0];
-                let e0 = rhs[0];
-                let s0 = e0 * ip0;
-                let fac1 = off[1] * ip0;
-                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
-                let e1 = rhs[1] - fac1 * e0;
-                let s1 = e1 * ip1;
-                let fac2 = off[2] * ip1;
-                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
-                let e2 = rhs[2] - fac2 * e1;
-                let s2 = e2 * ip2;
-                let fac3 = off[3] * ip2;
-                let ip3 = 1.0 / (diagonal[3] - fac3 * off[3]);
-                let e3 = rhs[3] - fac3 * e2;
-                let s3 = e3 * ip3;
-                let fac4 = off[4] * ip3;
-                let ip4 = 1.0 / (diagonal[4] - fac4 * off[4]);
-                let e4 = rhs[4] - fac4 * e3;
-                let s4 = e4 * ip4;
-                let fac5 = off[5] * ip4;
-                let ip5 = 1.0 / (diagonal[5] - fac5 * off[5]);
-                let e5 = rhs[5] - fac5 * e4;
-                let s5 = e5 * ip5;
-                let fac6 = off[6] * ip5;
-                let ip6 = 1.0 / (diagonal[6] - fac6 * off[6]);
-                let e6 = rhs[6] - fac6 * e5;
-                let s6 = e6 * ip6;
-                let fac7 = off[7] * ip6;
-                let ip7 = 1.0 / (diagonal[7] - fac7 * off[7]);
-                let e7 = rhs[7] - fac7 * e6;
-                let s7 = e7 * ip7;
-                let fac8 = off[8] * ip7;
-                let ip8 = 1.0 / (diagonal[8] - fac8 * off[8]);
-                let e8 = rhs[8] - fac8 * e7;
-                let s8 = e8 * ip8;
-                let fac9 = off[9] * ip8;
-                let ip9 = 1.0 / (diagonal[9] - fac9 * off[9]);
-                let e9 = rhs[9] - fac9 * e8;
-                let s9 = e9 * ip9;
-                let fac10 = off[10] * ip9;
-                let ip10 = 1.0 / (diagonal[10] - fac10 * off[10]);
-                let e10 = rhs[10] - fac10 * e9;
-                let s10 = e10 * ip10;
-                let fac11 = off[11] * ip10;
-                let ip11 = 1.0 / (diagonal[11] - fac11 * off[11]);
-                let e11 = rhs[11] - fac11 * e10;
-                let s11 = e11 * ip11;
-                (
-                    [0.0, fac1, fac2, fac3, fac4, fac5, fac6, fac7, fac8, fac9, fac10, fac11],
-                    [s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11],
-                )
-            }
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
             let g = self.chain.gravity();
@@ -2105,178 +2048,189 @@ const _: () = {
             let free_x11 = fx11 * self.rod_im11;
             let free_y11 = -g + fy11 * self.rod_im11;
             let b11 = self.rod_l11 * rate2_11 + ux11 * (free_x11 - free_x10) + uy11 * (free_y11 - free_y10);
-            let p0 = self.rod_diag0;
-            let ip0 = 1.0 / p0;
-            let e0 = b0;
-            let h0 = e0 * ip0;
             let off1 = -(ux0 * ux1 + uy0 * uy1) * self.rod_im0;
-            let p1 = self.rod_diag1 * p0 - (off1 * off1);
-            let ip1 = p0 / p1;
-            let fac1 = off1 * ip0;
-            let e1 = b1 - fac1 * e0;
-            let h1 = e1 * ip1;
             let off2 = -(ux1 * ux2 + uy1 * uy2) * self.rod_im1;
-            let p2 = self.rod_diag2 * p1 - (off2 * off2) * p0;
-            let ip2 = p1 / p2;
-            let fac2 = off2 * ip1;
-            let e2 = b2 - fac2 * e1;
-            let h2 = e2 * ip2;
             let off3 = -(ux2 * ux3 + uy2 * uy3) * self.rod_im2;
-            let p3 = self.rod_diag3 * p2 - (off3 * off3) * p1;
-            let ip3 = p2 / p3;
-            let fac3 = off3 * ip2;
-            let e3 = b3 - fac3 * e2;
-            let h3 = e3 * ip3;
             let off4 = -(ux3 * ux4 + uy3 * uy4) * self.rod_im3;
-            let p4 = self.rod_diag4 * p3 - (off4 * off4) * p2;
-            let ip4 = p3 / p4;
-            let fac4 = off4 * ip3;
-            let e4 = b4 - fac4 * e3;
-            let h4 = e4 * ip4;
             let off5 = -(ux4 * ux5 + uy4 * uy5) * self.rod_im4;
-            let p5 = self.rod_diag5 * p4 - (off5 * off5) * p3;
-            let ip5 = p4 / p5;
-            let fac5 = off5 * ip4;
-            let e5 = b5 - fac5 * e4;
-            let h5 = e5 * ip5;
             let off6 = -(ux5 * ux6 + uy5 * uy6) * self.rod_im5;
-            let p6 = self.rod_diag6 * p5 - (off6 * off6) * p4;
-            let ip6 = p5 / p6;
-            let fac6 = off6 * ip5;
-            let e6 = b6 - fac6 * e5;
-            let h6 = e6 * ip6;
             let off7 = -(ux6 * ux7 + uy6 * uy7) * self.rod_im6;
-            let p7 = self.rod_diag7 * p6 - (off7 * off7) * p5;
-            let ip7 = p6 / p7;
-            let fac7 = off7 * ip6;
-            let e7 = b7 - fac7 * e6;
-            let h7 = e7 * ip7;
             let off8 = -(ux7 * ux8 + uy7 * uy8) * self.rod_im7;
-            let p8 = self.rod_diag8 * p7 - (off8 * off8) * p6;
-            let ip8 = p7 / p8;
-            let fac8 = off8 * ip7;
-            let e8 = b8 - fac8 * e7;
-            let h8 = e8 * ip8;
             let off9 = -(ux8 * ux9 + uy8 * uy9) * self.rod_im8;
-            let p9 = self.rod_diag9 * p8 - (off9 * off9) * p7;
-            let ip9 = p8 / p9;
-            let fac9 = off9 * ip8;
-            let e9 = b9 - fac9 * e8;
-            let h9 = e9 * ip9;
             let off10 = -(ux9 * ux10 + uy9 * uy10) * self.rod_im9;
-            let p10 = self.rod_diag10 * p9 - (off10 * off10) * p8;
-            let ip10 = p9 / p10;
-            let fac10 = off10 * ip9;
-            let e10 = b10 - fac10 * e9;
-            let h10 = e10 * ip10;
             let off11 = -(ux10 * ux11 + uy10 * uy11) * self.rod_im10;
-            let p11 = self.rod_diag11 * p10 - (off11 * off11) * p9;
-            let ip11 = p10 / p11;
-            let fac11 = off11 * ip10;
-            let e11 = b11 - fac11 * e10;
-            let h11 = e11 * ip11;
-            let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-            let out_of_range = false
-                | (p0.to_bits().wrapping_sub(low) > span)
-                | (p1.to_bits().wrapping_sub(low) > span)
-                | (p2.to_bits().wrapping_sub(low) > span)
-                | (p3.to_bits().wrapping_sub(low) > span)
-                | (p4.to_bits().wrapping_sub(low) > span)
-                | (p5.to_bits().wrapping_sub(low) > span)
-                | (p6.to_bits().wrapping_sub(low) > span)
-                | (p7.to_bits().wrapping_sub(low) > span)
-                | (p8.to_bits().wrapping_sub(low) > span)
-                | (p9.to_bits().wrapping_sub(low) > span)
-                | (p10.to_bits().wrapping_sub(low) > span)
-                | (p11.to_bits().wrapping_sub(low) > span);
-            let (
-                fac1,
-                fac2,
-                fac3,
-                fac4,
-                fac5,
-                fac6,
-                fac7,
-                fac8,
-                fac9,
-                fac10,
-                fac11,
-                h0,
-                h1,
-                h2,
-                h3,
-                h4,
-                h5,
-                h6,
-                h7,
-                h8,
-                h9,
-                h10,
-                h11,
-            ) = if out_of_range {
-                let (factor, scaled) = pivots(
-                    [
-                        self.rod_diag0,
-                        self.rod_diag1,
-                        self.rod_diag2,
-                        self.rod_diag3,
-                        self.rod_diag4,
-                        self.rod_diag5,
-                        self.rod_diag6,
-                        self.rod_diag7,
-                        self.rod_diag8,
-                        self.rod_diag9,
-                        self.rod_diag10,
-                        self.rod_diag11,
-                    ],
-                    [0.0, off1, off2, off3, off4, off5, off6, off7, off8, off9, off10, off11],
-                    [b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, b11],
-                );
-                (
-                    factor[1], factor[2], factor[3], factor[4], factor[5], factor[6], factor[7], factor[8],
-                    factor[9], factor[10], factor[11], scaled[0], scaled[1], scaled[2], scaled[3], scaled[4],
-                    scaled[5], scaled[6], scaled[7], scaled[8], scaled[9], scaled[10], scaled[11],
-                )
-            } else {
-                (
-                    fac1, fac2, fac3, fac4, fac5, fac6, fac7, fac8, fac9, fac10, fac11, h0, h1, h2, h3, h4,
-                    h5, h6, h7, h8, h9, h10, h11,
-                )
+            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
+            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
+            #[cold]
+            #[inline(never)]
+            fn pivots(diagonal: [f64; 12], off: [f64; 12], rhs: [f64; 12]) -> [f64; 12] {
+                let ip0 = 1.0 / diagonal[0];
+                let e0 = rhs[0];
+                let s0 = e0 * ip0;
+                let fac1 = off[1] * ip0;
+                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
+                let e1 = rhs[1] - fac1 * e0;
+                let s1 = e1 * ip1;
+                let fac2 = off[2] * ip1;
+                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
+                let e2 = rhs[2] - fac2 * e1;
+                let s2 = e2 * ip2;
+                let fac3 = off[3] * ip2;
+                let ip3 = 1.0 / (diagonal[3] - fac3 * off[3]);
+                let e3 = rhs[3] - fac3 * e2;
+                let s3 = e3 * ip3;
+                let fac4 = off[4] * ip3;
+                let ip4 = 1.0 / (diagonal[4] - fac4 * off[4]);
+                let e4 = rhs[4] - fac4 * e3;
+                let s4 = e4 * ip4;
+                let fac5 = off[5] * ip4;
+                let ip5 = 1.0 / (diagonal[5] - fac5 * off[5]);
+                let e5 = rhs[5] - fac5 * e4;
+                let s5 = e5 * ip5;
+                let fac6 = off[6] * ip5;
+                let ip6 = 1.0 / (diagonal[6] - fac6 * off[6]);
+                let e6 = rhs[6] - fac6 * e5;
+                let s6 = e6 * ip6;
+                let fac7 = off[7] * ip6;
+                let ip7 = 1.0 / (diagonal[7] - fac7 * off[7]);
+                let e7 = rhs[7] - fac7 * e6;
+                let s7 = e7 * ip7;
+                let fac8 = off[8] * ip7;
+                let ip8 = 1.0 / (diagonal[8] - fac8 * off[8]);
+                let e8 = rhs[8] - fac8 * e7;
+                let s8 = e8 * ip8;
+                let fac9 = off[9] * ip8;
+                let ip9 = 1.0 / (diagonal[9] - fac9 * off[9]);
+                let e9 = rhs[9] - fac9 * e8;
+                let s9 = e9 * ip9;
+                let fac10 = off[10] * ip9;
+                let ip10 = 1.0 / (diagonal[10] - fac10 * off[10]);
+                let e10 = rhs[10] - fac10 * e9;
+                let s10 = e10 * ip10;
+                let fac11 = off[11] * ip10;
+                let ip11 = 1.0 / (diagonal[11] - fac11 * off[11]);
+                let e11 = rhs[11] - fac11 * e10;
+                let s11 = e11 * ip11;
+                let t11 = s11;
+                let t10 = s10 - fac11 * t11;
+                let t9 = s9 - fac10 * t10;
+                let t8 = s8 - fac9 * t9;
+                let t7 = s7 - fac8 * t8;
+                let t6 = s6 - fac7 * t7;
+                let t5 = s5 - fac6 * t6;
+                let t4 = s4 - fac5 * t5;
+                let t3 = s3 - fac4 * t4;
+                let t2 = s2 - fac3 * t3;
+                let t1 = s1 - fac2 * t2;
+                let t0 = s0 - fac1 * t1;
+                [t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11]
+            }
+            let (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11) = {
+                let p0 = self.rod_diag0;
+                let yt0 = b0;
+                let q11 = self.rod_diag11;
+                let zb11 = b11;
+                let p1 = self.rod_diag1 * p0 - off1 * off1;
+                let yt1 = b1 * p0 - off1 * yt0;
+                let q10 = self.rod_diag10 * q11 - off11 * off11;
+                let zb10 = b10 * q11 - off11 * zb11;
+                let p2 = self.rod_diag2 * p1 - (off2 * off2) * p0;
+                let yt2 = b2 * p1 - off2 * yt1;
+                let q9 = self.rod_diag9 * q10 - (off10 * off10) * q11;
+                let zb9 = b9 * q10 - off10 * zb10;
+                let p3 = self.rod_diag3 * p2 - (off3 * off3) * p1;
+                let yt3 = b3 * p2 - off3 * yt2;
+                let q8 = self.rod_diag8 * q9 - (off9 * off9) * q10;
+                let zb8 = b8 * q9 - off9 * zb9;
+                let p4 = self.rod_diag4 * p3 - (off4 * off4) * p2;
+                let yt4 = b4 * p3 - off4 * yt3;
+                let q7 = self.rod_diag7 * q8 - (off8 * off8) * q9;
+                let zb7 = b7 * q8 - off8 * zb8;
+                let p5 = self.rod_diag5 * p4 - (off5 * off5) * p3;
+                let yt5 = b5 * p4 - off5 * yt4;
+                let rp0 = 1.0 / p0;
+                let rp1 = 1.0 / p1;
+                let rp2 = 1.0 / p2;
+                let rp3 = 1.0 / p3;
+                let rp4 = 1.0 / p4;
+                let rp5 = 1.0 / p5;
+                let rq11 = 1.0 / q11;
+                let rq10 = 1.0 / q10;
+                let rq9 = 1.0 / q9;
+                let rq8 = 1.0 / q8;
+                let rq7 = 1.0 / q7;
+                let t6 = (b6 - off6 * yt5 * rp5 - off7 * zb7 * rq7)
+                    / (self.rod_diag6 - (off6 * off6) * p4 * rp5 - (off7 * off7) * q8 * rq7);
+                let t5 = yt5 * rp5 - off6 * p4 * rp5 * t6;
+                let t7 = zb7 * rq7 - off7 * q8 * rq7 * t6;
+                let t4 = yt4 * rp4 - off5 * p3 * rp4 * t5;
+                let t8 = zb8 * rq8 - off8 * q9 * rq8 * t7;
+                let t3 = yt3 * rp3 - off4 * p2 * rp3 * t4;
+                let t9 = zb9 * rq9 - off9 * q10 * rq9 * t8;
+                let t2 = yt2 * rp2 - off3 * p1 * rp2 * t3;
+                let t10 = zb10 * rq10 - off10 * q11 * rq10 * t9;
+                let t1 = yt1 * rp1 - off2 * p0 * rp1 * t2;
+                let t11 = zb11 * rq11 - off11 * rq11 * t10;
+                let t0 = yt0 * rp0 - off1 * rp0 * t1;
+                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
+                if false
+                    | (p0.to_bits().wrapping_sub(low) > span)
+                    | (p1.to_bits().wrapping_sub(low) > span)
+                    | (p2.to_bits().wrapping_sub(low) > span)
+                    | (p3.to_bits().wrapping_sub(low) > span)
+                    | (p4.to_bits().wrapping_sub(low) > span)
+                    | (p5.to_bits().wrapping_sub(low) > span)
+                    | (q11.to_bits().wrapping_sub(low) > span)
+                    | (q10.to_bits().wrapping_sub(low) > span)
+                    | (q9.to_bits().wrapping_sub(low) > span)
+                    | (q8.to_bits().wrapping_sub(low) > span)
+                    | (q7.to_bits().wrapping_sub(low) > span)
+                {
+                    let t = pivots(
+                        [
+                            self.rod_diag0,
+                            self.rod_diag1,
+                            self.rod_diag2,
+                            self.rod_diag3,
+                            self.rod_diag4,
+                            self.rod_diag5,
+                            self.rod_diag6,
+                            self.rod_diag7,
+                            self.rod_diag8,
+                            self.rod_diag9,
+                            self.rod_diag10,
+                            self.rod_diag11,
+                        ],
+                        [0.0, off1, off2, off3, off4, off5, off6, off7, off8, off9, off10, off11],
+                        [b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, b11],
+                    );
+                    (t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8], t[9], t[10], t[11])
+                } else {
+                    (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11)
+                }
             };
-            let t11 = h11;
             let a_x11 = free_x11 + (-t11 * ux11) * self.rod_im11;
             let a_y11 = free_y11 + (-t11 * uy11) * self.rod_im11;
-            let t10 = h10 - fac11 * t11;
             let a_x10 = free_x10 + (t11 * ux11 - t10 * ux10) * self.rod_im10;
             let a_y10 = free_y10 + (t11 * uy11 - t10 * uy10) * self.rod_im10;
-            let t9 = h9 - fac10 * t10;
             let a_x9 = free_x9 + (t10 * ux10 - t9 * ux9) * self.rod_im9;
             let a_y9 = free_y9 + (t10 * uy10 - t9 * uy9) * self.rod_im9;
-            let t8 = h8 - fac9 * t9;
             let a_x8 = free_x8 + (t9 * ux9 - t8 * ux8) * self.rod_im8;
             let a_y8 = free_y8 + (t9 * uy9 - t8 * uy8) * self.rod_im8;
-            let t7 = h7 - fac8 * t8;
             let a_x7 = free_x7 + (t8 * ux8 - t7 * ux7) * self.rod_im7;
             let a_y7 = free_y7 + (t8 * uy8 - t7 * uy7) * self.rod_im7;
-            let t6 = h6 - fac7 * t7;
             let a_x6 = free_x6 + (t7 * ux7 - t6 * ux6) * self.rod_im6;
             let a_y6 = free_y6 + (t7 * uy7 - t6 * uy6) * self.rod_im6;
-            let t5 = h5 - fac6 * t6;
             let a_x5 = free_x5 + (t6 * ux6 - t5 * ux5) * self.rod_im5;
             let a_y5 = free_y5 + (t6 * uy6 - t5 * uy5) * self.rod_im5;
-            let t4 = h4 - fac5 * t5;
             let a_x4 = free_x4 + (t5 * ux5 - t4 * ux4) * self.rod_im4;
             let a_y4 = free_y4 + (t5 * uy5 - t4 * uy4) * self.rod_im4;
-            let t3 = h3 - fac4 * t4;
             let a_x3 = free_x3 + (t4 * ux4 - t3 * ux3) * self.rod_im3;
             let a_y3 = free_y3 + (t4 * uy4 - t3 * uy3) * self.rod_im3;
-            let t2 = h2 - fac3 * t3;
             let a_x2 = free_x2 + (t3 * ux3 - t2 * ux2) * self.rod_im2;
             let a_y2 = free_y2 + (t3 * uy3 - t2 * uy2) * self.rod_im2;
-            let t1 = h1 - fac2 * t2;
             let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * self.rod_im1;
             let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * self.rod_im1;
-            let t0 = h0 - fac1 * t1;
             let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * self.rod_im0;
             let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * self.rod_im0;
             let udd_x0 = (a_x0 - pa_x) * self.rod_il0;

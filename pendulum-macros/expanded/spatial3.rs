@@ -544,24 +544,6 @@ const _: () = {
                     Ok(()) => error,
                 }
             }
-            #[doc = r" The elimination by classical pivots, for chains whose continuants leave"]
-            #[doc = r" `CONTINUANT_RANGE`: factors `c_i / D_{i−1}` and scaled right-hand sides `e_i / D_i`."]
-            #[cold]
-            #[inline(never)]
-            fn pivots(diagonal: [f64; 3], off: [f64; 3], rhs: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-                let ip0 = 1.0 / diagonal[0];
-                let e0 = rhs[0];
-                let s0 = e0 * ip0;
-                let fac1 = off[1] * ip0;
-                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
-                let e1 = rhs[1] - fac1 * e0;
-                let s1 = e1 * ip1;
-                let fac2 = off[2] * ip1;
-                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
-                let e2 = rhs[2] - fac2 * e1;
-                let s2 = e2 * ip2;
-                ([0.0, fac1, fac2], [s0, s1, s2])
-            }
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
             let g = self.chain.gravity();
@@ -656,43 +638,58 @@ const _: () = {
                 + ux2 * (free_x2 - free_x1)
                 + uy2 * (free_y2 - free_y1)
                 + uz2 * (free_z2 - free_z1);
-            let p0 = self.rod_diag0;
-            let ip0 = 1.0 / p0;
-            let e0 = b0;
-            let h0 = e0 * ip0;
             let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * self.rod_im0;
-            let p1 = self.rod_diag1 * p0 - (off1 * off1);
-            let ip1 = p0 / p1;
-            let fac1 = off1 * ip0;
-            let e1 = b1 - fac1 * e0;
-            let h1 = e1 * ip1;
             let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * self.rod_im1;
-            let p2 = self.rod_diag2 * p1 - (off2 * off2) * p0;
-            let ip2 = p1 / p2;
-            let fac2 = off2 * ip1;
-            let e2 = b2 - fac2 * e1;
-            let h2 = e2 * ip2;
-            let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-            let out_of_range = false
-                | (p0.to_bits().wrapping_sub(low) > span)
-                | (p1.to_bits().wrapping_sub(low) > span)
-                | (p2.to_bits().wrapping_sub(low) > span);
-            let (fac1, fac2, h0, h1, h2) = if out_of_range {
-                let (factor, scaled) =
-                    pivots([self.rod_diag0, self.rod_diag1, self.rod_diag2], [0.0, off1, off2], [b0, b1, b2]);
-                (factor[1], factor[2], scaled[0], scaled[1], scaled[2])
-            } else {
-                (fac1, fac2, h0, h1, h2)
+            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
+            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
+            #[cold]
+            #[inline(never)]
+            fn pivots(diagonal: [f64; 3], off: [f64; 3], rhs: [f64; 3]) -> [f64; 3] {
+                let ip0 = 1.0 / diagonal[0];
+                let e0 = rhs[0];
+                let s0 = e0 * ip0;
+                let fac1 = off[1] * ip0;
+                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
+                let e1 = rhs[1] - fac1 * e0;
+                let s1 = e1 * ip1;
+                let fac2 = off[2] * ip1;
+                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
+                let e2 = rhs[2] - fac2 * e1;
+                let s2 = e2 * ip2;
+                let t2 = s2;
+                let t1 = s1 - fac2 * t2;
+                let t0 = s0 - fac1 * t1;
+                [t0, t1, t2]
+            }
+            let (t0, t1, t2) = {
+                let p0 = self.rod_diag0;
+                let yt0 = b0;
+                let q2 = self.rod_diag2;
+                let zb2 = b2;
+                let rp0 = 1.0 / p0;
+                let rq2 = 1.0 / q2;
+                let t1 = (b1 - off1 * yt0 * rp0 - off2 * zb2 * rq2)
+                    / (self.rod_diag1 - (off1 * off1) * rp0 - (off2 * off2) * rq2);
+                let t0 = yt0 * rp0 - off1 * rp0 * t1;
+                let t2 = zb2 * rq2 - off2 * rq2 * t1;
+                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
+                if false | (p0.to_bits().wrapping_sub(low) > span) | (q2.to_bits().wrapping_sub(low) > span) {
+                    let t = pivots(
+                        [self.rod_diag0, self.rod_diag1, self.rod_diag2],
+                        [0.0, off1, off2],
+                        [b0, b1, b2],
+                    );
+                    (t[0], t[1], t[2])
+                } else {
+                    (t0, t1, t2)
+                }
             };
-            let t2 = h2;
             let a_x2 = free_x2 + (-t2 * ux2) * self.rod_im2;
             let a_y2 = free_y2 + (-t2 * uy2) * self.rod_im2;
             let a_z2 = free_z2 + (-t2 * uz2) * self.rod_im2;
-            let t1 = h1 - fac2 * t2;
             let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * self.rod_im1;
             let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * self.rod_im1;
             let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * self.rod_im1;
-            let t0 = h0 - fac1 * t1;
             let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * self.rod_im0;
             let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * self.rod_im0;
             let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * self.rod_im0;

@@ -192,72 +192,11 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
         body.extend(quote!(let #b = #l * #rate2 #(+ #dot)*;));
     }
 
-    // The elimination by continuants, then the range check and the fallback.
-    let mut off_values = Vec::new();
-    for i in 0..n {
-        let (p, ip, fac, e, h, b, diag) =
-            (id("p", i), id("ip", i), id("fac", i), id("e", i), id("h", i), id("b", i), field("rod_diag", i));
-        if i == 0 {
-            body.extend(quote! {
-                let #p = #diag;
-                let #ip = 1.0 / #p;
-                let #e = #b;
-            });
-            off_values.push(quote!(0.0));
-        } else {
-            let off = id("off", i);
-            let im_above = field("rod_im", i - 1);
-            let products = components.iter().map(|c| {
-                let (a, b) = (u(c, i - 1), u(c, i));
-                quote!(#a * #b)
-            });
-            let (p_above, ip_above, e_above) = (id("p", i - 1), id("ip", i - 1), id("e", i - 1));
-            // P_{−1} = 1.
-            let p_above2 = if i >= 2 {
-                let p2 = id("p", i - 2);
-                quote!(* #p2)
-            } else {
-                quote!()
-            };
-            body.extend(quote! {
-                let #off = -(#(#products)+*) * #im_above;
-                let #p = #diag * #p_above - (#off * #off) #p_above2;
-                let #ip = #p_above / #p;
-                let #fac = #off * #ip_above;
-                let #e = #b - #fac * #e_above;
-            });
-            off_values.push(quote!(#off));
-        }
-        body.extend(quote!(let #h = #e * #ip;));
-    }
-    let ps: Vec<Ident> = (0..n).map(|i| id("p", i)).collect();
-    let facs: Vec<Ident> = (1..n).map(|i| id("fac", i)).collect();
-    let hs: Vec<Ident> = (0..n).map(|i| id("h", i)).collect();
-    let bs: Vec<Ident> = (0..n).map(|i| id("b", i)).collect();
-    let diags: Vec<TokenStream> = (0..n).map(|i| field("rod_diag", i)).collect();
-    let fac_index = (1..n).map(index);
-    let h_index = (0..n).map(index);
-    body.extend(quote! {
-        let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-        let out_of_range = false #(| (#ps.to_bits().wrapping_sub(low) > span))*;
-        let (#(#facs,)* #(#hs,)*) = if out_of_range {
-            let (factor, scaled) = pivots([#(#diags),*], [#(#off_values),*], [#(#bs),*]);
-            (#(factor[#fac_index],)* #(scaled[#h_index],)*)
-        } else {
-            (#(#facs,)* #(#hs,)*)
-        };
-    });
-    let pivots = pivots(n);
+    body.extend(twisted_solve(n, components, &u, &field));
 
-    // The up pass: tensions, mass accelerations, link accelerations, angle accelerations.
+    // Mass accelerations, link accelerations, angle accelerations.
     for i in (0..n).rev() {
-        let (t, h) = (id("t", i), id("h", i));
-        if i + 1 == n {
-            body.extend(quote!(let #t = #h;));
-        } else {
-            let (fac_below, t_below) = (id("fac", i + 1), id("t", i + 1));
-            body.extend(quote!(let #t = #h - #fac_below * #t_below;));
-        }
+        let t = id("t", i);
         let im = field("rod_im", i);
         for c in components {
             let (a, fa, ui) = (id(&format!("a_{c}"), i), free(c, i), u(c, i));
@@ -316,7 +255,6 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
             out: &mut SVector<f64, #dof>,
         ) -> Result<()> {
             #failure
-            #pivots
             #body
             if #probe != 0.0 {
                 return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
@@ -327,10 +265,190 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
     }
 }
 
-/// `fn pivots` inside `accelerations`: the elimination by classical pivots
-/// `D_i = A_ii − c_i² / D_{i−1}` (a division on the serial chain, but no continuant to
-/// leave its range), for the chains whose continuants do: the factors `c_i / D_{i−1}` and
-/// the scaled right-hand sides `e_i / D_i`, straight-line like the rest.
+/// The lets of the tension solve `A T = b` (module docs): the off-diagonal entries
+/// `c_i = A_{i,i−1} = −(u_{i−1}·u_i)/m_{i−1}`, then a twisted factorisation that eliminates
+/// from both ends at once and meets at the middle row `k = ⌊n/2⌋`, so that each serial
+/// chain is half the chain long. Continuants from the top, `P_i = A_ii P_{i−1} − c_i² P_{i−2}`
+/// (`P_{−1} = 1`, rows `i < k`), and from the bottom, `Q_i = A_ii Q_{i+1} − c_{i+1}² Q_{i+2}`
+/// (`Q_n = 1`, rows `i > k`), with the right-hand sides eliminated in the same scaling,
+/// `Y_i = b_i P_{i−1} − c_i Y_{i−1}` and `Z_i = b_i Q_{i+1} − c_{i+1} Z_{i+1}`:
+/// ```text
+/// T_k = (b_k − c_k Y_{k−1}/P_{k−1} − c_{k+1} Z_{k+1}/Q_{k+1})
+///         / (A_kk − c_k² P_{k−2}/P_{k−1} − c_{k+1}² Q_{k+2}/Q_{k+1})
+/// T_i = (Y_i − c_{i+1} P_{i−1} T_{i+1}) / P_i   (i < k, upwards)
+/// T_i = (Z_i − c_i Q_{i+1} T_{i−1}) / Q_i       (i > k, downwards)
+/// ```
+/// No division on a serial chain. Should a continuant leave `CONTINUANT_RANGE`, the
+/// tensions come from the classical elimination instead ([`pivots`]).
+fn twisted_solve(
+    n: usize,
+    components: &[&str],
+    u: &dyn Fn(&str, usize) -> Ident,
+    field: &dyn Fn(&str, usize) -> TokenStream,
+) -> TokenStream {
+    let mut out = TokenStream::new();
+    let off = |i: usize| id("off", i);
+    for i in 1..n {
+        let (c, im_above) = (off(i), field("rod_im", i - 1));
+        let products = components.iter().map(|k| {
+            let (a, b) = (u(k, i - 1), u(k, i));
+            quote!(#a * #b)
+        });
+        out.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
+    }
+    let k = n / 2;
+    let (p, q, y, z, rp, rq) = (
+        |i: usize| id("p", i),
+        |i: usize| id("q", i),
+        |i: usize| id("yt", i),
+        |i: usize| id("zb", i),
+        |i: usize| id("rp", i),
+        |i: usize| id("rq", i),
+    );
+    let b = |i: usize| id("b", i);
+    // Top rows 0..k and bottom rows k+1..n, interleaved so that both chains are in flight.
+    let mut hot = TokenStream::new();
+    let top: Vec<usize> = (0..k).collect();
+    let bottom: Vec<usize> = (k + 1..n).rev().collect();
+    for step in 0..top.len().max(bottom.len()) {
+        if let Some(&i) = top.get(step) {
+            let (pi, yi, bi, d) = (p(i), y(i), b(i), field("rod_diag", i));
+            let value = match i {
+                0 => quote!(#d),
+                1 => {
+                    let (p1, c) = (p(0), off(1));
+                    quote!(#d * #p1 - #c * #c)
+                }
+                _ => {
+                    let (p1, p2, c) = (p(i - 1), p(i - 2), off(i));
+                    quote!(#d * #p1 - (#c * #c) * #p2)
+                }
+            };
+            hot.extend(quote!(let #pi = #value;));
+            if i == 0 {
+                hot.extend(quote!(let #yi = #bi;));
+            } else {
+                let (p1, y1, c) = (p(i - 1), y(i - 1), off(i));
+                hot.extend(quote!(let #yi = #bi * #p1 - #c * #y1;));
+            }
+        }
+        if let Some(&i) = bottom.get(step) {
+            let (qi, zi, bi, d) = (q(i), z(i), b(i), field("rod_diag", i));
+            let value = if i + 1 == n {
+                quote!(#d)
+            } else if i + 2 == n {
+                let (q1, c) = (q(i + 1), off(i + 1));
+                quote!(#d * #q1 - #c * #c)
+            } else {
+                let (q1, q2, c) = (q(i + 1), q(i + 2), off(i + 1));
+                quote!(#d * #q1 - (#c * #c) * #q2)
+            };
+            hot.extend(quote!(let #qi = #value;));
+            if i + 1 == n {
+                hot.extend(quote!(let #zi = #bi;));
+            } else {
+                let (q1, z1, c) = (q(i + 1), z(i + 1), off(i + 1));
+                hot.extend(quote!(let #zi = #bi * #q1 - #c * #z1;));
+            }
+        }
+    }
+    for &i in &top {
+        let (r, pi) = (rp(i), p(i));
+        hot.extend(quote!(let #r = 1.0 / #pi;));
+    }
+    for &i in &bottom {
+        let (r, qi) = (rq(i), q(i));
+        hot.extend(quote!(let #r = 1.0 / #qi;));
+    }
+    // The twist row.
+    let (dk, bk, tk) = (field("rod_diag", k), b(k), id("t", k));
+    let mut pivot = quote!(#dk);
+    let mut rhs = quote!(#bk);
+    if k >= 1 {
+        let (c, y1, r1) = (off(k), y(k - 1), rp(k - 1));
+        let p2 = if k >= 2 {
+            let p2 = p(k - 2);
+            quote!(* #p2)
+        } else {
+            quote!()
+        };
+        pivot = quote!(#pivot - (#c * #c) #p2 * #r1);
+        rhs = quote!(#rhs - #c * #y1 * #r1);
+    }
+    if k + 1 < n {
+        let (c, z1, r1) = (off(k + 1), z(k + 1), rq(k + 1));
+        let q2 = if k + 2 < n {
+            let q2 = q(k + 2);
+            quote!(* #q2)
+        } else {
+            quote!()
+        };
+        pivot = quote!(#pivot - (#c * #c) #q2 * #r1);
+        rhs = quote!(#rhs - #c * #z1 * #r1);
+    }
+    hot.extend(quote!(let #tk = (#rhs) / (#pivot);));
+    // Outwards from the twist, both directions at once.
+    let steps = k.max(n - 1 - k);
+    for step in 1..=steps {
+        if step <= k {
+            let i = k - step;
+            let (ti, t1, yi, r, c) = (id("t", i), id("t", i + 1), y(i), rp(i), off(i + 1));
+            let scale = if i >= 1 {
+                let p1 = p(i - 1);
+                quote!(#c * #p1 * #r)
+            } else {
+                quote!(#c * #r)
+            };
+            hot.extend(quote!(let #ti = #yi * #r - #scale * #t1;));
+        }
+        if k + step < n {
+            let i = k + step;
+            let (ti, t1, zi, r, c) = (id("t", i), id("t", i - 1), z(i), rq(i), off(i));
+            let scale = if i + 1 < n {
+                let q1 = q(i + 1);
+                quote!(#c * #q1 * #r)
+            } else {
+                quote!(#c * #r)
+            };
+            hot.extend(quote!(let #ti = #zi * #r - #scale * #t1;));
+        }
+    }
+    let continuants: Vec<Ident> = top.iter().map(|&i| p(i)).chain(bottom.iter().map(|&i| q(i))).collect();
+    let ts: Vec<Ident> = (0..n).map(|i| id("t", i)).collect();
+    let diags: Vec<TokenStream> = (0..n).map(|i| field("rod_diag", i)).collect();
+    let offs: Vec<TokenStream> = (0..n)
+        .map(|i| {
+            if i == 0 {
+                quote!(0.0)
+            } else {
+                let c = off(i);
+                quote!(#c)
+            }
+        })
+        .collect();
+    let bs: Vec<Ident> = (0..n).map(b).collect();
+    let t_index = (0..n).map(index);
+    let fallback = pivots(n);
+    out.extend(quote! {
+        #fallback
+        let (#(#ts,)*) = {
+            #hot
+            let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
+            if false #(| (#continuants.to_bits().wrapping_sub(low) > span))* {
+                let t = pivots([#(#diags),*], [#(#offs),*], [#(#bs),*]);
+                (#(t[#t_index],)*)
+            } else {
+                (#(#ts,)*)
+            }
+        };
+    });
+    out
+}
+
+/// `fn pivots` inside `accelerations`: the tensions by classical pivots
+/// `D_i = A_ii − c_i² / D_{i−1}` and back substitution (divisions on the serial chain, but
+/// no continuant to leave its range), for the chains whose continuants do; straight-line
+/// like the rest.
 fn pivots(n: usize) -> TokenStream {
     let links = index(n);
     let mut body = TokenStream::new();
@@ -352,27 +470,24 @@ fn pivots(n: usize) -> TokenStream {
         }
         body.extend(quote!(let #s = #e * #ip;));
     }
-    let facs = (0..n).map(|i| {
-        if i == 0 {
-            quote!(0.0)
+    for i in (0..n).rev() {
+        let (t, s) = (id("t", i), id("s", i));
+        if i + 1 == n {
+            body.extend(quote!(let #t = #s;));
         } else {
-            let f = id("fac", i);
-            quote!(#f)
+            let (fac, t_below) = (id("fac", i + 1), id("t", i + 1));
+            body.extend(quote!(let #t = #s - #fac * #t_below;));
         }
-    });
-    let ss = (0..n).map(|i| id("s", i));
+    }
+    let ts = (0..n).map(|i| id("t", i));
     quote! {
-        /// The elimination by classical pivots, for chains whose continuants leave
-        /// `CONTINUANT_RANGE`: factors `c_i / D_{i−1}` and scaled right-hand sides `e_i / D_i`.
+        /// The tensions by classical pivots and back substitution, for chains whose
+        /// continuants leave `CONTINUANT_RANGE`.
         #[cold]
         #[inline(never)]
-        fn pivots(
-            diagonal: [f64; #links],
-            off: [f64; #links],
-            rhs: [f64; #links],
-        ) -> ([f64; #links], [f64; #links]) {
+        fn pivots(diagonal: [f64; #links], off: [f64; #links], rhs: [f64; #links]) -> [f64; #links] {
             #body
-            ([#(#facs),*], [#(#ss),*])
+            [#(#ts),*]
         }
     }
 }
