@@ -30,11 +30,21 @@ mod plan;
 use proc_macro::TokenStream;
 
 /// Generates one fixed-N chain model per item
-/// `#[attrs] vis struct Name { kind: planar|spatial, links: N }`.
+/// `#[attrs] vis struct Name { kind: planar|spatial, links: N[, algorithm: dense|tension] }`.
 ///
 /// - `kind: planar`: coordinates `q = (θ_1 … θ_n)`, `Dof = Const<n>`, `Space = U2`;
 ///   `kind: spatial`: `q = (θ_1 … θ_n, φ_1 … φ_n)`, `Dof = Const<2n>`, `Space = U3`.
 /// - `links`: an integer literal from 1 to 16.
+/// - `algorithm` (optional): how `accelerations` solves for `q̈`. `dense` factors the mass
+///   matrix (below); `tension` solves the rods' tension system instead, O(n): the
+///   algorithm of `pendulum_core::PlanarTension` and `Directions` unrolled in the model's
+///   angles, its per-link constants (`1/m_i`, `l_i`, `1/l_i`, `λ_i/l_i`, the tension
+///   system's diagonal) stored by `new`, the sines and cosines from one vectorised kernel
+///   call, and the tridiagonal system by a twisted factorisation (eliminated from both
+///   ends at once, continuants instead of divisions on the serial chains, a classical
+///   fallback for chains whose continuants leave their range). Default: the faster one
+///   measured for that size, `dense` below n = 4 planar and n = 2 spatial, `tension` from
+///   there (`docs/bench.md`). `Name::ALGORITHM` is `"dense"` or `"tension"`.
 ///
 /// Each item becomes `vis struct Name { chain: Chain<Const<n>> }` (the attributes and doc
 /// comments pass through; `Clone` is derived, `Debug` and `PartialEq` show and compare
@@ -45,9 +55,10 @@ use proc_macro::TokenStream;
 /// identities, no loops and no allocation; what depends on the chain alone
 /// (`W_ij = M_max(i,j) l_i l_j`, `M_i l_i`, `1/W_00`) is computed by `new` and stored;
 /// `energy` shares one set of temporaries between `T` and `U`.
-/// `accelerations` solves `M q̈ = Q − c − (k + d)` by an unrolled `L D Lᵀ`
-/// factorisation (no square roots, one division per pivot), with `check_polar_sin` on
-/// every link for spatial models (with the sines it computes anyway). It returns
+/// With `algorithm: dense`, `accelerations` solves `M q̈ = Q − c − (k + d)` by an
+/// unrolled `L D Lᵀ` factorisation (no square roots, one division per pivot). Both
+/// algorithms run `check_polar_sin` on every link for spatial models (with the sines they
+/// compute anyway), and return
 /// `Error::NotPositiveDefinite` if a pivot is not positive or the result is not finite,
 /// and on the way to any error runs `check_inputs` first, whose error (a non-finite or
 /// missized input, named) takes precedence: a non-finite input always makes the result

@@ -77,21 +77,11 @@ pub(super) fn constructor_lets(plan: &Plan) -> TokenStream {
     }
 }
 
-/// `fn accelerations` by the rod tensions (module docs).
-pub(super) fn accelerations(plan: &Plan) -> TokenStream {
-    let n = plan.links;
-    let dof = index(plan.dof());
-    let space = space(plan);
-    let spatial = plan.kind == Kind::Spatial;
-    let failure = failure(plan);
-    let field = |name: &str, i: usize| {
-        let f = id(name, i);
-        quote!(self.#f)
-    };
-
-    // Sines and cosines of every angle at once (a vectorised kernel), then the links'
-    // directions, rates and force pairs.
-    // Padded to a multiple of four angles, the kernel's width with AVX2: no scalar tail.
+/// The first lets of `accelerations`: the inputs, gravity, and the sines and cosines of
+/// every angle from one call of the vectorised kernel (`trig[a] = [sin q_a, cos q_a]`),
+/// its input padded to a multiple of four angles (the kernel's width with AVX2: no
+/// scalar tail).
+fn prelude(plan: &Plan) -> TokenStream {
     let padded = plan.dof().div_ceil(4) * 4;
     let trig_call = if padded == plan.dof() {
         quote!(::pendulum_core::__private::sin_cos_into(q.as_slice(), &mut trig);)
@@ -104,13 +94,142 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
         }
     };
     let trig_len = index(padded);
-    let mut body = quote! {
+    quote! {
         let torque = &inputs.torque;
         let pivot = &inputs.pivot_acceleration;
         let g = self.chain.gravity();
         let mut trig = [[0.0f64; 2]; #trig_len];
         #trig_call
+    }
+}
+
+/// `fn accelerations` with `body` (which ends in the lets of `outputs`, the q̈ entries):
+/// the failure path, and the finiteness probe before the results are written.
+fn wrap(plan: &Plan, body: TokenStream, outputs: &[TokenStream]) -> TokenStream {
+    let dof = index(plan.dof());
+    let space = space(plan);
+    let failure = failure(plan);
+    let probe = finite_probe(outputs);
+    let out_index = (0..plan.dof()).map(index);
+    quote! {
+        fn accelerations(
+            &self,
+            q: &SVector<f64, #dof>,
+            qd: &SVector<f64, #dof>,
+            inputs: &Inputs<Const<#dof>, #space>,
+            out: &mut SVector<f64, #dof>,
+        ) -> Result<()> {
+            #failure
+            #body
+            if #probe != 0.0 {
+                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+            }
+            #(out[#out_index] = #outputs;)*
+            Ok(())
+        }
+    }
+}
+
+/// The planar route in the links' own frames: with `n_i = (cos θ_i, sin θ_i)`,
+/// `C_i = u_{i−1}·u_i = n_{i−1}·n_i = cos(θ_i − θ_{i−1})` and
+/// `S_i = n_{i−1}·u_i = sin(θ_i − θ_{i−1})`, and the pulls `f_i = σ_i/l_i − (λ_i/l_i) θ̇_i`
+/// (`F_i = f_i n_i`; `f_n = T_n = 0`), the module docs' system and accelerations reduce to
+/// ```text
+/// b_i = l_i θ̇_i² + f_{i+1} S_{i+1}/m_i − f_{i−1} S_i/m_{i−1}      (i ≥ 1)
+/// b_0 = l_0 θ̇_0² + u_0·(g⃗ − p̈) + f_1 S_1/m_0,   c_i = −C_i/m_{i−1}
+/// θ̈_i = ((f_i − f_{i+1} C_{i+1} + T_{i+1} S_{i+1})/m_i − (f_{i−1} C_i − f_i + T_{i−1} S_i)/m_{i−1}) / l_i
+/// θ̈_0 = ((f_0 − f_1 C_1 + T_1 S_1)/m_0 − n_0·(p̈ − g⃗)) / l_0
+/// ```
+/// (gravity cancels from every row but the first): no Cartesian accelerations at all.
+fn planar(plan: &Plan) -> TokenStream {
+    let n = plan.links;
+    let field = |name: &str, i: usize| {
+        let f = id(name, i);
+        quote!(self.#f)
     };
+    let mut body = prelude(plan);
+    body.extend(quote! {
+        let pa_x = pivot[0];
+        let pa_y = pivot[1];
+    });
+    for i in 0..n {
+        let (st, ct, dth, pull) = (id("st", i), id("ct", i), id("dth", i), id("pull", i));
+        let ii = index(i);
+        let (il, drag) = (field("rod_il", i), field("rod_drag", i));
+        body.extend(quote! {
+            let [#st, #ct] = trig[#ii];
+            let #dth = qd[#ii];
+            let #pull = torque[#ii] * #il - #drag * #dth;
+        });
+        if i >= 1 {
+            let (c, sd, st1, ct1) = (id("cd", i), id("sd", i), id("st", i - 1), id("ct", i - 1));
+            let (off, im_above) = (id("off", i), field("rod_im", i - 1));
+            body.extend(quote! {
+                let #c = #ct1 * #ct + #st1 * #st;
+                let #sd = #st * #ct1 - #ct * #st1;
+                let #off = -#c * #im_above;
+            });
+        }
+    }
+    for i in 0..n {
+        let (b, l, dth, im) = (id("b", i), field("rod_l", i), id("dth", i), field("rod_im", i));
+        let mut terms = vec![quote!(#l * #dth * #dth)];
+        if i == 0 {
+            let (st, ct) = (id("st", 0), id("ct", 0));
+            // u_0·(g⃗ − p̈) with u_0 = (sin θ_0, −cos θ_0), g⃗ = (0, −g).
+            terms.push(quote!(#ct * (g + pa_y) - #st * pa_x));
+        } else {
+            let (pull_above, sd, im_above) = (id("pull", i - 1), id("sd", i), field("rod_im", i - 1));
+            terms.push(quote!(-#pull_above * #sd * #im_above));
+        }
+        if i + 1 < n {
+            let (pull_below, sd_below) = (id("pull", i + 1), id("sd", i + 1));
+            terms.push(quote!(#pull_below * #sd_below * #im));
+        }
+        body.extend(quote!(let #b = #(#terms)+*;));
+    }
+    body.extend(twisted_solve(n, &field));
+    let mut outputs = Vec::new();
+    for i in 0..n {
+        let (x, pull, im, il) = (id("x_th", i), id("pull", i), field("rod_im", i), field("rod_il", i));
+        // (f_i − f_{i+1} C_{i+1} + T_{i+1} S_{i+1}) / m_i
+        let own = if i + 1 < n {
+            let (pull_below, cd, sd, t_below) =
+                (id("pull", i + 1), id("cd", i + 1), id("sd", i + 1), id("t", i + 1));
+            quote!((#pull - #pull_below * #cd + #t_below * #sd) * #im)
+        } else {
+            quote!(#pull * #im)
+        };
+        let above = if i == 0 {
+            let (st, ct) = (id("st", 0), id("ct", 0));
+            // n_0·(p̈ − g⃗) with n_0 = (cos θ_0, sin θ_0).
+            quote!((#ct * pa_x + #st * (pa_y + g)))
+        } else {
+            let (pull_above, cd, sd, t_above, im_above) =
+                (id("pull", i - 1), id("cd", i), id("sd", i), id("t", i - 1), field("rod_im", i - 1));
+            quote!((#pull_above * #cd - #pull + #t_above * #sd) * #im_above)
+        };
+        body.extend(quote!(let #x = (#own - #above) * #il;));
+        outputs.push(quote!(#x));
+    }
+    wrap(plan, body, &outputs)
+}
+
+/// `fn accelerations` by the rod tensions (module docs).
+pub(super) fn accelerations(plan: &Plan) -> TokenStream {
+    let n = plan.links;
+    let spatial = plan.kind == Kind::Spatial;
+    let field = |name: &str, i: usize| {
+        let f = id(name, i);
+        quote!(self.#f)
+    };
+
+    if !spatial {
+        return planar(plan);
+    }
+    // Sines and cosines of every angle at once (a vectorised kernel), then the links'
+    // directions, rates and force pairs.
+    let mut body = prelude(plan);
     let components: &[&str] = if spatial { &["x", "y", "z"] } else { &["x", "y"] };
     let pivot_names: Vec<Ident> = components.iter().map(|c| format_ident!("pa_{c}")).collect();
     for (k, p) in pivot_names.iter().enumerate() {
@@ -192,7 +311,15 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
         body.extend(quote!(let #b = #l * #rate2 #(+ #dot)*;));
     }
 
-    body.extend(twisted_solve(n, components, &u, &field));
+    for i in 1..n {
+        let (c, im_above) = (id("off", i), field("rod_im", i - 1));
+        let products = components.iter().map(|k| {
+            let (a, b) = (u(k, i - 1), u(k, i));
+            quote!(#a * #b)
+        });
+        body.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
+    }
+    body.extend(twisted_solve(n, &field));
 
     // Mass accelerations, link accelerations, angle accelerations.
     for i in (0..n).rev() {
@@ -244,29 +371,12 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
         }
         outputs[ii] = quote!(#x_th);
     }
-    let probe = finite_probe(&outputs);
-    let out_index = (0..plan.dof()).map(index);
-    quote! {
-        fn accelerations(
-            &self,
-            q: &SVector<f64, #dof>,
-            qd: &SVector<f64, #dof>,
-            inputs: &Inputs<Const<#dof>, #space>,
-            out: &mut SVector<f64, #dof>,
-        ) -> Result<()> {
-            #failure
-            #body
-            if #probe != 0.0 {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
-            }
-            #(out[#out_index] = #outputs;)*
-            Ok(())
-        }
-    }
+    wrap(plan, body, &outputs)
 }
 
-/// The lets of the tension solve `A T = b` (module docs): the off-diagonal entries
-/// `c_i = A_{i,i−1} = −(u_{i−1}·u_i)/m_{i−1}`, then a twisted factorisation that eliminates
+/// The lets of the tension solve `A T = b` (module docs), given the lets `b<i>` and the
+/// off-diagonal entries `off<i>` = `c_i = A_{i,i−1} = −(u_{i−1}·u_i)/m_{i−1}`: a twisted
+/// factorisation that eliminates
 /// from both ends at once and meets at the middle row `k = ⌊n/2⌋`, so that each serial
 /// chain is half the chain long. Continuants from the top, `P_i = A_ii P_{i−1} − c_i² P_{i−2}`
 /// (`P_{−1} = 1`, rows `i < k`), and from the bottom, `Q_i = A_ii Q_{i+1} − c_{i+1}² Q_{i+2}`
@@ -280,22 +390,9 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
 /// ```
 /// No division on a serial chain. Should a continuant leave `CONTINUANT_RANGE`, the
 /// tensions come from the classical elimination instead ([`pivots`]).
-fn twisted_solve(
-    n: usize,
-    components: &[&str],
-    u: &dyn Fn(&str, usize) -> Ident,
-    field: &dyn Fn(&str, usize) -> TokenStream,
-) -> TokenStream {
+fn twisted_solve(n: usize, field: &dyn Fn(&str, usize) -> TokenStream) -> TokenStream {
     let mut out = TokenStream::new();
     let off = |i: usize| id("off", i);
-    for i in 1..n {
-        let (c, im_above) = (off(i), field("rod_im", i - 1));
-        let products = components.iter().map(|k| {
-            let (a, b) = (u(k, i - 1), u(k, i));
-            quote!(#a * #b)
-        });
-        out.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
-    }
     let k = n / 2;
     let (p, q, y, z, rp, rq) = (
         |i: usize| id("p", i),
