@@ -5,7 +5,8 @@ use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
 use super::body::Body;
-use super::{ident, index, space};
+use super::guards::{failure, finite_probe};
+use super::names::{ident, index, space};
 use crate::plan::{Expr, Plan, Sym};
 
 /// `fn accelerations`: `M` and `Q − c − (k + d)` as lets with the polar-angle checks among
@@ -65,31 +66,6 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
             }
             #(out[#indices] = #xs;)*
             Ok(())
-        }
-    }
-}
-
-/// `fn failure` inside `accelerations`: the error of a failed evaluation, the input
-/// checks' first.
-pub(super) fn failure(plan: &Plan) -> TokenStream {
-    let dof = index(plan.dof());
-    let space = space(plan);
-    quote! {
-        /// The error of a failed evaluation: the input checks' if they fail (a
-        /// non-finite input always ends here), else `error`. Out of line: the hot path
-        /// stays small.
-        #[cold]
-        #[inline(never)]
-        fn failure(
-            q: &SVector<f64, #dof>,
-            qd: &SVector<f64, #dof>,
-            inputs: &Inputs<Const<#dof>, #space>,
-            error: Error,
-        ) -> Error {
-            match ::pendulum_core::check_inputs(#dof, q, qd, inputs) {
-                Err(input_error) => input_error,
-                Ok(()) => error,
-            }
         }
     }
 }
@@ -218,19 +194,4 @@ fn minus_products(first: Option<TokenStream>, products: &[(Ident, Ident)]) -> Op
         }
     };
     Some(products.fold(start, |acc, p| quote!(#acc - #p)))
-}
-
-/// `Σ (x − x)` over `values` as a balanced tree of additions (latency `log₂` of their
-/// number): `0.0` exactly when every value is finite, NaN otherwise (`x − x` is NaN for
-/// ±∞ and NaN). One subtraction and one addition per value, no branch per value.
-pub(super) fn finite_probe(values: &[TokenStream]) -> TokenStream {
-    match values {
-        [] => quote!(0.0),
-        [x] => quote!((#x - #x)),
-        _ => {
-            let (a, b) = values.split_at(values.len() / 2);
-            let (a, b) = (finite_probe(a), finite_probe(b));
-            quote!((#a + #b))
-        }
-    }
 }

@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::{ident, index};
+use super::names::{ident, index};
 use crate::plan::{Angle, Expr, Plan, Sym, Trig};
 
 /// `name` if the generated body uses it, `_name` otherwise (no unused-variable warnings).

@@ -5,7 +5,8 @@ use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
 use super::body::lets_from;
-use super::{ident, index, tension};
+use super::names::{ident, index};
+use super::rod_constants;
 use crate::parse::ModelDef;
 use crate::plan::{Algorithm, Kind, Plan, Sym};
 
@@ -20,7 +21,7 @@ pub(super) fn stored(plan: &Plan) -> Vec<Sym> {
 
 /// `vis struct Name { chain, <stored>, <what the algorithm needs> }`, with the input's
 /// attributes and a generated doc paragraph: `inv0` for the dense route, the per-link
-/// constants of the tension solve ([`tension::stored`]) for the other.
+/// constants of the tension solve ([`rod_constants::stored`]) for the other.
 pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm: Algorithm) -> TokenStream {
     let ModelDef { attrs, vis, ident: name, .. } = def;
     let n = index(plan.links);
@@ -43,7 +44,7 @@ pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
         },
         Algorithm::Tension => {
             let (fields, docs): (Vec<Ident>, Vec<String>) =
-                tension::stored(plan).into_iter().map(|(f, _, d)| (f, d)).unzip();
+                rod_constants::stored(plan).into_iter().map(|(f, _, d)| (f, d)).unzip();
             quote!(#(#[doc = #docs] #fields: ::core::primitive::f64,)*)
         }
     };
@@ -114,9 +115,9 @@ pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
             )
         }
         Algorithm::Tension => {
-            let inputs = tension::constructor_lets(plan);
+            let inputs = rod_constants::constructor_lets(plan);
             let (fields, values): (Vec<Ident>, Vec<TokenStream>) =
-                tension::stored(plan).into_iter().map(|(f, v, _)| (f, v)).unzip();
+                rod_constants::stored(plan).into_iter().map(|(f, v, _)| (f, v)).unzip();
             // In a block of its own: its lets may share names with the stored symbols'.
             (quote!(let (#(#fields,)*) = { #inputs (#(#values,)*) };), quote!(#(#fields),*))
         }

@@ -4,7 +4,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::body::{Body, expr, vector_outputs};
-use super::index;
+use super::names::index;
 use crate::plan::{Expr, Plan, Sym};
 
 /// `SVector<f64, dof>`, the type of `q`, `q̇` and the per-coordinate outputs.

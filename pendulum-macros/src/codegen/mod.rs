@@ -3,23 +3,30 @@
 //!
 //! [`model`] composes the items, one function each: [`items`] has the struct and its impls
 //! other than `Model`, [`model_impl`] the `Model` impl (its associated types here, its
-//! methods in [`methods`] and [`accelerations`]); [`body`] writes the methods' lets.
+//! methods in [`methods`], and `accelerations` by the chosen algorithm: [`accelerations`]
+//! for `dense`, [`tension`] for `tension`, with the per-link constants of the latter in
+//! [`rod_constants`]); [`body`] writes the methods' lets, [`guards`] the failure path and
+//! finiteness probe both `accelerations` end with, [`names`] the shared identifiers.
 
 mod accelerations;
 mod body;
 #[cfg(test)]
 mod expansions;
+mod guards;
 mod items;
 mod methods;
+mod names;
+mod rod_constants;
 mod tension;
 #[cfg(test)]
 mod tests;
 
-use proc_macro2::{Ident, Literal, Span, TokenStream};
-use quote::{format_ident, quote};
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
 
+use self::names::{chart, index, space};
 use crate::parse::{Input, ModelDef};
-use crate::plan::{Algorithm, Kind, Plan, Sym};
+use crate::plan::{Algorithm, Plan};
 
 /// Everything `model!` emits for its input.
 pub fn expand(input: &Input) -> TokenStream {
@@ -117,27 +124,4 @@ fn associated_types(plan: &Plan) -> TokenStream {
         type Space = #space;
         type Chart = ::pendulum_core::kinematics::#chart;
     }
-}
-
-/// The name of the `let` of `sym`.
-fn ident(sym: Sym) -> Ident {
-    Ident::new(&sym.name(), Span::call_site())
-}
-
-/// `i` as an unsuffixed literal.
-fn index(i: usize) -> Literal {
-    Literal::usize_unsuffixed(i)
-}
-
-/// The chart of the model's coordinates (`pendulum_core::kinematics`).
-fn chart(plan: &Plan) -> Ident {
-    match plan.kind {
-        Kind::Planar => format_ident!("PlanarAngles"),
-        Kind::Spatial => format_ident!("SphericalAngles"),
-    }
-}
-
-/// The pivot-acceleration type: `U2` planar, `U3` spatial.
-fn space(plan: &Plan) -> Ident {
-    format_ident!("U{}", plan.space())
 }
