@@ -267,7 +267,7 @@ fn algorithms_markdown(median: &Targets, fastest: &Targets) -> String {
     }
     let _ = writeln!(
         out,
-        "**Generated models: the algorithm at each n** (`model!`'s `algorithm: dense | tension`;          the default is `tension` from n = {} planar and n = {} spatial). Times are medians /          fastest samples; \"best other\" is the fastest other route computing the same q̈ in the          same angles ({}); the O(n) route in the same coordinates must be ≥ {ALGORITHM_TARGET}×          slower than the default (planar `PlanarTension<Dyn>` from n = 8; spatial          `Directions::spherical_accelerations`, which converts angles to directions and back and          allocates its result). `Directions` rhs, another quantity (the first-order right-hand          side in direction coordinates, no trigonometry), is listed for scale.\n",
+        "**Generated models: the algorithm at each n** (`model!`'s `algorithm: dense | tension`; the default is `tension` from n = {} planar and n = {} spatial). Times are medians / fastest samples; \"best other\" is the fastest other route computing the same q̈ in the same angles ({}); the O(n) route in the same coordinates must be ≥ {ALGORITHM_TARGET}× slower than the default (planar `PlanarTension<Dyn>` from n = 8; spatial `Directions::spherical_accelerations`, which converts angles to directions and back and allocates its result). `Directions` rhs, another quantity (the first-order right-hand side in direction coordinates, no trigonometry), is listed for scale.\n",
         GENERATED_CROSSOVER[0].1,
         GENERATED_CROSSOVER[1].1,
         SAME_QUANTITY.iter().map(|(k, o)| format!("{k}: {}", o.join(", "))).collect::<Vec<_>>().join("; ")
