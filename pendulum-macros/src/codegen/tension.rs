@@ -10,12 +10,13 @@
 //! (1/m_i + 1/m_{i−1}) T_i − (u_{i−1}·u_i / m_{i−1}) T_{i−1} − (u_i·u_{i+1} / m_i) T_{i+1}
 //!     = l_i |u̇_i|² + u_i · (a°_i − a°_{i−1})
 //! ```
-//! by continuants (`P_i = A_ii P_{i−1} − A_{i,i−1}² P_{i−2}`, pivots `P_i / P_{i−1}`: no
-//! division on the serial chain; classical pivots if a continuant leaves
+//! by a twisted factorisation ([`twisted_solve`]: continuants from both ends meeting at the
+//! middle row, no division on a serial chain; classical pivots if a continuant leaves
 //! `CONTINUANT_RANGE`), then the mass accelerations `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i`
 //! and `ü_i = (a_i − a_{i−1}) / l_i`, mapped to the angles:
 //! - planar, `u_i = (sin θ_i, −cos θ_i)`: `F_i = ((σ_i − λ_i θ̇_i) / l_i) (cos θ_i, sin θ_i)`,
-//!   `|u̇_i|² = θ̇_i²`, `θ̈_i = (cos θ_i, sin θ_i) · ü_i`;
+//!   `|u̇_i|² = θ̇_i²`, `θ̈_i = (cos θ_i, sin θ_i) · ü_i`, all written in the links' own
+//!   frames ([`planar`]);
 //! - spatial, `u_i = (sθ cφ, sθ sφ, −cθ)`, `e_θ = (cθ cφ, cθ sφ, sθ)`, `e_φ = (−sφ, cφ, 0)`:
 //!   `F_i = (Q_θ e_θ + (Q_φ / sin θ_i) e_φ) / l_i` (`Q_θ = σ_θ − λ θ̇`, `Q_φ = σ_φ − λ sin²θ φ̇`),
 //!   `|u̇_i|² = θ̇² + sin²θ φ̇²`, `θ̈ = e_θ·ü + φ̇² sin θ cos θ`,
