@@ -98,10 +98,6 @@ fn wrap(plan: &Plan, body: TokenStream, outputs: &[TokenStream]) -> TokenStream 
 /// (gravity cancels from every row but the first): no Cartesian accelerations at all.
 fn planar(plan: &Plan) -> TokenStream {
     let n = plan.links;
-    let field = |name: &str, i: usize| {
-        let f = id(name, i);
-        quote!(self.#f)
-    };
     let mut body = prelude(plan);
     body.extend(quote! {
         let pa_x = pivot[0];
@@ -143,7 +139,7 @@ fn planar(plan: &Plan) -> TokenStream {
         }
         body.extend(quote!(let #b = #(#terms)+*;));
     }
-    body.extend(twisted_solve(n, &field));
+    body.extend(twisted_solve(n));
     let mut outputs = Vec::new();
     for i in 0..n {
         let (x, pull, im, il) = (id("x_th", i), id("pull", i), field("rod_im", i), field("rod_il", i));
@@ -170,161 +166,141 @@ fn planar(plan: &Plan) -> TokenStream {
     wrap(plan, body, &outputs)
 }
 
-/// `fn accelerations` by the rod tensions (module docs).
+/// `fn accelerations` by the rod tensions (module docs): [`planar`] or [`spatial`].
 pub(super) fn accelerations(plan: &Plan) -> TokenStream {
-    let n = plan.links;
-    let spatial = plan.kind == Kind::Spatial;
-    let field = |name: &str, i: usize| {
-        let f = id(name, i);
-        quote!(self.#f)
-    };
-
-    if !spatial {
-        return planar(plan);
+    match plan.kind {
+        Kind::Planar => planar(plan),
+        Kind::Spatial => spatial(plan),
     }
+}
+
+/// `self.<name><i>`: a per-link constant stored by `new` ([`rod_constants`](super::rod_constants)).
+fn field(name: &str, i: usize) -> TokenStream {
+    let f = id(name, i);
+    quote!(self.#f)
+}
+
+/// The spatial route in Cartesian components (module docs): directions, force pairs and
+/// free accelerations per link, the tension solve, then `ü_i` mapped to `(θ̈_i, φ̈_i)`.
+fn spatial(plan: &Plan) -> TokenStream {
+    let n = plan.links;
+    const XYZ: [&str; 3] = ["x", "y", "z"];
+    let u = |c: &str, i: usize| id(&format!("u{c}"), i);
+    let f = |c: &str, i: usize| id(&format!("f{c}"), i);
+    let free = |c: &str, i: usize| id(&format!("free_{c}"), i);
+    let a = |c: &str, i: usize| id(&format!("a_{c}"), i);
+    let pivot_names: Vec<Ident> = XYZ.iter().map(|c| format_ident!("pa_{c}")).collect();
     // Sines and cosines of every angle at once (a vectorised kernel), then the links'
     // directions, rates and force pairs.
     let mut body = prelude(plan);
-    let components: &[&str] = if spatial { &["x", "y", "z"] } else { &["x", "y"] };
-    let pivot_names: Vec<Ident> = components.iter().map(|c| format_ident!("pa_{c}")).collect();
     for (k, p) in pivot_names.iter().enumerate() {
         let k = index(k);
         body.extend(quote!(let #p = pivot[#k];));
     }
     for i in 0..n {
-        let (st, ct, dth, tau) = (id("st", i), id("ct", i), id("dth", i), id("tau_th", i));
-        let ii = index(i);
+        let (st, ct, dth, sp, cp, dph, is) =
+            (id("st", i), id("ct", i), id("dth", i), id("sp", i), id("cp", i), id("dph", i), id("is", i));
+        let (th, phi, link) = (index(i), index(n + i), index(i + 1));
         let (il, drag) = (field("rod_il", i), field("rod_drag", i));
-        let (rate2, pull) = (id("rate2_", i), id("pull_th", i));
-        let [ux, uy] = [id("ux", i), id("uy", i)];
-        let [fx, fy] = [id("fx", i), id("fy", i)];
+        let (rate2, pull, pull_ph) = (id("rate2_", i), id("pull_th", i), id("pull_ph", i));
+        let [ux, uy, uz] = [u("x", i), u("y", i), u("z", i)];
+        let [fx, fy, fz] = [f("x", i), f("y", i), f("z", i)];
+        let (etx, ety) = (id("etx", i), id("ety", i));
         body.extend(quote! {
-            let [#st, #ct] = trig[#ii];
-            let #dth = qd[#ii];
-            let #tau = torque[#ii];
-            let #pull = #tau * #il - #drag * #dth;
+            let [#st, #ct] = trig[#th];
+            if let Err(error) = ::pendulum_core::check_polar_sin(#link, q[#th], #st) {
+                return Err(failure(q, qd, inputs, error));
+            }
+            let [#sp, #cp] = trig[#phi];
+            let #dth = qd[#th];
+            let #dph = qd[#phi];
+            let #is = 1.0 / #st;
+            let #ux = #st * #cp;
+            let #uy = #st * #sp;
+            let #uz = -#ct;
+            let #etx = #ct * #cp;
+            let #ety = #ct * #sp;
+            let #rate2 = #dth * #dth + #st * #st * #dph * #dph;
+            let #pull = torque[#th] * #il - #drag * #dth;
+            let #pull_ph = torque[#phi] * #il * #is - #drag * #st * #dph;
+            let #fx = #pull * #etx - #pull_ph * #sp;
+            let #fy = #pull * #ety + #pull_ph * #cp;
+            let #fz = #pull * #st;
         });
-        if spatial {
-            let link = index(i + 1);
-            let phi = index(n + i);
-            let (sp, cp, dph, tau_ph, is) =
-                (id("sp", i), id("cp", i), id("dph", i), id("tau_ph", i), id("is", i));
-            let pull_ph = id("pull_ph", i);
-            let (etx, ety, uz, fz) = (id("etx", i), id("ety", i), id("uz", i), id("fz", i));
-            body.extend(quote! {
-                if let Err(error) = ::pendulum_core::check_polar_sin(#link, q[#ii], #st) {
-                    return Err(failure(q, qd, inputs, error));
-                }
-                let [#sp, #cp] = trig[#phi];
-                let #dph = qd[#phi];
-                let #tau_ph = torque[#phi];
-                let #is = 1.0 / #st;
-                let #ux = #st * #cp;
-                let #uy = #st * #sp;
-                let #uz = -#ct;
-                let #etx = #ct * #cp;
-                let #ety = #ct * #sp;
-                let #rate2 = #dth * #dth + #st * #st * #dph * #dph;
-                let #pull_ph = #tau_ph * #il * #is - #drag * #st * #dph;
-                let #fx = #pull * #etx - #pull_ph * #sp;
-                let #fy = #pull * #ety + #pull_ph * #cp;
-                let #fz = #pull * #st;
-            });
-        } else {
-            body.extend(quote! {
-                let #ux = #st;
-                let #uy = -#ct;
-                let #rate2 = #dth * #dth;
-                let #fx = #pull * #ct;
-                let #fy = #pull * #st;
-            });
-        }
     }
 
     // Free accelerations a°_i and right-hand sides b_i.
-    let u = |c: &str, i: usize| id(&format!("u{c}"), i);
-    let f = |c: &str, i: usize| id(&format!("f{c}"), i);
-    let free = |c: &str, i: usize| id(&format!("free_{c}"), i);
     for i in 0..n {
         let im = field("rod_im", i);
         let mut dot = Vec::new();
-        for (k, c) in components.iter().enumerate() {
-            let (a, fi) = (free(c, i), f(c, i));
-            let gravity = if k + 1 == components.len() { quote!(-g +) } else { quote!() };
+        for (k, c) in XYZ.iter().enumerate() {
+            let (fa, fi) = (free(c, i), f(c, i));
+            let gravity = if k == 2 { quote!(-g +) } else { quote!() };
             let pair = if i + 1 < n {
                 let below = f(c, i + 1);
                 quote!((#fi - #below))
             } else {
                 quote!(#fi)
             };
-            body.extend(quote!(let #a = #gravity #pair * #im;));
+            body.extend(quote!(let #fa = #gravity #pair * #im;));
             let above = if i == 0 { pivot_names[k].clone() } else { free(c, i - 1) };
             let ui = u(c, i);
-            dot.push(quote!(#ui * (#a - #above)));
+            dot.push(quote!(#ui * (#fa - #above)));
         }
         let (b, l, rate2) = (id("b", i), field("rod_l", i), id("rate2_", i));
         body.extend(quote!(let #b = #l * #rate2 #(+ #dot)*;));
     }
-
     for i in 1..n {
         let (c, im_above) = (id("off", i), field("rod_im", i - 1));
-        let products = components.iter().map(|k| {
+        let products = XYZ.iter().map(|k| {
             let (a, b) = (u(k, i - 1), u(k, i));
             quote!(#a * #b)
         });
         body.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
     }
-    body.extend(twisted_solve(n, &field));
+    body.extend(twisted_solve(n));
 
-    // Mass accelerations, link accelerations, angle accelerations.
+    // Mass accelerations a_i, link accelerations ü_i, angle accelerations.
     for i in (0..n).rev() {
-        let t = id("t", i);
-        let im = field("rod_im", i);
-        for c in components {
-            let (a, fa, ui) = (id(&format!("a_{c}"), i), free(c, i), u(c, i));
+        let (t, im) = (id("t", i), field("rod_im", i));
+        for c in XYZ {
+            let (ai, fa, ui) = (a(c, i), free(c, i), u(c, i));
             let pull_below = if i + 1 < n {
                 let (t_below, u_below) = (id("t", i + 1), u(c, i + 1));
                 quote!(#t_below * #u_below -)
             } else {
                 quote!(-)
             };
-            body.extend(quote!(let #a = #fa + (#pull_below #t * #ui) * #im;));
+            body.extend(quote!(let #ai = #fa + (#pull_below #t * #ui) * #im;));
         }
     }
     let mut outputs: Vec<TokenStream> = vec![quote!(); plan.dof()];
     for i in 0..n {
         let il = field("rod_il", i);
-        let mut udd = Vec::new();
-        for (k, c) in components.iter().enumerate() {
-            let (a, w) = (id(&format!("a_{c}"), i), id(&format!("udd_{c}"), i));
-            let above = if i == 0 { pivot_names[k].clone() } else { id(&format!("a_{c}"), i - 1) };
-            body.extend(quote!(let #w = (#a - #above) * #il;));
-            udd.push(w);
+        let [wx, wy, wz] = XYZ.map(|c| id(&format!("udd_{c}"), i));
+        for (k, (c, w)) in XYZ.iter().zip([&wx, &wy, &wz]).enumerate() {
+            let ai = a(c, i);
+            let above = if i == 0 { pivot_names[k].clone() } else { a(c, i - 1) };
+            body.extend(quote!(let #w = (#ai - #above) * #il;));
         }
-        let (st, ct) = (id("st", i), id("ct", i));
-        let (x_th, ii) = (id("x_th", i), i);
-        if spatial {
-            let (sp, cp, dth, dph, is, etx, ety) = (
-                id("sp", i),
-                id("cp", i),
-                id("dth", i),
-                id("dph", i),
-                id("is", i),
-                id("etx", i),
-                id("ety", i),
-            );
-            let x_ph = id("x_ph", i);
-            let [wx, wy, wz] = [&udd[0], &udd[1], &udd[2]];
-            body.extend(quote! {
-                let #x_th = #etx * #wx + #ety * #wy + #st * #wz + #dph * #dph * #st * #ct;
-                let #x_ph = (#cp * #wy - #sp * #wx - 2.0 * #dth * #dph * #ct) * #is;
-            });
-            outputs[n + ii] = quote!(#x_ph);
-        } else {
-            let [wx, wy] = [&udd[0], &udd[1]];
-            body.extend(quote!(let #x_th = #ct * #wx + #st * #wy;));
-        }
-        outputs[ii] = quote!(#x_th);
+        let (st, ct, sp, cp, dth, dph, is, etx, ety) = (
+            id("st", i),
+            id("ct", i),
+            id("sp", i),
+            id("cp", i),
+            id("dth", i),
+            id("dph", i),
+            id("is", i),
+            id("etx", i),
+            id("ety", i),
+        );
+        let (x_th, x_ph) = (id("x_th", i), id("x_ph", i));
+        body.extend(quote! {
+            let #x_th = #etx * #wx + #ety * #wy + #st * #wz + #dph * #dph * #st * #ct;
+            let #x_ph = (#cp * #wy - #sp * #wx - 2.0 * #dth * #dph * #ct) * #is;
+        });
+        outputs[i] = quote!(#x_th);
+        outputs[n + i] = quote!(#x_ph);
     }
     wrap(plan, body, &outputs)
 }
@@ -345,7 +321,7 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
 /// ```
 /// No division on a serial chain. Should a continuant leave `CONTINUANT_RANGE`, the
 /// tensions come from the classical elimination instead ([`pivots`]).
-fn twisted_solve(n: usize, field: &dyn Fn(&str, usize) -> TokenStream) -> TokenStream {
+fn twisted_solve(n: usize) -> TokenStream {
     let mut out = TokenStream::new();
     let off = |i: usize| id("off", i);
     let k = n / 2;
