@@ -125,39 +125,15 @@ pub fn with_generic<V: ModelVisitor>(kind: Kind, params: &Params, visitor: V) ->
 }
 
 /// Runs `visitor` on the generated model of `kind` with `links` links built from
-/// `params`, or returns `None` if no model of that size is generated.
+/// `params`, with the size's default algorithm, or returns `None` if no model of that size
+/// is generated.
 pub fn with_generated<V: ModelVisitor>(
     kind: Kind,
     links: usize,
     params: &Params,
     visitor: V,
 ) -> Result<Option<V::Output>> {
-    /// One line per generated type: `Kind n => Type`.
-    macro_rules! dispatch {
-        ($($kind:ident $n:literal => $model:ty),* $(,)?) => {{
-            $(
-                if (kind, links) == (Kind::$kind, $n) {
-                    return Ok(Some(visitor.visit(&<$model>::new(chain::<nalgebra::Const<$n>>(params)?))));
-                }
-            )*
-            Ok(None)
-        }};
-    }
-    dispatch! {
-        Planar 1 => Planar1,
-        Planar 2 => Planar2,
-        Planar 3 => Planar3,
-        Planar 4 => Planar4,
-        Planar 5 => Planar5,
-        Planar 6 => Planar6,
-        Planar 7 => Planar7,
-        Planar 8 => Planar8,
-        Spatial 1 => Spatial1,
-        Spatial 2 => Spatial2,
-        Spatial 3 => Spatial3,
-        Spatial 4 => Spatial4,
-        Spatial 5 => Spatial5,
-    }
+    dispatch(kind, links, None, params, visitor)
 }
 
 /// The generated algorithms, as named in `model!` (`algorithm: dense | tension`).
@@ -173,16 +149,29 @@ pub fn with_generated_algorithm<V: ModelVisitor>(
     params: &Params,
     visitor: V,
 ) -> Result<Option<V::Output>> {
-    /// One line per size: `Kind n => Dense, Tension`.
+    dispatch(kind, links, Some(algorithm), params, visitor)
+}
+
+/// The one dispatch over the generated types: the default model of `(kind, links)` for
+/// `algorithm: None`, else the one with that algorithm.
+fn dispatch<V: ModelVisitor>(
+    kind: Kind,
+    links: usize,
+    algorithm: Option<&str>,
+    params: &Params,
+    visitor: V,
+) -> Result<Option<V::Output>> {
+    /// One line per size: `Kind n => Default, Dense, Tension`.
     macro_rules! dispatch {
-        ($($kind:ident $n:literal => $dense:ty, $tension:ty),* $(,)?) => {{
+        ($($kind:ident $n:literal => $default:ty, $dense:ty, $tension:ty),* $(,)?) => {{
             $(
                 if (kind, links) == (Kind::$kind, $n) {
                     let chain = chain::<nalgebra::Const<$n>>(params)?;
                     return Ok(match algorithm {
-                        "dense" => Some(visitor.visit(&<$dense>::new(chain))),
-                        "tension" => Some(visitor.visit(&<$tension>::new(chain))),
-                        _ => None,
+                        None => Some(visitor.visit(&<$default>::new(chain))),
+                        Some("dense") => Some(visitor.visit(&<$dense>::new(chain))),
+                        Some("tension") => Some(visitor.visit(&<$tension>::new(chain))),
+                        Some(_) => None,
                     });
                 }
             )*
@@ -190,18 +179,18 @@ pub fn with_generated_algorithm<V: ModelVisitor>(
         }};
     }
     dispatch! {
-        Planar 1 => PlanarDense1, PlanarTension1,
-        Planar 2 => PlanarDense2, PlanarTension2,
-        Planar 3 => PlanarDense3, PlanarTension3,
-        Planar 4 => PlanarDense4, PlanarTension4,
-        Planar 5 => PlanarDense5, PlanarTension5,
-        Planar 6 => PlanarDense6, PlanarTension6,
-        Planar 7 => PlanarDense7, PlanarTension7,
-        Planar 8 => PlanarDense8, PlanarTension8,
-        Spatial 1 => SpatialDense1, SpatialTension1,
-        Spatial 2 => SpatialDense2, SpatialTension2,
-        Spatial 3 => SpatialDense3, SpatialTension3,
-        Spatial 4 => SpatialDense4, SpatialTension4,
-        Spatial 5 => SpatialDense5, SpatialTension5,
+        Planar 1 => Planar1, PlanarDense1, PlanarTension1,
+        Planar 2 => Planar2, PlanarDense2, PlanarTension2,
+        Planar 3 => Planar3, PlanarDense3, PlanarTension3,
+        Planar 4 => Planar4, PlanarDense4, PlanarTension4,
+        Planar 5 => Planar5, PlanarDense5, PlanarTension5,
+        Planar 6 => Planar6, PlanarDense6, PlanarTension6,
+        Planar 7 => Planar7, PlanarDense7, PlanarTension7,
+        Planar 8 => Planar8, PlanarDense8, PlanarTension8,
+        Spatial 1 => Spatial1, SpatialDense1, SpatialTension1,
+        Spatial 2 => Spatial2, SpatialDense2, SpatialTension2,
+        Spatial 3 => Spatial3, SpatialDense3, SpatialTension3,
+        Spatial 4 => Spatial4, SpatialDense4, SpatialTension4,
+        Spatial 5 => Spatial5, SpatialDense5, SpatialTension5,
     }
 }

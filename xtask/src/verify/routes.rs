@@ -9,10 +9,11 @@
 //! `Directions` takes no torques: its states have `σ = 0` (the reference is evaluated so).
 
 use anyhow::{Context, Result, bail};
-use nalgebra::{DVector, DefaultAllocator, DimName, U1, U2, U3, Vector2, Vector3};
+use nalgebra::{DVector, DefaultAllocator, U2, U3, Vector2, Vector3};
 use pendulum_core::{Directions, FnDrive, Inputs, Model, ModelAlloc, PlanarTension};
 
 use super::bounds::{BOUND, acceleration_error};
+use super::compare::ModelPoint;
 use super::models;
 use super::reference::Reference;
 use crate::case::{Case, Kind, Point};
@@ -54,22 +55,12 @@ impl models::ModelVisitor for Accelerations<'_> {
     where
         DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
     {
-        let point = self.0;
-        let vector = |v: &[f64]| OVectorOf::<M>::from_iterator_generic(model.dof(), U1, v.iter().copied());
-        let pivot_acceleration = nalgebra::OVector::<f64, M::Space>::from_iterator_generic(
-            M::Space::name(),
-            U1,
-            point.pivot_acceleration.iter().copied(),
-        );
-        let inputs = Inputs { torque: vector(&point.torque), pivot_acceleration };
-        let mut a = vector(&point.q);
-        model.accelerations(&vector(&point.q), &vector(&point.qd), &inputs, &mut a)?;
+        let ModelPoint { q, qd, inputs } = ModelPoint::new(model, self.0);
+        let mut a = q.clone();
+        model.accelerations(&q, &qd, &inputs, &mut a)?;
         Ok(DVector::from_column_slice(a.as_slice()))
     }
 }
-
-/// A model's vector of coordinates.
-type OVectorOf<M> = nalgebra::OVector<f64, <M as Model>::Dof>;
 
 /// `point` with its torques set to zero.
 fn without_torque(point: &Point) -> Point {
