@@ -238,6 +238,10 @@ fn the_energy_ledger_closes_for_a_driven_damped_run() {
         (their_drive - drive_work).abs() < 1e-5 * damped,
         "drive work {their_drive} against {drive_work} (H(T) − H(0) − W_torque + E_damped)"
     );
+    println!(
+        "drive work {their_drive} J against {drive_work} J rebuilt (difference {:.1e} J); dissipated {their_damped} J against {damped} J",
+        their_drive - drive_work
+    );
     let residual = e.column("balance_residual");
     let worst = residual.iter().map(|r| r.abs()).fold(0.0, f64::max);
     assert!(worst < 1e-8 * (1.0 + (h[last] - h[0]).abs()), "balance residual {worst} J");

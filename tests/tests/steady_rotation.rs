@@ -47,8 +47,8 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
     let problem = SteadyRotation::new(&chain, 0.0).unwrap();
     let speeds = problem.bifurcation_speeds(3).unwrap();
     let opts = ContinuationOptions::default();
-    for k in 1..=3 {
-        let branch = problem.branch(k, 1.6 * speeds[2], &opts).unwrap();
+    let branches: Vec<_> = (1..=3).map(|k| problem.branch(k, 1.6 * speeds[2], &opts).unwrap()).collect();
+    for (branch, k) in branches.iter().zip(1..) {
         // The whole way to the speed asked for, not a branch of one vertical point.
         assert_eq!(branch.end, BranchEnd::ReachedOmega, "k = {k}");
         let pts = &branch.points[1..];
@@ -68,8 +68,7 @@ fn branches_leave_the_vertical_with_k_nodes_and_grow() {
     }
     // Only the one-node branch is stable; the others have directions of descent of the
     // amended potential.
-    for k in 1..=3 {
-        let branch = problem.branch(k, 1.6 * speeds[2], &opts).unwrap();
+    for (branch, k) in branches.iter().zip(1..) {
         let st = stability(&problem, branch.points.last().unwrap(), None).unwrap();
         if k == 1 {
             assert!(st.spectrally_stable && st.index == 0, "k = 1: {st:?}");

@@ -233,6 +233,7 @@ mod tests {
         // Drag against the rotation (+y direction of motion at x > 0) tilts links to −y
         // (u_y = sin ψ < 0), by a small angle, and leaves the in-plane shape near the
         // undamped one.
+        println!("out-of-plane tilts ψ_i: {:?}", eq.angles.iter().map(|a| a.1).collect::<Vec<_>>());
         assert!(eq.angles.iter().all(|&(_, p)| p < 0.0 && p > -0.1), "{:?}", eq.angles);
         for (&(t, _), undamped) in eq.angles.iter().zip(shape.theta.iter()) {
             assert!((t - undamped).abs() < 0.05, "θ {t} against undamped {undamped}");

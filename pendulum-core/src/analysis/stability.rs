@@ -378,6 +378,10 @@ mod tests {
         let st = stability(&p, last, None).unwrap();
         // Index 2 and a complex quartet with growth ~0.2/s: unstable, not merely of
         // nonzero index.
+        println!(
+            "second branch at ω = {}: index {}, growth rate {:.3} 1/s",
+            last.omega, st.index, st.growth_rate
+        );
         assert_eq!(st.index, 2);
         assert!(!st.spectrally_stable && st.growth_rate > 0.1, "{st:?}");
     }
