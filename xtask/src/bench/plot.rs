@@ -18,11 +18,14 @@ use super::results::Results;
 fn colour(implementation: &str) -> RGBColor {
     match implementation {
         "generated" => RGBColor(31, 119, 180),
+        "generated_dense" => RGBColor(23, 190, 207),
+        "generated_tension" => RGBColor(188, 189, 34),
         "generic_fixed" => RGBColor(255, 127, 14),
         "generic_dyn" => RGBColor(214, 39, 40),
         "closed_form" => RGBColor(44, 160, 44),
         "tension" => RGBColor(148, 103, 189),
         "directions" => RGBColor(140, 86, 75),
+        "directions_angles" => RGBColor(227, 119, 194),
         "baseline" => RGBColor(60, 60, 60),
         _ => RGBColor(127, 127, 127),
     }
@@ -140,6 +143,23 @@ mod tests {
         assert!([1.0, 2.0, 5.0, 10.0, 20.0, 500.0, 1000.0].into_iter().all(is_round));
         assert!(![3.0, 9.0, 30.0, 4096.0].into_iter().any(is_round));
         assert_eq!([10.0, 2000.0, 1e6, 5e8].map(tick_time), ["10 ns", "2 µs", "1 ms", "500 ms"]);
+    }
+
+    #[test]
+    fn every_implementation_has_a_colour_of_its_own() {
+        let colours: Vec<RGBColor> =
+            super::super::report::IMPLEMENTATIONS.iter().map(|(i, _)| colour(i)).collect();
+        for (k, a) in colours.iter().enumerate() {
+            assert_ne!(
+                *a,
+                colour("unknown"),
+                "{} has the fallback grey",
+                super::super::report::IMPLEMENTATIONS[k].0
+            );
+            for b in &colours[k + 1..] {
+                assert_ne!(a, b, "{} shares its colour", super::super::report::IMPLEMENTATIONS[k].0);
+            }
+        }
     }
 
     #[test]
