@@ -27,6 +27,7 @@
 //! assert!(drift.abs() < 1e-6);
 //! ```
 
+mod block_tridiagonal;
 mod fixed_point;
 mod gauss;
 mod lu;
@@ -37,6 +38,7 @@ mod tableau;
 
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
+pub use block_tridiagonal::BlockTridiagonal;
 pub use fixed_point::GaussFixedPoint;
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};
 pub use projected::{Constrained, Projected};
@@ -112,7 +114,7 @@ where
     }
 
     /// `t += h`, `x += increment` with compensated (Kahan) summation.
-    fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
+    pub(crate) fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
         (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
         for i in 0..self.x.len() {
             (self.x[i], self.x_carry[i]) = kahan_add(self.x[i], self.x_carry[i], increment[i]);

@@ -6,6 +6,7 @@
 pub(crate) mod closed_form;
 pub(crate) mod directions;
 pub(crate) mod planar;
+pub(crate) mod rod_midpoint;
 pub(crate) mod rods;
 pub(crate) mod spatial;
 pub(crate) mod tension;
@@ -14,5 +15,6 @@ pub(crate) mod trig;
 pub use closed_form::DoublePendulum;
 pub use directions::Directions;
 pub use planar::Planar;
+pub use rod_midpoint::RodMidpoint;
 pub use spatial::Spatial;
 pub use tension::PlanarTension;
