@@ -61,13 +61,8 @@ impl<const B: usize> BlockTridiagonal<B> {
             }
             let Some(lu) = SmallLu::new(pivot) else { return false };
             if i + 1 < self.len() {
-                let mut g = self.sup[i];
-                for c in 0..B {
-                    let mut column = g.column(c).into_owned();
-                    lu.solve_mut(&mut column);
-                    g.set_column(c, &column);
-                }
-                self.ahead[i] = g;
+                self.ahead[i] = self.sup[i];
+                lu.solve_columns(&mut self.ahead[i]);
             }
             self.pivots.push(lu);
         }
@@ -130,6 +125,29 @@ impl<const B: usize> SmallLu<B> {
             }
         }
         Some(Self { lu: a, swaps })
+    }
+
+    /// `X ← A⁻¹ X`, column by column in place.
+    fn solve_columns(&self, x: &mut SMatrix<f64, B, B>) {
+        for k in 0..B {
+            x.swap_rows(k, self.swaps[k]);
+        }
+        for c in 0..B {
+            for i in 0..B {
+                let mut v = x[(i, c)];
+                for j in 0..i {
+                    v -= self.lu[(i, j)] * x[(j, c)];
+                }
+                x[(i, c)] = v;
+            }
+            for i in (0..B).rev() {
+                let mut v = x[(i, c)];
+                for j in i + 1..B {
+                    v -= self.lu[(i, j)] * x[(j, c)];
+                }
+                x[(i, c)] = v / self.lu[(i, i)];
+            }
+        }
     }
 
     /// `b ← A⁻¹ b`.

@@ -152,6 +152,9 @@ pub struct Stats {
     /// Steps on which simplified Newton failed and full Newton (a Jacobian at every stage,
     /// every iteration) was used.
     pub full_newton_steps: u64,
+    /// Steps an implicit method split into two halves because its Newton iteration did not
+    /// converge ([`RodMidpoint`](crate::RodMidpoint)).
+    pub halved_steps: u64,
 }
 
 /// A one-step method advancing a [`State`] of the system `S` by a given step.

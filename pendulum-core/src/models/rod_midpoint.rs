@@ -49,7 +49,6 @@ pub struct RodMidpoint {
     stats: Stats,
     tolerance: f64,
     max_iterations: usize,
-    multipliers: Vec<f64>,
     planar: Work<3>,
     spatial: Work<4>,
 }
@@ -77,7 +76,11 @@ impl Default for RodMidpoint {
     }
 }
 
+/// How often a step whose Newton iteration fails is halved before it is an error.
+const MAX_HALVINGS: u32 = 6;
+
 /// What one converged step produced, besides the new state.
+#[derive(Debug, Default)]
 struct StepWork {
     drive: f64,
     damped: f64,
@@ -85,13 +88,13 @@ struct StepWork {
 
 impl RodMidpoint {
     /// The step with its Newton iteration converged to `1e-13` of the chain's reach
-    /// (`Σ l_i`) per position, at most 30 iterations.
+    /// (`Σ l_i`) per position, at most 12 iterations; a step whose iteration does not converge
+    /// is taken as two halves (up to 6 times nested).
     pub fn new() -> Self {
         Self {
             stats: Stats::default(),
             tolerance: 1e-13,
-            max_iterations: 30,
-            multipliers: Vec::new(),
+            max_iterations: 12,
             planar: Work { matrix: BlockTridiagonal::new(0), rhs: Vec::new() },
             spatial: Work { matrix: BlockTridiagonal::new(0), rhs: Vec::new() },
         }
@@ -119,34 +122,78 @@ impl RodMidpoint {
         if !(h.is_finite() && h != 0.0) {
             return Err(Error::InvalidStepSize { h });
         }
-        let drive = chain.drive();
-        let ends = [drive.position(t), drive.position(t + h), drive.velocity(t), drive.velocity(t + h)];
-        let limits = self.limits();
-        let result = match S::DIM {
-            2 => {
-                let ends = ends.map(|v| [v[0], v[1]]);
-                let work = self.planar.sized(chain.links());
-                newton::<2, 3>(work, &mut self.multipliers, chain.chain(), ends, motion, h, out, &limits)
-            }
-            3 => {
-                let ends = ends.map(|v| [v[0], v[1], v[2]]);
-                let work = self.spatial.sized(chain.links());
-                newton::<3, 4>(work, &mut self.multipliers, chain.chain(), ends, motion, h, out, &limits)
-            }
-            d => return Err(Error::LengthMismatch { what: "space", expected: 3, got: d }),
-        };
-        match result {
-            Ok((work, iterations)) => {
+        if S::DIM != 2 && S::DIM != 3 {
+            return Err(Error::LengthMismatch { what: "space", expected: 3, got: S::DIM });
+        }
+        match self.attempt(chain, t, motion, h, out, 0) {
+            Ok(work) => {
                 self.stats.steps += 1;
-                self.stats.newton_iterations += iterations as u64;
-                self.stats.factorizations += iterations as u64;
                 Ok(work)
             }
             Err(iterations) => {
                 self.stats.failed_steps += 1;
-                self.stats.newton_iterations += iterations as u64;
-                self.multipliers.clear();
                 Err(Error::StageSolveFailed { t, h, iterations })
+            }
+        }
+    }
+
+    /// One step, split into two halves (recursively, at most [`MAX_HALVINGS`] deep) when
+    /// its Newton iteration does not converge. Errors: the iterations spent.
+    fn attempt<S: DimName, Dr: Drive<S>>(
+        &mut self,
+        chain: &Directions<S, Dr>,
+        t: f64,
+        motion: &[f64],
+        h: f64,
+        out: &mut [f64],
+        depth: u32,
+    ) -> std::result::Result<StepWork, usize>
+    where
+        DefaultAllocator: Allocator<S>,
+    {
+        let drive = chain.drive();
+        let ends = [drive.position(t), drive.position(t + h), drive.velocity(t), drive.velocity(t + h)];
+        let limits = self.limits();
+        // The multipliers' start: the tensions at t.
+        let n = chain.links();
+        let mut start = vec![0.0; (S::DIM + 1) * n];
+        let (accelerations, tensions) = start.split_at_mut(S::DIM * n);
+        let start_state = DVector::from_column_slice(motion);
+        if chain.accelerations(t, &start_state, accelerations, Some(tensions)).is_err() {
+            return Err(0);
+        }
+        let start = Start { tensions };
+        let result = match S::DIM {
+            2 => {
+                let ends = ends.map(|v| [v[0], v[1]]);
+                let work = self.planar.sized(chain.links());
+                newton::<2, 3>(work, &start, chain.chain(), ends, motion, h, out, &limits)
+            }
+            _ => {
+                let ends = ends.map(|v| [v[0], v[1], v[2]]);
+                let work = self.spatial.sized(chain.links());
+                newton::<3, 4>(work, &start, chain.chain(), ends, motion, h, out, &limits)
+            }
+        };
+        match result {
+            Ok((work, count)) => {
+                self.stats.rhs_evaluations += 1;
+                self.stats.newton_iterations += count.iterations as u64;
+                self.stats.factorizations += count.factorizations as u64;
+                Ok(work)
+            }
+            Err(count) => {
+                self.stats.rhs_evaluations += 1;
+                self.stats.newton_iterations += count.iterations as u64;
+                self.stats.factorizations += count.factorizations as u64;
+                if depth == MAX_HALVINGS {
+                    return Err(count.iterations);
+                }
+                self.stats.halved_steps += 1;
+                let mut middle = motion.to_vec();
+                let first = self.attempt(chain, t, motion, 0.5 * h, &mut middle, depth + 1)?;
+                let second = self.attempt(chain, t + 0.5 * h, &middle, 0.5 * h, out, depth + 1)?;
+                Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped })
             }
         }
     }
@@ -154,6 +201,18 @@ impl RodMidpoint {
     fn limits(&self) -> Limits {
         Limits { tolerance: self.tolerance, max_iterations: self.max_iterations }
     }
+}
+
+/// The rod tensions `T_i` at the start of a step.
+struct Start<'a> {
+    tensions: &'a [f64],
+}
+
+/// Newton iterations and factorisations of one attempt.
+#[derive(Debug, Clone, Copy, Default)]
+struct Count {
+    iterations: usize,
+    factorizations: usize,
 }
 
 struct Limits {
@@ -178,24 +237,25 @@ fn at<const C: usize>(v: &[f64], i: usize) -> [f64; C] {
 #[allow(clippy::too_many_arguments)] // One step's data, all of it needed.
 fn newton<const C: usize, const B: usize>(
     work: &mut Work<B>,
-    multipliers: &mut Vec<f64>,
+    start: &Start,
     chain: &Chain<nalgebra::Dyn>,
     ends: [[f64; C]; 4],
     motion: &[f64],
     h: f64,
     out: &mut [f64],
     limits: &Limits,
-) -> std::result::Result<(StepWork, usize), usize> {
+) -> std::result::Result<(StepWork, Count), Count> {
     debug_assert_eq!(B, C + 1);
     let [p0, p1, pv0, pv1] = ends;
     let n = chain.links();
-    let (m, l, lambda, tails) = (chain.masses(), chain.lengths(), chain.damping(), chain.tail_masses());
+    let (m, l, lambda) = (chain.masses(), chain.lengths(), chain.damping());
     let mut gravity = [0.0; C];
     gravity[C - 1] = -chain.gravity();
     let reach: f64 = l.iter().sum::<f64>() + p0.iter().chain(&p1).fold(0.0_f64, |a, b| a.max(b.abs()));
     let (u, w) = motion.split_at(C * n);
 
-    // Positions and velocities at t; the start of the iteration: each rod turned by h w_i.
+    // Positions and velocities at t; the start of the iteration: each rod turned by h w_i
+    // (with h²/2 ü_i too it took more iterations), the multipliers μ_i = T_i / l_i at t.
     let mut x0 = vec![0.0; C * n];
     let mut v0 = vec![0.0; C * n];
     let mut x1 = vec![0.0; C * n];
@@ -213,10 +273,7 @@ fn newton<const C: usize, const B: usize>(
             x1[i * C + k] = r1[k];
         }
     }
-    if multipliers.len() != n {
-        *multipliers = (0..n).map(|i| tails[i] * chain.gravity() / l[i]).collect();
-    }
-    let mu = multipliers;
+    let mut mu: Vec<f64> = (0..n).map(|i| start.tensions[i] / l[i]).collect();
     let damping: Vec<f64> = (0..n).map(|i| lambda[i] / (l[i] * l[i] * h)).collect();
     let inertia: Vec<f64> = (0..n).map(|i| 2.0 * m[i] / (h * h)).collect();
     let pivot_step = sub(p1, p0);
@@ -231,12 +288,14 @@ fn newton<const C: usize, const B: usize>(
         (e, d, s)
     };
 
-    let mut iterations = 0;
+    // Newton's method, the matrix refactored at every iteration (a frozen matrix, tried,
+    // took several times the iterations once the free end whips).
+    let mut count = Count::default();
     loop {
-        if iterations == limits.max_iterations {
-            return Err(iterations);
+        if count.iterations == limits.max_iterations {
+            return Err(count);
         }
-        iterations += 1;
+        count.iterations += 1;
         let Work { matrix, rhs } = &mut *work;
         // Residuals and Jacobian, block row i = (R_i, C_i), columns (x_j, μ_j).
         let mut next = rod(&x1, 0);
@@ -263,7 +322,6 @@ fn newton<const C: usize, const B: usize>(
             }
             row[C] = -0.5 * (dot(e, e) - l[i] * l[i]);
             rhs[i] = row;
-
             let diag = &mut matrix.diag[i];
             diag.fill(0.0);
             let k_i = inertia[i] + c_i + c_next + 0.5 * (mu_i + mu_next);
@@ -287,8 +345,9 @@ fn newton<const C: usize, const B: usize>(
                 }
             }
         }
+        count.factorizations += 1;
         if !matrix.factor() {
-            return Err(iterations);
+            return Err(count);
         }
         matrix.solve(rhs);
         let mut largest: f64 = 0.0;
@@ -300,7 +359,7 @@ fn newton<const C: usize, const B: usize>(
             mu[i] += rhs[i][C];
         }
         if !largest.is_finite() {
-            return Err(iterations);
+            return Err(count);
         }
         if largest <= limits.tolerance * reach {
             break;
@@ -326,9 +385,9 @@ fn newton<const C: usize, const B: usize>(
         previous_velocity = velocity;
     }
     if !out.iter().all(|v| v.is_finite()) {
-        return Err(iterations);
+        return Err(count);
     }
-    Ok((StepWork { drive, damped }, iterations))
+    Ok((StepWork { drive, damped }, count))
 }
 
 impl<S: DimName, Dr: Drive<S>> Integrator<Directions<S, Dr>> for RodMidpoint
