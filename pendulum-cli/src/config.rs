@@ -101,6 +101,10 @@ pub struct RunConfig {
     pub view: View,
     /// Most frames in the animation.
     pub frames: usize,
+    /// What the run chose itself of integrator, step and sampling, and why (absent when
+    /// the options named all three).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chosen: Option<String>,
 }
 
 impl RunConfig {
@@ -163,7 +167,7 @@ impl RunConfig {
             return Err(CliError::usage("--spin (initial azimuthal rate) applies to --dim 3 only"));
         }
         let initial = initial_state(&p.initial, p.dim, n, p.spin.unwrap_or(0.0))?;
-        let config = Self {
+        let mut config = Self {
             dim: p.dim,
             masses,
             lengths,
@@ -171,15 +175,27 @@ impl RunConfig {
             damping,
             torque,
             drive,
-            integrator: p.integrator,
+            integrator: p.integrator.unwrap_or(IntegratorKind::Gl2),
             solver: p.solver,
-            step: p.step,
+            step: p.step.unwrap_or(1.0),
             end: p.end,
-            every: p.every,
+            every: p.every.unwrap_or(1),
             initial,
             view,
             frames,
+            chosen: None,
         };
+        if let Some(h) = p.step {
+            check_step(h)?;
+        }
+        if !(p.end.is_finite() && p.end > 0.0) {
+            return Err(CliError::usage(format!("--end must be finite and positive, got {}", p.end)));
+        }
+        let choice = crate::choice::choose(&config, p.integrator, p.step, p.every);
+        config.integrator = choice.integrator;
+        config.step = choice.step;
+        config.every = choice.every;
+        config.chosen = choice.reason;
         config.check()?;
         Ok(config)
     }
@@ -231,16 +247,19 @@ impl RunConfig {
         if let Some(v) = self.torque.iter().find(|v| !v.is_finite()) {
             return Err(CliError::usage(format!("--torque: {v} is not finite")));
         }
-        if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(CliError::usage(format!("--step must be finite and positive, got {}", self.step)));
-        }
+        check_step(self.step)?;
         if !(self.end.is_finite() && self.end > 0.0) {
             return Err(CliError::usage(format!("--end must be finite and positive, got {}", self.end)));
         }
         let steps = (self.end / self.step).ceil();
         if steps > 1e8 {
+            let origin = if self.chosen.as_deref().is_some_and(|c| c.contains("step ")) {
+                " (chosen for the chain's fastest mode; name one with --step)"
+            } else {
+                ""
+            };
             return Err(CliError::usage(format!(
-                "--end {} with --step {} needs {steps:e} steps; more than 1e8 is refused",
+                "--end {} with --step {:e}{origin} needs {steps:e} steps; more than 1e8 is refused",
                 self.end, self.step
             )));
         }
@@ -258,6 +277,11 @@ impl RunConfig {
                     direction.len()
                 )));
             }
+        }
+        if self.integrator == IntegratorKind::Midpoint && self.dim == Dimension::Two {
+            return Err(CliError::usage(
+                "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
+            ));
         }
         if matches!(self.drive, DriveConfig::Circle { .. }) && self.dim == Dimension::Two {
             return Err(CliError::usage(
@@ -324,6 +348,15 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
         }
     };
     Ok(InitialConfig { spec: spec.to_string(), coordinates, rates, directions: None })
+}
+
+/// Errors unless the step is finite and positive.
+fn check_step(h: f64) -> CliResult<()> {
+    if h.is_finite() && h > 0.0 {
+        Ok(())
+    } else {
+        Err(CliError::usage(format!("--step must be finite and positive, got {h}")))
+    }
 }
 
 /// What `run.json` holds: the program and version that made it, the configuration and

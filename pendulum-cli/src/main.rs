@@ -4,6 +4,7 @@
 
 mod args;
 mod chain_args;
+mod choice;
 mod cli;
 mod config;
 mod error;

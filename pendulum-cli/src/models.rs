@@ -10,7 +10,7 @@ use pendulum_core::integrate::{
 use pendulum_core::kinematics::Chart;
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Driven, FirstOrder, Fixed, Harmonic, Ledger,
-    Model, ModelAlloc, PlanarTension, RampedCircle, Spatial, Turning,
+    Model, ModelAlloc, PlanarTension, RampedCircle, RodMidpoint, Spatial, Turning,
 };
 
 use crate::args::{Dimension, IntegratorKind, StageSolver};
@@ -38,14 +38,15 @@ pub struct Sample {
 const FIXED_POINT_SWEEPS: usize = 100;
 
 /// The integrator of a kind for an unconstrained system, Gauss–Legendre stages solved by
-/// `solver`.
+/// `solver`. Errors: a kind the system does not have ([`IntegratorKind::Midpoint`] is
+/// for chains in unit directions).
 fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
     kind: IntegratorKind,
     solver: StageSolver,
     system: &S,
-) -> Box<dyn Integrator<S> + 'a> {
+) -> CliResult<Box<dyn Integrator<S> + 'a>> {
     let options = GaussOptions::default();
-    match (kind, solver) {
+    Ok(match (kind, solver) {
         (IntegratorKind::Gl1, StageSolver::Newton) => {
             Box::new(GaussLegendre::<Dyn, U1>::new(system, options))
         }
@@ -65,7 +66,12 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
             Box::new(GaussFixedPoint::<Dyn, U3>::new(system, FIXED_POINT_SWEEPS))
         }
         (IntegratorKind::Rk4, _) => Box::new(Rk4::new(system)),
-    }
+        (IntegratorKind::Midpoint, _) => {
+            return Err(CliError::usage(
+                "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
+            ));
+        }
+    })
 }
 
 /// [`plain_integrator`] followed by the system's projection after every step.
@@ -73,8 +79,8 @@ fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
     kind: IntegratorKind,
     solver: StageSolver,
     system: &S,
-) -> Box<dyn Integrator<S> + 'a> {
-    Box::new(Projected::new(plain_integrator(kind, solver, system)))
+) -> CliResult<Box<dyn Integrator<S> + 'a>> {
+    Ok(Box::new(Projected::new(plain_integrator(kind, solver, system)?)))
 }
 
 /// A chain's motion as `pendulum simulate` runs it: what the core's ledger needs
@@ -92,7 +98,7 @@ pub trait Motion: Powered + Sized {
         system: &'a Accounted<Self>,
         kind: IntegratorKind,
         solver: StageSolver,
-    ) -> Box<dyn Integrator<Accounted<Self>> + 'a>;
+    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>>;
 }
 
 /// A model in angles with a boxed pivot drive and constant torques.
@@ -129,7 +135,7 @@ where
         system: &'a Accounted<Self>,
         kind: IntegratorKind,
         solver: StageSolver,
-    ) -> Box<dyn Integrator<Accounted<Self>> + 'a> {
+    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
         plain_integrator(kind, solver, system)
     }
 }
@@ -161,8 +167,13 @@ where
         system: &'a Accounted<Self>,
         kind: IntegratorKind,
         solver: StageSolver,
-    ) -> Box<dyn Integrator<Accounted<Self>> + 'a> {
-        projected_integrator(kind, solver, system)
+    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
+        match kind {
+            // Exact on the rods by construction; a projection of the rates would change the
+            // energy outside the ledger.
+            IntegratorKind::Midpoint => Ok(Box::new(RodMidpoint::new())),
+            _ => projected_integrator(kind, solver, system),
+        }
     }
 }
 
@@ -215,7 +226,7 @@ impl<P: Motion> Simulation<P> {
         &self,
         kind: IntegratorKind,
         solver: StageSolver,
-    ) -> Box<dyn Integrator<Accounted<P>> + '_> {
+    ) -> CliResult<Box<dyn Integrator<Accounted<P>> + '_>> {
         P::integrator(&self.system, kind, solver)
     }
 }

@@ -10,15 +10,16 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_core::integrate::State;
-use pendulum_core::{fastest_frequency_bound, trajectory};
+use pendulum_core::trajectory;
 
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
-use crate::config::{DriveConfig, Outcome, RunConfig, RunFile};
+use crate::choice::{drive_frequency, fastest_mode, suggested_step};
+use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
 use crate::interrupt::INTERRUPTED;
 use crate::json_file::warn_other_version;
-use crate::models::{AnySimulation, Motion, Sample, Simulation, build, chain};
+use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
 use crate::plot;
 use crate::render;
 use crate::whirl::Whirl;
@@ -144,7 +145,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     let dims = if config.dim == Dimension::Two { 2 } else { 3 };
     let mut progress = Progress::new(total_steps, config.end, options.quiet);
     let system = simulation.system();
-    let mut solver = simulation.integrator(config.integrator, config.solver);
+    let mut solver = simulation.integrator(config.integrator, config.solver)?;
     let mut state = State::new(0.0, simulation.initial_state());
     let mut kept = Kept::default();
     let whirl = Whirl::of(config)?;
@@ -278,39 +279,6 @@ fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
         (true, StageSolver::Newton) | (false, _) => " or --integrator rk4",
     };
     format!(" ({cause}: try --step {suggested:.1e}{other})")
-}
-
-/// The chain's fastest angular frequency (rad/s), [`fastest_frequency_bound`] with the
-/// drive's largest acceleration added to gravity; `0` if the chain is invalid (the run
-/// would not have started).
-fn fastest_mode(config: &RunConfig) -> f64 {
-    let accel = match &config.drive {
-        DriveConfig::Fixed => 0.0,
-        DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
-        DriveConfig::Circle { radius, omega } => radius * omega * omega,
-        DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
-            radius * initial_omega.abs().max(omega.abs()).powi(2)
-        }
-    };
-    chain(config).map_or(0.0, |c| fastest_frequency_bound(&c, config.gravity + accel))
-}
-
-/// The drive's angular frequency (rad/s), if it has one.
-fn drive_frequency(config: &RunConfig) -> Option<f64> {
-    match &config.drive {
-        DriveConfig::Fixed => None,
-        DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
-        DriveConfig::RampedCircle { initial_omega, omega, .. } => Some(initial_omega.abs().max(omega.abs())),
-    }
-}
-
-/// A step that resolves both: `h = 0.5 / ω_fastest`, at most a fortieth of the drive period.
-fn suggested_step(fastest: f64, drive: Option<f64>) -> f64 {
-    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
-    if let Some(w) = drive.filter(|w| *w > 0.0) {
-        h = h.min(std::f64::consts::TAU / w / 40.0);
-    }
-    h
 }
 
 /// The steps a failed run completed (the failed step's number).

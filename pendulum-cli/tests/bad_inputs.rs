@@ -97,12 +97,27 @@ fn a_3d_start_hanging_straight_down_runs() {
 #[test]
 fn an_extreme_chain_fails_at_run_time_with_a_message() {
     // Valid parameters (every length positive) whose mass matrix underflows.
-    let (code, got) = run("tiny", &["simulate", "--lengths", "1e-300", "--out", "run", "--no-plots"]);
+    let (code, got) =
+        run("tiny", &["simulate", "--lengths", "1e-300", "--step", "0.005", "--out", "run", "--no-plots"]);
     assert_eq!(code, Some(1), "{got}");
     assert_eq!(
         got,
         "error: the run stopped at t = 0 s: step 0 of the run, from t = 0 s, failed: the mass matrix is not \
          numerically positive definite at this state; files hold what was computed"
+    );
+}
+
+#[test]
+fn a_step_chosen_too_small_for_the_run_is_a_usage_error_naming_it() {
+    let (code, got) = run("tiny-auto", &["simulate", "--lengths", "1e-300", "--out", "run", "--no-plots"]);
+    assert_eq!(code, Some(2), "{got}");
+    assert!(got.starts_with("error: --end 10 with --step 5.04818777346"), "{got}");
+    assert!(
+        got.ends_with(
+            " (chosen for the chain's fastest mode; name one with --step) needs 1.9809088823063011e152 steps; \
+             more than 1e8 is refused"
+        ),
+        "{got}"
     );
 }
 

@@ -319,7 +319,11 @@ fn a_hanging_3d_chain_is_swung_out_by_a_circling_pivot_with_rigid_rods() {
     let out = run_in(&dir, &args);
     assert!(out.status.success(), "{}", stderr(&out));
     let config = &run_json(&dir.join("run"))["config"];
-    assert_eq!((&config["integrator"], &config["solver"]), (&"gl2".into(), &"fixed-point".into()));
+    // Driven in 3D without --integrator: the implicit midpoint step, and run.json says why.
+    assert_eq!(config["integrator"], "midpoint");
+    let chosen = config["chosen"].as_str().unwrap();
+    assert!(chosen.starts_with("integrator midpoint: a driven 3D chain"), "{chosen}");
+    assert!(chosen.contains("every 3 steps: about 500 samples"), "{chosen}");
     let tr = Csv::read(&dir.join("run/trajectory.csv"));
     let first = &tr.rows[0];
     assert_eq!(&first[1..4], &[0.0, 0.0, -1.0], "u1 hangs straight down");
@@ -369,7 +373,8 @@ fn ctrl_c_leaves_valid_files_for_what_was_computed() {
     let dir = scratch("interrupt");
     // A run far longer than the test: only the interruption can end it in time.
     let child = common::pendulum()
-        .args(["simulate", "--n", "3", "--end", "100000", "--step", "0.01", "--out", "run", "--frames", "20"])
+        .args(["simulate", "--n", "3", "--end", "100000", "--step", "0.01", "--every", "4", "--out", "run"])
+        .args(["--frames", "20"])
         .current_dir(&dir)
         .stderr(std::process::Stdio::piped())
         .spawn()

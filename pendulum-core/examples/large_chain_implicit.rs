@@ -61,11 +61,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let chain = Chain::uniform(n, 1.0 / n as f64, 1.0 / n as f64, 9.81)?;
     let limit = 2.8 / fastest_frequency_bound(&chain, 9.81);
     let model = Directions::<U3>::new(chain);
-    let q: Vec<f64> =
-        (0..2 * n).map(|i| if i < n { 0.2 } else { std::f64::consts::PI * (i - n) as f64 / n as f64 }).collect();
+    let q: Vec<f64> = (0..2 * n)
+        .map(|i| if i < n { 0.2 } else { std::f64::consts::PI * (i - n) as f64 / n as f64 })
+        .collect();
     let x0 = model.from_spherical(&q, &vec![0.0; 2 * n])?;
     println!("n = {n}, {duration} s; RK4's stability limit 2.8/ω_max = {limit:.2e} s");
-    println!("| method | h, s | h ÷ limit | worst \\|ΔH\\|/\\|H₀\\| | rod error | wall, s | Newton iterations per step | steps halved | tip off the reference, m |");
+    println!(
+        "| method | h, s | h ÷ limit | worst \\|ΔH\\|/\\|H₀\\| | rod error | wall, s | Newton iterations per step | steps halved | tip off the reference, m |"
+    );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     let reference_step = limit / 4.0;
     let reference = run(Projected::new(Rk4::new(&model)), &model, &x0, duration, reference_step)?;

@@ -291,6 +291,7 @@ fn newton<const C: usize, const B: usize>(
     // Newton's method, the matrix refactored at every iteration (a frozen matrix, tried,
     // took several times the iterations once the free end whips).
     let mut count = Count::default();
+    let mut previous = f64::INFINITY;
     loop {
         if count.iterations == limits.max_iterations {
             return Err(count);
@@ -361,9 +362,14 @@ fn newton<const C: usize, const B: usize>(
         if !largest.is_finite() {
             return Err(count);
         }
-        if largest <= limits.tolerance * reach {
+        // Newton converges quadratically: the error left after this correction is about
+        // δ_k²/δ_{k−1} (or less), so stop once that is below the tolerance.
+        if largest <= limits.tolerance * reach
+            || (previous.is_finite() && largest * largest / previous <= limits.tolerance * reach)
+        {
             break;
         }
+        previous = largest;
     }
 
     // The new state and the step's work.

@@ -1,0 +1,147 @@
+//! The integrator, step and sampling of a run whose options do not name them, chosen
+//! from the chain's fastest mode, its slowest and the drive; and the step a failed run is
+//! advised to try.
+
+use pendulum_core::fastest_frequency_bound;
+
+use crate::args::{Dimension, IntegratorKind};
+use crate::config::{DriveConfig, RunConfig};
+use crate::models::chain;
+
+/// Samples a run writes when `--every` is not given (about; at least one per step).
+const TARGET_SAMPLES: f64 = 500.0;
+
+/// Steps of the implicit midpoint rule per period of the faster of the drive and the
+/// chain's slowest swing.
+const MIDPOINT_STEPS_PER_PERIOD: f64 = 20.0;
+
+/// The default step of the Gauss–Legendre and RK4 integrators where the chain allows it, s.
+const EXPLICIT_DEFAULT_STEP: f64 = 0.005;
+
+/// What a run was given or chose: the integrator, step and sampling, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice {
+    /// The integrator.
+    pub integrator: IntegratorKind,
+    /// The step, s.
+    pub step: f64,
+    /// A sample every `every` steps.
+    pub every: usize,
+    /// Why, in words, for what was chosen (`None` when everything was given).
+    pub reason: Option<String>,
+}
+
+/// Fills in what the options left open:
+/// - integrator: `midpoint` for a 3D chain that is driven or damped (implicit, stable
+///   past the chain's fastest mode, which such a run need not resolve; the ledger closes
+///   exactly), `gl2` otherwise (conservative runs, where its energy behaviour matters, and
+///   2D runs, in angles);
+/// - step: for `midpoint` a twentieth of the period of the faster of the drive and the
+///   chain's slowest swing `√(g/L)`; for the others `min(0.005 s, 0.5/ω_fastest, T_drive/40)`
+///   ([`suggested_step`]);
+/// - every: about 500 samples over the run.
+pub fn choose(
+    config: &RunConfig,
+    integrator: Option<IntegratorKind>,
+    step: Option<f64>,
+    every: Option<usize>,
+) -> Choice {
+    let mut reasons = Vec::new();
+    let driven = !matches!(config.drive, DriveConfig::Fixed);
+    let damped = config.damping.iter().any(|l| *l != 0.0);
+    let fastest = fastest_mode(config);
+    let chosen_integrator = integrator.unwrap_or_else(|| {
+        let kind = if config.dim == Dimension::Three && (driven || damped) {
+            IntegratorKind::Midpoint
+        } else {
+            IntegratorKind::Gl2
+        };
+        reasons.push(match kind {
+            IntegratorKind::Midpoint => format!(
+                "integrator midpoint: a {} 3D chain, stepped implicitly over its fastest mode \
+                 (about {fastest:.3e} rad/s; an explicit step would need h < {:.1e} s), the ledger exact",
+                if driven { "driven" } else { "damped" },
+                2.8 / fastest.max(f64::MIN_POSITIVE)
+            ),
+            _ => "integrator gl2: Gauss–Legendre, order 4, for its energy behaviour (not driven, \
+                  not damped, or 2D)"
+                .into(),
+        });
+        kind
+    });
+    let drive = drive_frequency(config);
+    let chosen_step = step.unwrap_or_else(|| {
+        let (h, why) = match chosen_integrator {
+            IntegratorKind::Midpoint => {
+                let slowest = slowest_swing(config);
+                let (omega, what) = match drive {
+                    Some(w) if w > slowest => (w, format!("the drive's period ({w} rad/s)")),
+                    _ => (slowest, format!("the chain's slowest swing (√(g/L) = {slowest:.3} rad/s)")),
+                };
+                if omega > 0.0 {
+                    (std::f64::consts::TAU / omega / MIDPOINT_STEPS_PER_PERIOD, format!("1/20 of {what}"))
+                } else {
+                    (config.end / 1000.0, "a thousandth of the run (no gravity, no drive)".into())
+                }
+            }
+            _ => {
+                let h = suggested_step(fastest, drive).min(EXPLICIT_DEFAULT_STEP);
+                (h, format!("min(0.005 s, 0.5/ω_fastest, T_drive/40), ω_fastest ≈ {fastest:.3e} rad/s"))
+            }
+        };
+        let h = h.min(config.end);
+        reasons.push(format!("step {h:.4e} s: {why}"));
+        h
+    });
+    let chosen_every = every.unwrap_or_else(|| {
+        let k = (config.end / (chosen_step * TARGET_SAMPLES)).floor().max(1.0) as usize;
+        reasons.push(format!("every {k} steps: about {TARGET_SAMPLES} samples"));
+        k
+    });
+    Choice {
+        integrator: chosen_integrator,
+        step: chosen_step,
+        every: chosen_every,
+        reason: (!reasons.is_empty()).then(|| reasons.join("; ")),
+    }
+}
+
+/// The slowest swing of the chain as one pendulum of its whole length, `√(g/L)` (rad/s),
+/// with `L = Σ l_i`: the first mode of a uniform chain is 1.2 times that.
+fn slowest_swing(config: &RunConfig) -> f64 {
+    let length: f64 = config.lengths.iter().sum();
+    (config.gravity.max(0.0) / length).sqrt()
+}
+
+/// The chain's fastest angular frequency (rad/s), [`fastest_frequency_bound`] with the
+/// drive's largest acceleration added to gravity; `0` if the chain is invalid (the run
+/// would not have started).
+pub fn fastest_mode(config: &RunConfig) -> f64 {
+    let accel = match &config.drive {
+        DriveConfig::Fixed => 0.0,
+        DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
+        DriveConfig::Circle { radius, omega } => radius * omega * omega,
+        DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
+            radius * initial_omega.abs().max(omega.abs()).powi(2)
+        }
+    };
+    chain(config).map_or(0.0, |c| fastest_frequency_bound(&c, config.gravity + accel))
+}
+
+/// The drive's angular frequency (rad/s), if it has one.
+pub fn drive_frequency(config: &RunConfig) -> Option<f64> {
+    match &config.drive {
+        DriveConfig::Fixed => None,
+        DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
+        DriveConfig::RampedCircle { initial_omega, omega, .. } => Some(initial_omega.abs().max(omega.abs())),
+    }
+}
+
+/// A step that resolves both: `h = 0.5 / ω_fastest`, at most a fortieth of the drive period.
+pub fn suggested_step(fastest: f64, drive: Option<f64>) -> f64 {
+    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
+    if let Some(w) = drive.filter(|w| *w > 0.0) {
+        h = h.min(std::f64::consts::TAU / w / 40.0);
+    }
+    h
+}
