@@ -84,6 +84,8 @@ fn a_row_per_point_and_kind_with_the_node_counts_of_simulate() {
         let mut run = vec!["simulate", "--dim", "3", "--drive", "circle", "--radius", "0.02", "--omega", &w];
         run.extend_from_slice(&CHAIN);
         run.extend(["--integrator", "rk4", "--step", &step, "--end", "40", "--initial", "hanging"]);
+        // The sweep feeds the shape tracker every 4 steps (its FEED_EVERY).
+        run.extend(["--every", "4"]);
         run.extend(["--no-plots", "--quiet", "--out", &name]);
         if kinds[i] == "ramp-up" {
             run.extend(["--ramp-time", "12"]);

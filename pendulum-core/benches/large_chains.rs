@@ -1,5 +1,6 @@
 //! One force evaluation of long chains: the O(n) tension routes against the dense route
-//! (mass matrix + Cholesky, O(n³)) and against the floor of n `sin_cos` calls.
+//! (mass matrix + Cholesky, O(n³)) and against the floor of n `sin_cos` calls; and one
+//! integrator step of the whirl and of a free chain of 1000 links (group `step`).
 //!
 //! ```sh
 //! cargo bench -p pendulum-core --bench large_chains
@@ -10,11 +11,13 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{
-    BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main, measurement::WallTime,
+    BatchSize, BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main, measurement::WallTime,
 };
 use nalgebra::{DVector, U2, U3};
-use pendulum_core::integrate::System;
-use pendulum_core::{Chain, Directions, Model, Planar, PlanarTension, Spatial};
+use pendulum_core::integrate::{Integrator, Projected, Rk4, State, System};
+use pendulum_core::{
+    Accounted, Chain, Circle, Directions, Model, Planar, PlanarTension, RodMidpoint, Spatial,
+};
 
 const SIZES: [usize; 10] = [8, 16, 32, 64, 100, 128, 256, 1000, 1024, 4096];
 /// The dense route costs O(n³): measured up to here.
@@ -118,5 +121,50 @@ fn spatial(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, planar, spatial);
+/// One step of the whirl of `docs/large-chains.md` §7 (3D, n = 100, 1 m, 1 kg, λ = 3e-4,
+/// pivot on a 2 cm circle at 6 rad/s, ledger carried), from its state after 20 s: the
+/// implicit midpoint step at the default h = T/20 and RK4 with projection at 1 ms; and a
+/// free 3D chain of 1000 links swinging from a 0.2 rad tilt (after 1 s), midpoint at
+/// 0.01 s and RK4 at 4e-4 s (just inside its stability limit 4.5e-4 s).
+fn step(c: &mut Criterion) {
+    let mut group = c.benchmark_group("step");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2)).sample_size(30);
+    let whirl =
+        Chain::uniform(100, 0.01, 0.01, 9.81).and_then(|c| c.with_damping(&[3e-4; 100])).expect("chain");
+    let system =
+        Accounted::of(Directions::<U3>::new(whirl).with_drive(Circle::new(0.02, 6.0).expect("drive")));
+    let h = std::f64::consts::TAU / 6.0 / 20.0;
+    let mut state = State::new(0.0, system.state(&system.chain().hanging()).expect("state"));
+    RodMidpoint::new().integrate(&system, &mut state, 20.0, (20.0 / h).round() as usize).expect("spin-up");
+    let mut midpoint = RodMidpoint::new();
+    group.bench_function("whirl_100/midpoint_T_over_20", |b| {
+        b.iter_batched_ref(|| state.clone(), |s| midpoint.step(&system, s, h).unwrap(), BatchSize::SmallInput)
+    });
+    let mut rk4 = Projected::new(Rk4::new(&system));
+    group.bench_function("whirl_100/rk4_1ms", |b| {
+        b.iter_batched_ref(|| state.clone(), |s| rk4.step(&system, s, 1e-3).unwrap(), BatchSize::SmallInput)
+    });
+    let n = 1000;
+    let free = Directions::<U3>::new(Chain::uniform(n, 1e-3, 1e-3, 9.81).expect("chain"));
+    let q: Vec<f64> = (0..2 * n)
+        .map(|i| if i < n { 0.2 } else { std::f64::consts::PI * (i - n) as f64 / n as f64 })
+        .collect();
+    let mut state = State::new(0.0, free.from_spherical(&q, &vec![0.0; 2 * n]).expect("state"));
+    RodMidpoint::new().integrate(&free, &mut state, 1.0, 100).expect("swing");
+    let mut midpoint = RodMidpoint::new();
+    group.bench_function("free_1000/midpoint_10ms", |b| {
+        b.iter_batched_ref(
+            || state.clone(),
+            |s| midpoint.step(&free, s, 0.01).unwrap(),
+            BatchSize::SmallInput,
+        )
+    });
+    let mut rk4 = Projected::new(Rk4::new(&free));
+    group.bench_function("free_1000/rk4_0.4ms", |b| {
+        b.iter_batched_ref(|| state.clone(), |s| rk4.step(&free, s, 4e-4).unwrap(), BatchSize::SmallInput)
+    });
+    group.finish();
+}
+
+criterion_group!(benches, planar, spatial, step);
 criterion_main!(benches);

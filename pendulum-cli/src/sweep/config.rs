@@ -17,8 +17,8 @@ use crate::json_file::write_json_atomic;
 use crate::spec::{expand, per_link};
 use crate::steady::round_up;
 
-/// The shape analysis is fed every this many steps (`pendulum simulate`'s default
-/// `--every`, so a point and the same `simulate` run report the same).
+/// The shape analysis is fed every this many steps (a point and the same `simulate` run
+/// with `--every 4` report the same).
 pub const FEED_EVERY: usize = 4;
 
 /// Settle window of the shape analysis, drive periods (`ShapeOptions` default).
