@@ -39,7 +39,9 @@ use crate::models::directions::Directions;
 ///
 /// Each Newton iteration assembles and factors the `n` blocks of `(S+1) × (S+1)` (link
 /// `i`'s position and multiplier), `O(n)`. Start: the rods turned by `h w_i` and the
-/// multipliers of the previous step. The state is the [`Directions`] state `(u, w)`
+/// multipliers `T_i/l_i` of the tensions at `t`. A step in which a link would turn by more
+/// than 1 rad, or whose Newton iteration does not converge in 12 iterations, is taken as
+/// two halves (up to 6 times nested). The state is the [`Directions`] state `(u, w)`
 /// (`u_i = (x_i − x_{i−1})/l_i`, `w_i = (v_i − v_{i−1})/l_i` with `v_0 = ṗ`), which this
 /// step keeps on `|u_i| = 1` by construction; the rates are not projected (`u_i·w_i` is
 /// of the size of the step's error), since that would change the energy outside the
@@ -75,6 +77,11 @@ impl Default for RodMidpoint {
         Self::new()
     }
 }
+
+/// The most a link may turn in one step, rad (`h |w_i|`); a longer step is halved before
+/// it is tried. The midpoint rod `d_i` is the chord of the turn and vanishes at a half
+/// turn, where the Newton matrix becomes singular; a whipping free end gets there.
+const MAX_TURN: f64 = 1.0;
 
 /// How often a step whose Newton iteration fails is halved before it is an error.
 const MAX_HALVINGS: u32 = 6;
@@ -151,11 +158,24 @@ impl RodMidpoint {
     where
         DefaultAllocator: Allocator<S>,
     {
+        let n = chain.links();
+        // A link turning by more than MAX_TURN in the step: halve it without trying.
+        let fastest = motion[S::DIM * n..]
+            .chunks_exact(S::DIM)
+            .map(|w| w.iter().map(|v| v * v).sum::<f64>())
+            .fold(0.0, f64::max)
+            .sqrt();
+        if depth < MAX_HALVINGS && h.abs() * fastest > MAX_TURN {
+            self.stats.halved_steps += 1;
+            let mut middle = motion.to_vec();
+            let first = self.attempt(chain, t, motion, 0.5 * h, &mut middle, depth + 1)?;
+            let second = self.attempt(chain, t + 0.5 * h, &middle, 0.5 * h, out, depth + 1)?;
+            return Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped });
+        }
         let drive = chain.drive();
         let ends = [drive.position(t), drive.position(t + h), drive.velocity(t), drive.velocity(t + h)];
         let limits = self.limits();
         // The multipliers' start: the tensions at t.
-        let n = chain.links();
         let mut start = vec![0.0; (S::DIM + 1) * n];
         let (accelerations, tensions) = start.split_at_mut(S::DIM * n);
         let start_state = DVector::from_column_slice(motion);
