@@ -101,6 +101,26 @@ pub enum Error {
         /// The step size, s.
         h: f64,
     },
+    /// An error-controlled integrator could not meet its tolerance: its internal step
+    /// shrank below 1e-12 of the step asked for, or it took a million internal steps. The
+    /// state is left as it was before the step.
+    #[error("the error-controlled step from t = {} s could not meet the tolerance {}: its internal \
+         step shrank to {} s (a stiff chain: try --integrator midpoint, or a looser --tolerance)",
+         num(.t), num(.tolerance), num(.h))]
+    StepSizeCollapsed {
+        /// Time where it gave up, s.
+        t: f64,
+        /// The internal step it had come down to, s.
+        h: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// A tolerance of an error-controlled integrator outside `[1e-14, 0.1]` or NaN.
+    #[error("tolerance must be within 1e-14 … 0.1, got {}", num(.tolerance))]
+    InvalidTolerance {
+        /// The offending value.
+        tolerance: f64,
+    },
     /// An integrator was asked for a step of size zero, infinite or NaN.
     #[error("step size h must be finite and non-zero, got {}", num(.h))]
     InvalidStepSize {

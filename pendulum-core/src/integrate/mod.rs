@@ -1,5 +1,6 @@
 //! Time integrators for first-order systems `x' = f(t, x)`: Gauss–Legendre (implicit,
-//! s = 1, 2, 3 stages, orders 2, 4, 6) and classical RK4 (explicit).
+//! s = 1, 2, 3 stages, orders 2, 4, 6), classical RK4 (explicit) and Dormand–Prince 5(4)
+//! (explicit, error-controlled).
 //!
 //! The pieces are separate values:
 //! - the problem, a [`System`] (for a chain model, [`FirstOrder`](crate::systems::FirstOrder));
@@ -28,6 +29,7 @@
 //! ```
 
 mod block_tridiagonal;
+mod dormand_prince;
 mod fixed_point;
 mod gauss;
 mod lu;
@@ -39,6 +41,7 @@ mod tableau;
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
 pub use block_tridiagonal::BlockTridiagonal;
+pub use dormand_prince::{DormandPrince, OntoConstraints, Projection, Unprojected};
 pub use fixed_point::GaussFixedPoint;
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};
 pub use projected::{Constrained, Projected};
@@ -155,6 +158,9 @@ pub struct Stats {
     /// Steps an implicit method split into two halves because its Newton iteration did not
     /// converge ([`RodMidpoint`](crate::RodMidpoint)).
     pub halved_steps: u64,
+    /// Internal steps an error-controlled method rejected and retried smaller
+    /// ([`DormandPrince`]).
+    pub rejected_steps: u64,
 }
 
 /// A one-step method advancing a [`State`] of the system `S` by a given step.
