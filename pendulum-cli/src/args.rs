@@ -113,6 +113,9 @@ pub enum IntegratorKind {
     /// 3D only: the implicit midpoint rule on the rod constraints, O(n) per Newton
     /// iteration, stable at any step; energy and ledger exact; order 2.
     Midpoint,
+    /// Dormand–Prince 5(4), explicit, its own step chosen inside each --step to meet
+    /// --tolerance (3D: projected onto the rods after every internal step).
+    Dp54,
 }
 
 /// How an implicit Gauss–Legendre step solves its stage equations.
@@ -219,7 +222,12 @@ pub struct Physics {
     /// Stage solve of the Gauss–Legendre integrators.
     #[arg(long, value_enum, default_value = "fixed-point")]
     pub solver: StageSolver,
-    /// Step size h, s (the run takes ⌈end / h⌉ equal steps). [default: chosen for the
+    /// dp54: relative error tolerance per internal step (per state entry, with the same
+    /// absolute floor) [default: 1e-8].
+    #[arg(long, allow_negative_numbers = true)]
+    pub tolerance: Option<f64>,
+    /// Step size h, s (the run takes ⌈end / h⌉ equal steps; dp54: the interval it
+    /// adapts its own steps within). [default: chosen for the
     /// integrator from the chain's fastest mode and the drive, see run.json's "chosen"]
     #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,

@@ -37,7 +37,8 @@ pub struct Choice {
 ///   exactly), `gl2` otherwise (conservative runs, where its energy behaviour matters, and
 ///   2D runs, in angles);
 /// - step: for `midpoint` a twentieth of the period of the faster of the drive and the
-///   chain's slowest swing `√(g/L)`; for the others `min(0.005 s, 0.5/ω_fastest, T_drive/40)`
+///   chain's slowest swing `√(g/L)`; for `dp54` the sample interval of about 500 samples
+///   (it adapts its own steps inside); for the others `min(0.005 s, 0.5/ω_fastest, T_drive/40)`
 ///   ([`suggested_step`]);
 /// - every: about 500 samples over the run.
 pub fn choose(
@@ -84,6 +85,10 @@ pub fn choose(
                     (config.end / 1000.0, "a thousandth of the run (no gravity, no drive)".into())
                 }
             }
+            IntegratorKind::Dp54 => (
+                config.end / TARGET_SAMPLES,
+                "the sample interval, about 500 samples (dp54 sizes its own steps within it)".into(),
+            ),
             _ => {
                 let h = suggested_step(fastest, drive).min(EXPLICIT_DEFAULT_STEP);
                 (h, format!("min(0.005 s, 0.5/ω_fastest, T_drive/40), ω_fastest ≈ {fastest:.3e} rad/s"))

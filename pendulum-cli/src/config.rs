@@ -91,6 +91,9 @@ pub struct RunConfig {
     pub solver: StageSolver,
     /// Step size, s.
     pub step: f64,
+    /// The dp54 integrator's tolerance (absent for the others).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
     /// End time, s (start at 0).
     pub end: f64,
     /// Sample every `every` steps.
@@ -178,6 +181,7 @@ impl RunConfig {
             integrator: p.integrator.unwrap_or(IntegratorKind::Gl2),
             solver: p.solver,
             step: p.step.unwrap_or(1.0),
+            tolerance: None,
             end: p.end,
             every: p.every.unwrap_or(1),
             initial,
@@ -196,6 +200,11 @@ impl RunConfig {
         config.step = choice.step;
         config.every = choice.every;
         config.chosen = choice.reason;
+        config.tolerance = match (config.integrator, p.tolerance) {
+            (IntegratorKind::Dp54, t) => Some(t.unwrap_or(DEFAULT_TOLERANCE)),
+            (_, None) => None,
+            (_, Some(_)) => return Err(CliError::usage("--tolerance applies to --integrator dp54 only")),
+        };
         config.check()?;
         Ok(config)
     }
@@ -248,6 +257,11 @@ impl RunConfig {
             return Err(CliError::usage(format!("--torque: {v} is not finite")));
         }
         check_step(self.step)?;
+        if let Some(t) = self.tolerance
+            && !(1e-14..=1e-1).contains(&t)
+        {
+            return Err(CliError::usage(format!("--tolerance must be within 1e-14 … 0.1, got {t}")));
+        }
         if !(self.end.is_finite() && self.end > 0.0) {
             return Err(CliError::usage(format!("--end must be finite and positive, got {}", self.end)));
         }
@@ -350,6 +364,9 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
     Ok(InitialConfig { spec: spec.to_string(), coordinates, rates, directions: None })
 }
 
+/// The dp54 integrator's tolerance when `--tolerance` is not given.
+pub const DEFAULT_TOLERANCE: f64 = 1e-8;
+
 /// Errors unless the step is finite and positive.
 fn check_step(h: f64) -> CliResult<()> {
     if h.is_finite() && h > 0.0 {
@@ -390,6 +407,38 @@ pub struct Outcome {
     /// The error, when the run failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// What the integrator did (absent in files of earlier versions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub work: Option<IntegratorWork>,
+}
+
+/// What the integrator did over a run: the counts that say what a step cost.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorWork {
+    /// Right-hand sides evaluated by the integrator itself.
+    pub rhs_evaluations: u64,
+    /// Steps it took (dp54: internal steps accepted; midpoint: the steps asked for).
+    pub steps: u64,
+    /// dp54: internal steps rejected and retried smaller.
+    pub rejected_steps: u64,
+    /// Implicit methods: Newton iterations.
+    pub newton_iterations: u64,
+    /// midpoint: steps split into halves (a link turning more than 1 rad, or Newton not
+    /// converging).
+    pub halved_steps: u64,
+}
+
+impl From<&pendulum_core::integrate::Stats> for IntegratorWork {
+    fn from(s: &pendulum_core::integrate::Stats) -> Self {
+        Self {
+            rhs_evaluations: s.rhs_evaluations,
+            steps: s.steps,
+            rejected_steps: s.rejected_steps,
+            newton_iterations: s.newton_iterations,
+            halved_steps: s.halved_steps,
+        }
+    }
 }
 
 impl RunFile {

@@ -5,7 +5,8 @@
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, U2, U3};
 use pendulum_core::energy::Powered;
 use pendulum_core::integrate::{
-    Constrained, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, System,
+    Constrained, DormandPrince, GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, OntoConstraints,
+    Projected, Rk4, System, Unprojected,
 };
 use pendulum_core::kinematics::Chart;
 use pendulum_core::{
@@ -14,7 +15,7 @@ use pendulum_core::{
 };
 
 use crate::args::{Dimension, IntegratorKind, StageSolver};
-use crate::config::{DriveConfig, RunConfig};
+use crate::config::{DEFAULT_TOLERANCE, DriveConfig, RunConfig};
 use crate::error::{CliError, CliResult};
 
 /// One sample of a run, in plain numbers.
@@ -37,16 +38,36 @@ pub struct Sample {
 /// Most sweeps of the fixed-point stage solve per step.
 const FIXED_POINT_SWEEPS: usize = 100;
 
-/// The integrator of a kind for an unconstrained system, Gauss–Legendre stages solved by
-/// `solver`. Errors: a kind the system does not have ([`IntegratorKind::Midpoint`] is
-/// for chains in unit directions).
+/// How a run integrates: the integrator, the Gauss–Legendre stage solve, dp54's tolerance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Method {
+    /// The integrator.
+    pub kind: IntegratorKind,
+    /// The Gauss–Legendre stage solve.
+    pub solver: StageSolver,
+    /// dp54's tolerance.
+    pub tolerance: f64,
+}
+
+impl Method {
+    /// The method of a configuration.
+    pub fn of(config: &RunConfig) -> Self {
+        Self {
+            kind: config.integrator,
+            solver: config.solver,
+            tolerance: config.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+        }
+    }
+}
+
+/// The integrator of a method for an unconstrained system. Errors: a kind the system does
+/// not have ([`IntegratorKind::Midpoint`] is for chains in unit directions).
 fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
-    kind: IntegratorKind,
-    solver: StageSolver,
+    method: Method,
     system: &S,
 ) -> CliResult<Box<dyn Integrator<S> + 'a>> {
     let options = GaussOptions::default();
-    Ok(match (kind, solver) {
+    Ok(match (method.kind, method.solver) {
         (IntegratorKind::Gl1, StageSolver::Newton) => {
             Box::new(GaussLegendre::<Dyn, U1>::new(system, options))
         }
@@ -66,6 +87,7 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
             Box::new(GaussFixedPoint::<Dyn, U3>::new(system, FIXED_POINT_SWEEPS))
         }
         (IntegratorKind::Rk4, _) => Box::new(Rk4::new(system)),
+        (IntegratorKind::Dp54, _) => Box::new(DormandPrince::new(system, method.tolerance, Unprojected)?),
         (IntegratorKind::Midpoint, _) => {
             return Err(CliError::usage(
                 "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
@@ -76,11 +98,14 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
 
 /// [`plain_integrator`] followed by the system's projection after every step.
 fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
-    kind: IntegratorKind,
-    solver: StageSolver,
+    method: Method,
     system: &S,
 ) -> CliResult<Box<dyn Integrator<S> + 'a>> {
-    Ok(Box::new(Projected::new(plain_integrator(kind, solver, system)?)))
+    Ok(match method.kind {
+        // Projected after every internal step, not only at the end of each step.
+        IntegratorKind::Dp54 => Box::new(DormandPrince::new(system, method.tolerance, OntoConstraints)?),
+        _ => Box::new(Projected::new(plain_integrator(method, system)?)),
+    })
 }
 
 /// A chain's motion as `pendulum simulate` runs it: what the core's ledger needs
@@ -96,8 +121,7 @@ pub trait Motion: Powered + Sized {
     /// constraints where the motion has them).
     fn integrator<'a>(
         system: &'a Accounted<Self>,
-        kind: IntegratorKind,
-        solver: StageSolver,
+        method: Method,
     ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>>;
 }
 
@@ -133,10 +157,9 @@ where
 
     fn integrator<'a>(
         system: &'a Accounted<Self>,
-        kind: IntegratorKind,
-        solver: StageSolver,
+        method: Method,
     ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
-        plain_integrator(kind, solver, system)
+        plain_integrator(method, system)
     }
 }
 
@@ -165,14 +188,13 @@ where
 
     fn integrator<'a>(
         system: &'a Accounted<Self>,
-        kind: IntegratorKind,
-        solver: StageSolver,
+        method: Method,
     ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
-        match kind {
+        match method.kind {
             // Exact on the rods by construction; a projection of the rates would change the
             // energy outside the ledger.
             IntegratorKind::Midpoint => Ok(Box::new(RodMidpoint::new())),
-            _ => projected_integrator(kind, solver, system),
+            _ => projected_integrator(method, system),
         }
     }
 }
@@ -221,13 +243,9 @@ impl<P: Motion> Simulation<P> {
         }
     }
 
-    /// The integrator of this kind for the system.
-    pub fn integrator(
-        &self,
-        kind: IntegratorKind,
-        solver: StageSolver,
-    ) -> CliResult<Box<dyn Integrator<Accounted<P>> + '_>> {
-        P::integrator(&self.system, kind, solver)
+    /// The integrator of this method for the system.
+    pub fn integrator(&self, method: Method) -> CliResult<Box<dyn Integrator<Accounted<P>> + '_>> {
+        P::integrator(&self.system, method)
     }
 }
 

@@ -19,7 +19,7 @@ use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
 use crate::interrupt::INTERRUPTED;
 use crate::json_file::warn_other_version;
-use crate::models::{AnySimulation, Motion, Sample, Simulation, build};
+use crate::models::{AnySimulation, Method, Motion, Sample, Simulation, build};
 use crate::plot;
 use crate::render;
 use crate::whirl::Whirl;
@@ -145,7 +145,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
     let dims = if config.dim == Dimension::Two { 2 } else { 3 };
     let mut progress = Progress::new(total_steps, config.end, options.quiet);
     let system = simulation.system();
-    let mut solver = simulation.integrator(config.integrator, config.solver)?;
+    let mut solver = simulation.integrator(Method::of(config))?;
     let mut state = State::new(0.0, simulation.initial_state());
     let mut kept = Kept::default();
     let whirl = Whirl::of(config)?;
@@ -208,6 +208,7 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
         steps,
         samples: sample_count,
         error: error.clone(),
+        work: Some(solver.stats().into()),
     });
     run_file.write_atomic(&run_json)?;
 

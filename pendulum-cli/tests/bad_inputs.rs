@@ -108,6 +108,32 @@ fn an_extreme_chain_fails_at_run_time_with_a_message() {
 }
 
 #[test]
+fn integrator_options_that_do_not_fit_are_usage_errors() {
+    let cases: [(&[&str], &str); 4] = [
+        (&["--tolerance", "1e-8"], "error: --tolerance applies to --integrator dp54 only"),
+        (
+            &["--integrator", "dp54", "--tolerance", "0"],
+            "error: --tolerance must be within 1e-14 … 0.1, got 0",
+        ),
+        (
+            &["--integrator", "dp54", "--tolerance", "NaN"],
+            "error: --tolerance must be within 1e-14 … 0.1, got NaN",
+        ),
+        (
+            &["--integrator", "midpoint"],
+            "error: --integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
+        ),
+    ];
+    for (i, (extra, message)) in cases.iter().enumerate() {
+        let mut args = vec!["simulate", "--out", "run", "--no-plots"];
+        args.extend_from_slice(extra);
+        let (code, got) = run(&format!("integrator-{i}"), &args);
+        assert_eq!(code, Some(2), "{got}");
+        assert_eq!(got, *message);
+    }
+}
+
+#[test]
 fn a_step_chosen_too_small_for_the_run_is_a_usage_error_naming_it() {
     let (code, got) = run("tiny-auto", &["simulate", "--lengths", "1e-300", "--out", "run", "--no-plots"]);
     assert_eq!(code, Some(2), "{got}");

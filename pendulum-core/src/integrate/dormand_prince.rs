@@ -56,15 +56,8 @@ const A: [[f64; 6]; 7] = [
 /// Order-5 weights (the last row of `A`; the seventh weight is 0).
 const B: [f64; 7] = [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0, 0.0];
 /// Order-5 minus order-4 weights: the error estimate's.
-const E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
+const E: [f64; 7] =
+    [71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0];
 
 /// Dormand–Prince 5(4) with step-size control: each [`step`](Integrator::step) of `h`
 /// advances exactly to `t + h` in as many internal steps as the tolerance needs, each
@@ -129,7 +122,13 @@ where
 
     /// One attempt of an internal step `h` from `(t, x)`, `k[0] = f(t, x)` given: writes
     /// the increment and returns the error measure.
-    fn attempt<S: System<Dim = D>>(&mut self, system: &S, t: f64, x: &OVector<f64, D>, h: f64) -> Result<f64> {
+    fn attempt<S: System<Dim = D>>(
+        &mut self,
+        system: &S,
+        t: f64,
+        x: &OVector<f64, D>,
+        h: f64,
+    ) -> Result<f64> {
         for s in 1..7 {
             self.y.copy_from(x);
             for (j, a) in A[s].iter().enumerate().take(s) {
@@ -194,7 +193,11 @@ where
                 Err(e) => return self.fail(state, saved, e),
             };
             if sub.abs() < 1e-12 * h.abs() {
-                return self.fail(state, saved, Error::StepSizeCollapsed { t, h: sub, tolerance: self.tolerance });
+                return self.fail(
+                    state,
+                    saved,
+                    Error::StepSizeCollapsed { t, h: sub, tolerance: self.tolerance },
+                );
             }
             let factor = if error == 0.0 { 5.0 } else { (0.9 * error.powf(-0.2)).clamp(0.2, 5.0) };
             if error <= 1.0 {
@@ -215,7 +218,11 @@ where
             }
         }
         let t = state.t();
-        self.fail(state, saved, Error::StepSizeCollapsed { t, h: self.next.unwrap_or(h), tolerance: self.tolerance })
+        self.fail(
+            state,
+            saved,
+            Error::StepSizeCollapsed { t, h: self.next.unwrap_or(h), tolerance: self.tolerance },
+        )
     }
 
     fn stats(&self) -> &Stats {
@@ -238,7 +245,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Vector2, U2};
+    use nalgebra::{U2, Vector2};
 
     use super::*;
 
@@ -293,7 +300,10 @@ mod tests {
         assert!(rods < 1e-14, "{rods:e}");
         let drift = (model.energy(state.x()) - e0).abs() / e0.abs();
         assert!(drift < 1e-7, "{drift:e}");
-        assert!(solver.stats.steps > 40 && solver.stats.rhs_evaluations < 7 * (solver.stats.steps + solver.stats.rejected_steps) + 50);
+        assert!(
+            solver.stats.steps > 40
+                && solver.stats.rhs_evaluations < 7 * (solver.stats.steps + solver.stats.rejected_steps) + 50
+        );
     }
 
     #[test]
