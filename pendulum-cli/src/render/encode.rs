@@ -105,12 +105,28 @@ impl GifFile {
         // Nothing changed: one transparent pixel holds the time.
         let (left, top, right, bottom) = changed.unwrap_or((0, 0, 1, 1));
         self.indices.clear();
+        // Runs of one colour (the background, mostly) skip the palette's lookup.
+        let mut last: Option<([u8; 3], u8)> = None;
+        let first = self.shown.is_empty();
         for y in top..bottom {
-            for x in left..right {
-                let at = 3 * (y * w + x);
-                let c = [rgb[at], rgb[at + 1], rgb[at + 2]];
-                let same = changed.is_none() || (!self.shown.is_empty() && self.shown[at..at + 3] == c);
-                self.indices.push(if same { CLEAR } else { self.palette.index(c) });
+            let span = 3 * (y * w + left)..3 * (y * w + right);
+            let row = &rgb[span.clone()];
+            let old = if first { row } else { &self.shown[span] };
+            for (pixel, before) in row.chunks_exact(3).zip(old.chunks_exact(3)) {
+                let c = [pixel[0], pixel[1], pixel[2]];
+                let index = if changed.is_none() || (!first && pixel == before) {
+                    CLEAR
+                } else {
+                    match last {
+                        Some((colour, index)) if colour == c => index,
+                        _ => {
+                            let index = self.palette.index(c);
+                            last = Some((c, index));
+                            index
+                        }
+                    }
+                };
+                self.indices.push(index);
             }
         }
         let frame = gif::Frame {

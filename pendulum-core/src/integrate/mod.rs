@@ -28,7 +28,6 @@
 //! assert!(drift.abs() < 1e-6);
 //! ```
 
-mod block_tridiagonal;
 mod dormand_prince;
 mod fixed_point;
 mod gauss;
@@ -40,7 +39,6 @@ mod tableau;
 
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
-pub use block_tridiagonal::BlockTridiagonal;
 pub use dormand_prince::{DormandPrince, OntoConstraints, Projection, Unprojected};
 pub use fixed_point::GaussFixedPoint;
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};

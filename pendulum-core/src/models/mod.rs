@@ -7,6 +7,7 @@ pub(crate) mod closed_form;
 pub(crate) mod directions;
 pub(crate) mod planar;
 pub(crate) mod rod_midpoint;
+pub(crate) mod rod_newton;
 pub(crate) mod rods;
 pub(crate) mod spatial;
 pub(crate) mod tension;

@@ -8,14 +8,15 @@
 //! drive and damping ledger exactly, so it can step over those modes; it does not resolve
 //! them (their frequencies come out too low), and it is of order 2.
 
-use nalgebra::{DVector, DefaultAllocator, DimName, SVector, allocator::Allocator};
+use nalgebra::{DVector, DefaultAllocator, DimName, allocator::Allocator};
 
 use crate::chain::Chain;
 use crate::drive::Drive;
 use crate::energy::Accounted;
 use crate::error::{Error, Result};
-use crate::integrate::{BlockTridiagonal, Integrator, State, Stats};
+use crate::integrate::{Integrator, State, Stats};
 use crate::models::directions::Directions;
+use crate::models::rod_newton::{self, LinkRow, Pivot};
 
 /// The energy-conserving midpoint step of a chain of point masses on rigid rods
 /// (Gonzalez, *Mechanical systems subject to holonomic constraints*, 1999), on the mass
@@ -37,8 +38,8 @@ use crate::models::directions::Directions;
 /// which is what it adds to an [`Accounted`] ledger: the balance closes to the Newton
 /// tolerance and round-off at any step size.
 ///
-/// Each Newton iteration assembles and factors the `n` blocks of `(S+1) × (S+1)` (link
-/// `i`'s position and multiplier), `O(n)`. Start: the rods turned by `h w_i` and the
+/// Each Newton iteration assembles the Newton matrix link by link (link `i`'s position and
+/// multiplier) and eliminates it in `O(n)` (`rod_newton`). Start: the rods turned by `h w_i` and the
 /// multipliers `T_i/l_i` of the tensions at `t`. A step in which a link would turn by more
 /// than 1 rad, or whose Newton iteration does not converge in 12 iterations, is taken as
 /// two halves (up to 6 times nested). The state is the [`Directions`] state `(u, w)`
@@ -51,25 +52,16 @@ pub struct RodMidpoint {
     stats: Stats,
     tolerance: f64,
     max_iterations: usize,
-    planar: Work<3>,
-    spatial: Work<4>,
+    planar: Work<2>,
+    spatial: Work<3>,
 }
 
-/// The Newton matrix and right-hand side of one block size.
-#[derive(Debug, Clone)]
-struct Work<const B: usize> {
-    matrix: BlockTridiagonal<B>,
-    rhs: Vec<SVector<f64, B>>,
-}
-
-impl<const B: usize> Work<B> {
-    fn sized(&mut self, n: usize) -> &mut Self {
-        if self.matrix.len() != n {
-            self.matrix = BlockTridiagonal::new(n);
-            self.rhs = vec![SVector::zeros(); n];
-        }
-        self
-    }
+/// The Newton matrix's rows and its elimination's pivots, in `C` dimensions: buffers kept
+/// from step to step.
+#[derive(Debug, Clone, Default)]
+struct Work<const C: usize> {
+    rows: Vec<LinkRow<C>>,
+    pivots: Vec<Pivot<C>>,
 }
 
 impl Default for RodMidpoint {
@@ -102,8 +94,8 @@ impl RodMidpoint {
             stats: Stats::default(),
             tolerance: 1e-13,
             max_iterations: 12,
-            planar: Work { matrix: BlockTridiagonal::new(0), rhs: Vec::new() },
-            spatial: Work { matrix: BlockTridiagonal::new(0), rhs: Vec::new() },
+            planar: Work::default(),
+            spatial: Work::default(),
         }
     }
 
@@ -186,13 +178,11 @@ impl RodMidpoint {
         let result = match S::DIM {
             2 => {
                 let ends = ends.map(|v| [v[0], v[1]]);
-                let work = self.planar.sized(chain.links());
-                newton::<2, 3>(work, &start, chain.chain(), ends, motion, h, out, &limits)
+                newton::<2>(&mut self.planar, &start, chain.chain(), ends, motion, h, out, &limits)
             }
             _ => {
                 let ends = ends.map(|v| [v[0], v[1], v[2]]);
-                let work = self.spatial.sized(chain.links());
-                newton::<3, 4>(work, &start, chain.chain(), ends, motion, h, out, &limits)
+                newton::<3>(&mut self.spatial, &start, chain.chain(), ends, motion, h, out, &limits)
             }
         };
         match result {
@@ -251,12 +241,12 @@ fn at<const C: usize>(v: &[f64], i: usize) -> [f64; C] {
     std::array::from_fn(|k| v[i * C + k])
 }
 
-/// The Newton iteration of one step in `C` dimensions (blocks of `B = C + 1`). `ends`:
+/// The Newton iteration of one step in `C` dimensions. `ends`:
 /// pivot position at `t` and `t + h`, velocity at `t` and `t + h`. Returns the step's
 /// work and the iterations, or the iterations spent when it did not converge.
 #[allow(clippy::too_many_arguments)] // One step's data, all of it needed.
-fn newton<const C: usize, const B: usize>(
-    work: &mut Work<B>,
+fn newton<const C: usize>(
+    work: &mut Work<C>,
     start: &Start,
     chain: &Chain<nalgebra::Dyn>,
     ends: [[f64; C]; 4],
@@ -265,7 +255,6 @@ fn newton<const C: usize, const B: usize>(
     out: &mut [f64],
     limits: &Limits,
 ) -> std::result::Result<(StepWork, Count), Count> {
-    debug_assert_eq!(B, C + 1);
     let [p0, p1, pv0, pv1] = ends;
     let n = chain.links();
     let (m, l, lambda) = (chain.masses(), chain.lengths(), chain.damping());
@@ -317,8 +306,9 @@ fn newton<const C: usize, const B: usize>(
             return Err(count);
         }
         count.iterations += 1;
-        let Work { matrix, rhs } = &mut *work;
-        // Residuals and Jacobian, block row i = (R_i, C_i), columns (x_j, μ_j).
+        // Residuals and the Newton matrix, link by link (`rod_newton` module docs).
+        let Work { rows, pivots } = &mut *work;
+        rows.clear();
         let mut next = rod(&x1, 0);
         for i in 0..n {
             let (e, d, s) = next;
@@ -332,52 +322,34 @@ fn newton<const C: usize, const B: usize>(
             let xi = at::<C>(&x1, i);
             let x0i = at::<C>(&x0, i);
             let v0i = at::<C>(&v0, i);
-            let mut row = SVector::<f64, B>::zeros();
-            for k in 0..C {
+            let force: [f64; C] = std::array::from_fn(|k| {
                 let mut r =
                     inertia[i] * (xi[k] - x0i[k] - h * v0i[k]) - m[i] * gravity[k] + c_i * s[k] + mu_i * d[k];
                 if has_next {
                     r -= c_next * s_next[k] + mu_next * d_next[k];
                 }
-                row[k] = -r;
-            }
-            row[C] = -0.5 * (dot(e, e) - l[i] * l[i]);
-            rhs[i] = row;
-            let diag = &mut matrix.diag[i];
-            diag.fill(0.0);
-            let k_i = inertia[i] + c_i + c_next + 0.5 * (mu_i + mu_next);
-            for k in 0..C {
-                diag[(k, k)] = k_i;
-                diag[(k, C)] = d[k];
-                diag[(C, k)] = e[k];
-            }
-            let lower = &mut matrix.sub[i];
-            lower.fill(0.0);
-            for k in 0..C {
-                lower[(k, k)] = -c_i - 0.5 * mu_i;
-                lower[(C, k)] = -e[k];
-            }
-            let upper = &mut matrix.sup[i];
-            upper.fill(0.0);
-            if has_next {
-                for k in 0..C {
-                    upper[(k, k)] = -c_next - 0.5 * mu_next;
-                    upper[(k, C)] = -d_next[k];
-                }
-            }
+                -r
+            });
+            rows.push(LinkRow {
+                stiffness: inertia[i] + c_i + c_next + 0.5 * (mu_i + mu_next),
+                coupling: c_i + 0.5 * mu_i,
+                midpoint: d,
+                end: e,
+                force,
+                constraint: -0.5 * (dot(e, e) - l[i] * l[i]),
+            });
         }
         count.factorizations += 1;
-        if !matrix.factor() {
+        if !rod_newton::solve(rows, pivots) {
             return Err(count);
         }
-        matrix.solve(rhs);
         let mut largest: f64 = 0.0;
-        for i in 0..n {
+        for (i, row) in rows.iter().enumerate() {
             for k in 0..C {
-                x1[i * C + k] += rhs[i][k];
-                largest = largest.max(rhs[i][k].abs());
+                x1[i * C + k] += row.force[k];
+                largest = largest.max(row.force[k].abs());
             }
-            mu[i] += rhs[i][C];
+            mu[i] += row.constraint;
         }
         if !largest.is_finite() {
             return Err(count);
