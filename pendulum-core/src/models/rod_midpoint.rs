@@ -42,7 +42,7 @@ use crate::models::rod_newton::{self, LinkRow, Pivot};
 /// multiplier) and eliminates it in `O(n)` (`rod_newton`). Start: the rods turned by `h w_i` and the
 /// multipliers `T_i/l_i` of the tensions at `t`. A step in which a link would turn by more
 /// than 1 rad, or whose Newton iteration does not converge in 12 iterations, is taken as
-/// two halves (up to 6 times nested). The state is the [`Directions`] state `(u, w)`
+/// two halves (up to 10 times nested). The state is the [`Directions`] state `(u, w)`
 /// (`u_i = (x_i − x_{i−1})/l_i`, `w_i = (v_i − v_{i−1})/l_i` with `v_0 = ṗ`), which this
 /// step keeps on `|u_i| = 1` by construction; the rates are not projected (`u_i·w_i` is
 /// of the size of the step's error), since that would change the energy outside the
@@ -76,7 +76,7 @@ impl Default for RodMidpoint {
 const MAX_TURN: f64 = 1.0;
 
 /// How often a step whose Newton iteration fails is halved before it is an error.
-const MAX_HALVINGS: u32 = 6;
+const MAX_HALVINGS: u32 = 10;
 
 /// What one converged step produced, besides the new state.
 #[derive(Debug, Default)]
@@ -88,7 +88,7 @@ struct StepWork {
 impl RodMidpoint {
     /// The step with its Newton iteration converged to `1e-13` of the chain's reach
     /// (`Σ l_i`) per position, at most 12 iterations; a step whose iteration does not converge
-    /// is taken as two halves (up to 6 times nested).
+    /// is taken as two halves (up to 10 times nested).
     pub fn new() -> Self {
         Self {
             stats: Stats::default(),

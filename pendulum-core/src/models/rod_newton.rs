@@ -51,8 +51,7 @@ pub(crate) struct Pivot<const C: usize> {
 /// singular or not finite.
 pub(crate) fn solve<const C: usize>(rows: &mut [LinkRow<C>], pivots: &mut Vec<Pivot<C>>) -> bool {
     pivots.clear();
-    for i in 0..rows.len() {
-        let row = rows[i];
+    for &row in rows.iter() {
         let mut p = [[0.0; C]; C];
         for (k, line) in p.iter_mut().enumerate() {
             line[k] = row.stiffness;
@@ -104,8 +103,8 @@ pub(crate) fn solve<const C: usize>(rows: &mut [LinkRow<C>], pivots: &mut Vec<Pi
         if let Some((dx, dmu)) = next {
             let after = &rows[i + 1];
             let g: [f64; C] = std::array::from_fn(|k| after.coupling * dx[k] + after.midpoint[k] * dmu);
-            for j in 0..C {
-                x[j] += (0..C).map(|k| pivot.top[j][k] * g[k]).sum::<f64>();
+            for (xj, top) in x.iter_mut().zip(&pivot.top) {
+                *xj += (0..C).map(|k| top[k] * g[k]).sum::<f64>();
             }
             mu += (0..C).map(|k| pivot.bottom[k] * g[k]).sum::<f64>();
         }
@@ -212,9 +211,10 @@ mod tests {
     fn small_inverses_are_inverses() {
         let a = [[4.0, 1.0, -2.0], [0.5, 3.0, 1.0], [-1.0, 2.0, 5.0]];
         let b = invert(a).unwrap();
+        let product = |i: usize, j: usize| (0..3).map(|k| a[i][k] * b[k][j]).sum::<f64>();
         for i in 0..3 {
             for j in 0..3 {
-                let p: f64 = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+                let p = product(i, j);
                 assert!((p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14, "{i} {j} {p}");
             }
         }
