@@ -5,7 +5,7 @@
 use pendulum_core::fastest_frequency_bound;
 
 use crate::args::{Dimension, IntegratorKind};
-use crate::config::{DriveConfig, RunConfig};
+use crate::config::{Choice, DriveConfig, RunConfig};
 use crate::models::chain;
 
 /// Samples a run writes when `--every` is not given (about; at least one per step).
@@ -17,19 +17,6 @@ const MIDPOINT_STEPS_PER_PERIOD: f64 = 20.0;
 
 /// The default step of the Gauss–Legendre and RK4 integrators where the chain allows it, s.
 const EXPLICIT_DEFAULT_STEP: f64 = 0.005;
-
-/// What a run was given or chose: the integrator, step and sampling, and why.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Choice {
-    /// The integrator.
-    pub integrator: IntegratorKind,
-    /// The step, s.
-    pub step: f64,
-    /// A sample every `every` steps.
-    pub every: usize,
-    /// Why, in words, for what was chosen (`None` when everything was given).
-    pub reason: Option<String>,
-}
 
 /// Fills in what the options left open:
 /// - integrator: `midpoint` for a 3D chain that is driven or damped (implicit, stable

@@ -117,8 +117,15 @@ impl RunConfig {
     }
 
     /// Resolves the command line into a complete configuration, checking what the core
-    /// does not check itself (counts, signs, combinations).
-    pub fn from_args(p: &Physics, view: View, frames: usize) -> CliResult<Self> {
+    /// does not check itself (counts, signs, combinations); `choose` fills in the
+    /// integrator, step and sampling the options leave open
+    /// ([`choose`](crate::choice::choose)).
+    pub fn from_args(
+        p: &Physics,
+        view: View,
+        frames: usize,
+        choose: impl FnOnce(&RunConfig, Option<IntegratorKind>, Option<f64>, Option<usize>) -> Choice,
+    ) -> CliResult<Self> {
         let (masses, lengths) = per_link_values(&p.chain)?;
         let n = masses.len();
         let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
@@ -195,7 +202,7 @@ impl RunConfig {
         if !(p.end.is_finite() && p.end > 0.0) {
             return Err(CliError::usage(format!("--end must be finite and positive, got {}", p.end)));
         }
-        let choice = crate::choice::choose(&config, p.integrator, p.step, p.every);
+        let choice = choose(&config, p.integrator, p.step, p.every);
         config.integrator = choice.integrator;
         config.step = choice.step;
         config.every = choice.every;
@@ -362,6 +369,19 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
         }
     };
     Ok(InitialConfig { spec: spec.to_string(), coordinates, rates, directions: None })
+}
+
+/// What a run was given or chose: the integrator, step and sampling, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice {
+    /// The integrator.
+    pub integrator: IntegratorKind,
+    /// The step, s.
+    pub step: f64,
+    /// A sample every `every` steps.
+    pub every: usize,
+    /// Why, in words, for what was chosen (`None` when everything was given).
+    pub reason: Option<String>,
 }
 
 /// The dp54 integrator's tolerance when `--tolerance` is not given.

@@ -13,7 +13,7 @@ use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
 use crate::args::{Dimension, SimulateArgs, StageSolver, View};
-use crate::choice::{drive_frequency, fastest_mode, suggested_step};
+use crate::choice::{choose, drive_frequency, fastest_mode, suggested_step};
 use crate::config::{Outcome, RunConfig, RunFile};
 use crate::error::{CliError, CliResult, io_failed};
 use crate::final_state::FinalState;
@@ -34,7 +34,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
             }
             file.config
         }
-        None => RunConfig::from_args(&args.physics, View::Xz, 150)?,
+        None => RunConfig::from_args(&args.physics, View::Xz, 150, choose)?,
     };
     // Presentation only: may differ from the recorded run.
     config.view = args.view.unwrap_or(config.view);
