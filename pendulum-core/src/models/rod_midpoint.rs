@@ -75,7 +75,7 @@ impl Default for RodMidpoint {
 /// turn, where the Newton matrix becomes singular; a whipping free end gets there.
 const MAX_TURN: f64 = 1.0;
 
-/// How often a step whose Newton iteration fails is halved before it is an error.
+/// How deep a step may be halved (a half of a half …) before its failure is an error.
 const MAX_HALVINGS: u32 = 10;
 
 /// What one converged step produced, besides the new state.
@@ -89,8 +89,9 @@ pub(crate) struct StepWork {
 
 impl RodMidpoint {
     /// The step with its Newton iteration converged to `1e-13` of the chain's reach
-    /// (`Σ l_i`) per position, at most 12 iterations; a step whose iteration does not converge
-    /// is taken as two halves (up to 10 times nested).
+    /// (`Σ l_i`) per position, at most 12 iterations; a step in which a link would turn by
+    /// more than [`MAX_TURN`], or whose iteration does not converge, is taken as two halves
+    /// (up to [`MAX_HALVINGS`] times nested).
     pub fn new() -> Self {
         Self {
             stats: Stats::default(),
@@ -232,7 +233,7 @@ struct Limits {
     max_iterations: usize,
 }
 
-/// `a − b`, `a + b`, `s a`, `a·b` on small arrays.
+/// `a − b`, `a·b` and the `i`-th `C`-vector of a flat slice.
 fn sub<const C: usize>(a: [f64; C], b: [f64; C]) -> [f64; C] {
     std::array::from_fn(|k| a[k] - b[k])
 }
