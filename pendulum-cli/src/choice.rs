@@ -137,3 +137,89 @@ pub fn suggested_step(fastest: f64, drive: Option<f64>) -> f64 {
     }
     h
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::args::{StageSolver, View};
+    use crate::config::InitialConfig;
+
+    /// `n` links of 1/n m and 1/n kg (a 1 m chain), hanging, 300 s.
+    fn config(dim: Dimension, n: usize, drive: DriveConfig, damping: f64) -> RunConfig {
+        let link = 1.0 / n as f64;
+        RunConfig {
+            dim,
+            masses: vec![link; n],
+            lengths: vec![link; n],
+            gravity: 9.81,
+            damping: vec![damping; n],
+            torque: if dim == Dimension::Two { vec![0.0; n] } else { Vec::new() },
+            drive,
+            integrator: IntegratorKind::Gl2,
+            solver: StageSolver::FixedPoint,
+            step: 1.0,
+            tolerance: None,
+            end: 300.0,
+            every: 1,
+            initial: InitialConfig {
+                spec: "hanging".into(),
+                coordinates: vec![0.0; n],
+                rates: vec![0.0; n],
+                directions: None,
+            },
+            view: View::Xz,
+            frames: 150,
+            chosen: None,
+        }
+    }
+
+    const WHIRL: DriveConfig = DriveConfig::Circle { radius: 0.02, omega: 6.0 };
+
+    #[test]
+    fn a_driven_3d_chain_gets_the_midpoint_step_at_a_twentieth_of_the_drive_period() {
+        let c = choose(&config(Dimension::Three, 100, WHIRL, 3e-4), None, None, None);
+        assert_eq!(c.integrator, IntegratorKind::Midpoint);
+        assert!((c.step - std::f64::consts::TAU / 6.0 / 20.0).abs() < 1e-15, "{}", c.step);
+        assert_eq!(c.every, 11, "300 s / (0.0524 s × 500)");
+        let reason = c.reason.unwrap();
+        assert!(reason.starts_with("integrator midpoint: a driven 3D chain"), "{reason}");
+        assert!(reason.contains("about 6.474e2 rad/s"), "{reason}");
+    }
+
+    #[test]
+    fn a_damped_undriven_3d_chain_steps_by_its_slowest_swing() {
+        let c = choose(&config(Dimension::Three, 10, DriveConfig::Fixed, 1e-3), None, None, None);
+        assert_eq!(c.integrator, IntegratorKind::Midpoint);
+        let period = std::f64::consts::TAU / 9.81_f64.sqrt();
+        assert!((c.step - period / 20.0).abs() < 1e-15, "{}", c.step);
+        assert!(c.reason.unwrap().contains("a damped 3D chain"));
+    }
+
+    #[test]
+    fn conservative_and_planar_runs_keep_gauss_legendre_below_the_fastest_mode() {
+        // A free 3D chain of 100 links: gl2 at 0.5/ω_fastest, far below 0.005 s.
+        let free = config(Dimension::Three, 100, DriveConfig::Fixed, 0.0);
+        let c = choose(&free, None, None, None);
+        assert_eq!(c.integrator, IntegratorKind::Gl2);
+        assert!((c.step - 0.5 / fastest_mode(&free)).abs() < 1e-15);
+        // A driven damped planar triple pendulum: gl2 at 0.005 s (its modes are slow).
+        let drive =
+            DriveConfig::Harmonic { direction: vec![0.0, 1.0], amplitude: 0.01, omega: 2.0, phase: 0.0 };
+        let c = choose(&config(Dimension::Two, 3, drive, 0.01), None, None, None);
+        assert_eq!((c.integrator, c.step), (IntegratorKind::Gl2, EXPLICIT_DEFAULT_STEP));
+    }
+
+    #[test]
+    fn dp54_samples_its_adaptive_steps_about_500_times() {
+        let c = choose(&config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None);
+        assert_eq!((c.step, c.every), (300.0 / 500.0, 1));
+        assert!(c.reason.unwrap().starts_with("step 6.0000e-1 s: the sample interval"));
+    }
+
+    #[test]
+    fn what_is_given_is_kept_and_not_explained() {
+        let c =
+            choose(&config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), Some(7));
+        assert_eq!(c, Choice { integrator: IntegratorKind::Rk4, step: 1e-3, every: 7, reason: None });
+    }
+}
