@@ -66,5 +66,11 @@ pendulum sweep --n 20 --lengths 0.05 --masses 0.05 --radius 0.02 --damping 5.623
     --omega 0.5:5:24 --scaled --kind sudden,ramp-up,ramp-down --duration 600 --ramp-time 200 \
     --out "$runs/sweep" --quiet > "$runs/sweep.txt"
 cp "$runs/sweep/sweep.png" "$gallery/sweep.png"
+# The viewer (needs chromium for the screenshot): the 6 rad/s whirl with the defaults, 300 s.
+pendulum simulate --dim 3 --n 100 --masses 0.01 --lengths 0.01 --damping 3e-4 --initial hanging \
+    --drive circle --radius 0.02 --omega 6 --end 300 --out "$runs/whirl-6-defaults" --quiet > /dev/null
+pendulum view "$runs/whirl-6-defaults" --export "$runs/whirl-6-defaults.html"
+chromium --headless --no-sandbox --disable-gpu --window-size=1200,800 --virtual-time-budget=3000 \
+    --screenshot="$gallery/view.png" "file://$(cd "$runs" && pwd)/whirl-6-defaults.html#t=500"
 cat "$runs"/whirl-3.txt "$runs"/whirl-6.txt "$runs"/whirl-11.txt "$runs"/sudden-5.txt "$runs"/ramp-5.txt
 ls -l "$gallery"

@@ -1,4 +1,4 @@
-//! The command line: `pendulum simulate | eval | modes | steady | render | sweep`, the
+//! The command line: `pendulum simulate | eval | modes | steady | render | sweep | view`, the
 //! top of the CLI (it names every command's options; nothing imports it but `main`).
 
 use clap::{Parser, Subcommand};
@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use crate::args::{EvalArgs, ModesArgs, SimulateArgs, SteadyArgs};
 use crate::render::RenderArgs;
 use crate::sweep::SweepArgs;
+use crate::view::ViewArgs;
 
 /// Swing N-link pendulums: chains of point masses on massless rigid rods hung from a
 /// pivot that may be fixed or driven, in 2D or 3D.
@@ -77,4 +78,12 @@ pub enum Command {
     /// chosen against ω over the steady branch diagram of `pendulum steady --radius R`),
     /// and prints a table. Ctrl-C stops: finished points are kept, the files stay valid.
     Sweep(Box<SweepArgs>),
+    /// A run in the browser, exported as one self-contained HTML file (--export FILE:
+    /// data and scripts inline, nothing fetched; opens offline): the chain under an orbit
+    /// camera (drag to turn, wheel to zoom; 2D runs in their plane), play/pause, one
+    /// sample back and on, a time slider, playback speed, the frame co-rotating with a
+    /// circling pivot, the tip's trail, the rotation axis and a scale bar, the energy
+    /// ledger under a cursor at the shown time, the run's parameters and its shape
+    /// summary. Long runs are thinned to --frames samples.
+    View(ViewArgs),
 }

@@ -20,6 +20,7 @@ mod simulate;
 mod spec;
 mod steady;
 mod sweep;
+mod view;
 mod whirl;
 
 use std::process::ExitCode;
@@ -55,6 +56,7 @@ fn main() -> ExitCode {
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
         Command::Render(args) => render::render(args),
+        Command::View(args) => view::view(args),
         Command::Sweep(args) => sweep::sweep(args),
     };
     match result {

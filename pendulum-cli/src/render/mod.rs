@@ -8,7 +8,7 @@
 
 mod draw;
 mod encode;
-mod source;
+pub mod source;
 mod timing;
 mod view;
 

@@ -1,0 +1,167 @@
+//! What the page shows of a run, read from its files: the positions of pivot and masses
+//! at every kept sample, the energy ledger, the parameters and the shape summary.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::args::Dimension;
+use crate::config::DriveConfig;
+use crate::error::{CliError, CliResult};
+use crate::render::source::{Run, Trajectory};
+
+/// Frames a page holds by default: a 300 s run of 100 links at 500 samples stays whole,
+/// and any run stays within about 20 MB (9 bytes per coordinate).
+pub const DEFAULT_FRAMES: usize = 6000;
+
+/// The page's data.
+#[derive(Debug, Serialize)]
+pub struct Scene {
+    /// 2 or 3.
+    pub dim: usize,
+    /// Links.
+    pub links: usize,
+    /// Σ l_i, m: the scale of the view.
+    pub reach: f64,
+    /// Kept sample times, s.
+    pub times: Vec<f32>,
+    /// Per kept sample: the pivot then every mass, x, y, z each (z = 0 in 2D; 2D y is up).
+    pub positions: Vec<f32>,
+    /// Energy ledger at the same kept samples: H and H0 + W (J).
+    pub energy: Vec<f32>,
+    pub predicted: Vec<f32>,
+    /// The drive's angular speed for the co-rotating frame (circling pivots), rad/s.
+    pub turning: bool,
+    /// Samples in the trajectory and the thinning factor.
+    pub samples: u64,
+    pub every: u64,
+    /// Lines of the parameter panel.
+    pub parameters: Vec<String>,
+    /// The shape summary (shape.json), when the run has one.
+    pub shape: Option<serde_json::Value>,
+}
+
+impl Scene {
+    /// Reads the run in `dir`, keeping at most `frames` samples (every k-th).
+    pub fn read(dir: &Path, run: &Run, frames: usize) -> CliResult<Self> {
+        let config = &run.file.config;
+        let mut count = Trajectory::open(&run.trajectory, config)?;
+        let mut row = count.row();
+        while count.next(&mut row)? {}
+        let samples = count.rows;
+        if samples == 0 {
+            return Err(CliError::usage(format!("{}: no samples", run.trajectory.display())));
+        }
+        let every = samples.div_ceil(frames as u64).max(1);
+        let mut trajectory = Trajectory::open(&run.trajectory, config)?;
+        let (mut times, mut positions) = (Vec::new(), Vec::new());
+        let mut index = 0;
+        while trajectory.next(&mut row)? {
+            if index % every == 0 {
+                times.push(row.t as f32);
+                for p in std::iter::once(&row.pivot).chain(&row.masses) {
+                    positions.extend(p.iter().map(|v| *v as f32));
+                }
+            }
+            index += 1;
+        }
+        let (energy, predicted) = ledger(dir, &times)?;
+        let shape =
+            std::fs::read_to_string(dir.join("shape.json")).ok().and_then(|t| serde_json::from_str(&t).ok());
+        Ok(Self {
+            dim: if config.dim == Dimension::Two { 2 } else { 3 },
+            links: config.links(),
+            reach: config.lengths.iter().sum(),
+            times,
+            positions,
+            energy,
+            predicted,
+            turning: matches!(config.drive, DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. }),
+            samples,
+            every,
+            parameters: parameters(run),
+            shape,
+        })
+    }
+
+    /// Kept samples.
+    pub fn frame_count(&self) -> usize {
+        self.times.len()
+    }
+}
+
+/// H and H0 + W at the kept times, from energy.csv (the rows with those times; missing
+/// rows as NaN, which the plot skips).
+fn ledger(dir: &Path, times: &[f32]) -> CliResult<(Vec<f32>, Vec<f32>)> {
+    let path = dir.join("energy.csv");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| CliError::usage(format!("cannot read {}: {e}", path.display())))?;
+    let mut rows = Vec::new();
+    for (number, line) in text.lines().enumerate().skip(1) {
+        let fields: Vec<f64> = line.split(',').filter_map(|v| v.trim().parse().ok()).collect();
+        if fields.len() != 6 {
+            return Err(CliError::usage(format!(
+                "{} line {}: expected 6 numbers",
+                path.display(),
+                number + 1
+            )));
+        }
+        rows.push(fields);
+    }
+    let h0 = rows.first().map_or(0.0, |r| r[1]);
+    let (mut energy, mut predicted) = (Vec::new(), Vec::new());
+    let mut k = 0;
+    for &t in times {
+        while k < rows.len() && (rows[k][0] as f32) < t {
+            k += 1;
+        }
+        match rows.get(k).filter(|r| r[0] as f32 == t) {
+            Some(r) => {
+                energy.push(r[1] as f32);
+                predicted.push((h0 + r[2] + r[3] - r[4]) as f32);
+            }
+            None => {
+                energy.push(f32::NAN);
+                predicted.push(f32::NAN);
+            }
+        }
+    }
+    Ok((energy, predicted))
+}
+
+/// The parameter panel's lines.
+fn parameters(run: &Run) -> Vec<String> {
+    let c = &run.file.config;
+    let mass: f64 = c.masses.iter().sum();
+    let reach: f64 = c.lengths.iter().sum();
+    let drive = match &c.drive {
+        DriveConfig::Fixed => "pivot fixed".to_string(),
+        DriveConfig::Harmonic { amplitude, omega, .. } => {
+            format!("pivot harmonic: A = {amplitude} m, ω = {omega} rad/s")
+        }
+        DriveConfig::Circle { radius, omega } => {
+            format!("pivot on a circle: R = {radius} m, ω = {omega} rad/s")
+        }
+        DriveConfig::RampedCircle { radius, initial_omega, omega, duration } => {
+            format!(
+                "pivot on a circle: R = {radius} m, ω from {initial_omega} to {omega} rad/s over {duration} s"
+            )
+        }
+    };
+    let damping = c.damping.iter().fold(0.0_f64, |a, b| a.max(*b));
+    let mut lines = vec![
+        format!(
+            "{} links, {}D, L = {reach:.4} m, M = {mass:.4} kg, g = {} m/s²",
+            c.links(),
+            if c.dim == Dimension::Two { 2 } else { 3 },
+            c.gravity
+        ),
+        drive,
+        format!("damping λ ≤ {damping} N·m·s"),
+        format!("integrator {:?}, h = {:.4e} s, t = 0 … {} s", c.integrator, c.step, run.reached()),
+    ];
+    if let Some(chosen) = &c.chosen {
+        lines.push(format!("chosen: {chosen}"));
+    }
+    lines
+}

@@ -1,0 +1,161 @@
+//! `pendulum view --export`: one self-contained page, checked in a headless Chromium when
+//! there is one (`.ci/run` installs it and sets `PENDULUM_BROWSER_TEST=require`, so CI
+//! cannot skip it).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{run_in, scratch, stderr};
+
+/// A short whirl of 8 links run with the defaults (midpoint, h = T/20 = 0.0625 s: 97
+/// samples), and its exported page.
+fn exported(name: &str) -> (PathBuf, PathBuf) {
+    let dir = scratch(name);
+    let args = [
+        "simulate",
+        "--dim",
+        "3",
+        "--n",
+        "8",
+        "--lengths",
+        "0.1",
+        "--masses",
+        "0.1",
+        "--damping",
+        "1e-3",
+        "--initial",
+        "hanging",
+        "--drive",
+        "circle",
+        "--radius",
+        "0.05",
+        "--omega",
+        "5",
+        "--end",
+        "6",
+        "--no-plots",
+        "--quiet",
+        "--out",
+        "run",
+    ];
+    let out = run_in(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = run_in(&dir, &["view", "run", "--export", "page.html"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("page.html: 97 frames of 97 samples (every 1)"), "{}", stderr(&out));
+    (dir.clone(), dir.join("page.html"))
+}
+
+#[test]
+fn the_page_holds_everything_and_fetches_nothing() {
+    let (_, page) = exported("view-page");
+    let text = std::fs::read_to_string(&page).unwrap();
+    assert!(!text.contains("http://") && !text.contains("https://"), "the page names a URL");
+    assert!(!text.contains("<script src") && !text.contains("<link"), "the page loads a file");
+    assert!(text.contains("const SCENE = {\"dim\":3,\"links\":8,"), "the data is inline");
+    assert!(text.contains("function selftest()"), "the viewer is inline");
+    assert!(text.len() < 2_000_000, "{} bytes", text.len());
+}
+
+#[test]
+fn bad_inputs_are_one_line_errors() {
+    let dir = scratch("view-bad");
+    std::fs::create_dir_all(dir.join("empty")).unwrap();
+    let out = run_in(&dir, &["view", "empty", "--export", "p.html"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("holds no run: no run.json"), "{}", stderr(&out));
+    let out = run_in(&dir, &["view", "empty"]);
+    assert_eq!(out.status.code(), Some(2), "--export is required");
+    // A trajectory cut in the middle of a line.
+    let (run_dir, _) = exported("view-truncated");
+    let csv = run_dir.join("run/trajectory.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::write(&csv, &text[..text.len() - 40]).unwrap();
+    let out = run_in(&run_dir, &["view", "run", "--export", "p.html"]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = stderr(&out);
+    assert!(
+        message.contains("the line is cut short (no line end)") && message.lines().count() == 1,
+        "{message}"
+    );
+    let out = run_in(&run_dir, &["view", "run", "--export", "p.html", "--frames", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(stderr(&out).trim(), "error: --frames must be at least 2, got 1");
+}
+
+/// The headless browser, if there is one.
+fn chromium() -> Option<String> {
+    if let Ok(path) = std::env::var("PENDULUM_CHROMIUM") {
+        return Some(path);
+    }
+    ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|name| Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success()))
+        .map(String::from)
+}
+
+fn browser(page: &Path, fragment: &str, extra: &[&str]) -> Option<std::process::Output> {
+    let Some(program) = chromium() else {
+        assert!(
+            std::env::var("PENDULUM_BROWSER_TEST").as_deref() != Ok("require"),
+            "PENDULUM_BROWSER_TEST=require but no chromium found"
+        );
+        eprintln!("no chromium: the browser checks are skipped");
+        return None;
+    };
+    let url = format!("file://{}#{fragment}", page.canonicalize().unwrap().display());
+    let out = Command::new(program)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--window-size=1200,800",
+            "--virtual-time-budget=4000",
+        ])
+        .args(extra)
+        .arg(url)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    Some(out)
+}
+
+/// In the browser: the chain is drawn where the positions say (every mass's pixel has
+/// the mass colour), and the slider shows the sample it is moved to, with its time.
+#[test]
+fn in_the_browser_the_slider_shows_the_right_sample_and_the_chain_is_where_it_should_be() {
+    let (_, page) = exported("view-browser");
+    let Some(out) = browser(&page, "selftest", &["--dump-dom"]) else { return };
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let start = dom.find("<pre id=\"selftest\">").expect("the self-test ran") + "<pre id=\"selftest\">".len();
+    let json: serde_json::Value =
+        serde_json::from_str(&dom[start..start + dom[start..].find('<').unwrap()]).unwrap();
+    assert_eq!(json["frames"], 97);
+    let checks = json["checks"].as_array().unwrap();
+    assert_eq!(checks.len(), 3);
+    for (check, (asked, time)) in checks.iter().zip([(0, 0.0), (48, 3.0), (96, 6.0)]) {
+        assert_eq!(check["asked"], asked, "{check}");
+        assert_eq!(check["shown"], asked, "{check}");
+        assert!((check["time"].as_f64().unwrap() - time).abs() < 1e-5, "{check}");
+        let label = check["label"].as_str().unwrap();
+        assert_eq!(label, format!("t = {time:.3} s ({}/97)", asked + 1));
+        assert_eq!(check["masses_on_mass_pixels"], 8, "every mass drawn where it is: {check}");
+        assert!(check["inked"].as_u64().unwrap() > 500, "{check}");
+    }
+    // The screenshot is not blank.
+    let shot = page.with_file_name("page.png");
+    let arg = format!("--screenshot={}", shot.display());
+    browser(&page, "t=48", &[&arg]).unwrap();
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&shot).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    let channels = info.color_type.samples();
+    let dark = pixels[..info.buffer_size()]
+        .chunks(channels)
+        .filter(|p| p[..3].iter().map(|&v| v as u32).sum::<u32>() < 300)
+        .count();
+    assert!((info.width, info.height) == (1200, 800) && dark > 2000, "{} dark pixels", dark);
+}
