@@ -11,7 +11,7 @@ use crate::error::{CliError, CliResult};
 use crate::render::source::{Run, Trajectory};
 
 /// Frames a page holds by default: a 300 s run of 100 links at 500 samples stays whole,
-/// and any run stays within about 20 MB (9 bytes per coordinate).
+/// and a run of 100 links stays within about 15 MB (about 7.5 bytes per coordinate).
 pub const DEFAULT_FRAMES: usize = 6000;
 
 /// The page's data.
@@ -25,8 +25,11 @@ pub struct Scene {
     pub reach: f64,
     /// Kept sample times, s.
     pub times: Vec<f32>,
-    /// Per kept sample: the pivot then every mass, x, y, z each (z = 0 in 2D; 2D y is up).
-    pub positions: Vec<f32>,
+    /// Per kept sample: the pivot then every mass, x, y, z each (z = 0 in 2D; 2D y is up),
+    /// in units of [`unit`](Self::unit) (whole numbers keep the page small).
+    pub positions: Vec<i64>,
+    /// The positions' unit, m: a millionth of the chain's length.
+    pub unit: f64,
     /// Energy ledger at the same kept samples: H and H0 + W (J).
     pub energy: Vec<f32>,
     pub predicted: Vec<f32>,
@@ -54,13 +57,15 @@ impl Scene {
         }
         let every = samples.div_ceil(frames as u64).max(1);
         let mut trajectory = Trajectory::open(&run.trajectory, config)?;
+        let reach: f64 = config.lengths.iter().sum();
+        let unit = reach * 1e-6;
         let (mut times, mut positions) = (Vec::new(), Vec::new());
         let mut index = 0;
         while trajectory.next(&mut row)? {
             if index % every == 0 {
                 times.push(row.t as f32);
                 for p in std::iter::once(&row.pivot).chain(&row.masses) {
-                    positions.extend(p.iter().map(|v| *v as f32));
+                    positions.extend(p.iter().map(|v| (v / unit).round() as i64));
                 }
             }
             index += 1;
@@ -71,9 +76,10 @@ impl Scene {
         Ok(Self {
             dim: if config.dim == Dimension::Two { 2 } else { 3 },
             links: config.links(),
-            reach: config.lengths.iter().sum(),
+            reach,
             times,
             positions,
+            unit,
             energy,
             predicted,
             turning: matches!(config.drive, DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. }),

@@ -17,7 +17,7 @@
   // as x–z); co-rotating: turned back by the pivot's azimuth.
   function point(f, k) {
     const o = f * per + 3 * k;
-    let x = S.positions[o], y = S.positions[o + 1], z = S.positions[o + 2];
+    let x = S.unit * S.positions[o], y = S.unit * S.positions[o + 1], z = S.unit * S.positions[o + 2];
     if (S.dim === 2) return [x, 0, y];
     if (view.corotating && S.turning) {
       const a = -Math.atan2(S.positions[f * per + 1], S.positions[f * per]);
