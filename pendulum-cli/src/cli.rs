@@ -78,8 +78,9 @@ pub enum Command {
     /// chosen against ω over the steady branch diagram of `pendulum steady --radius R`),
     /// and prints a table. Ctrl-C stops: finished points are kept, the files stay valid.
     Sweep(Box<SweepArgs>),
-    /// A run in the browser, exported as one self-contained HTML file (--export FILE:
-    /// data and scripts inline, nothing fetched; opens offline): the chain under an orbit
+    /// A run in the browser: served on http://127.0.0.1:PORT/ until Ctrl-C, or exported
+    /// as one self-contained HTML file (--export FILE: data and scripts inline, nothing
+    /// fetched; opens offline). The page shows the chain under an orbit
     /// camera (drag to turn, wheel to zoom; 2D runs in their plane), play/pause, one
     /// sample back and on, a time slider, playback speed, the frame co-rotating with a
     /// circling pivot, the tip's trail, the rotation axis and a scale bar, the energy

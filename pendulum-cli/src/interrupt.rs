@@ -1,5 +1,5 @@
 //! Ctrl-C: a flag the long runs (`simulate`, `sweep`) look at between samples, so that
-//! they stop, write valid files and exit 130.
+//! they stop, write valid files and exit 130; and that stops `pendulum view`'s server.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -56,7 +56,10 @@ fn main() -> ExitCode {
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
         Command::Render(args) => render::render(args),
-        Command::View(args) => view::view(args),
+        Command::View(args) => {
+            interrupt::install_handler();
+            view::view(args)
+        }
         Command::Sweep(args) => sweep::sweep(args),
     };
     match result {

@@ -1,4 +1,4 @@
-//! `pendulum view --export`: one self-contained page, checked in a headless Chromium when
+//! `pendulum view`: one self-contained page, exported or served, checked in a headless Chromium when
 //! there is one (`.ci/run` installs it and sets `PENDULUM_BROWSER_TEST=require`, so CI
 //! cannot skip it).
 
@@ -66,8 +66,8 @@ fn bad_inputs_are_one_line_errors() {
     let out = run_in(&dir, &["view", "empty", "--export", "p.html"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("holds no run: no run.json"), "{}", stderr(&out));
-    let out = run_in(&dir, &["view", "empty"]);
-    assert_eq!(out.status.code(), Some(2), "--export is required");
+    let out = run_in(&dir, &["view", "empty", "--port", "0"]);
+    assert_eq!(out.status.code(), Some(2), "no server for a directory without a run");
     // A trajectory cut in the middle of a line.
     let (run_dir, _) = exported("view-truncated");
     let csv = run_dir.join("run/trajectory.csv");
@@ -158,4 +158,52 @@ fn in_the_browser_the_slider_shows_the_right_sample_and_the_chain_is_where_it_sh
         .filter(|p| p[..3].iter().map(|&v| v as u32).sum::<u32>() < 300)
         .count();
     assert!((info.width, info.height) == (1200, 800) && dark > 2000, "{} dark pixels", dark);
+}
+
+/// `GET /` from the server at `address` (`127.0.0.1:PORT`): the response's body.
+fn get(address: &str) -> String {
+    use std::io::{Read, Write};
+    let mut stream = std::net::TcpStream::connect(address).unwrap();
+    stream.write_all(b"GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n").unwrap();
+    let mut response = String::new();
+    stream.read_to_string(&mut response).unwrap();
+    assert!(response.starts_with("HTTP/1.1 200 OK"), "{}", &response[..80.min(response.len())]);
+    response.split_once("\r\n\r\n").unwrap().1.to_string()
+}
+
+/// The served page is the exported one; a client that hangs up does not stop the server;
+/// Ctrl-C stops it (exit 0); a port in use is a one-line usage error naming it.
+#[cfg(unix)]
+#[test]
+fn the_server_serves_the_page_until_ctrl_c_and_refuses_a_port_in_use() {
+    use std::io::{BufRead, BufReader};
+    let (dir, page) = exported("view-serve");
+    let mut child = common::pendulum()
+        .args(["view", "run", "--port", "0"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let line = lines.next().unwrap().unwrap();
+    let address = line.split("http://").nth(1).and_then(|s| s.split('/').next()).expect(&line).to_string();
+    assert!(line.ends_with("/ (Ctrl-C stops)"), "{line}");
+    // A client that connects and hangs up at once.
+    drop(std::net::TcpStream::connect(&address).unwrap());
+    assert_eq!(get(&address), std::fs::read_to_string(&page).unwrap());
+    assert_eq!(get(&address), std::fs::read_to_string(&page).unwrap(), "still serving");
+    // The port is taken: a second server on it is refused.
+    let port = address.rsplit(':').next().unwrap();
+    let out = run_in(&dir, &["view", "run", "--port", port]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = stderr(&out);
+    assert!(
+        message.starts_with(&format!("error: --port {port}: cannot listen on 127.0.0.1:{port}: ")),
+        "{message}"
+    );
+    assert_eq!(message.lines().count(), 1, "{message}");
+    let killed = Command::new("sh").args(["-c", &format!("kill -INT {}", child.id())]).status().unwrap();
+    assert!(killed.success());
+    assert!(child.wait().unwrap().success());
+    assert_eq!(lines.next().unwrap().unwrap(), "pendulum: stopped");
 }

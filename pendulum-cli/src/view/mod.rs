@@ -1,8 +1,9 @@
-//! `pendulum view RUN_DIR --export page.html`: a run as one self-contained web page (data
-//! and scripts inline, nothing fetched) with an orbit camera, playback, a time slider and
-//! the energy ledger; see `viewer.js`.
+//! `pendulum view RUN_DIR`: a run as one self-contained web page (data and scripts inline,
+//! nothing fetched) with an orbit camera, playback, a time slider and the energy ledger
+//! (`viewer.js`), served on localhost or written to a file (`--export`).
 
 mod scene;
+mod serve;
 
 use std::path::PathBuf;
 
@@ -24,9 +25,13 @@ pub struct ViewArgs {
     /// trajectory.csv and energy.csv are read; shape.json when there is one).
     #[arg(value_name = "RUN_DIR")]
     pub run: PathBuf,
-    /// Write the page to this file: one self-contained HTML file that opens offline.
-    #[arg(long, value_name = "FILE", required = true)]
+    /// Write the page to this file instead of serving it: one self-contained HTML file
+    /// that opens offline.
+    #[arg(long, value_name = "FILE")]
     pub export: Option<PathBuf>,
+    /// Serve on this port of 127.0.0.1 (0: any free port; the URL is printed).
+    #[arg(long, default_value_t = 8765, conflicts_with = "export")]
+    pub port: u16,
     /// Most frames in the page; longer runs are thinned to every k-th sample.
     #[arg(long, value_name = "N", default_value_t = scene::DEFAULT_FRAMES)]
     pub frames: usize,
@@ -44,8 +49,16 @@ pub fn view(args: &ViewArgs) -> CliResult<()> {
     // Inside a <script> element nothing may close it.
     let json = json.replace("</", "<\\/");
     let page = PAGE.replacen("/*SCENE*/", &json, 1).replacen("/*VIEWER*/", VIEWER, 1);
+    let what = format!(
+        "{}: {} frames of {} samples (every {}), {:.1} MB",
+        args.run.display(),
+        scene.frame_count(),
+        scene.samples,
+        scene.every,
+        page.len() as f64 / 1e6
+    );
     let Some(path) = &args.export else {
-        return Err(CliError::usage("pendulum view needs --export FILE"));
+        return serve::serve(page, args.port, &what);
     };
     std::fs::write(path, page.as_bytes()).map_err(|e| io_failed("write", path, e))?;
     eprintln!(

@@ -1,0 +1,41 @@
+//! `pendulum view RUN_DIR`: the page served on localhost until Ctrl-C.
+
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+use axum::Router;
+use axum::response::Html;
+use axum::routing::get;
+
+use crate::error::{CliError, CliResult};
+use crate::interrupt::INTERRUPTED;
+
+/// Serves `page` at `http://127.0.0.1:PORT/` (any free port for 0) on one thread until
+/// Ctrl-C. A port that cannot be listened on is a usage error naming it.
+pub fn serve(page: String, port: u16, what: &str) -> CliResult<()> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_io()
+        .enable_time()
+        .build()
+        .map_err(|e| CliError::failed(format!("cannot start the server: {e}")))?;
+    runtime.block_on(async move {
+        let listener = tokio::net::TcpListener::bind(("127.0.0.1", port))
+            .await
+            .map_err(|e| CliError::usage(format!("--port {port}: cannot listen on 127.0.0.1:{port}: {e}")))?;
+        let address =
+            listener.local_addr().map_err(|e| CliError::failed(format!("the server's address: {e}")))?;
+        eprintln!("pendulum: {what} at http://{address}/ (Ctrl-C stops)");
+        let app = Router::new().route("/", get(move || async move { Html(page) }));
+        let stopped = async {
+            while !INTERRUPTED.load(Ordering::SeqCst) {
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            }
+        };
+        axum::serve(listener, app)
+            .with_graceful_shutdown(stopped)
+            .await
+            .map_err(|e| CliError::failed(format!("the server stopped: {e}")))?;
+        eprintln!("pendulum: stopped");
+        Ok(())
+    })
+}
