@@ -30,13 +30,15 @@ pub struct Scene {
     pub positions: Vec<i64>,
     /// The positions' unit, m: a millionth of the chain's length.
     pub unit: f64,
-    /// Energy ledger at the same kept samples: H and H0 + W (J).
+    /// The inertial-frame energy H at the kept samples, J (NaN where energy.csv has no row).
     pub energy: Vec<f32>,
+    /// What the ledger says it should be, H0 + W_drive + W_torque − E_damped, J.
     pub predicted: Vec<f32>,
-    /// The drive's angular speed for the co-rotating frame (circling pivots), rad/s.
+    /// Whether the pivot circles the vertical (the page then offers the co-rotating frame).
     pub turning: bool,
-    /// Samples in the trajectory and the thinning factor.
+    /// Samples in the trajectory.
     pub samples: u64,
+    /// One sample in `every` is kept.
     pub every: u64,
     /// Lines of the parameter panel.
     pub parameters: Vec<String>,
