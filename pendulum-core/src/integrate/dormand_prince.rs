@@ -64,9 +64,10 @@ const E: [f64; 7] =
 /// accepted when the embedded error estimate, measured as
 /// `‖e_i / (tol (1 + max(|x_i|, |x⁺_i|)))‖_rms ≤ 1`, and the next one sized by
 /// `h_new = h · clamp(0.9 err^(−1/5), 0.2, 5)` (no growth right after a rejection).
-/// Seven right-hand sides per attempt, six after the first (the last stage is the next
-/// first; after a projection it is used as is, which changes the next step by about the
-/// projection's move, a higher-order term). `P` projects after every accepted internal
+/// Seven right-hand sides for the first attempt of each step asked for, six for every
+/// further one inside it (the last stage is the next first; after a projection it is used
+/// as is, which changes the next step by about the projection's move, a higher-order
+/// term). `P` projects after every accepted internal
 /// step ([`OntoConstraints`], for chains in unit directions) or not ([`Unprojected`]).
 ///
 /// Its step sits where the error control puts it, or at its stability limit
@@ -82,7 +83,7 @@ where
     projection: P,
     /// The next internal step's size, once known (its sign follows the step asked for).
     next: Option<f64>,
-    /// `k[0]` holds `f(t, x)` of the current state when `fresh` is true.
+    /// `k[0]` holds `f(t, x)` of the current state when `fresh` is true (within one step).
     k: [OVector<f64, D>; 7],
     fresh: bool,
     y: OVector<f64, D>,
@@ -167,6 +168,9 @@ where
         check_step(self.y.len(), state.x(), h)?;
         let end = state.t() + h;
         let saved = state.clone();
+        // The first stage of the step's first attempt is evaluated afresh: the state may
+        // not be the one the last call ended on. Inside the step, the last stage is reused.
+        self.fresh = false;
         let mut last_rejected = false;
         for _ in 0..MAX_INTERNAL_STEPS {
             let t = state.t();
@@ -187,8 +191,7 @@ where
                 self.stats.rhs_evaluations += 1;
                 self.fresh = true;
             }
-            let x = state.x().clone();
-            let error = match self.attempt(system, t, &x, sub) {
+            let error = match self.attempt(system, t, state.x(), sub) {
                 Ok(e) => e,
                 Err(e) => return self.fail(state, saved, e),
             };
@@ -202,9 +205,8 @@ where
             let factor = if error == 0.0 { 5.0 } else { (0.9 * error.powf(-0.2)).clamp(0.2, 5.0) };
             if error <= 1.0 {
                 state.advance(sub, &self.increment);
-                let mut moved = state.x().clone();
-                self.projection.apply(system, &mut moved);
-                state.constrain(|x| x.copy_from(&moved));
+                let projection = &self.projection;
+                state.constrain(|x| projection.apply(system, x));
                 // FSAL: the last stage, f(t + h, x⁺), is the next step's first.
                 self.k.swap(0, 6);
                 self.stats.steps += 1;

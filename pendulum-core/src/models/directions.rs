@@ -115,7 +115,7 @@ where
     }
 
     /// [`check_state`](Self::check_state) of a state held as a slice.
-    fn check_state_slice(&self, x: &[f64]) -> Result<()> {
+    pub(crate) fn check_state_slice(&self, x: &[f64]) -> Result<()> {
         check_vector("x", x, self.state_len())
     }
 
@@ -191,7 +191,7 @@ where
     }
 
     /// [`accelerations`](Self::accelerations) for a state already checked.
-    fn accelerations_of_valid(
+    pub(crate) fn accelerations_of_valid(
         &self,
         t: f64,
         x: &[f64],

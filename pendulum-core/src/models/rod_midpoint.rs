@@ -8,7 +8,7 @@
 //! drive and damping ledger exactly, so it can step over those modes; it does not resolve
 //! them (their frequencies come out too low), and it is of order 2.
 
-use nalgebra::{DVector, DefaultAllocator, DimName, allocator::Allocator};
+use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 
 use crate::chain::Chain;
 use crate::drive::Drive;
@@ -120,7 +120,7 @@ impl RodMidpoint {
     where
         DefaultAllocator: Allocator<S>,
     {
-        chain.check_state(&DVector::from_column_slice(motion))?;
+        chain.check_state_slice(motion)?;
         if !(h.is_finite() && h != 0.0) {
             return Err(Error::InvalidStepSize { h });
         }
@@ -161,20 +161,15 @@ impl RodMidpoint {
             .fold(0.0, f64::max)
             .sqrt();
         if depth < MAX_HALVINGS && h.abs() * fastest > MAX_TURN {
-            self.stats.halved_steps += 1;
-            let mut middle = motion.to_vec();
-            let first = self.attempt(chain, t, motion, 0.5 * h, &mut middle, depth + 1)?;
-            let second = self.attempt(chain, t + 0.5 * h, &middle, 0.5 * h, out, depth + 1)?;
-            return Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped });
+            return self.halves(chain, t, motion, h, out, depth);
         }
         let drive = chain.drive();
         let ends = [drive.position(t), drive.position(t + h), drive.velocity(t), drive.velocity(t + h)];
         let limits = self.limits();
-        // The multipliers' start: the tensions at t.
+        // The multipliers' start: the tensions at t (the accelerations come with them).
         let mut start = vec![0.0; (S::DIM + 1) * n];
         let (accelerations, tensions) = start.split_at_mut(S::DIM * n);
-        let start_state = DVector::from_column_slice(motion);
-        if chain.accelerations(t, &start_state, accelerations, Some(tensions)).is_err() {
+        if chain.accelerations_of_valid(t, motion, accelerations, Some(tensions)).is_err() {
             return Err(0);
         }
         let start = Start { tensions };
@@ -188,27 +183,38 @@ impl RodMidpoint {
                 newton::<3>(&mut self.spatial, &start, chain.chain(), ends, motion, h, out, &limits)
             }
         };
+        // One tension solve for the start; one factorisation per Newton iteration.
+        let iterations = match &result {
+            Ok((_, i)) | Err(i) => *i,
+        };
+        self.stats.rhs_evaluations += 1;
+        self.stats.newton_iterations += iterations as u64;
+        self.stats.factorizations += iterations as u64;
         match result {
-            Ok((work, count)) => {
-                self.stats.rhs_evaluations += 1;
-                self.stats.newton_iterations += count.iterations as u64;
-                self.stats.factorizations += count.factorizations as u64;
-                Ok(work)
-            }
-            Err(count) => {
-                self.stats.rhs_evaluations += 1;
-                self.stats.newton_iterations += count.iterations as u64;
-                self.stats.factorizations += count.factorizations as u64;
-                if depth == MAX_HALVINGS {
-                    return Err(count.iterations);
-                }
-                self.stats.halved_steps += 1;
-                let mut middle = motion.to_vec();
-                let first = self.attempt(chain, t, motion, 0.5 * h, &mut middle, depth + 1)?;
-                let second = self.attempt(chain, t + 0.5 * h, &middle, 0.5 * h, out, depth + 1)?;
-                Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped })
-            }
+            Ok((work, _)) => Ok(work),
+            Err(iterations) if depth == MAX_HALVINGS => Err(iterations),
+            Err(_) => self.halves(chain, t, motion, h, out, depth),
         }
+    }
+
+    /// The step as two halves, each an [`attempt`](Self::attempt) one level deeper.
+    fn halves<S: DimName, Dr: Drive<S>>(
+        &mut self,
+        chain: &Directions<S, Dr>,
+        t: f64,
+        motion: &[f64],
+        h: f64,
+        out: &mut [f64],
+        depth: u32,
+    ) -> std::result::Result<StepWork, usize>
+    where
+        DefaultAllocator: Allocator<S>,
+    {
+        self.stats.halved_steps += 1;
+        let mut middle = motion.to_vec();
+        let first = self.attempt(chain, t, motion, 0.5 * h, &mut middle, depth + 1)?;
+        let second = self.attempt(chain, t + 0.5 * h, &middle, 0.5 * h, out, depth + 1)?;
+        Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped })
     }
 
     fn limits(&self) -> Limits {
@@ -219,13 +225,6 @@ impl RodMidpoint {
 /// The rod tensions `T_i` at the start of a step.
 struct Start<'a> {
     tensions: &'a [f64],
-}
-
-/// Newton iterations and factorisations of one attempt.
-#[derive(Debug, Clone, Copy, Default)]
-struct Count {
-    iterations: usize,
-    factorizations: usize,
 }
 
 struct Limits {
@@ -246,7 +245,8 @@ fn at<const C: usize>(v: &[f64], i: usize) -> [f64; C] {
 
 /// The Newton iteration of one step in `C` dimensions. `ends`:
 /// pivot position at `t` and `t + h`, velocity at `t` and `t + h`. Returns the step's
-/// work and the iterations, or the iterations spent when it did not converge.
+/// work and its Newton iterations (each one factorisation), or the iterations spent when
+/// it did not converge.
 #[allow(clippy::too_many_arguments)] // One step's data, all of it needed.
 fn newton<const C: usize>(
     work: &mut Work<C>,
@@ -257,7 +257,7 @@ fn newton<const C: usize>(
     h: f64,
     out: &mut [f64],
     limits: &Limits,
-) -> std::result::Result<(StepWork, Count), Count> {
+) -> std::result::Result<(StepWork, usize), usize> {
     let [p0, p1, pv0, pv1] = ends;
     let n = chain.links();
     let (m, l, lambda) = (chain.masses(), chain.lengths(), chain.damping());
@@ -286,8 +286,10 @@ fn newton<const C: usize>(
         }
     }
     let mut mu: Vec<f64> = (0..n).map(|i| start.tensions[i] / l[i]).collect();
-    let damping: Vec<f64> = (0..n).map(|i| lambda[i] / (l[i] * l[i] * h)).collect();
-    let inertia: Vec<f64> = (0..n).map(|i| 2.0 * m[i] / (h * h)).collect();
+    // Rod i's damping pair per unit change of the rod vector, λ_i/(l_i² h), and mass i's
+    // inertia term 2 m_i/h².
+    let damping = |i: usize| lambda[i] / (l[i] * l[i] * h);
+    let inertia = |i: usize| 2.0 * m[i] / (h * h);
     let pivot_step = sub(p1, p0);
 
     // Rod i's vectors: endpoint e_i, midpoint d_i, change of the rod vector s_i.
@@ -302,13 +304,13 @@ fn newton<const C: usize>(
 
     // Newton's method, the matrix refactored at every iteration (a frozen matrix, tried,
     // took several times the iterations once the free end whips).
-    let mut count = Count::default();
+    let mut iterations = 0;
     let mut previous = f64::INFINITY;
     loop {
-        if count.iterations == limits.max_iterations {
-            return Err(count);
+        if iterations == limits.max_iterations {
+            return Err(iterations);
         }
-        count.iterations += 1;
+        iterations += 1;
         // Residuals and the Newton matrix, link by link (`rod_newton` module docs).
         let Work { rows, pivots } = &mut *work;
         rows.clear();
@@ -321,20 +323,20 @@ fn newton<const C: usize>(
             }
             let (_, d_next, s_next) = next;
             let (mu_i, mu_next) = (mu[i], if has_next { mu[i + 1] } else { 0.0 });
-            let (c_i, c_next) = (damping[i], if has_next { damping[i + 1] } else { 0.0 });
+            let (c_i, c_next) = (damping(i), if has_next { damping(i + 1) } else { 0.0 });
             let xi = at::<C>(&x1, i);
             let x0i = at::<C>(&x0, i);
             let v0i = at::<C>(&v0, i);
             let force: [f64; C] = std::array::from_fn(|k| {
                 let mut r =
-                    inertia[i] * (xi[k] - x0i[k] - h * v0i[k]) - m[i] * gravity[k] + c_i * s[k] + mu_i * d[k];
+                    inertia(i) * (xi[k] - x0i[k] - h * v0i[k]) - m[i] * gravity[k] + c_i * s[k] + mu_i * d[k];
                 if has_next {
                     r -= c_next * s_next[k] + mu_next * d_next[k];
                 }
                 -r
             });
             rows.push(LinkRow {
-                stiffness: inertia[i] + c_i + c_next + 0.5 * (mu_i + mu_next),
+                stiffness: inertia(i) + c_i + c_next + 0.5 * (mu_i + mu_next),
                 coupling: c_i + 0.5 * mu_i,
                 midpoint: d,
                 end: e,
@@ -342,9 +344,8 @@ fn newton<const C: usize>(
                 constraint: -0.5 * (dot(e, e) - l[i] * l[i]),
             });
         }
-        count.factorizations += 1;
         if !rod_newton::solve(rows, pivots) {
-            return Err(count);
+            return Err(iterations);
         }
         let mut largest: f64 = 0.0;
         for (i, row) in rows.iter().enumerate() {
@@ -355,7 +356,7 @@ fn newton<const C: usize>(
             mu[i] += row.constraint;
         }
         if !largest.is_finite() {
-            return Err(count);
+            return Err(iterations);
         }
         // Newton converges quadratically: the error left after this correction is about
         // δ_k²/δ_{k−1} (or less), so stop once that is below the tolerance.
@@ -371,12 +372,12 @@ fn newton<const C: usize>(
     let (u_out, w_out) = out.split_at_mut(C * n);
     let mut previous_velocity = pv1;
     let (_, d_first, s_first) = rod(&x1, 0);
-    let pair_first: [f64; C] = std::array::from_fn(|k| -damping[0] * s_first[k]);
+    let pair_first: [f64; C] = std::array::from_fn(|k| -damping(0) * s_first[k]);
     let drive: f64 = (0..C).map(|k| (pair_first[k] - mu[0] * d_first[k]) * pivot_step[k]).sum();
     let mut damped = 0.0;
     for i in 0..n {
         let (e, _, s) = rod(&x1, i);
-        damped += damping[i] * dot(s, s);
+        damped += damping(i) * dot(s, s);
         let velocity: [f64; C] =
             std::array::from_fn(|k| 2.0 * (x1[i * C + k] - x0[i * C + k]) / h - v0[i * C + k]);
         for k in 0..C {
@@ -386,9 +387,9 @@ fn newton<const C: usize>(
         previous_velocity = velocity;
     }
     if !out.iter().all(|v| v.is_finite()) {
-        return Err(count);
+        return Err(iterations);
     }
-    Ok((StepWork { drive, damped }, count))
+    Ok((StepWork { drive, damped }, iterations))
 }
 
 impl<S: DimName, Dr: Drive<S>> Integrator<Directions<S, Dr>> for RodMidpoint
@@ -410,7 +411,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{U2, U3};
+    use nalgebra::{DVector, U2, U3};
 
     use super::*;
     use crate::integrate::{Projected, Rk4};

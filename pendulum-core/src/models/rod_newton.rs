@@ -15,8 +15,9 @@
 //! ```
 //! and `D'⁻¹_i` follows from the inverse of its `C × C` block and one scalar Schur
 //! complement. Against a general block elimination with pivoted LU of each `(C+1)²`
-//! block, the midpoint step of a 1000-link chain took 0.66 ms instead of 1.25 ms
-//! (`cargo bench -p pendulum-core --bench large_chains -- step/`).
+//! block (commit `617ffd4`), the midpoint step of a 1000-link chain took 0.66 ms instead
+//! of 1.25 ms (`cargo bench -p pendulum-core --bench large_chains -- step/free_1000` at
+//! each commit, one run each).
 
 /// Link `i`'s row of the Newton matrix and its right-hand side.
 #[derive(Debug, Clone, Copy)]
