@@ -72,5 +72,15 @@ pendulum simulate --dim 3 --n 100 --masses 0.01 --lengths 0.01 --damping 3e-4 --
 pendulum view "$runs/whirl-6-defaults" --export "$runs/whirl-6-defaults.html"
 chromium --headless --no-sandbox --disable-gpu --window-size=1200,800 --virtual-time-budget=3000 \
     --screenshot="$gallery/view.png" "file://$(cd "$runs" && pwd)/whirl-6-defaults.html#t=500"
+# The live page (needs chromium): the whirl's chain 120 s into its motion, the pivot
+# dragged by (120, −60) px half a second after the page opens, 6 s on.
+# (the binary itself, not `cargo run`, so that Ctrl-C reaches the server)
+"${PENDULUM:-$root/target/release/pendulum}" view --live --port 0 --start 120 2> "$runs/live.log" &
+server=$!
+sleep 3
+url="$(grep -o 'http://[0-9.:]*/' "$runs/live.log")"
+chromium --headless --no-sandbox --disable-gpu --window-size=1200,800 --virtual-time-budget=10000 \
+    --user-data-dir="$runs/profile" --screenshot="$gallery/live.png" "${url}#drag&hold=6"
+kill -INT "$server"
 cat "$runs"/whirl-3.txt "$runs"/whirl-6.txt "$runs"/whirl-11.txt "$runs"/sudden-5.txt "$runs"/ramp-5.txt
 ls -l "$gallery"

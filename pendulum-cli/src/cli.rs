@@ -86,5 +86,11 @@ pub enum Command {
     /// circling pivot, the tip's trail, the rotation axis and a scale bar, the energy
     /// ledger under a cursor at the shown time, the run's parameters and its shape
     /// summary. Long runs are thinned to --frames samples.
+    ///
+    /// --live: no run; the server simulates a 3D chain in real time for each page (the
+    /// README's whirl unless --n, --masses, --lengths, --damping, --radius, --omega say
+    /// otherwise) and streams it over a WebSocket. Drag the pivot with the mouse (it
+    /// follows the pointer in the screen's plane; its acceleration enters the equations
+    /// like any drive), set the circling speed, radius and damping while it runs.
     View(ViewArgs),
 }

@@ -1,6 +1,7 @@
 //! One force evaluation of long chains: the O(n) tension routes against the dense route
 //! (mass matrix + Cholesky, O(n³)) and against the floor of n `sin_cos` calls; and one
-//! integrator step of the whirl and of a free chain of 1000 links (group `step`).
+//! integrator step of the whirl and of a free chain of 1000 links (group `step`); one
+//! simulated second of the live viewer's chain, steered by hand (group `live`).
 //!
 //! ```sh
 //! cargo bench -p pendulum-core --bench large_chains
@@ -13,10 +14,10 @@ use std::time::Duration;
 use criterion::{
     BatchSize, BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main, measurement::WallTime,
 };
-use nalgebra::{DVector, U2, U3};
+use nalgebra::{DVector, U2, U3, Vector3};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State, System};
 use pendulum_core::{
-    Accounted, Chain, Circle, Directions, Model, Planar, PlanarTension, RodMidpoint, Spatial,
+    Accounted, Chain, Circle, Directions, Model, Planar, PlanarTension, RodMidpoint, Spatial, Steered,
 };
 
 const SIZES: [usize; 10] = [8, 16, 32, 64, 100, 128, 256, 1000, 1024, 4096];
@@ -166,5 +167,48 @@ fn step(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, planar, spatial, step);
+/// One simulated second of `pendulum view --live` at its defaults: the whirl's chain, the
+/// pivot [`Steered`] (hand rate 20/s, circle rate 2/s) toward a 2 cm circle at 6 rad/s
+/// about a hand that swings ±0.2 m along x at 1.5 Hz (a new target every 4 steps, as a
+/// 60 Hz pointer gives), midpoint steps of 1/240 s, from the state 5 s in. Real time
+/// needs this under 1 s.
+fn live(c: &mut Criterion) {
+    const STEP: f64 = 1.0 / 240.0;
+    fn second(
+        system: &mut Directions<U3, Steered>,
+        state: &mut State<nalgebra::Dyn>,
+        midpoint: &mut RodMidpoint,
+    ) {
+        for k in 0..240 {
+            if k % 4 == 0 {
+                let t = state.t();
+                let hand = 0.2 * (std::f64::consts::TAU * 1.5 * t).sin();
+                system.drive_mut().steer(t, Vector3::new(hand, 0.0, 0.0)).unwrap();
+            }
+            midpoint.step(system, state, STEP).unwrap();
+        }
+    }
+    let mut group = c.benchmark_group("live");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(5)).sample_size(20);
+    let whirl =
+        Chain::uniform(100, 0.01, 0.01, 9.81).and_then(|c| c.with_damping(&[3e-4; 100])).expect("chain");
+    let mut drive = Steered::new(20.0, 2.0).expect("drive");
+    drive.set_radius(0.0, 0.02).and_then(|_| drive.set_speed(0.0, 6.0)).expect("circle");
+    let mut system = Directions::<U3>::new(whirl).with_drive(drive);
+    let mut state = State::new(0.0, system.hanging());
+    let mut midpoint = RodMidpoint::new();
+    for _ in 0..5 {
+        second(&mut system, &mut state, &mut midpoint);
+    }
+    group.bench_function("whirl_100/one_second_steered", |b| {
+        b.iter_batched_ref(
+            || (system.clone(), state.clone()),
+            |(system, state)| second(system, state, &mut midpoint),
+            BatchSize::SmallInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, planar, spatial, step, live);
 criterion_main!(benches);

@@ -53,7 +53,7 @@ pub use analysis::{
 };
 pub use chain::Chain;
 pub use drive::{
-    Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, RampedCircle, TorqueAt, Turning,
+    Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, RampedCircle, Steered, TorqueAt, Turning,
 };
 pub use energy::{
     Accounted, AccountedDirections, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum,

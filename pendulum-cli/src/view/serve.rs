@@ -1,18 +1,16 @@
-//! `pendulum view RUN_DIR`: the page served on localhost until Ctrl-C.
+//! `pendulum view`: a page (and the live page's socket) served on localhost until Ctrl-C.
 
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use axum::Router;
-use axum::response::Html;
-use axum::routing::get;
 
 use crate::error::{CliError, CliResult};
 use crate::interrupt::INTERRUPTED;
 
-/// Serves `page` at `http://127.0.0.1:PORT/` (any free port for 0) on one thread until
+/// Serves `app` at `http://127.0.0.1:PORT/` (any free port for 0) on one thread until
 /// Ctrl-C. A port that cannot be listened on is a usage error naming it.
-pub fn serve(page: String, port: u16, what: &str) -> CliResult<()> {
+pub fn serve(app: Router, port: u16, what: &str) -> CliResult<()> {
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_io()
         .enable_time()
@@ -25,7 +23,6 @@ pub fn serve(page: String, port: u16, what: &str) -> CliResult<()> {
         let address =
             listener.local_addr().map_err(|e| CliError::failed(format!("the server's address: {e}")))?;
         eprintln!("pendulum: {what} at http://{address}/ (Ctrl-C stops)");
-        let app = Router::new().route("/", get(move || async move { Html(page) }));
         let stopped = async {
             while !INTERRUPTED.load(Ordering::SeqCst) {
                 tokio::time::sleep(Duration::from_millis(100)).await;

@@ -1,17 +1,14 @@
-// The run viewer: an orthographic orbit view of the chain, playback on the sample times,
-// the energy ledger under a cursor. Plain JavaScript on two canvases; SCENE is the run
-// (pendulum-cli/src/view/scene.rs). `#t=K` opens at sample K; `#selftest` checks the
+// The run viewer: the chain under an orbit camera (draw.js), playback on the sample
+// times, the energy ledger under a cursor. Plain JavaScript on two canvases; SCENE is the
+// run (pendulum-cli/src/view/scene.rs). `#t=K` opens at sample K; `#selftest` checks the
 // page in a headless browser and writes the result into <pre id="selftest">.
 "use strict";
 (function () {
   const S = SCENE;
   const n = S.links, count = S.times.length, per = 3 * (n + 1);
   const $ = (id) => document.getElementById(id);
-  const canvas = $("chain"), ctx = canvas.getContext("2d");
-  const slider = $("slider");
-  const ROD = "#1f5fbf", MASS = [20, 50, 150], PIVOT = "#d62728";
-  const view = { yaw: S.dim === 3 ? -0.5 : 0, pitch: S.dim === 3 ? 0.3 : 0, zoom: 1, frame: 0, playing: false,
-    clock: 0, corotating: false, trail: true };
+  const canvas = $("chain"), slider = $("slider");
+  const view = { frame: 0, playing: false, clock: 0, corotating: false, trail: true };
 
   // Point k (0: the pivot) of sample f, x, y, z with z up (a 2D run's plane x–y is shown
   // as x–z); co-rotating: turned back by the pivot's azimuth.
@@ -25,6 +22,7 @@
     }
     return [x, y, z];
   }
+  const points = (f) => Array.from({ length: n + 1 }, (_, k) => point(f, k));
 
   // The box the motion fills (every sample, every point): the view centres on it.
   const box = [0, 1, 2].map((a) => {
@@ -32,56 +30,23 @@
     for (let f = 0; f < count; f++) for (let k = 0; k <= n; k++) { const v = point(f, k)[a]; lo = Math.min(lo, v); hi = Math.max(hi, v); }
     return [lo, hi];
   });
-  const centre = box.map(([lo, hi]) => (lo + hi) / 2);
   const extent = Math.max(...box.map(([lo, hi]) => hi - lo), 0.05 * S.reach);
-
-  // Orthographic about the box's centre: turned by yaw about the vertical, tilted by
-  // pitch; screen y up is z.
-  function project(p) {
-    const q = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
-    const cy = Math.cos(view.yaw), sy = Math.sin(view.yaw), cp = Math.cos(view.pitch), sp = Math.sin(view.pitch);
-    const across = cy * q[0] - sy * q[1], depth = sy * q[0] + cy * q[1];
-    const up = cp * q[2] + sp * depth;
-    const scale = view.zoom * 0.85 * Math.min(canvas.width, canvas.height) / extent;
-    return [canvas.width / 2 + scale * across, canvas.height / 2 - scale * up, scale];
-  }
-
-  function line(a, b, colour, width, dash) {
-    ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.setLineDash(dash || []);
-    ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.stroke(); ctx.setLineDash([]);
-  }
+  const camera = chainView(canvas, box.map(([lo, hi]) => (lo + hi) / 2), extent, S.dim === 3);
 
   function draw() {
     const f = view.frame;
-    ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const scale = project([0, 0, 0])[2];
+    camera.clear();
     // The rotation axis of a circling pivot: the vertical through the circle's centre.
-    if (S.turning) line(project([0, 0, box[2][1] + 0.1 * extent]), project([0, 0, box[2][0] - 0.1 * extent]), "#888", 1, [6, 4]);
-    // Scale bar: a round length near a quarter of the chain.
-    const bar = Math.pow(10, Math.floor(Math.log10(extent / 4)));
-    const length = [5, 2, 1].map((m) => m * bar).find((v) => v <= extent / 2) || bar;
-    const x0 = 20, y0 = canvas.height - 20;
-    line([x0, y0], [x0 + length * scale, y0], "#000", 2);
-    ctx.fillStyle = "#000"; ctx.font = "13px system-ui, sans-serif";
-    ctx.fillText(`${length} m`, x0, y0 - 6);
+    if (S.turning) camera.axis(0, 0, box[2][1] + 0.1 * extent, box[2][0] - 0.1 * extent);
+    camera.scaleBar();
     // The tip's trail over the last 200 samples.
     if (view.trail) {
-      ctx.strokeStyle = "rgba(214, 39, 40, 0.45)"; ctx.lineWidth = 1; ctx.beginPath();
-      for (let g = Math.max(0, f - 200); g <= f; g++) {
-        const q = project(point(g, n));
-        if (g === Math.max(0, f - 200)) ctx.moveTo(q[0], q[1]); else ctx.lineTo(q[0], q[1]);
-      }
-      ctx.stroke();
+      const tip = [];
+      for (let g = Math.max(0, f - 200); g <= f; g++) tip.push(point(g, n));
+      camera.trail(tip);
     }
-    const pts = [];
-    for (let k = 0; k <= n; k++) pts.push(project(point(f, k)));
-    for (let k = 1; k <= n; k++) line(pts[k - 1], pts[k], ROD, 2);
-    const radius = Math.max(2, Math.min(6, 120 / n));
-    ctx.fillStyle = `rgb(${MASS})`;
-    for (let k = 1; k <= n; k++) { ctx.beginPath(); ctx.arc(pts[k][0], pts[k][1], radius, 0, 2 * Math.PI); ctx.fill(); }
-    ctx.fillStyle = PIVOT; ctx.fillRect(pts[0][0] - 4, pts[0][1] - 4, 8, 8);
-    ctx.fillStyle = "#000";
-    ctx.fillText(`t = ${S.times[f].toFixed(3)} s${view.corotating && S.turning ? " (co-rotating)" : ""}`, 12, 20);
+    camera.chain(points(f));
+    camera.label(`t = ${S.times[f].toFixed(3)} s${view.corotating && S.turning ? " (co-rotating)" : ""}`);
     $("time").textContent = `t = ${S.times[f].toFixed(3)} s (${f + 1}/${count})`;
     slider.value = String(f);
     drawEnergy();
@@ -156,20 +121,7 @@
     if (e.key === "ArrowLeft") show(view.frame - 1);
     if (e.key === "ArrowRight") show(view.frame + 1);
   });
-  let drag = null;
-  canvas.addEventListener("mousedown", (e) => { drag = [e.clientX, e.clientY]; });
-  window.addEventListener("mouseup", () => { drag = null; });
-  window.addEventListener("mousemove", (e) => {
-    if (!drag || S.dim === 2) return;
-    view.yaw += 0.01 * (e.clientX - drag[0]);
-    view.pitch = Math.max(-1.55, Math.min(1.55, view.pitch + 0.01 * (e.clientY - drag[1])));
-    drag = [e.clientX, e.clientY]; draw();
-  });
-  canvas.addEventListener("wheel", (e) => { e.preventDefault(); view.zoom *= Math.exp(-0.001 * e.deltaY); draw(); });
-  function fit() {
-    canvas.width = canvas.clientWidth; canvas.height = canvas.clientHeight; draw();
-  }
-  window.addEventListener("resize", fit);
+  camera.orbit(draw);
 
   $("parameters").textContent = S.parameters.join("\n") +
     `\n${count} frames shown of ${S.samples} samples (every ${S.every})`;
@@ -179,32 +131,22 @@
       `${shape.settled ? "settled" : "not settled"} (drift ${Number(shape.drift).toExponential(1)} m)`
     : "(no shape.json: not a whirled 3D run)";
 
-  // The masses' pixels of the shown sample must be drawn in the mass colour.
-  function onChain(image, x, y) {
-    for (let dy = -1; dy <= 1; dy++) for (let dx = -1; dx <= 1; dx++) {
-      const i = 4 * (Math.round(y + dy) * canvas.width + Math.round(x + dx));
-      if (Math.abs(image[i] - MASS[0]) < 40 && Math.abs(image[i + 1] - MASS[1]) < 40 && Math.abs(image[i + 2] - MASS[2]) < 40) return true;
-    }
-    return false;
-  }
+  // For each of three samples: the slider moved there, what is shown and whether the
+  // masses of that sample are drawn where their positions say; the middle one's picture.
   function selftest() {
-    const checks = [];
-    for (const k of [0, Math.floor(count / 2), count - 1]) {
+    const checks = [], middle = Math.floor(count / 2);
+    let picture = null;
+    for (const k of [0, middle, count - 1]) {
       slider.value = String(k);
       slider.dispatchEvent(new Event("input"));
-      const image = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
-      let masses = 0;
-      for (let i = 1; i <= n; i++) { const [x, y] = project(point(view.frame, i)); if (onChain(image, x, y)) masses++; }
-      let inked = 0;
-      for (let i = 0; i < image.length; i += 4) if (image[i] + image[i + 1] + image[i + 2] < 600) inked++;
-      checks.push({ asked: k, shown: view.frame, time: S.times[view.frame], label: $("time").textContent,
-        masses_on_mass_pixels: masses, inked });
+      const seen = camera.inspect(points(view.frame).slice(1));
+      checks.push({ asked: k, shown: view.frame, time: S.times[view.frame], label: $("time").textContent, ...seen });
+      if (k === middle) picture = { sample: view.frame, ...camera.picture() };
     }
-    $("selftest").textContent = JSON.stringify({ frames: count, links: n, checks });
+    $("selftest").textContent = JSON.stringify({ frames: count, links: n, checks, picture });
     $("selftest").hidden = false;
   }
 
-  fit();
   const at = /^#t=(\d+)$/.exec(location.hash);
   show(at ? Number(at[1]) : 0);
   if (location.hash === "#selftest") selftest();

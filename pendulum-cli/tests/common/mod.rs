@@ -109,3 +109,99 @@ impl Table {
             .collect()
     }
 }
+
+/// The colour the pages draw masses in (`MASS` in pendulum-cli/src/view/draw.js).
+pub const MASS_COLOUR: [u8; 3] = [20, 50, 150];
+
+/// The headless browser, if there is one: `$PENDULUM_CHROMIUM`, else `chromium`,
+/// `chromium-browser` or `google-chrome` on the path. None (the browser checks are
+/// skipped) only when `PENDULUM_BROWSER_TEST` is not `require`.
+pub fn chromium() -> Option<String> {
+    let found = std::env::var("PENDULUM_CHROMIUM").ok().or_else(|| {
+        ["chromium", "chromium-browser", "google-chrome"]
+            .into_iter()
+            .find(|name| Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success()))
+            .map(String::from)
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var("PENDULUM_BROWSER_TEST").as_deref() != Ok("require"),
+            "PENDULUM_BROWSER_TEST=require but no chromium found"
+        );
+        eprintln!("no chromium: the browser checks are skipped");
+    }
+    found
+}
+
+/// A PNG screenshot's pixels, RGB.
+pub struct Screenshot {
+    pub width: usize,
+    pub height: usize,
+    rgb: Vec<[u8; 3]>,
+}
+
+impl Screenshot {
+    /// Reads the PNG at `path`, checking its size.
+    pub fn read(path: &Path, size: (u32, u32)) -> Self {
+        let shot = Self::decode(&std::fs::read(path).unwrap());
+        assert_eq!((shot.width as u32, shot.height as u32), size, "{}", path.display());
+        shot
+    }
+
+    /// Decodes a PNG.
+    pub fn decode(bytes: &[u8]) -> Self {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder.read_info().unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut pixels).unwrap();
+        let channels = info.color_type.samples();
+        let rgb = pixels[..info.buffer_size()].chunks(channels).map(|p| [p[0], p[1], p[2]]).collect();
+        Self { width: info.width as usize, height: info.height as usize, rgb }
+    }
+
+    /// Whether the pixel is within 40 of `rgb` in each channel.
+    fn is(&self, x: usize, y: usize, rgb: [u8; 3]) -> bool {
+        self.rgb[y * self.width + x].iter().zip(rgb).all(|(&v, c)| v.abs_diff(c) < 40)
+    }
+
+    /// The pixels of the colour `rgb` (within 40 in each channel).
+    pub fn count(&self, rgb: [u8; 3]) -> usize {
+        (0..self.height)
+            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| self.is(x, y, rgb))
+            .count()
+    }
+
+    /// Whether a pixel within one of `(x, y)` has the colour `rgb`.
+    pub fn near(&self, x: f64, y: f64, rgb: [u8; 3]) -> bool {
+        let (x, y) = (x.round() as i64, y.round() as i64);
+        (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy))).any(|(x, y)| {
+            (0..self.width as i64).contains(&x)
+                && (0..self.height as i64).contains(&y)
+                && self.is(x as usize, y as usize, rgb)
+        })
+    }
+}
+
+/// Checks a page's self-test `picture` (its camera and the canvas as a PNG data URL,
+/// `picture()` in pendulum-cli/src/view/draw.js): every point of `masses` (m, z up),
+/// projected here as the page's orthographic camera does (turned by yaw about the
+/// vertical, tilted by pitch, about its centre), lands within a pixel of the mass colour.
+pub fn assert_drawn_at(picture: &serde_json::Value, masses: &[[f64; 3]]) {
+    use base64::Engine;
+    let number = |key: &str| picture[key].as_f64().unwrap_or_else(|| panic!("no {key} in the picture"));
+    let (yaw, pitch, scale) = (number("yaw"), number("pitch"), number("scale"));
+    let centre: Vec<f64> = (0..3).map(|k| picture["centre"][k].as_f64().unwrap()).collect();
+    let data =
+        picture["image"].as_str().unwrap().strip_prefix("data:image/png;base64,").expect("a PNG data URL");
+    let image = Screenshot::decode(&base64::engine::general_purpose::STANDARD.decode(data).unwrap());
+    assert_eq!((image.width as f64, image.height as f64), (number("width"), number("height")));
+    for (i, p) in masses.iter().enumerate() {
+        let q = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+        let across = yaw.cos() * q[0] - yaw.sin() * q[1];
+        let depth = yaw.sin() * q[0] + yaw.cos() * q[1];
+        let up = pitch.cos() * q[2] + pitch.sin() * depth;
+        let (x, y) = (image.width as f64 / 2.0 + scale * across, image.height as f64 / 2.0 - scale * up);
+        assert!(image.near(x, y, MASS_COLOUR), "mass {} at {p:?} is not drawn at ({x:.1}, {y:.1})", i + 1);
+    }
+}

@@ -5,7 +5,7 @@ use nalgebra::{DVector, Dyn, U2, Vector2};
 use super::*;
 
 /// Central differences of p and ṗ match ṗ and p̈.
-fn assert_consistent<S: DimName, D: Drive<S>>(drive: &D)
+pub(super) fn assert_consistent<S: DimName, D: Drive<S>>(drive: &D)
 where
     DefaultAllocator: Allocator<S>,
 {

@@ -79,6 +79,12 @@ where
         &self.drive
     }
 
+    /// The pivot drive, to change between steps (a drive steered while it runs, such as
+    /// [`Steered`](crate::Steered)).
+    pub fn drive_mut(&mut self) -> &mut Dr {
+        &mut self.drive
+    }
+
     /// Number of links.
     pub fn links(&self) -> usize {
         self.chain.links()
