@@ -20,7 +20,7 @@ export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4
 # would go stale whenever a workspace dependency changes; cargo resolves it minimally.
 cargo build --release --target "$host" --bins
 [ "$seconds" -gt 0 ] || exit 0
-for t in reference_expr reference_case cli_numbers cli_run_json; do
+for t in reference_expr reference_case cli_numbers cli_run_json claims_parse; do
     work="$target_dir/fuzz-corpus/$t"
     artifacts="$target_dir/fuzz-artifacts/$t"
     mkdir -p "$work" "$artifacts"

@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod case;
+pub mod claims;
 pub mod expr;
 pub mod regen;
 pub mod sample;

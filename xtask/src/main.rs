@@ -29,7 +29,13 @@ enum Task {
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().task {
-        Task::Verify(options) => xtask::verify::run(&options),
+        Task::Verify(options) => match &options.claims {
+            Some(path) => {
+                let cases = xtask::case::load_all(&xtask::cases_dir())?;
+                xtask::claims::run(path, &cases, options.states, options.seed).map(|_| ())
+            }
+            None => xtask::verify::run(&options),
+        },
         Task::Reference { check } => xtask::regen::run(check),
         Task::Bench(options) => xtask::bench::run(&options),
     }

@@ -8,7 +8,8 @@
 //! per case, quantity and model ([`dense`]) is printed as a table ([`report`]); any error
 //! above [`BOUND`] ([`bounds`]) fails the run, naming the case, state, quantity and entry.
 //! The O(n) routes (accelerations only) follow in their own table ([`routes`]), then the
-//! seed document's printed equations ([`document`]).
+//! seed document's printed equations ([`document`]). (`--claims FILE` is not this run:
+//! `main` hands it to [`crate::claims`].)
 //!
 //! This module is the run itself: the options and the order of the sections. The others
 //! import downwards only: `bounds` ← `reference` ← `compare` ← `report` ← `dense`, and
@@ -60,11 +61,16 @@ pub struct Options {
     /// Only the cases whose name contains FILTER (e.g. `spatial`, `planar_n3`).
     #[arg(long = "case", value_name = "FILTER")]
     pub case: Option<String>,
+    /// Check the claims of this file (`reference/CLAIMS.md`) against the reference
+    /// instead: a table of verdicts, the first disagreeing entry, and a diagnosis with the
+    /// corrected claim where a common slip explains the difference.
+    #[arg(long, value_name = "FILE")]
+    pub claims: Option<std::path::PathBuf>,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { states: DEFAULT_STATES, seed: DEFAULT_SEED, case: None }
+        Self { states: DEFAULT_STATES, seed: DEFAULT_SEED, case: None, claims: None }
     }
 }
 

@@ -33,7 +33,7 @@ pub mod claims;
 pub mod errata;
 mod planar;
 mod spatial;
-mod state;
+pub(crate) mod state;
 pub mod tally;
 
 use std::fmt::Write as _;

@@ -8,46 +8,46 @@ use crate::case::{Case, Evaluated, Params, Point};
 use crate::expr::Scaled;
 
 /// One random state of one case, evaluated by the reference.
-pub(super) struct State<'a> {
-    pub(super) case: &'a Case,
-    pub(super) index: usize,
-    pub(super) params: Params,
-    pub(super) point: Point,
-    pub(super) ev: Evaluated,
-    pub(super) sc: Evaluated,
+pub(crate) struct State<'a> {
+    pub(crate) case: &'a Case,
+    pub(crate) index: usize,
+    pub(crate) params: Params,
+    pub(crate) point: Point,
+    pub(crate) ev: Evaluated,
+    pub(crate) sc: Evaluated,
 }
 
 impl State<'_> {
-    pub(super) fn site(&self) -> Site<'_> {
+    pub(crate) fn site(&self) -> Site<'_> {
         Site { case: &self.case.name, state: self.index }
     }
 
-    pub(super) fn mass(&self, i: usize, j: usize) -> Scaled {
+    pub(crate) fn mass(&self, i: usize, j: usize) -> Scaled {
         Scaled::with_scale(self.ev.mass_matrix[(i, j)], self.sc.mass_matrix[(i, j)])
     }
 
-    pub(super) fn velocity(&self, i: usize) -> Scaled {
+    pub(crate) fn velocity(&self, i: usize) -> Scaled {
         Scaled::with_scale(self.ev.velocity_terms[i], self.sc.velocity_terms[i])
     }
 
-    pub(super) fn gravity(&self, i: usize) -> Scaled {
+    pub(crate) fn gravity(&self, i: usize) -> Scaled {
         Scaled::with_scale(self.ev.gravity_terms[i], self.sc.gravity_terms[i])
     }
 
-    pub(super) fn force(&self, i: usize) -> Scaled {
+    pub(crate) fn force(&self, i: usize) -> Scaled {
         Scaled::with_scale(self.ev.generalized_forces[i], self.sc.generalized_forces[i])
     }
 
-    pub(super) fn kinetic(&self) -> Scaled {
+    pub(crate) fn kinetic(&self) -> Scaled {
         Scaled::with_scale(self.ev.kinetic_energy, self.sc.kinetic_energy)
     }
 
-    pub(super) fn potential(&self) -> Scaled {
+    pub(crate) fn potential(&self) -> Scaled {
         Scaled::with_scale(self.ev.potential_energy, self.sc.potential_energy)
     }
 
     /// The reference's velocity terms `c` at this configuration with rates `qd`.
-    pub(super) fn velocity_terms_at(&self, qd: Vec<f64>) -> Vec<Scaled> {
+    pub(crate) fn velocity_terms_at(&self, qd: Vec<f64>) -> Vec<Scaled> {
         let point = Point {
             q: self.point.q.clone(),
             qd,
@@ -61,7 +61,7 @@ impl State<'_> {
     }
 
     /// `c` with rate `j` (and optionally also rate `k`) set to one, all others zero.
-    pub(super) fn velocity_terms_unit(&self, j: usize, k: Option<usize>) -> Vec<Scaled> {
+    pub(crate) fn velocity_terms_unit(&self, j: usize, k: Option<usize>) -> Vec<Scaled> {
         let mut qd = vec![0.0; self.point.qd.len()];
         qd[j] = 1.0;
         if let Some(k) = k {
@@ -71,13 +71,13 @@ impl State<'_> {
     }
 
     /// `(M q̈ + c + k)_d` at accelerations `qdd`.
-    pub(super) fn lagrange_lhs(&self, qdd: &[Scaled], d: usize) -> Scaled {
+    pub(crate) fn lagrange_lhs(&self, qdd: &[Scaled], d: usize) -> Scaled {
         (0..qdd.len()).map(|j| self.mass(d, j) * qdd[j]).sum::<Scaled>() + self.velocity(d) + self.gravity(d)
     }
 
     /// The free, undriven, undamped accelerations `M⁻¹(−c − k)`, each with the
     /// componentwise round-off bound `|M⁻¹|(s_M |q̈| + s_c + s_k)` as its scale.
-    pub(super) fn free_accelerations(&self) -> Option<Vec<Scaled>> {
+    pub(crate) fn free_accelerations(&self) -> Option<Vec<Scaled>> {
         let mass = &self.ev.mass_matrix;
         let rhs: DVector<f64> = -(&self.ev.velocity_terms + &self.ev.gravity_terms);
         let inverse: DMatrix<f64> = mass.clone().try_inverse()?;
@@ -90,6 +90,6 @@ impl State<'_> {
 }
 
 /// The tail masses `M_i = Σ_{j≥i} m_j` (eq 10), exact, 0-based.
-pub(super) fn tail_masses(masses: &[f64]) -> Vec<Scaled> {
+pub(crate) fn tail_masses(masses: &[f64]) -> Vec<Scaled> {
     (0..masses.len()).map(|i| masses[i..].iter().map(|&m| Scaled::exact(m)).sum()).collect()
 }

@@ -25,9 +25,9 @@ pub(super) struct Tally {
 
 /// Where a comparison happens, for the report.
 #[derive(Clone, Copy)]
-pub(super) struct Site<'a> {
-    pub(super) case: &'a str,
-    pub(super) state: usize,
+pub(crate) struct Site<'a> {
+    pub(crate) case: &'a str,
+    pub(crate) state: usize,
 }
 
 impl Tally {

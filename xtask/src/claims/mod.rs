@@ -1,0 +1,197 @@
+//! Claims files: equations of motion written by hand in index notation
+//! (`reference/CLAIMS.md`), checked against the sympy reference with
+//! `cargo xtask verify --claims FILE`.
+//!
+//! [`syntax`] reads a file (every error with its line and column), [`eval`] gives its
+//! names their meaning and evaluates an entry at one state, [`check`] compares an entry
+//! with the reference at random states of every case it covers, [`diagnose`] tries the
+//! common slips on a disagreeing entry and prints the corrected entry.
+
+pub mod check;
+pub mod diagnose;
+pub mod eval;
+pub mod syntax;
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, bail};
+
+use crate::case::Case;
+use check::{Tally, check_entry, covered};
+use diagnose::{Diagnosis, diagnose};
+use syntax::{Claim, Entry, parse};
+
+/// What checking one entry of a claim found.
+pub struct EntryOutcome {
+    pub entry: Entry,
+    pub tally: Tally,
+    pub diagnosis: Option<Diagnosis>,
+}
+
+/// What checking one claim found.
+pub struct Outcome {
+    pub claim: Claim,
+    /// The cases it covered, by name.
+    pub cases: Vec<String>,
+    pub entries: Vec<EntryOutcome>,
+}
+
+impl Outcome {
+    pub fn verdict(&self) -> &'static str {
+        if self.cases.is_empty() {
+            "untested"
+        } else if self.entries.iter().all(|e| e.tally.agrees()) {
+            "agrees"
+        } else {
+            "disagrees"
+        }
+    }
+
+    pub fn worst(&self) -> f64 {
+        self.entries.iter().map(|e| e.tally.worst).fold(0.0, f64::max)
+    }
+}
+
+/// `file:line:col: found: expected …`, one line per error.
+fn located(file: &Path, line: usize, col: usize, found: &str, expected: &str, source: &str) -> String {
+    let text = source.lines().nth(line.saturating_sub(1)).unwrap_or("");
+    format!("{}:{line}:{col}: found {found}; expected {expected}\n    | {text}", file.display())
+}
+
+/// Reads and parses a claims file: every syntax error, or the claims.
+pub fn load(path: &Path) -> anyhow::Result<Vec<Claim>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    parse(&text).map_err(|errors| {
+        let all: Vec<String> = errors
+            .iter()
+            .map(|e| located(path, e.pos.line, e.pos.col, &e.found, &e.message, &text))
+            .collect();
+        anyhow::anyhow!(
+            "{} error{} in {}:\n{}",
+            all.len(),
+            if all.len() == 1 { "" } else { "s" },
+            path.display(),
+            all.join("\n")
+        )
+    })
+}
+
+/// Checks every claim at `states` random states per covered case; a disagreeing entry
+/// is diagnosed. Errors (an unknown symbol, an index out of range, …) of every claim are
+/// reported together, each with its place in `path`.
+pub fn check_all(
+    path: &Path,
+    claims: Vec<Claim>,
+    cases: &[Case],
+    states: usize,
+    seed: u64,
+) -> anyhow::Result<Vec<Outcome>> {
+    let source = std::fs::read_to_string(path).unwrap_or_default();
+    let mut outcomes = Vec::new();
+    let mut errors = Vec::new();
+    for claim in claims {
+        let covering = covered(&claim, cases);
+        let mut entries = Vec::new();
+        for entry in &claim.entries {
+            match check_entry(entry, &covering, states, seed) {
+                Ok(tally) => {
+                    let diagnosis =
+                        if tally.agrees() { None } else { diagnose(entry, &tally, &covering, seed) };
+                    entries.push(EntryOutcome { entry: entry.clone(), tally, diagnosis });
+                }
+                Err(found) => {
+                    errors.extend(found.into_iter().map(|(line, col, what, expected)| {
+                        located(path, line, col, &what, &expected, &source)
+                    }))
+                }
+            }
+        }
+        let cases = covering.iter().map(|c| c.name.clone()).collect();
+        outcomes.push(Outcome { claim, cases, entries });
+    }
+    if !errors.is_empty() {
+        errors.dedup();
+        bail!(
+            "{} error{} in {}:\n{}",
+            errors.len(),
+            if errors.len() == 1 { "" } else { "s" },
+            path.display(),
+            errors.join("\n")
+        );
+    }
+    Ok(outcomes)
+}
+
+/// `planar n = 1..4 (4 cases)`: the chains claimed and the cases there were.
+fn cases_text(claim: &Claim, cases: &[String]) -> String {
+    let c = &claim.chains;
+    let kind = if c.spatial { "spatial" } else { "planar" };
+    let range = match c.high {
+        Some(h) if h == c.low => format!("n = {h}"),
+        Some(h) => format!("n = {}..{h}", c.low),
+        None => format!("n ≥ {}", c.low),
+    };
+    format!("{kind} {range} ({} case{})", cases.len(), if cases.len() == 1 { "" } else { "s" })
+}
+
+/// The outcomes as a table, then every diagnosis with its corrected claim.
+pub fn render(outcomes: &[Outcome]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "| claim | cases | verdict | worst rel. error | first disagreeing entry and state | diagnosis |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    for o in outcomes {
+        let first = o.entries.iter().find_map(|e| e.tally.first.clone());
+        let diagnosis: Vec<&str> =
+            o.entries.iter().filter_map(|e| e.diagnosis.as_ref().map(|d| d.slip.as_str())).collect();
+        let undiagnosed =
+            o.entries.iter().any(|e| !e.tally.agrees() && e.diagnosis.is_none() && e.tally.count > 0);
+        let diagnosis = match (diagnosis.is_empty(), undiagnosed) {
+            (true, false) => "–".to_string(),
+            (true, true) => "none of the common slips explains it".to_string(),
+            _ => diagnosis.join("; "),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.1e} | {} | {} |",
+            o.claim.title,
+            cases_text(&o.claim, &o.cases),
+            o.verdict(),
+            o.worst(),
+            first.as_deref().unwrap_or("–"),
+            diagnosis
+        );
+    }
+    for o in outcomes {
+        for e in &o.entries {
+            if let Some(d) = &e.diagnosis {
+                let _ = writeln!(
+                    out,
+                    "\n{} (line {}): {}. Corrected:\n{}",
+                    o.claim.title,
+                    e.entry.pos.line,
+                    d.slip,
+                    d.corrected.render()
+                );
+            }
+        }
+    }
+    out
+}
+
+/// `cargo xtask verify --claims FILE`: checks the file's claims and prints the table;
+/// errors only when the file has errors (a disagreeing claim is a finding).
+pub fn run(path: &Path, cases: &[Case], states: usize, seed: u64) -> anyhow::Result<Vec<Outcome>> {
+    let claims = load(path)?;
+    let outcomes = check_all(path, claims, cases, states, seed)?;
+    println!(
+        "{}: {} claims ({states} random states per case, seed {seed:#x}):",
+        path.display(),
+        outcomes.len()
+    );
+    print!("{}", render(&outcomes));
+    Ok(outcomes)
+}

@@ -1,0 +1,876 @@
+//! The claims file: its tokens, its grammar and its printed form (`reference/CLAIMS.md`).
+//!
+//! ```text
+//! file    := { comment | claim }
+//! claim   := 'claim' STRING NL  'chain' ('planar' | 'spatial') [ 'n' range ] NL  { entry }
+//! range   := '=' INT [ '..' INT ] | '>=' INT | '<=' INT
+//! entry   := lhs '=' expr [ 'if' cond ] NL { '=' expr ( 'if' cond | 'otherwise' ) NL }
+//!            (a line continues the one before while a bracket is open, or when it
+//!            starts with + - * / ^)
+//! lhs     := QUANTITY [ '[' index { ',' index } ']' ]
+//! expr    := term { ('+' | '-') term }
+//! term    := unary { [ '*' | '/' ] unary }            (juxtaposition multiplies)
+//! unary   := '-' unary | power
+//! power   := primary [ '^' [ '-' ] INT ]
+//! primary := NUMBER | '(' expr ')' | FUNC '(' expr ')' | SYMBOL [ '[' index ']' ]
+//!          | 'sum' '(' VAR '=' index '..' index ')' term
+//! index   := item { ('+' | '-') item },  item := INT | VAR | 'n' | ('max' | 'min') '(' index ',' index ')'
+//! cond    := index CMP index { 'and' index CMP index }
+//! ```
+
+use std::fmt::{self, Write as _};
+
+/// Where a token starts: 1-based line and column (in characters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Pos {
+    pub line: usize,
+    pub col: usize,
+}
+
+/// An error in a claims file: where, the text there, and what was expected.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SyntaxError {
+    pub pos: Pos,
+    pub found: String,
+    pub message: String,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Ident(String),
+    Int(i64),
+    Num(f64),
+    Str(String),
+    Op(&'static str),
+}
+
+impl Tok {
+    fn text(&self) -> String {
+        match self {
+            Tok::Ident(s) => s.clone(),
+            Tok::Int(v) => v.to_string(),
+            Tok::Num(v) => v.to_string(),
+            Tok::Str(s) => format!("{s:?}"),
+            Tok::Op(o) => (*o).to_string(),
+        }
+    }
+}
+
+const OPS: [&str; 18] =
+    ["..", ">=", "<=", "==", "!=", "+", "-", "*", "/", "^", "(", ")", "[", "]", ",", "=", "<", ">"];
+
+/// The tokens of one line (comments from `#` dropped), each with its position.
+fn lex(line: &str, number: usize) -> Result<Vec<(Tok, Pos)>, SyntaxError> {
+    let chars: Vec<char> = line.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let pos = Pos { line: number, col: i + 1 };
+        if c == '#' {
+            break;
+        }
+        if c.is_whitespace() {
+            i += 1;
+            continue;
+        }
+        if c == '"' {
+            let end = chars[i + 1..].iter().position(|&d| d == '"').ok_or_else(|| SyntaxError {
+                pos,
+                found: chars[i..].iter().collect(),
+                message: "a string that ends on this line (a closing \")".into(),
+            })?;
+            out.push((Tok::Str(chars[i + 1..i + 1 + end].iter().collect()), pos));
+            i += end + 2;
+            continue;
+        }
+        if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit())) {
+            let start = i;
+            while i < chars.len() && chars[i].is_ascii_digit() {
+                i += 1;
+            }
+            // A decimal point, unless it starts a range `1..n`.
+            let mut float = false;
+            if i < chars.len() && chars[i] == '.' && chars.get(i + 1) != Some(&'.') {
+                float = true;
+                i += 1;
+                while i < chars.len() && chars[i].is_ascii_digit() {
+                    i += 1;
+                }
+            }
+            if i < chars.len() && (chars[i] == 'e' || chars[i] == 'E') {
+                let sign = usize::from(matches!(chars.get(i + 1), Some('+' | '-')));
+                if chars.get(i + 1 + sign).is_some_and(|d| d.is_ascii_digit()) {
+                    float = true;
+                    i += 1 + sign;
+                    while i < chars.len() && chars[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                }
+            }
+            let text: String = chars[start..i].iter().collect();
+            let tok = if float {
+                let v: f64 = text.parse().map_err(|_| bad_number(pos, &text))?;
+                if !v.is_finite() {
+                    return Err(bad_number(pos, &text));
+                }
+                Tok::Num(v)
+            } else {
+                Tok::Int(text.parse().map_err(|_| bad_number(pos, &text))?)
+            };
+            out.push((tok, pos));
+            continue;
+        }
+        if c.is_alphabetic() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_' || chars[i] == '\u{307}')
+            {
+                i += 1;
+            }
+            out.push((Tok::Ident(chars[start..i].iter().collect()), pos));
+            continue;
+        }
+        let rest: String = chars[i..].iter().take(2).collect();
+        let Some(op) = OPS.iter().find(|op| rest.starts_with(**op)) else {
+            return Err(SyntaxError {
+                pos,
+                found: c.to_string(),
+                message: "a number, a name, an operator (+ - * / ^), brackets or a comparison".into(),
+            });
+        };
+        out.push((Tok::Op(op), pos));
+        i += op.chars().count();
+    }
+    Ok(out)
+}
+
+fn bad_number(pos: Pos, text: &str) -> SyntaxError {
+    SyntaxError { pos, found: text.into(), message: "a finite number (whole numbers below 2^63)".into() }
+}
+
+/// An index expression (1-based, integer valued).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Index {
+    Int(i64),
+    /// An index variable (`i`, `j`, a sum's variable) or `n`.
+    Var(String, Pos),
+    Add(Box<Index>, Box<Index>),
+    Sub(Box<Index>, Box<Index>),
+    Max(Box<Index>, Box<Index>),
+    Min(Box<Index>, Box<Index>),
+}
+
+/// A function of a value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Func {
+    Sin,
+    Cos,
+    Tan,
+    Cot,
+    Sqrt,
+}
+
+impl Func {
+    fn named(name: &str) -> Option<Func> {
+        Some(match name {
+            "sin" => Func::Sin,
+            "cos" => Func::Cos,
+            "tan" => Func::Tan,
+            "cot" => Func::Cot,
+            "sqrt" => Func::Sqrt,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Cot => "cot",
+            Func::Sqrt => "sqrt",
+        }
+    }
+}
+
+/// A value expression.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    Num(f64),
+    /// A symbol as written (`theta`, `θ`, `m`, `g`, …), with its index if it has one.
+    Sym {
+        name: String,
+        index: Option<Index>,
+        pos: Pos,
+    },
+    Neg(Box<Expr>),
+    Add(Box<Expr>, Box<Expr>),
+    Sub(Box<Expr>, Box<Expr>),
+    /// A product; `explicit` when written with `*` (else by juxtaposition).
+    Mul(Box<Expr>, Box<Expr>, bool),
+    Div(Box<Expr>, Box<Expr>),
+    Pow(Box<Expr>, i32),
+    Call(Func, Box<Expr>),
+    Sum {
+        var: String,
+        from: Index,
+        to: Index,
+        body: Box<Expr>,
+        pos: Pos,
+    },
+}
+
+impl Expr {
+    /// The same node with each child expression replaced by `f` of it.
+    pub fn map_children(&self, f: &mut dyn FnMut(&Expr) -> Expr) -> Expr {
+        let mut go = |a: &Expr| Box::new(f(a));
+        match self {
+            Expr::Num(_) | Expr::Sym { .. } => self.clone(),
+            Expr::Neg(a) => Expr::Neg(go(a)),
+            Expr::Pow(a, k) => Expr::Pow(go(a), *k),
+            Expr::Call(func, a) => Expr::Call(*func, go(a)),
+            Expr::Add(a, b) => Expr::Add(go(a), go(b)),
+            Expr::Sub(a, b) => Expr::Sub(go(a), go(b)),
+            Expr::Mul(a, b, x) => Expr::Mul(go(a), go(b), *x),
+            Expr::Div(a, b) => Expr::Div(go(a), go(b)),
+            Expr::Sum { var, from, to, body, pos } => {
+                Expr::Sum { var: var.clone(), from: from.clone(), to: to.clone(), body: go(body), pos: *pos }
+            }
+        }
+    }
+}
+
+/// A comparison of two indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Compare {
+    pub left: Index,
+    pub op: &'static str,
+    pub right: Index,
+}
+
+/// One branch of an entry: the value, and the condition it holds under (none: always,
+/// or `otherwise` for the last).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Branch {
+    pub value: Expr,
+    pub when: Option<Vec<Compare>>,
+    pub otherwise: bool,
+    pub pos: Pos,
+}
+
+/// `quantity[indices] = branches`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Entry {
+    pub quantity: String,
+    pub indices: Vec<Index>,
+    pub branches: Vec<Branch>,
+    pub pos: Pos,
+}
+
+/// Planar or spatial chains, for `n` in `low..=high` (`high` none: no bound).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chains {
+    pub spatial: bool,
+    pub low: usize,
+    pub high: Option<usize>,
+}
+
+/// One claim: its title, the chains it covers and its entries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Claim {
+    pub title: String,
+    pub chains: Chains,
+    pub entries: Vec<Entry>,
+    pub pos: Pos,
+}
+
+/// Parses a claims file; every error found, not only the first.
+///
+/// A line continues the one before while that one leaves a bracket open, or when it
+/// starts with an operator (`+ - * / ^`).
+pub fn parse(text: &str) -> Result<Vec<Claim>, Vec<SyntaxError>> {
+    let mut errors = Vec::new();
+    // Logical lines: their tokens, and where the last physical line ends.
+    let mut logical: Vec<(Vec<(Tok, Pos)>, Pos)> = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let end = Pos { line: number + 1, col: line.chars().count() + 1 };
+        let tokens = match lex(line, number + 1) {
+            Ok(tokens) if tokens.is_empty() => continue,
+            Ok(tokens) => tokens,
+            Err(e) => {
+                errors.push(e);
+                continue;
+            }
+        };
+        let leads_with_operator = matches!(tokens.first(), Some((Tok::Op("+" | "-" | "*" | "/" | "^"), _)));
+        match logical.last_mut() {
+            Some((previous, at)) if open_brackets(previous) > 0 || leads_with_operator => {
+                previous.extend(tokens);
+                *at = end;
+            }
+            _ => logical.push((tokens, end)),
+        }
+    }
+    let mut claims: Vec<Claim> = Vec::new();
+    for (tokens, end) in logical {
+        let mut p = Parser { tokens, at: 0, line: end.line, end: end.col };
+        if let Err(e) = p.line_into(&mut claims) {
+            errors.push(e);
+        }
+    }
+    // A claim with a bad line is not also reported for lacking entries.
+    let faulty = |claim: &Claim, next: Option<&Claim>| {
+        errors.iter().any(|e| e.pos.line > claim.pos.line && next.is_none_or(|n| e.pos.line < n.pos.line))
+    };
+    let mut empty = Vec::new();
+    for (k, claim) in claims.iter().enumerate() {
+        if claim.entries.is_empty() && !faulty(claim, claims.get(k + 1)) {
+            empty.push(SyntaxError {
+                pos: claim.pos,
+                found: format!("claim {:?}", claim.title),
+                message: "at least one entry (a line `quantity[indices] = value`)".into(),
+            });
+        }
+    }
+    errors.extend(empty);
+    errors.sort_by_key(|e| (e.pos.line, e.pos.col));
+    if errors.is_empty() { Ok(claims) } else { Err(errors) }
+}
+
+/// Brackets left open by `tokens`.
+fn open_brackets(tokens: &[(Tok, Pos)]) -> i64 {
+    tokens
+        .iter()
+        .map(|(t, _)| match t {
+            Tok::Op("(" | "[") => 1,
+            Tok::Op(")" | "]") => -1,
+            _ => 0,
+        })
+        .sum()
+}
+
+struct Parser {
+    tokens: Vec<(Tok, Pos)>,
+    at: usize,
+    line: usize,
+    end: usize,
+}
+
+impl Parser {
+    fn peek(&self) -> Option<&Tok> {
+        self.tokens.get(self.at).map(|(t, _)| t)
+    }
+
+    fn pos(&self) -> Pos {
+        self.tokens.get(self.at).map_or(Pos { line: self.line, col: self.end }, |(_, p)| *p)
+    }
+
+    fn error(&self, expected: &str) -> SyntaxError {
+        let found = self.peek().map_or_else(|| "the end of the line".into(), Tok::text);
+        SyntaxError { pos: self.pos(), found, message: expected.into() }
+    }
+
+    fn is_op(&self, op: &str) -> bool {
+        matches!(self.peek(), Some(Tok::Op(o)) if *o == op)
+    }
+
+    fn is_word(&self, word: &str) -> bool {
+        matches!(self.peek(), Some(Tok::Ident(w)) if w == word)
+    }
+
+    fn expect_op(&mut self, op: &str, expected: &str) -> Result<(), SyntaxError> {
+        if self.is_op(op) {
+            self.at += 1;
+            Ok(())
+        } else {
+            Err(self.error(expected))
+        }
+    }
+
+    fn int(&mut self, expected: &str) -> Result<i64, SyntaxError> {
+        match self.peek() {
+            Some(Tok::Int(v)) => {
+                let v = *v;
+                self.at += 1;
+                Ok(v)
+            }
+            _ => Err(self.error(expected)),
+        }
+    }
+
+    fn done(&self) -> Result<(), SyntaxError> {
+        match self.peek() {
+            None => Ok(()),
+            Some(_) => Err(self.error("the end of the line (or an operator joining what came before)")),
+        }
+    }
+
+    /// One non-empty line, added to the claims.
+    fn line_into(&mut self, claims: &mut Vec<Claim>) -> Result<(), SyntaxError> {
+        let pos = self.pos();
+        if self.is_word("claim") {
+            self.at += 1;
+            let Some(Tok::Str(title)) = self.peek().cloned() else {
+                return Err(self.error("the claim's title in quotes, e.g. claim \"Eq 22: the mass matrix\""));
+            };
+            self.at += 1;
+            self.done()?;
+            let chains = Chains { spatial: false, low: 0, high: None };
+            claims.push(Claim { title, chains, entries: Vec::new(), pos });
+            return Ok(());
+        }
+        let Some(claim) = claims.last_mut() else {
+            return Err(self.error("a claim first: claim \"title\""));
+        };
+        if self.is_word("chain") {
+            self.at += 1;
+            claim.chains = self.chains()?;
+            return self.done();
+        }
+        if claim.chains.low == 0 {
+            return Err(self.error("the chains the claim covers first: chain planar|spatial [n = 1..8]"));
+        }
+        if self.is_op("=") {
+            let Some(entry) = claim.entries.last_mut() else {
+                return Err(self.error("an entry first: quantity[indices] = value"));
+            };
+            self.at += 1;
+            let branch = self.branch(pos, true)?;
+            entry.branches.push(branch);
+            return Ok(());
+        }
+        let Some(Tok::Ident(quantity)) = self.peek().cloned() else {
+            return Err(self.error("an entry: quantity[indices] = value"));
+        };
+        self.at += 1;
+        let mut indices = Vec::new();
+        if self.is_op("[") {
+            self.at += 1;
+            loop {
+                indices.push(self.index()?);
+                if self.is_op(",") {
+                    self.at += 1;
+                    continue;
+                }
+                self.expect_op("]", "`,` or `]` after an index")?;
+                break;
+            }
+        }
+        self.expect_op("=", "`=` after the entry's name")?;
+        let branch = self.branch(pos, false)?;
+        claim.entries.push(Entry { quantity, indices, branches: vec![branch], pos });
+        Ok(())
+    }
+
+    fn branch(&mut self, pos: Pos, continued: bool) -> Result<Branch, SyntaxError> {
+        let value = self.expr()?;
+        let mut branch = Branch { value, when: None, otherwise: false, pos };
+        if self.is_word("if") {
+            self.at += 1;
+            branch.when = Some(self.condition()?);
+        } else if self.is_word("otherwise") {
+            if !continued {
+                return Err(self.error("`if` on a first branch (`otherwise` belongs to the last)"));
+            }
+            self.at += 1;
+            branch.otherwise = true;
+        }
+        self.done()?;
+        Ok(branch)
+    }
+
+    fn chains(&mut self) -> Result<Chains, SyntaxError> {
+        let spatial = match self.peek() {
+            Some(Tok::Ident(w)) if w == "planar" => false,
+            Some(Tok::Ident(w)) if w == "spatial" => true,
+            _ => return Err(self.error("planar or spatial")),
+        };
+        self.at += 1;
+        if self.is_op(",") {
+            self.at += 1;
+        }
+        if self.peek().is_none() {
+            return Ok(Chains { spatial, low: 1, high: None });
+        }
+        if !self.is_word("n") {
+            return Err(self.error("n = N, n = A..B, n >= A or n <= B"));
+        }
+        self.at += 1;
+        let what = "a number of links (at least 1)";
+        let (low, high) = if self.is_op("=") {
+            self.at += 1;
+            let low = self.int(what)?;
+            if self.is_op("..") {
+                self.at += 1;
+                (low, Some(self.int(what)?))
+            } else {
+                (low, Some(low))
+            }
+        } else if self.is_op(">=") {
+            self.at += 1;
+            (self.int(what)?, None)
+        } else if self.is_op("<=") {
+            self.at += 1;
+            (1, Some(self.int(what)?))
+        } else {
+            return Err(self.error("=, >= or <= after n"));
+        };
+        if low < 1 || high.is_some_and(|h| h < low) {
+            return Err(SyntaxError {
+                pos: self.pos(),
+                found: format!("n from {low} to {}", high.map_or("any".into(), |h| h.to_string())),
+                message: "a range of at least one chain of at least 1 link".into(),
+            });
+        }
+        Ok(Chains { spatial, low: low as usize, high: high.map(|h| h as usize) })
+    }
+
+    fn condition(&mut self) -> Result<Vec<Compare>, SyntaxError> {
+        let mut all = Vec::new();
+        loop {
+            let left = self.index()?;
+            let op = match self.peek() {
+                Some(Tok::Op(op @ (">=" | "<=" | "==" | "!=" | "<" | ">"))) => *op,
+                _ => return Err(self.error("a comparison: < <= == != >= >")),
+            };
+            self.at += 1;
+            let right = self.index()?;
+            all.push(Compare { left, op, right });
+            if !self.is_word("and") {
+                return Ok(all);
+            }
+            self.at += 1;
+        }
+    }
+
+    fn index(&mut self) -> Result<Index, SyntaxError> {
+        let mut left = self.index_item()?;
+        loop {
+            if self.is_op("+") {
+                self.at += 1;
+                left = Index::Add(Box::new(left), Box::new(self.index_item()?));
+            } else if self.is_op("-") {
+                self.at += 1;
+                left = Index::Sub(Box::new(left), Box::new(self.index_item()?));
+            } else {
+                return Ok(left);
+            }
+        }
+    }
+
+    fn index_item(&mut self) -> Result<Index, SyntaxError> {
+        let pos = self.pos();
+        match self.peek().cloned() {
+            Some(Tok::Int(v)) => {
+                self.at += 1;
+                Ok(Index::Int(v))
+            }
+            Some(Tok::Ident(w)) if w == "max" || w == "min" => {
+                self.at += 1;
+                self.expect_op("(", "`(` after max or min")?;
+                let a = self.index()?;
+                self.expect_op(",", "`,` between the two indices of max or min")?;
+                let b = self.index()?;
+                self.expect_op(")", "`)` closing max or min")?;
+                Ok(if w == "max" {
+                    Index::Max(Box::new(a), Box::new(b))
+                } else {
+                    Index::Min(Box::new(a), Box::new(b))
+                })
+            }
+            Some(Tok::Ident(w)) if w.chars().all(|c| c.is_ascii_alphanumeric()) => {
+                self.at += 1;
+                Ok(Index::Var(w, pos))
+            }
+            Some(Tok::Op("(")) => {
+                self.at += 1;
+                let inner = self.index()?;
+                self.expect_op(")", "`)` closing the index")?;
+                Ok(inner)
+            }
+            _ => Err(self.error("an index: a whole number, an index name, n, max(…, …) or min(…, …)")),
+        }
+    }
+
+    fn expr(&mut self) -> Result<Expr, SyntaxError> {
+        let first = self.term()?;
+        self.more_terms(first)
+    }
+
+    fn more_terms(&mut self, mut left: Expr) -> Result<Expr, SyntaxError> {
+        loop {
+            if self.is_op("+") {
+                self.at += 1;
+                left = Expr::Add(Box::new(left), Box::new(self.term()?));
+            } else if self.is_op("-") {
+                self.at += 1;
+                left = Expr::Sub(Box::new(left), Box::new(self.term()?));
+            } else {
+                return Ok(left);
+            }
+        }
+    }
+
+    /// Whether the next token starts a factor (for juxtaposition).
+    fn starts_factor(&self) -> bool {
+        match self.peek() {
+            Some(Tok::Int(_) | Tok::Num(_)) => true,
+            Some(Tok::Op("(")) => true,
+            Some(Tok::Ident(w)) => !matches!(w.as_str(), "if" | "otherwise" | "and"),
+            _ => false,
+        }
+    }
+
+    fn term(&mut self) -> Result<Expr, SyntaxError> {
+        let mut left = self.unary()?;
+        loop {
+            if self.is_op("*") {
+                self.at += 1;
+                left = Expr::Mul(Box::new(left), Box::new(self.unary()?), true);
+            } else if self.is_op("/") {
+                self.at += 1;
+                left = Expr::Div(Box::new(left), Box::new(self.unary()?));
+            } else if self.starts_factor() {
+                left = Expr::Mul(Box::new(left), Box::new(self.unary()?), false);
+            } else {
+                return Ok(left);
+            }
+        }
+    }
+
+    fn unary(&mut self) -> Result<Expr, SyntaxError> {
+        if self.is_op("-") {
+            self.at += 1;
+            return Ok(Expr::Neg(Box::new(self.unary()?)));
+        }
+        let base = self.primary()?;
+        if !self.is_op("^") {
+            return Ok(base);
+        }
+        self.at += 1;
+        let negative = self.is_op("-");
+        if negative {
+            self.at += 1;
+        }
+        let k = self.int("a whole exponent, e.g. ^2 or ^-1")?;
+        let k = i32::try_from(k).map_err(|_| self.error("an exponent of at most 2^31"))?;
+        Ok(Expr::Pow(Box::new(base), if negative { -k } else { k }))
+    }
+
+    fn primary(&mut self) -> Result<Expr, SyntaxError> {
+        let pos = self.pos();
+        match self.peek().cloned() {
+            Some(Tok::Int(v)) => {
+                self.at += 1;
+                Ok(Expr::Num(v as f64))
+            }
+            Some(Tok::Num(v)) => {
+                self.at += 1;
+                Ok(Expr::Num(v))
+            }
+            Some(Tok::Op("(")) => {
+                self.at += 1;
+                let inner = self.expr()?;
+                self.expect_op(")", "`)` closing the bracket")?;
+                Ok(inner)
+            }
+            Some(Tok::Ident(w)) if w == "sum" => {
+                self.at += 1;
+                self.expect_op("(", "`(` after sum: sum(k = 1..n) term")?;
+                let var = match self.peek().cloned() {
+                    Some(Tok::Ident(v)) => v,
+                    _ => return Err(self.error("the sum's index name: sum(k = 1..n) term")),
+                };
+                self.at += 1;
+                self.expect_op("=", "`=` after the sum's index: sum(k = 1..n) term")?;
+                let from = self.index()?;
+                self.expect_op("..", "`..` between the sum's bounds: sum(k = 1..n) term")?;
+                let to = self.index()?;
+                self.expect_op(")", "`)` after the sum's bounds")?;
+                let body = self.term()?;
+                Ok(Expr::Sum { var, from, to, body: Box::new(body), pos })
+            }
+            Some(Tok::Ident(w)) => {
+                self.at += 1;
+                if let Some(f) = Func::named(&w) {
+                    self.expect_op("(", &format!("`(` after {w}"))?;
+                    let arg = self.expr()?;
+                    self.expect_op(")", &format!("`)` closing {w}(…)"))?;
+                    return Ok(Expr::Call(f, Box::new(arg)));
+                }
+                let index = if self.is_op("[") {
+                    self.at += 1;
+                    let index = self.index()?;
+                    self.expect_op("]", "`]` closing the index (symbols take one index)")?;
+                    Some(index)
+                } else {
+                    None
+                };
+                Ok(Expr::Sym { name: w, index, pos })
+            }
+            _ => Err(self.error("a value: a number, a symbol, a function, sum(…) or a bracket")),
+        }
+    }
+}
+
+impl fmt::Display for Index {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Index::Int(v) => write!(f, "{v}"),
+            Index::Var(v, _) => f.write_str(v),
+            Index::Add(a, b) => write!(f, "{a}+{b}"),
+            Index::Sub(a, b) => match **b {
+                Index::Add(..) | Index::Sub(..) => write!(f, "{a}-({b})"),
+                _ => write!(f, "{a}-{b}"),
+            },
+            Index::Max(a, b) => write!(f, "max({a},{b})"),
+            Index::Min(a, b) => write!(f, "min({a},{b})"),
+        }
+    }
+}
+
+/// Binding strength of an expression's top: 1 sums, 2 products, 3 unary minus, 4 powers
+/// and atoms.
+fn strength(e: &Expr) -> u8 {
+    match e {
+        Expr::Add(..) | Expr::Sub(..) => 1,
+        Expr::Mul(..) | Expr::Div(..) | Expr::Sum { .. } => 2,
+        Expr::Neg(_) => 3,
+        Expr::Num(v) if *v < 0.0 => 3,
+        _ => 4,
+    }
+}
+
+/// Whether `e` printed ends in a sum's body, which would run on into what follows.
+fn ends_open(e: &Expr) -> bool {
+    match e {
+        Expr::Sum { .. } => true,
+        Expr::Mul(_, b, _) => ends_open(b),
+        Expr::Neg(b) => ends_open(b),
+        _ => false,
+    }
+}
+
+fn wrapped(e: &Expr, at_least: u8) -> String {
+    if strength(e) < at_least { format!("({e})") } else { e.to_string() }
+}
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            // Whole numbers as such; large ones in exponent form (they would lex as
+            // integers too large).
+            Expr::Num(v) if v.fract() == 0.0 && v.abs() < 1e15 => write!(f, "{}", *v as i64),
+            Expr::Num(v) if v.abs() >= 1e15 => write!(f, "{v:e}"),
+            Expr::Num(v) => write!(f, "{v}"),
+            Expr::Sym { name, index: Some(i), .. } => write!(f, "{name}[{i}]"),
+            Expr::Sym { name, index: None, .. } => f.write_str(name),
+            // A product's sign may stand before its first factor.
+            Expr::Neg(e) => write!(f, "-{}", wrapped(e, 2)),
+            Expr::Add(a, b) => write!(f, "{a} + {}", wrapped(b, 2)),
+            Expr::Sub(a, b) => write!(f, "{a} - {}", wrapped(b, 2)),
+            Expr::Mul(a, b, explicit) => {
+                // A sum's body runs to the end of its product: it must come last.
+                let left = if ends_open(a) { format!("({a})") } else { wrapped(a, 2) };
+                // a (b c) = a b c and a (b / c) = a b / c; a sum on the right runs to the end.
+                let right = if matches!(**b, Expr::Neg(_)) { format!("({b})") } else { wrapped(b, 2) };
+                write!(f, "{left}{}{right}", if *explicit { " * " } else { " " })
+            }
+            Expr::Div(a, b) => {
+                let left = if ends_open(a) { format!("({a})") } else { wrapped(a, 2) };
+                write!(f, "{left} / {}", wrapped(b, 4))
+            }
+            Expr::Pow(e, k) if matches!(**e, Expr::Pow(..)) => write!(f, "({e})^{k}"),
+            Expr::Pow(e, k) => write!(f, "{}^{k}", wrapped(e, 4)),
+            Expr::Call(func, e) => write!(f, "{}({e})", func.name()),
+            Expr::Sum { var, from, to, body, .. } => {
+                write!(f, "sum({var} = {from}..{to}) {}", wrapped(body, 2))
+            }
+        }
+    }
+}
+
+impl fmt::Display for Compare {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {} {}", self.left, self.op, self.right)
+    }
+}
+
+impl Entry {
+    /// The entry in the file's syntax, one branch per line.
+    pub fn render(&self) -> String {
+        let mut out = self.quantity.clone();
+        if !self.indices.is_empty() {
+            let indices: Vec<String> = self.indices.iter().map(Index::to_string).collect();
+            let _ = write!(out, "[{}]", indices.join(","));
+        }
+        let width = out.chars().count();
+        for (k, b) in self.branches.iter().enumerate() {
+            if k > 0 {
+                out.push('\n');
+                out.push_str(&" ".repeat(width));
+            }
+            let _ = write!(out, " = {}", b.value);
+            if let Some(when) = &b.when {
+                let all: Vec<String> = when.iter().map(Compare::to_string).collect();
+                let _ = write!(out, "  if {}", all.join(" and "));
+            } else if b.otherwise {
+                out.push_str("  otherwise");
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one(text: &str) -> Claim {
+        let mut claims = parse(text).unwrap_or_else(|e| panic!("{e:?}"));
+        assert_eq!(claims.len(), 1);
+        claims.remove(0)
+    }
+
+    #[test]
+    fn a_claim_parses_and_prints_back() {
+        let c = one("# a comment\nclaim \"Eq 23\"   # trailing\n  chain planar, n = 1..8\n  \
+             S[i,j] = M[i] l[i] l[j] sin(θ[i] - θ[j])  if i >= j\n         = M[j] l[j] l[i] sin(θ[j]-θ[i]) otherwise\n");
+        assert_eq!(c.title, "Eq 23");
+        assert_eq!(c.chains, Chains { spatial: false, low: 1, high: Some(8) });
+        let e = &c.entries[0];
+        assert_eq!((e.quantity.as_str(), e.indices.len(), e.branches.len()), ("S", 2, 2));
+        assert_eq!(
+            e.render(),
+            "S[i,j] = M[i] l[i] l[j] sin(θ[i] - θ[j])  if i >= j\n       = M[j] l[j] l[i] sin(θ[j] - θ[i])  otherwise"
+        );
+        // The printed form parses to the same entry.
+        let again = one(&format!("claim \"x\"\nchain planar\n{}\n", e.render()));
+        assert_eq!(again.entries[0].render(), e.render());
+    }
+
+    #[test]
+    fn precedence_sums_powers_and_continuations() {
+        let c = one("claim \"T\"\nchain spatial n >= 2\nT = 1/2 sum(i = 1..n) m[i] v[i]^2\n  + 2 * -g\n");
+        assert_eq!(c.entries[0].render(), "T = 1 / 2 sum(i = 1..n) m[i] v[i]^2 + 2 * (-g)");
+        assert_eq!(c.chains, Chains { spatial: true, low: 2, high: None });
+        let e = one("claim \"p\"\nchain planar\nk[i] = (a + b) c^-1 - d e\n").entries.remove(0);
+        assert_eq!(e.render(), "k[i] = (a + b) c^-1 - d e");
+        let e = one("claim \"m\"\nchain planar\nM[i,j] = m[max(i,j)+1] 1.5e-3\n").entries.remove(0);
+        assert_eq!(e.render(), "M[i,j] = m[max(i,j)+1] 0.0015");
+    }
+
+    #[test]
+    fn errors_say_where_what_and_what_was_expected() {
+        let errors = parse("chain planar\nclaim \"a\"\nchain wobbly\nclaim b\nclaim \"c\"\nchain planar\nM[i,j] = sin(θ[i]\nT = 3 $\n")
+            .unwrap_err();
+        let got: Vec<(usize, usize, &str)> =
+            errors.iter().map(|e| (e.pos.line, e.pos.col, e.found.as_str())).collect();
+        assert_eq!(
+            got,
+            [(1, 1, "chain"), (3, 7, "wobbly"), (4, 7, "b"), (7, 18, "the end of the line"), (8, 7, "$"),]
+        );
+        assert!(errors[1].message.contains("planar or spatial"));
+        assert!(errors[3].message.contains("`)` closing sin"), "{}", errors[3].message);
+    }
+}
