@@ -1,7 +1,11 @@
 //! A claim against the reference: every entry at every random state of every case it
 //! covers, with the relative error of the document's checks.
 
-use std::collections::BTreeSet;
+use std::cell::RefCell;
+use std::collections::{BTreeSet, HashMap};
+use std::rc::Rc;
+
+use rand::Rng;
 
 use super::eval::{Bindings, EvalError, QUANTITIES, Quantity, Truth, entry_value};
 use super::syntax::{Claim, Entry, Index};
@@ -161,19 +165,56 @@ fn label(entry: &Entry, at: &[usize]) -> String {
     format!("{}[{}]", entry.quantity, at.join(","))
 }
 
-/// Checks one entry of a claim at `states` random states of every covered case.
-pub fn check_entry(
-    entry: &Entry,
-    cases: &[&Case],
-    states: usize,
+/// One state's reference, shared by every entry that reads it.
+type Shared<'a> = Rc<RefCell<Truth<'a>>>;
+
+/// The reference at the random states, each evaluated once for every entry and claim
+/// that asks (with the coefficient matrices it derives, as they are asked for).
+pub struct Samples<'a> {
     seed: u64,
+    evaluated: RefCell<HashMap<(String, usize), Shared<'a>>>,
+}
+
+impl<'a> Samples<'a> {
+    /// The states of `cargo xtask verify` for `seed` ([`crate::sample::state`]).
+    pub fn new(seed: u64) -> Self {
+        Self { seed, evaluated: RefCell::new(HashMap::new()) }
+    }
+
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// State `index` of `case`, evaluated by the reference.
+    fn get(&self, case: &'a Case, index: usize) -> Shared<'a> {
+        let key = (case.name.clone(), index);
+        if let Some(truth) = self.evaluated.borrow().get(&key) {
+            return Rc::clone(truth);
+        }
+        // The accelerations EL is taken at are drawn after the state, from the same
+        // generator: the ones the document check draws.
+        let (params, point, mut rng) = crate::sample::state_with_rng(self.seed, case.kind, case.links, index);
+        let qdd: Vec<f64> = (0..case.dof()).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let (ev, sc) = case.evaluate_with_scales(&params, &point);
+        let truth = Rc::new(RefCell::new(Truth::new(State { case, index, params, point, ev, sc }, qdd)));
+        self.evaluated.borrow_mut().insert(key, Rc::clone(&truth));
+        truth
+    }
+}
+
+/// Checks one entry of a claim at `states` random states of every covered case.
+pub fn check_entry<'a>(
+    entry: &Entry,
+    cases: &[&'a Case],
+    states: usize,
+    samples: &Samples<'a>,
 ) -> Result<Tally, BTreeSet<(usize, usize, String, String)>> {
     let mut tally = Tally::default();
     let mut errors = BTreeSet::new();
     let mut fail = |e: EvalError| {
         errors.insert((e.pos.line, e.pos.col, e.found, e.message));
     };
-    for case in cases {
+    for &case in cases {
         let n = case.links;
         let quantity = match quantity_of(entry, case.kind) {
             Ok(q) => q,
@@ -190,9 +231,8 @@ pub fn check_entry(
             }
         };
         for index in 0..states {
-            let (params, point) = crate::sample::state(seed, case.kind, n, index);
-            let (ev, sc) = case.evaluate_with_scales(&params, &point);
-            let mut truth = Truth::new(State { case, index, params, point, ev, sc });
+            let shared = samples.get(case, index);
+            let mut truth = shared.borrow_mut();
             for (at, bound) in &combos {
                 let mut bound = bound.clone();
                 let claimed = match entry_value(&truth, entry, &mut bound) {

@@ -6,7 +6,7 @@
 //! sign of one triangle (i > j or i < j); sin for cos or cos for sin at one place;
 //! transposed indices; an index off by one at one place; the wrong tail-mass index.
 
-use super::check::{Tally, check_entry};
+use super::check::{Samples, Tally, check_entry};
 use super::syntax::{Branch, Compare, Entry, Expr, Func, Index, Pos};
 use crate::case::Case;
 
@@ -21,10 +21,15 @@ pub struct Diagnosis {
 const STATES: usize = 3;
 
 /// The first slip that makes `entry` agree, given what checking it found.
-pub fn diagnose(entry: &Entry, tally: &Tally, cases: &[&Case], seed: u64) -> Option<Diagnosis> {
+pub fn diagnose<'a>(
+    entry: &Entry,
+    tally: &Tally,
+    cases: &[&'a Case],
+    samples: &Samples<'a>,
+) -> Option<Diagnosis> {
     candidates(entry, tally)
         .into_iter()
-        .find(|(_, corrected)| check_entry(corrected, cases, STATES, seed).is_ok_and(|t| t.agrees()))
+        .find(|(_, corrected)| check_entry(corrected, cases, STATES, samples).is_ok_and(|t| t.agrees()))
         .map(|(slip, corrected)| Diagnosis { slip, corrected })
 }
 
@@ -176,7 +181,7 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
                 found.push(e.clone());
                 e.clone()
             });
-            let Some(Expr::Sum { var, from, to, body, pos }) = found.pop() else { continue };
+            let Some(Expr::Sum { var, from, to, body, when, pos }) = found.pop() else { continue };
             let rests = [
                 (Index::Int(1), shifted(&from, -1)),
                 (shifted(&to, 1), Index::Var("n".into(), Pos::default())),
@@ -198,6 +203,7 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
                         from: low.clone(),
                         to: high.clone(),
                         body: Box::new(body.clone()),
+                        when: when.clone(),
                         pos,
                     };
                     let changed =
@@ -310,11 +316,20 @@ fn rename(e: &Expr, a: &str, b: &str) -> Expr {
         Expr::Sym { name, index, pos } => {
             Expr::Sym { name: name.clone(), index: index.as_ref().map(|i| rename_index(i, a, b)), pos: *pos }
         }
-        Expr::Sum { var, from, to, body, pos } => Expr::Sum {
+        Expr::Sum { var, from, to, body, when, pos } => Expr::Sum {
             var: var.clone(),
             from: rename_index(from, a, b),
             to: rename_index(to, a, b),
             body: Box::new(rename(body, a, b)),
+            when: when.as_ref().map(|w| {
+                w.iter()
+                    .map(|c| Compare {
+                        left: rename_index(&c.left, a, b),
+                        op: c.op,
+                        right: rename_index(&c.right, a, b),
+                    })
+                    .collect()
+            }),
             pos: *pos,
         },
         other => other.map_children(&mut |x| rename(x, a, b)),

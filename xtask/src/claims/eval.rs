@@ -25,6 +25,11 @@ pub enum Quantity {
     Kinetic,
     Potential,
     Accelerations,
+    /// `(M q̈ + c + k)_i` at the accelerations θ̈, φ̈ drawn with the state: the
+    /// Euler–Lagrange expression `d/dt ∂L/∂q̇_i − ∂L/∂q_i`.
+    EulerLagrange,
+    /// `−(c + k)`: the right side of the free chain's `M q̈ = −(c + k)`.
+    FreeRhs,
     /// Planar `S`, `S θ̇² = −c`.
     S,
     /// Spatial block `(row block, column block)` of M, 0-based.
@@ -37,7 +42,8 @@ pub enum Quantity {
 
 /// Every quantity name a claim may use, and what it means.
 pub const QUANTITIES: &str = "M (mass matrix) [i,j], c (velocity terms) [i], k (gravity terms) [i], \
-d (pivot terms) [i], Q (generalized forces) [i], T, U, qdd (free accelerations) [i]; planar S [i,j]; \
+d (pivot terms) [i], Q (generalized forces) [i], T, U, qdd (free accelerations) [i], \
+EL (M θ̈ + c + k at random θ̈) [i], rhs (−c − k) [i]; planar S [i,j]; \
 spatial A11 A12 A21 A22 B11 B12 B21 B22 C1 C2 [i,j]";
 
 impl Quantity {
@@ -51,6 +57,8 @@ impl Quantity {
             "T" => Quantity::Kinetic,
             "U" => Quantity::Potential,
             "qdd" | "accelerations" => Quantity::Accelerations,
+            "EL" | "lagrange" => Quantity::EulerLagrange,
+            "rhs" => Quantity::FreeRhs,
             "S" => Quantity::S,
             "A11" => Quantity::A(0, 0),
             "A12" => Quantity::A(0, 1),
@@ -85,9 +93,9 @@ impl Quantity {
             | Quantity::Gravity
             | Quantity::Pivot
             | Quantity::Forces
-            | Quantity::Accelerations => {
-                vec![dof]
-            }
+            | Quantity::Accelerations
+            | Quantity::EulerLagrange
+            | Quantity::FreeRhs => vec![dof],
             Quantity::S | Quantity::A(..) | Quantity::B(..) | Quantity::C(_) => vec![n, n],
         }
     }
@@ -100,6 +108,9 @@ pub enum Symbol {
     Phi,
     ThetaDot,
     PhiDot,
+    /// The accelerations `EL` is taken at: random, drawn with the state.
+    ThetaDdot,
+    PhiDdot,
     Mass,
     TailMass,
     Length,
@@ -112,7 +123,8 @@ pub enum Symbol {
 }
 
 /// Every symbol a claim may use.
-pub const SYMBOLS: &str = "theta θ, phi φ, thetadot θ̇, phidot φ̇ (coordinates and rates) [i], m (masses) [i], \
+pub const SYMBOLS: &str = "theta θ, phi φ, thetadot θ̇, phidot φ̇ (coordinates and rates) [i], \
+thetaddot θ̈, phiddot φ̈ (the accelerations EL is taken at) [i], m (masses) [i], \
 M (tail masses M_i = Σ_{k≥i} m_k) [i], l (lengths) [i], lambda λ (damping) [i], sigma σ (torques) [i], \
 g, n, pi, ax ay az (pivot acceleration)";
 
@@ -123,6 +135,8 @@ impl Symbol {
             "phi" | "φ" | "ph" => Symbol::Phi,
             "thetadot" | "θ̇" | "dtheta" | "thd" => Symbol::ThetaDot,
             "phidot" | "φ̇" | "dphi" | "phd" => Symbol::PhiDot,
+            "thetaddot" | "θ̈" | "ddtheta" => Symbol::ThetaDdot,
+            "phiddot" | "φ̈" | "ddphi" => Symbol::PhiDdot,
             "m" => Symbol::Mass,
             "M" => Symbol::TailMass,
             "l" => Symbol::Length,
@@ -201,6 +215,9 @@ pub fn holds(all: &[Compare], bound: &Bindings, n: usize) -> Result<bool, EvalEr
 /// The reference and the symbols' values at one state of one case.
 pub struct Truth<'a> {
     pub(crate) st: State<'a>,
+    /// The accelerations `EL` is taken at.
+    qdd: Vec<Scaled>,
+    qdd_values: Vec<f64>,
     n: usize,
     tail: Vec<Scaled>,
     /// Lazily: `c` at unit rates `e_j` (columns) and at `e_j + e_{n+j}` (spatial pairs).
@@ -210,10 +227,12 @@ pub struct Truth<'a> {
 }
 
 impl<'a> Truth<'a> {
-    pub(crate) fn new(st: State<'a>) -> Self {
+    /// The reference at `st`, with `EL` taken at the accelerations `qdd`.
+    pub(crate) fn new(st: State<'a>, qdd: Vec<f64>) -> Self {
         let n = st.case.links;
         let tail = tail_masses(&st.params.masses);
-        Self { st, n, tail, unit: None, pairs: None, accelerations: None }
+        let exact = qdd.iter().map(|&v| Scaled::exact(v)).collect();
+        Self { st, qdd: exact, qdd_values: qdd, n, tail, unit: None, pairs: None, accelerations: None }
     }
 
     /// The symbol's value at 1-based `index` (ignored for scalars); None out of range.
@@ -228,6 +247,8 @@ impl<'a> Truth<'a> {
             Symbol::Phi => at(&st.point.q, n),
             Symbol::ThetaDot => at(&st.point.qd, 0),
             Symbol::PhiDot => at(&st.point.qd, n),
+            Symbol::ThetaDdot => at(&self.qdd_values, 0),
+            Symbol::PhiDdot => at(&self.qdd_values, n),
             Symbol::Mass => at(&st.params.masses, 0),
             // M_{n+1} = 0: the sum over no masses.
             Symbol::TailMass => {
@@ -273,7 +294,9 @@ impl<'a> Truth<'a> {
                         });
                     }
                 };
-                if matches!(symbol, Symbol::Phi | Symbol::PhiDot) && self.st.case.kind == Kind::Planar {
+                if matches!(symbol, Symbol::Phi | Symbol::PhiDot | Symbol::PhiDdot)
+                    && self.st.case.kind == Kind::Planar
+                {
                     return Err(EvalError {
                         pos: *pos,
                         found: name.clone(),
@@ -307,7 +330,7 @@ impl<'a> Truth<'a> {
                     }
                 }
             }
-            Expr::Sum { var, from, to, body, pos } => {
+            Expr::Sum { var, from, to, body, when, pos } => {
                 let (lo, hi) = (index_value(from, bound, n)?, index_value(to, bound, n)?);
                 if hi.saturating_sub(lo) >= MAX_TERMS {
                     return Err(EvalError {
@@ -320,7 +343,9 @@ impl<'a> Truth<'a> {
                 let mut total = Scaled::zero();
                 for k in lo..=hi {
                     bound.insert(var.clone(), k);
-                    total = total + self.value(body, bound)?;
+                    if when.as_ref().map_or(Ok(true), |w| holds(w, bound, n))? {
+                        total = total + self.value(body, bound)?;
+                    }
                 }
                 match saved {
                     Some(v) => bound.insert(var.clone(), v),
@@ -365,6 +390,8 @@ impl<'a> Truth<'a> {
             Quantity::Kinetic => st.kinetic(),
             Quantity::Potential => st.potential(),
             Quantity::Accelerations => self.accelerations()?[at[0]],
+            Quantity::EulerLagrange => st.lagrange_lhs(&self.qdd, at[0]),
+            Quantity::FreeRhs => -(st.velocity(at[0]) + st.gravity(at[0])),
             Quantity::S => -self.unit()[at[1]][at[0]],
             Quantity::A(r, c) => st.mass(r * n + at[0], c * n + at[1]),
             Quantity::B(r, c) => -self.unit()[c * n + at[1]][r * n + at[0]],

@@ -18,7 +18,7 @@ use std::path::Path;
 use anyhow::{Context, bail};
 
 use crate::case::Case;
-use check::{Tally, check_entry, covered};
+use check::{Samples, Tally, check_entry, covered};
 use diagnose::{Diagnosis, diagnose};
 use syntax::{Claim, Entry, parse};
 
@@ -90,14 +90,15 @@ pub fn check_all(
     let source = std::fs::read_to_string(path).unwrap_or_default();
     let mut outcomes = Vec::new();
     let mut errors = Vec::new();
+    let samples = Samples::new(seed);
     for claim in claims {
         let covering = covered(&claim, cases);
         let mut entries = Vec::new();
         for entry in &claim.entries {
-            match check_entry(entry, &covering, states, seed) {
+            match check_entry(entry, &covering, states, &samples) {
                 Ok(tally) => {
                     let diagnosis =
-                        if tally.agrees() { None } else { diagnose(entry, &tally, &covering, seed) };
+                        if tally.agrees() { None } else { diagnose(entry, &tally, &covering, &samples) };
                     entries.push(EntryOutcome { entry: entry.clone(), tally, diagnosis });
                 }
                 Err(found) => {
@@ -187,11 +188,8 @@ pub fn render(outcomes: &[Outcome]) -> String {
 pub fn run(path: &Path, cases: &[Case], states: usize, seed: u64) -> anyhow::Result<Vec<Outcome>> {
     let claims = load(path)?;
     let outcomes = check_all(path, claims, cases, states, seed)?;
-    println!(
-        "{}: {} claims ({states} random states per case, seed {seed:#x}):",
-        path.display(),
-        outcomes.len()
-    );
+    let (count, plural) = (outcomes.len(), if outcomes.len() == 1 { "" } else { "s" });
+    println!("{}: {count} claim{plural} ({states} random states per case, seed {seed:#x}):", path.display());
     print!("{}", render(&outcomes));
     Ok(outcomes)
 }

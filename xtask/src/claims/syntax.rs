@@ -13,7 +13,7 @@
 //! unary   := '-' unary | power
 //! power   := primary [ '^' [ '-' ] INT ]
 //! primary := NUMBER | '(' expr ')' | FUNC '(' expr ')' | SYMBOL [ '[' index ']' ]
-//!          | 'sum' '(' VAR '=' index '..' index ')' term
+//!          | 'sum' '(' VAR '=' index '..' index [ 'if' cond ] ')' term
 //! index   := item { ('+' | '-') item },  item := INT | VAR | 'n' | ('max' | 'min') '(' index ',' index ')'
 //! cond    := index CMP index { 'and' index CMP index }
 //! ```
@@ -123,7 +123,10 @@ fn lex(line: &str, number: usize) -> Result<Vec<(Tok, Pos)>, SyntaxError> {
         }
         if c.is_alphabetic() || c == '_' {
             let start = i;
-            while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_' || chars[i] == '\u{307}')
+            while i < chars.len()
+                && (chars[i].is_alphanumeric()
+                    || chars[i] == '_'
+                    || matches!(chars[i], '\u{307}' | '\u{308}'))
             {
                 i += 1;
             }
@@ -216,6 +219,8 @@ pub enum Expr {
         from: Index,
         to: Index,
         body: Box<Expr>,
+        /// Only the terms where this holds (`sum(k = 1..n if k != j) …`).
+        when: Option<Vec<Compare>>,
         pos: Pos,
     },
 }
@@ -233,9 +238,14 @@ impl Expr {
             Expr::Sub(a, b) => Expr::Sub(go(a), go(b)),
             Expr::Mul(a, b, x) => Expr::Mul(go(a), go(b), *x),
             Expr::Div(a, b) => Expr::Div(go(a), go(b)),
-            Expr::Sum { var, from, to, body, pos } => {
-                Expr::Sum { var: var.clone(), from: from.clone(), to: to.clone(), body: go(body), pos: *pos }
-            }
+            Expr::Sum { var, from, to, body, when, pos } => Expr::Sum {
+                var: var.clone(),
+                from: from.clone(),
+                to: to.clone(),
+                body: go(body),
+                when: when.clone(),
+                pos: *pos,
+            },
         }
     }
 }
@@ -686,9 +696,15 @@ impl Parser {
                 let from = self.index()?;
                 self.expect_op("..", "`..` between the sum's bounds: sum(k = 1..n) term")?;
                 let to = self.index()?;
-                self.expect_op(")", "`)` after the sum's bounds")?;
+                let when = if self.is_word("if") {
+                    self.at += 1;
+                    Some(self.condition()?)
+                } else {
+                    None
+                };
+                self.expect_op(")", "`)` after the sum's bounds (or `if` and a condition)")?;
                 let body = self.term()?;
-                Ok(Expr::Sum { var, from, to, body: Box::new(body), pos })
+                Ok(Expr::Sum { var, from, to, body: Box::new(body), when, pos })
             }
             Some(Tok::Ident(w)) => {
                 self.at += 1;
@@ -783,8 +799,11 @@ impl fmt::Display for Expr {
             Expr::Pow(e, k) if matches!(**e, Expr::Pow(..)) => write!(f, "({e})^{k}"),
             Expr::Pow(e, k) => write!(f, "{}^{k}", wrapped(e, 4)),
             Expr::Call(func, e) => write!(f, "{}({e})", func.name()),
-            Expr::Sum { var, from, to, body, .. } => {
-                write!(f, "sum({var} = {from}..{to}) {}", wrapped(body, 2))
+            Expr::Sum { var, from, to, body, when, .. } => {
+                let when = when.as_ref().map_or(String::new(), |w| {
+                    format!(" if {}", w.iter().map(Compare::to_string).collect::<Vec<_>>().join(" and "))
+                });
+                write!(f, "sum({var} = {from}..{to}{when}) {}", wrapped(body, 2))
             }
         }
     }
