@@ -27,7 +27,7 @@ fn outcomes(name: &str) -> Vec<Outcome> {
 #[test]
 fn equivalent_forms_of_correct_formulas_agree() {
     for o in outcomes("equivalent.claims") {
-        assert_eq!(o.verdict(), "agrees", "{}: worst {:e}", o.claim.title, o.worst());
+        assert_eq!(o.verdict().as_str(), "agrees", "{}: worst {:e}", o.claim.title, o.worst());
         assert!(o.worst() < 1e-14, "{}: {:e}", o.claim.title, o.worst());
         assert!(!o.cases.is_empty());
     }
@@ -61,7 +61,7 @@ fn each_slip_is_diagnosed_and_corrected() {
     let found = outcomes("slips.claims");
     assert_eq!(found.len(), expected.len());
     for (o, (slip, corrected)) in found.iter().zip(expected) {
-        assert_eq!(o.verdict(), "disagrees", "{}", o.claim.title);
+        assert_eq!(o.verdict().as_str(), "disagrees", "{}", o.claim.title);
         let e = &o.entries[0];
         assert!(e.tally.first.as_deref().is_some_and(|f| f.contains("state")), "{}", o.claim.title);
         let d = e.diagnosis.as_ref().unwrap_or_else(|| panic!("{}: no diagnosis", o.claim.title));
@@ -78,7 +78,7 @@ fn each_slip_is_diagnosed_and_corrected() {
         };
         std::fs::write(&path, format!("claim \"corrected\"\nchain {chains}, {range}\n{text}\n")).unwrap();
         let again = check_all(&path, load(&path).unwrap(), &cases(), 6, SEED).unwrap();
-        assert_eq!(again[0].verdict(), "agrees", "{}: {text}", o.claim.title);
+        assert_eq!(again[0].verdict().as_str(), "agrees", "{}: {text}", o.claim.title);
     }
 }
 
@@ -142,12 +142,12 @@ fn the_seed_claims_match_the_errata() {
     let summary = parse_summary(&std::fs::read_to_string(errata_path()).unwrap()).unwrap();
     let path = xtask::workspace_root().join("reference/claims/seed.claims");
     let found = check_all(&path, load(&path).unwrap(), &cases(), 6, SEED).unwrap();
-    assert_eq!(found.len(), 30, "29 equations, eq 12 planar and spatial");
+    assert_eq!(found.len(), 33, "32 equations, eq 12 planar and spatial");
     for o in &found {
         // "Eq 24 S: …" → "24 S"; "Eq 12: U (spatial…)" → "12".
         let equation = o.claim.title.trim_start_matches("Eq ").split(':').next().unwrap();
         let recorded = summary.iter().find(|(e, _)| e == equation).map(|(_, v)| v.as_str());
-        assert_eq!(Some(o.verdict()), recorded, "eq {equation}: worst {:e}", o.worst());
+        assert_eq!(Some(o.verdict().as_str()), recorded, "eq {equation}: worst {:e}", o.worst());
     }
     let diagnoses = |equation: &str| -> Vec<String> {
         let o = found.iter().find(|o| o.claim.title.starts_with(&format!("Eq {equation}:"))).unwrap();
@@ -161,6 +161,11 @@ fn the_seed_claims_match_the_errata() {
     }
     assert_eq!(diagnoses("43"), ["a constant factor and the sign: the reference is -2 × the claim"]);
     assert_eq!(diagnoses("50"), ["an index off by one: `θ[1]` should be `θ[2]` (+1)"]);
-    // Two slips at once (cos for sin and a missing θ̇_d): not one of the common slips.
-    assert!(diagnoses("15").is_empty());
+    // Two slips at once (cos for sin and a missing θ̇_d), θ for θ̇: not common slips.
+    assert!(diagnoses("15").is_empty() && diagnoses("41").is_empty());
+    for o in &found {
+        if let Some((verdict, worst)) = o.corrected() {
+            assert_eq!(verdict.as_str(), "agrees", "{}: the corrected form, worst {worst:e}", o.claim.title);
+        }
+    }
 }

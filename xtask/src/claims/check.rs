@@ -8,11 +8,22 @@ use std::rc::Rc;
 use rand::Rng;
 
 use super::eval::{Bindings, EvalError, QUANTITIES, Quantity, Truth, entry_value};
+use super::state::State;
 use super::syntax::{Claim, Entry, Index};
 use crate::case::{Case, Kind};
 use crate::expr::Scaled;
-use crate::verify::document::state::State;
-use crate::verify::document::tally::{AGREEMENT, relative_error};
+
+/// A claim agrees with the reference if its worst relative error is below this.
+pub const AGREEMENT: f64 = 1e-10;
+
+/// `|c − r| / (scale_c + scale_r)`; 0 if they are equal, ∞ if they differ at zero scale.
+pub fn relative_error(claimed: Scaled, reference: Scaled) -> f64 {
+    let diff = (claimed.v - reference.v).abs();
+    if diff == 0.0 {
+        return 0.0;
+    }
+    diff / (claimed.s + reference.s)
+}
 
 /// What checking one entry found.
 #[derive(Clone, Debug, Default)]
@@ -166,7 +177,7 @@ fn label(entry: &Entry, at: &[usize]) -> String {
 }
 
 /// One state's reference, shared by every entry that reads it.
-type Shared<'a> = Rc<RefCell<Truth<'a>>>;
+type Shared<'a> = Rc<Truth<'a>>;
 
 /// The reference at the random states, each evaluated once for every entry and claim
 /// that asks (with the coefficient matrices it derives, as they are asked for).
@@ -196,7 +207,7 @@ impl<'a> Samples<'a> {
         let (params, point, mut rng) = crate::sample::state_with_rng(self.seed, case.kind, case.links, index);
         let qdd: Vec<f64> = (0..case.dof()).map(|_| rng.random_range(-2.0..2.0)).collect();
         let (ev, sc) = case.evaluate_with_scales(&params, &point);
-        let truth = Rc::new(RefCell::new(Truth::new(State { case, index, params, point, ev, sc }, qdd)));
+        let truth = Rc::new(Truth::new(State { case, params, point, ev, sc }, qdd));
         self.evaluated.borrow_mut().insert(key, Rc::clone(&truth));
         truth
     }
@@ -231,8 +242,7 @@ pub fn check_entry<'a>(
             }
         };
         for index in 0..states {
-            let shared = samples.get(case, index);
-            let mut truth = shared.borrow_mut();
+            let truth = samples.get(case, index);
             for (at, bound) in &combos {
                 let mut bound = bound.clone();
                 let claimed = match entry_value(&truth, entry, &mut bound) {
@@ -252,4 +262,18 @@ pub fn check_entry<'a>(
         }
     }
     if errors.is_empty() { Ok(tally) } else { Err(errors) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_error_is_scaled_and_zero_safe() {
+        assert_eq!(relative_error(Scaled::zero(), Scaled::zero()), 0.0);
+        assert_eq!(relative_error(Scaled::exact(1.0), Scaled::zero()), 1.0);
+        let a = Scaled::exact(0.3).sin() * Scaled::exact(2.0);
+        assert!(relative_error(a, Scaled::with_scale(2.0 * 0.3f64.sin(), 2.0)) < 1e-15);
+        assert!(relative_error(-a, Scaled::with_scale(2.0 * 0.3f64.sin(), 2.0)) > 0.1);
+    }
 }

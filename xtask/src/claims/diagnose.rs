@@ -74,12 +74,10 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
             }
             (p, q) => format!("a constant factor: the reference is {} × the claim", ratio(p, q)),
         };
-        let corrected = with_values(entry, |v| {
-            if (p, q) == (-1, 1) {
-                negate(v)
-            } else {
-                Expr::Mul(Box::new(factor.clone()), Box::new(v.clone()), false)
-            }
+        let corrected = with_values(entry, |v| match (p, q) {
+            (-1, 1) => negate(v),
+            (p, 1) => times(p as f64, v),
+            _ => Expr::Mul(Box::new(factor.clone()), Box::new(v.clone()), false),
         });
         out.push((slip, corrected));
     }
@@ -239,6 +237,17 @@ fn tail_choices(entry: &Entry) -> Vec<Index> {
     choices
 }
 
+/// `k e` with the factor merged into a leading number or sign (`2 (-x y)` is `-2 x y`).
+fn times(k: f64, e: &Expr) -> Expr {
+    match e {
+        Expr::Num(v) => Expr::Num(k * v),
+        Expr::Neg(inner) => times(-k, inner),
+        Expr::Mul(a, b, x) => Expr::Mul(Box::new(times(k, a)), b.clone(), *x),
+        Expr::Div(a, b) => Expr::Div(Box::new(times(k, a)), b.clone()),
+        other => Expr::Mul(Box::new(Expr::Num(k)), Box::new(other.clone()), false),
+    }
+}
+
 /// `−e`, without a double sign: the sign goes on a product's first factor.
 fn negate(e: &Expr) -> Expr {
     match e {
@@ -282,7 +291,7 @@ fn simplify(base: &Index, offset: i64) -> Index {
 fn count(e: &Expr, eligible: &dyn Fn(&Expr) -> bool) -> usize {
     let here = usize::from(eligible(e));
     here + match e {
-        Expr::Num(_) | Expr::Sym { .. } => 0,
+        Expr::Num(_) | Expr::Sym { .. } | Expr::Ref { .. } => 0,
         Expr::Neg(a) | Expr::Pow(a, _) | Expr::Call(_, a) => count(a, eligible),
         Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b, _) | Expr::Div(a, b) => {
             count(a, eligible) + count(b, eligible)
@@ -316,6 +325,11 @@ fn rename(e: &Expr, a: &str, b: &str) -> Expr {
         Expr::Sym { name, index, pos } => {
             Expr::Sym { name: name.clone(), index: index.as_ref().map(|i| rename_index(i, a, b)), pos: *pos }
         }
+        Expr::Ref { name, indices, pos } => Expr::Ref {
+            name: name.clone(),
+            indices: indices.iter().map(|i| rename_index(i, a, b)).collect(),
+            pos: *pos,
+        },
         Expr::Sum { var, from, to, body, when, pos } => Expr::Sum {
             var: var.clone(),
             from: rename_index(from, a, b),

@@ -7,12 +7,13 @@
 //! side is evaluated with [`Scaled`] arithmetic, so its round-off scale is tracked as the
 //! document's checks do.
 
+use std::cell::OnceCell;
 use std::collections::HashMap;
 
+use super::state::{State, tail_masses};
 use super::syntax::{Compare, Entry, Expr, Func, Index, Pos};
 use crate::case::Kind;
 use crate::expr::Scaled;
-use crate::verify::document::state::{State, tail_masses};
 
 /// A quantity a claim's entry can name, with its shape for `n` links.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -221,9 +222,9 @@ pub struct Truth<'a> {
     n: usize,
     tail: Vec<Scaled>,
     /// Lazily: `c` at unit rates `e_j` (columns) and at `e_j + e_{n+j}` (spatial pairs).
-    unit: Option<Vec<Vec<Scaled>>>,
-    pairs: Option<Vec<Vec<Scaled>>>,
-    accelerations: Option<Vec<Scaled>>,
+    unit: OnceCell<Vec<Vec<Scaled>>>,
+    pairs: OnceCell<Vec<Vec<Scaled>>>,
+    accelerations: OnceCell<Option<Vec<Scaled>>>,
 }
 
 impl<'a> Truth<'a> {
@@ -232,7 +233,8 @@ impl<'a> Truth<'a> {
         let n = st.case.links;
         let tail = tail_masses(&st.params.masses);
         let exact = qdd.iter().map(|&v| Scaled::exact(v)).collect();
-        Self { st, qdd: exact, qdd_values: qdd, n, tail, unit: None, pairs: None, accelerations: None }
+        let (unit, pairs, accelerations) = (OnceCell::new(), OnceCell::new(), OnceCell::new());
+        Self { st, qdd: exact, qdd_values: qdd, n, tail, unit, pairs, accelerations }
     }
 
     /// The symbol's value at 1-based `index` (ignored for scalars); None out of range.
@@ -312,6 +314,38 @@ impl<'a> Truth<'a> {
                     message: format!("an index in 1..{n} (n = {n})"),
                 })?
             }
+            Expr::Ref { name, indices, pos } => {
+                let kind = self.st.case.kind;
+                let shape = Quantity::named(name)
+                    .map(|q| (q, q.shape(kind, n)))
+                    .filter(|(q, shape)| shape.len() == indices.len() && q.only().is_none_or(|k| k == kind));
+                let Some((quantity, shape)) = shape else {
+                    return Err(EvalError {
+                        pos: *pos,
+                        found: format!("{name}[…] with {} indices", indices.len()),
+                        message: format!(
+                            "a matrix of the reference for {kind} chains (M, S or A11…C2) with two indices"
+                        ),
+                    });
+                };
+                let mut at = Vec::new();
+                for (index, size) in indices.iter().zip(&shape) {
+                    let k = index_value(index, bound, n)?;
+                    if !(1..=*size as i64).contains(&k) {
+                        return Err(EvalError {
+                            pos: *pos,
+                            found: format!("{name}[…{index}…] = {k}"),
+                            message: format!("an index in 1..{size} (n = {n})"),
+                        });
+                    }
+                    at.push(k as usize - 1);
+                }
+                self.reference(quantity, &at).ok_or_else(|| EvalError {
+                    pos: *pos,
+                    found: name.clone(),
+                    message: "a state where the reference has it (its mass matrix is singular here)".into(),
+                })?
+            }
             Expr::Neg(e) => -self.value(e, bound)?,
             Expr::Add(a, b) => self.value(a, bound)? + self.value(b, bound)?,
             Expr::Sub(a, b) => self.value(a, bound)? - self.value(b, bound)?,
@@ -357,28 +391,24 @@ impl<'a> Truth<'a> {
     }
 
     /// The velocity terms at unit rates: column `j` of `c(e_j)` (every rate, θ then φ).
-    fn unit(&mut self) -> &Vec<Vec<Scaled>> {
+    fn unit(&self) -> &Vec<Vec<Scaled>> {
         let dof = self.st.case.dof();
-        self.unit.get_or_insert_with(|| (0..dof).map(|j| self.st.velocity_terms_unit(j, None)).collect())
+        self.unit.get_or_init(|| (0..dof).map(|j| self.st.velocity_terms_unit(j, None)).collect())
     }
 
-    fn pairs(&mut self) -> &Vec<Vec<Scaled>> {
+    fn pairs(&self) -> &Vec<Vec<Scaled>> {
         let n = self.n;
-        self.pairs
-            .get_or_insert_with(|| (0..n).map(|j| self.st.velocity_terms_unit(j, Some(n + j))).collect())
+        self.pairs.get_or_init(|| (0..n).map(|j| self.st.velocity_terms_unit(j, Some(n + j))).collect())
     }
 
     /// The free accelerations `M⁻¹(−c − k)` (no torques, damping or pivot motion), with
     /// their round-off scales; None if M is singular.
-    fn accelerations(&mut self) -> Option<&Vec<Scaled>> {
-        if self.accelerations.is_none() {
-            self.accelerations = self.st.free_accelerations();
-        }
-        self.accelerations.as_ref()
+    fn accelerations(&self) -> Option<&Vec<Scaled>> {
+        self.accelerations.get_or_init(|| self.st.free_accelerations()).as_ref()
     }
 
     /// The reference's entry (0-based indices within the quantity's shape).
-    pub fn reference(&mut self, q: Quantity, at: &[usize]) -> Option<Scaled> {
+    pub fn reference(&self, q: Quantity, at: &[usize]) -> Option<Scaled> {
         let n = self.n;
         let st = &self.st;
         Some(match q {

@@ -10,6 +10,7 @@
 pub mod check;
 pub mod diagnose;
 pub mod eval;
+pub(crate) mod state;
 pub mod syntax;
 
 use std::fmt::Write as _;
@@ -21,6 +22,25 @@ use crate::case::Case;
 use check::{Samples, Tally, check_entry, covered};
 use diagnose::{Diagnosis, diagnose};
 use syntax::{Claim, Entry, parse};
+
+/// A claim's verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Agrees,
+    Disagrees,
+    /// None of the cases it covers was given.
+    Untested,
+}
+
+impl Verdict {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Agrees => "agrees",
+            Verdict::Disagrees => "disagrees",
+            Verdict::Untested => "untested",
+        }
+    }
+}
 
 /// What checking one entry of a claim found.
 pub struct EntryOutcome {
@@ -35,22 +55,37 @@ pub struct Outcome {
     /// The cases it covered, by name.
     pub cases: Vec<String>,
     pub entries: Vec<EntryOutcome>,
+    /// The corrected form's entries (no diagnoses), if the claim has one.
+    pub corrected: Vec<EntryOutcome>,
 }
 
 impl Outcome {
-    pub fn verdict(&self) -> &'static str {
-        if self.cases.is_empty() {
-            "untested"
-        } else if self.entries.iter().all(|e| e.tally.agrees()) {
-            "agrees"
-        } else {
-            "disagrees"
-        }
+    pub fn verdict(&self) -> Verdict {
+        verdict(&self.cases, &self.entries)
     }
 
     pub fn worst(&self) -> f64 {
-        self.entries.iter().map(|e| e.tally.worst).fold(0.0, f64::max)
+        worst(&self.entries)
     }
+
+    /// The corrected form's verdict and worst error, if the claim has one.
+    pub fn corrected(&self) -> Option<(Verdict, f64)> {
+        (!self.corrected.is_empty()).then(|| (verdict(&self.cases, &self.corrected), worst(&self.corrected)))
+    }
+}
+
+fn verdict(cases: &[String], entries: &[EntryOutcome]) -> Verdict {
+    if cases.is_empty() {
+        Verdict::Untested
+    } else if entries.iter().all(|e| e.tally.agrees()) {
+        Verdict::Agrees
+    } else {
+        Verdict::Disagrees
+    }
+}
+
+fn worst(entries: &[EntryOutcome]) -> f64 {
+    entries.iter().map(|e| e.tally.worst).fold(0.0, f64::max)
 }
 
 /// `file:line:col: found: expected …`, one line per error.
@@ -93,23 +128,27 @@ pub fn check_all(
     let samples = Samples::new(seed);
     for claim in claims {
         let covering = covered(&claim, cases);
-        let mut entries = Vec::new();
-        for entry in &claim.entries {
-            match check_entry(entry, &covering, states, &samples) {
-                Ok(tally) => {
-                    let diagnosis =
-                        if tally.agrees() { None } else { diagnose(entry, &tally, &covering, &samples) };
-                    entries.push(EntryOutcome { entry: entry.clone(), tally, diagnosis });
-                }
-                Err(found) => {
-                    errors.extend(found.into_iter().map(|(line, col, what, expected)| {
+        let mut check = |entries: &[Entry], diagnosed: bool| {
+            let mut out = Vec::new();
+            for entry in entries {
+                match check_entry(entry, &covering, states, &samples) {
+                    Ok(tally) => {
+                        let diagnosis = (diagnosed && !tally.agrees())
+                            .then(|| diagnose(entry, &tally, &covering, &samples))
+                            .flatten();
+                        out.push(EntryOutcome { entry: entry.clone(), tally, diagnosis });
+                    }
+                    Err(found) => errors.extend(found.into_iter().map(|(line, col, what, expected)| {
                         located(path, line, col, &what, &expected, &source)
-                    }))
+                    })),
                 }
             }
-        }
+            out
+        };
+        let entries = check(&claim.entries, true);
+        let corrected = check(&claim.corrected, false);
         let cases = covering.iter().map(|c| c.name.clone()).collect();
-        outcomes.push(Outcome { claim, cases, entries });
+        outcomes.push(Outcome { claim, cases, entries, corrected });
     }
     if !errors.is_empty() {
         errors.dedup();
@@ -141,31 +180,29 @@ pub fn render(outcomes: &[Outcome]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "| claim | cases | verdict | worst rel. error | first disagreeing entry and state | diagnosis |"
+        "| claim | cases | verdict | worst rel. error | corrected form | first disagreeing entry and state | diagnosis |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|");
     for o in outcomes {
-        let first = o.entries.iter().find_map(|e| e.tally.first.clone());
-        let diagnosis: Vec<&str> =
-            o.entries.iter().filter_map(|e| e.diagnosis.as_ref().map(|d| d.slip.as_str())).collect();
-        let undiagnosed =
-            o.entries.iter().any(|e| !e.tally.agrees() && e.diagnosis.is_none() && e.tally.count > 0);
-        let diagnosis = match (diagnosis.is_empty(), undiagnosed) {
-            (true, false) => "–".to_string(),
-            (true, true) => "none of the common slips explains it".to_string(),
-            _ => diagnosis.join("; "),
-        };
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.1e} | {} | {} |",
+            "| {} | {} | {} | {:.1e} | {} | {} | {} |",
             o.claim.title,
             cases_text(&o.claim, &o.cases),
-            o.verdict(),
+            o.verdict().as_str(),
             o.worst(),
-            first.as_deref().unwrap_or("–"),
-            diagnosis
+            o.corrected().map_or("–".into(), |(v, w)| format!("{} ({w:.1e})", v.as_str())),
+            o.first_disagreement().unwrap_or("–"),
+            o.diagnosis()
         );
     }
+    out.push_str(&corrections(outcomes));
+    out
+}
+
+/// Every diagnosis with its corrected entry, as printed after the table.
+pub fn corrections(outcomes: &[Outcome]) -> String {
+    let mut out = String::new();
     for o in outcomes {
         for e in &o.entries {
             if let Some(d) = &e.diagnosis {
@@ -181,6 +218,26 @@ pub fn render(outcomes: &[Outcome]) -> String {
         }
     }
     out
+}
+
+impl Outcome {
+    /// The first disagreeing entry, with its case and state.
+    pub fn first_disagreement(&self) -> Option<&str> {
+        self.entries.iter().find_map(|e| e.tally.first.as_deref())
+    }
+
+    /// The slips found, or why there are none.
+    pub fn diagnosis(&self) -> String {
+        let found: Vec<&str> =
+            self.entries.iter().filter_map(|e| e.diagnosis.as_ref().map(|d| d.slip.as_str())).collect();
+        let undiagnosed =
+            self.entries.iter().any(|e| !e.tally.agrees() && e.diagnosis.is_none() && e.tally.count > 0);
+        match (found.is_empty(), undiagnosed) {
+            (true, false) => "–".to_string(),
+            (true, true) => "none of the common slips explains it".to_string(),
+            _ => found.join("; "),
+        }
+    }
 }
 
 /// `cargo xtask verify --claims FILE`: checks the file's claims and prints the table;

@@ -3,6 +3,7 @@
 //! ```text
 //! file    := { comment | claim }
 //! claim   := 'claim' STRING NL  'chain' ('planar' | 'spatial') [ 'n' range ] NL  { entry }
+//!            [ 'corrected' NL { entry } ]                (a corrected form, checked too)
 //! range   := '=' INT [ '..' INT ] | '>=' INT | '<=' INT
 //! entry   := lhs '=' expr [ 'if' cond ] NL { '=' expr ( 'if' cond | 'otherwise' ) NL }
 //!            (a line continues the one before while a bracket is open, or when it
@@ -13,6 +14,7 @@
 //! unary   := '-' unary | power
 //! power   := primary [ '^' [ '-' ] INT ]
 //! primary := NUMBER | '(' expr ')' | FUNC '(' expr ')' | SYMBOL [ '[' index ']' ]
+//!          | MATRIX '[' index ',' index ']'           (the reference's own entry)
 //!          | 'sum' '(' VAR '=' index '..' index [ 'if' cond ] ')' term
 //! index   := item { ('+' | '-') item },  item := INT | VAR | 'n' | ('max' | 'min') '(' index ',' index ')'
 //! cond    := index CMP index { 'and' index CMP index }
@@ -206,6 +208,13 @@ pub enum Expr {
         index: Option<Index>,
         pos: Pos,
     },
+    /// An entry of one of the reference's matrices (`S[i,j]`, `B11[i,j]`, `M[i,j]`): a
+    /// name with two indices.
+    Ref {
+        name: String,
+        indices: Vec<Index>,
+        pos: Pos,
+    },
     Neg(Box<Expr>),
     Add(Box<Expr>, Box<Expr>),
     Sub(Box<Expr>, Box<Expr>),
@@ -230,7 +239,7 @@ impl Expr {
     pub fn map_children(&self, f: &mut dyn FnMut(&Expr) -> Expr) -> Expr {
         let mut go = |a: &Expr| Box::new(f(a));
         match self {
-            Expr::Num(_) | Expr::Sym { .. } => self.clone(),
+            Expr::Num(_) | Expr::Sym { .. } | Expr::Ref { .. } => self.clone(),
             Expr::Neg(a) => Expr::Neg(go(a)),
             Expr::Pow(a, k) => Expr::Pow(go(a), *k),
             Expr::Call(func, a) => Expr::Call(*func, go(a)),
@@ -291,7 +300,18 @@ pub struct Claim {
     pub title: String,
     pub chains: Chains,
     pub entries: Vec<Entry>,
+    /// The entries after a line `corrected`: the claim's corrected form, checked too.
+    pub corrected: Vec<Entry>,
+    /// Where the line `corrected` is, if there is one.
+    pub corrected_at: Option<Pos>,
     pub pos: Pos,
+}
+
+impl Claim {
+    /// The entries lines are added to now: the corrected form's after `corrected`.
+    fn current(&mut self) -> &mut Vec<Entry> {
+        if self.corrected_at.is_some() { &mut self.corrected } else { &mut self.entries }
+    }
 }
 
 /// Parses a claims file; every error found, not only the first.
@@ -334,6 +354,13 @@ pub fn parse(text: &str) -> Result<Vec<Claim>, Vec<SyntaxError>> {
     };
     let mut empty = Vec::new();
     for (k, claim) in claims.iter().enumerate() {
+        if let Some(at) = claim.corrected_at.filter(|_| claim.corrected.is_empty()) {
+            empty.push(SyntaxError {
+                pos: at,
+                found: "corrected".into(),
+                message: "the corrected form's entries after `corrected`".into(),
+            });
+        }
         if claim.entries.is_empty() && !faulty(claim, claims.get(k + 1)) {
             empty.push(SyntaxError {
                 pos: claim.pos,
@@ -426,7 +453,14 @@ impl Parser {
             self.at += 1;
             self.done()?;
             let chains = Chains { spatial: false, low: 0, high: None };
-            claims.push(Claim { title, chains, entries: Vec::new(), pos });
+            claims.push(Claim {
+                title,
+                chains,
+                entries: Vec::new(),
+                corrected: Vec::new(),
+                corrected_at: None,
+                pos,
+            });
             return Ok(());
         }
         let Some(claim) = claims.last_mut() else {
@@ -440,8 +474,15 @@ impl Parser {
         if claim.chains.low == 0 {
             return Err(self.error("the chains the claim covers first: chain planar|spatial [n = 1..8]"));
         }
+        if self.is_word("corrected") && self.tokens.len() == 1 {
+            if claim.corrected_at.is_some() || claim.entries.is_empty() {
+                return Err(self.error("one `corrected` per claim, after its entries"));
+            }
+            claim.corrected_at = Some(pos);
+            return Ok(());
+        }
         if self.is_op("=") {
-            let Some(entry) = claim.entries.last_mut() else {
+            let Some(entry) = claim.current().last_mut() else {
                 return Err(self.error("an entry first: quantity[indices] = value"));
             };
             self.at += 1;
@@ -468,7 +509,7 @@ impl Parser {
         }
         self.expect_op("=", "`=` after the entry's name")?;
         let branch = self.branch(pos, false)?;
-        claim.entries.push(Entry { quantity, indices, branches: vec![branch], pos });
+        claim.current().push(Entry { quantity, indices, branches: vec![branch], pos });
         Ok(())
     }
 
@@ -714,15 +755,21 @@ impl Parser {
                     self.expect_op(")", &format!("`)` closing {w}(…)"))?;
                     return Ok(Expr::Call(f, Box::new(arg)));
                 }
-                let index = if self.is_op("[") {
+                if !self.is_op("[") {
+                    return Ok(Expr::Sym { name: w, index: None, pos });
+                }
+                self.at += 1;
+                let mut indices = vec![self.index()?];
+                while self.is_op(",") {
                     self.at += 1;
-                    let index = self.index()?;
-                    self.expect_op("]", "`]` closing the index (symbols take one index)")?;
-                    Some(index)
+                    indices.push(self.index()?);
+                }
+                self.expect_op("]", "`,` or `]` after an index")?;
+                if indices.len() == 1 {
+                    Ok(Expr::Sym { name: w, index: indices.pop(), pos })
                 } else {
-                    None
-                };
-                Ok(Expr::Sym { name: w, index, pos })
+                    Ok(Expr::Ref { name: w, indices, pos })
+                }
             }
             _ => Err(self.error("a value: a number, a symbol, a function, sum(…) or a bracket")),
         }
@@ -781,6 +828,10 @@ impl fmt::Display for Expr {
             Expr::Num(v) => write!(f, "{v}"),
             Expr::Sym { name, index: Some(i), .. } => write!(f, "{name}[{i}]"),
             Expr::Sym { name, index: None, .. } => f.write_str(name),
+            Expr::Ref { name, indices, .. } => {
+                let all: Vec<String> = indices.iter().map(Index::to_string).collect();
+                write!(f, "{name}[{}]", all.join(","))
+            }
             // A product's sign may stand before its first factor.
             Expr::Neg(e) => write!(f, "-{}", wrapped(e, 2)),
             Expr::Add(a, b) => write!(f, "{a} + {}", wrapped(b, 2)),
@@ -789,7 +840,9 @@ impl fmt::Display for Expr {
                 // A sum's body runs to the end of its product: it must come last.
                 let left = if ends_open(a) { format!("({a})") } else { wrapped(a, 2) };
                 // a (b c) = a b c and a (b / c) = a b / c; a sum on the right runs to the end.
-                let right = if matches!(**b, Expr::Neg(_)) { format!("({b})") } else { wrapped(b, 2) };
+                // A right factor that prints with a sign would read as a subtraction.
+                let right = wrapped(b, 2);
+                let right = if right.starts_with('-') { format!("({right})") } else { right };
                 write!(f, "{left}{}{right}", if *explicit { " * " } else { " " })
             }
             Expr::Div(a, b) => {
@@ -875,6 +928,9 @@ mod tests {
         assert_eq!(c.chains, Chains { spatial: true, low: 2, high: None });
         let e = one("claim \"p\"\nchain planar\nk[i] = (a + b) c^-1 - d e\n").entries.remove(0);
         assert_eq!(e.render(), "k[i] = (a + b) c^-1 - d e");
+        // A signed right factor keeps its bracket (else it would read as a subtraction).
+        let e = one("claim \"s\"\nchain planar\nk[i] = 2 (-l[i] g)\n").entries.remove(0);
+        assert_eq!(e.render(), "k[i] = 2 (-l[i] g)");
         let e = one("claim \"m\"\nchain planar\nM[i,j] = m[max(i,j)+1] 1.5e-3\n").entries.remove(0);
         assert_eq!(e.render(), "M[i,j] = m[max(i,j)+1] 0.0015");
     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::claims::{Finding, Verdict};
+use super::finding::{Finding, Verdict};
 
 /// Where the errata (and the machine-readable summary table) live.
 pub fn errata_path() -> PathBuf {
@@ -52,12 +52,12 @@ pub fn differences(findings: &[Finding], summary: &[(String, String)]) -> Vec<St
         if summary[..k].iter().any(|(e, _)| e == equation) {
             out.push(format!("eq {equation}: listed more than once in the ERRATA summary"));
         }
-        if !findings.iter().any(|f| f.equation == equation) {
+        if !findings.iter().any(|f| &f.equation == equation) {
             out.push(format!("eq {equation}: in the ERRATA summary but not a checked equation"));
         }
     }
     for f in findings {
-        match summary.iter().find(|(e, _)| e == f.equation) {
+        match summary.iter().find(|(e, _)| *e == f.equation) {
             None => out.push(format!(
                 "eq {}: measured {} but missing from the ERRATA summary",
                 f.equation,
@@ -95,13 +95,14 @@ mod tests {
         let text = "# x\n\n| equation | verdict |\n|---|---|\n| 22 | agrees |\n| 23 | agrees |\n| 99 | agrees |\n\nmore\n";
         let rows = parse_summary(text).unwrap();
         assert_eq!(rows.len(), 3);
-        let finding = |equation, verdict| Finding {
-            equation,
-            claim: "",
+        let finding = |equation: &str, verdict| Finding {
+            equation: equation.into(),
+            claim: String::new(),
             verdict,
             worst: 0.0,
             first_disagreement: None,
             corrected: None,
+            diagnosis: String::new(),
         };
         let found = [
             finding("22", Verdict::Agrees),

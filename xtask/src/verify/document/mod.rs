@@ -1,74 +1,83 @@
 //! "The document as printed": a numerical check of the seed document's hand derivation.
 //!
-//! The seed document ("鎖を振り回したい", 中山大樹, 2018) prints the
-//! equations of motion of planar and spatial N-link pendulums. Its equations are
-//! *claims*; the truth is the sympy reference in `reference/cases` (positions → T, U →
-//! Euler–Lagrange). This module encodes the printed equations **exactly as printed**
-//! (typos included) and compares each one, in isolation, with the reference at many
-//! random states: every ingredient other than the equation under test is taken from
-//! the reference, so each verdict is attributable to that one equation.
+//! The seed document ("鎖を振り回したい", 中山大樹, 2018) prints the equations of motion
+//! of planar and spatial N-link pendulums. Its equations are *claims*; the truth is the
+//! sympy reference in `reference/cases`. They are written down **exactly as printed**
+//! (typos included) in `reference/claims/seed.claims`, one claim per checked equation
+//! titled `Eq N: …`, with the corrected form `reference/ERRATA.md` gives after
+//! `corrected`. This module checks that file as any claims file is checked
+//! ([`crate::claims`]: every entry at the random states of `verify`, each claim in
+//! isolation, the common slips diagnosed) and turns the outcomes into one row per
+//! printed equation.
 //!
-//! Reference conventions: `M q̈ + c + k + d = Q`, `c` the velocity terms (exactly
-//! quadratic in the rates), `k = ∂U/∂q`. In the document's planar notation (eq 18)
-//! `C = M`, `S θ̇² = −c`, `h = k`; in the spatial block form (eq 30)
-//! `B [θ̇²; φ̇²] − C [θ̇φ̇] − [g; 0] = −c − k`. The reference's coefficient matrices
-//! `S`, `B`, `C` are extracted numerically from `c` (unit rates and polarization).
-//!
-//! Every compared number carries an absolute round-off scale (the sum of the absolute
-//! values of the terms it was computed from): one rule, [`Scaled`], tracked through the
-//! printed formula here and through the reference's expressions by
-//! [`Case::evaluate_with_scales`]. The relative error of an entry is
-//! `|printed − reference| / (scale_printed + scale_reference)`; an equation agrees if
-//! its worst relative error over all entries, cases and states is below
-//! [`AGREEMENT`](tally::AGREEMENT).
-//!
-//! The verdicts are recorded in `reference/ERRATA.md` (with the corrected forms, which
-//! are checked here too); [`run`] fails if the measured findings no longer match it.
-//!
-//! The checked equations are listed in [`claims`] and encoded as printed in `planar` and
-//! `spatial`, which read the reference through `state`; [`tally`] turns their errors into
-//! verdicts, [`errata`] compares those with `reference/ERRATA.md`.
+//! The verdicts are recorded in `reference/ERRATA.md`; [`run`] fails if the measured
+//! findings no longer match it, or if a corrected form does not agree.
 
-pub mod claims;
 pub mod errata;
-mod planar;
-mod spatial;
-pub(crate) mod state;
-pub mod tally;
+pub mod finding;
 
 use std::fmt::Write as _;
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use rand::Rng;
 
-use crate::case::{Case, Kind};
-use crate::expr::Scaled;
-use claims::{Finding, Verdict};
+use crate::case::Case;
+use crate::claims::{Outcome, check_all, corrections, load};
 use errata::{differences, errata_path, parse_summary};
-use state::State;
-use tally::Recorder;
+use finding::{Finding, Verdict};
 
-/// Check every printed equation against the reference `cases` at `states` random
-/// states per case (the states of [`crate::sample::state`] for `seed`). Pure: reads nothing but `cases`.
-pub fn findings(cases: &[Case], states: usize, seed: u64) -> Vec<Finding> {
-    let mut rec = Recorder::new();
-    for case in cases {
-        let n = case.links;
-        for index in 0..states {
-            // State `index` is the one `verify` draws ([`crate::sample::state`]); the
-            // accelerations for eqs 15–17 are drawn after it from the same generator.
-            let (params, point, mut rng) = crate::sample::state_with_rng(seed, case.kind, n, index);
-            let qdd: Vec<Scaled> =
-                (0..case.dof()).map(|_| Scaled::exact(rng.random_range(-2.0..2.0))).collect();
-            let (ev, sc) = case.evaluate_with_scales(&params, &point);
-            let st = State { case, index, params, point, ev, sc };
-            match case.kind {
-                Kind::Planar => planar::check(&mut rec, &st, &qdd),
-                Kind::Spatial => spatial::check(&mut rec, &st),
-            }
+/// The seed document's equations as a claims file.
+pub fn seed_claims_path() -> PathBuf {
+    crate::workspace_root().join("reference").join("claims").join("seed.claims")
+}
+
+/// `"Eq 24 S: the n = 3 matrix S"` → `("24 S", "the n = 3 matrix S")`.
+fn equation_of(title: &str) -> anyhow::Result<(String, String)> {
+    let rest = title.strip_prefix("Eq ").with_context(|| format!("claim {title:?}: a title `Eq N: …`"))?;
+    let (equation, claim) =
+        rest.split_once(':').with_context(|| format!("claim {title:?}: a title `Eq N: what it claims`"))?;
+    Ok((equation.trim().to_string(), claim.trim().to_string()))
+}
+
+/// One finding per printed equation (claims of the same equation, e.g. eq 12 planar and
+/// spatial, merged), in the file's order, and the claims' outcomes.
+pub fn findings(cases: &[Case], states: usize, seed: u64) -> anyhow::Result<(Vec<Finding>, Vec<Outcome>)> {
+    let path = seed_claims_path();
+    let outcomes = check_all(&path, load(&path)?, cases, states, seed)?;
+    let mut found: Vec<Finding> = Vec::new();
+    for o in &outcomes {
+        let (equation, claim) = equation_of(&o.claim.title)?;
+        let next = Finding {
+            equation,
+            claim,
+            verdict: o.verdict(),
+            worst: o.worst(),
+            first_disagreement: o.first_disagreement().map(String::from),
+            corrected: o.corrected(),
+            diagnosis: o.diagnosis(),
+        };
+        let Some(f) = found.iter_mut().find(|f| f.equation == next.equation) else {
+            found.push(next);
+            continue;
+        };
+        f.verdict = match (f.verdict, next.verdict) {
+            (Verdict::Disagrees, _) | (_, Verdict::Disagrees) => Verdict::Disagrees,
+            (Verdict::Untested, Verdict::Untested) => Verdict::Untested,
+            _ => Verdict::Agrees,
+        };
+        f.claim = format!("{}; {}", f.claim, next.claim);
+        f.worst = f.worst.max(next.worst);
+        f.first_disagreement = f.first_disagreement.take().or(next.first_disagreement);
+        if next.diagnosis != "–" {
+            f.diagnosis = if f.diagnosis == "–" {
+                next.diagnosis
+            } else {
+                format!("{}; {}", f.diagnosis, next.diagnosis)
+            };
         }
+        f.corrected = f.corrected.or(next.corrected);
     }
-    rec.findings()
+    Ok((found, outcomes))
 }
 
 /// The findings as a table.
@@ -76,9 +85,9 @@ pub fn render(findings: &[Finding]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "| equation | what it claims | verdict | worst rel. error | corrected form | first disagreeing entry and state |"
+        "| equation | what it claims | verdict | worst rel. error | corrected form | first disagreeing entry and state | diagnosis |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|");
     for f in findings {
         let corrected = match f.corrected {
             Some((verdict, worst)) => format!("{} ({worst:.1e})", verdict.as_str()),
@@ -86,25 +95,31 @@ pub fn render(findings: &[Finding]) -> String {
         };
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.1e} | {} | {} |",
+            "| {} | {} | {} | {:.1e} | {} | {} | {} |",
             f.equation,
             f.claim,
             f.verdict.as_str(),
             f.worst,
             corrected,
-            f.first_disagreement.as_deref().unwrap_or("–")
+            f.first_disagreement.as_deref().unwrap_or("–"),
+            f.diagnosis
         );
     }
     out
 }
 
 /// Check the document's printed equations at `states` random states per case, print
-/// the findings, and fail iff they no longer match `reference/ERRATA.md`.
-/// Disagreements with the reference are findings, not failures.
+/// the findings and the corrections the diagnoses give, and fail iff they no longer
+/// match `reference/ERRATA.md`. Disagreements with the reference are findings, not
+/// failures.
 pub fn run(cases: &[Case], states: usize, seed: u64) -> anyhow::Result<()> {
-    let findings = findings(cases, states, seed);
-    println!("The document as printed ({states} random states per case, seed {seed}):");
+    let (findings, outcomes) = findings(cases, states, seed)?;
+    println!(
+        "The document as printed ({}, {states} random states per case, seed {seed}):",
+        seed_claims_path().strip_prefix(crate::workspace_root()).unwrap_or(&seed_claims_path()).display()
+    );
     print!("{}", render(&findings));
+    print!("{}", corrections(&outcomes));
     let path = errata_path();
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let summary = parse_summary(&text).with_context(|| format!("parsing {}", path.display()))?;
@@ -113,7 +128,7 @@ pub fn run(cases: &[Case], states: usize, seed: u64) -> anyhow::Result<()> {
         bail!("the document check no longer matches {}:\n  {}", path.display(), differences.join("\n  "));
     }
     let untested: Vec<&str> =
-        findings.iter().filter(|f| f.verdict == Verdict::Untested).map(|f| f.equation).collect();
+        findings.iter().filter(|f| f.verdict == Verdict::Untested).map(|f| f.equation.as_str()).collect();
     if !untested.is_empty() {
         println!("Untested (none of their cases given): eqs {}.", untested.join(", "));
     }
@@ -125,17 +140,28 @@ pub fn run(cases: &[Case], states: usize, seed: u64) -> anyhow::Result<()> {
 mod tests {
     use super::*;
 
-    /// The committed reference and ERRATA.md agree with a short run.
+    /// The committed reference, seed.claims and ERRATA.md agree with a short run: the
+    /// same 32 equations, verdicts and corrected forms.
     #[test]
     fn findings_match_errata() {
         let cases = crate::case::load_all(&crate::cases_dir()).expect("the committed reference cases load");
-        let findings = findings(&cases, 6, 20181223);
+        let (findings, _) = findings(&cases, 6, 20181223).expect("seed.claims checks");
+        assert_eq!(findings.len(), 32, "{}", render(&findings));
         let untested: Vec<_> =
-            findings.iter().filter(|f| f.verdict == Verdict::Untested).map(|f| f.equation).collect();
+            findings.iter().filter(|f| f.verdict == Verdict::Untested).map(|f| f.equation.clone()).collect();
         assert!(untested.is_empty(), "the committed cases leave eqs {untested:?} untested");
         let text = std::fs::read_to_string(errata_path()).expect("reference/ERRATA.md exists");
         let summary = parse_summary(&text).expect("the ERRATA summary parses");
         let differences = differences(&findings, &summary);
         assert!(differences.is_empty(), "{}\n{}", render(&findings), differences.join("\n"));
+        for f in findings.iter().filter(|f| f.verdict == Verdict::Disagrees) {
+            assert!(f.corrected.is_some(), "eq {}: no corrected form in seed.claims", f.equation);
+        }
+    }
+
+    #[test]
+    fn titles_name_their_equation() {
+        assert_eq!(equation_of("Eq 24 S: S written out").unwrap(), ("24 S".into(), "S written out".into()));
+        assert!(equation_of("Eq 24 S S").is_err() && equation_of("24: x").is_err());
     }
 }

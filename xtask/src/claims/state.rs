@@ -3,14 +3,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::tally::Site;
 use crate::case::{Case, Evaluated, Params, Point};
 use crate::expr::Scaled;
 
 /// One random state of one case, evaluated by the reference.
 pub(crate) struct State<'a> {
     pub(crate) case: &'a Case,
-    pub(crate) index: usize,
     pub(crate) params: Params,
     pub(crate) point: Point,
     pub(crate) ev: Evaluated,
@@ -18,10 +16,6 @@ pub(crate) struct State<'a> {
 }
 
 impl State<'_> {
-    pub(crate) fn site(&self) -> Site<'_> {
-        Site { case: &self.case.name, state: self.index }
-    }
-
     pub(crate) fn mass(&self, i: usize, j: usize) -> Scaled {
         Scaled::with_scale(self.ev.mass_matrix[(i, j)], self.sc.mass_matrix[(i, j)])
     }
