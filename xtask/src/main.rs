@@ -22,8 +22,16 @@ enum Task {
     Reference {
         /// Regenerate into a scratch directory and fail, naming the files, if the
         /// committed ones differ.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "claims")]
         check: bool,
+        /// Instead: have sympy prove each entry of this claims file's claims (and
+        /// corrected forms) that agree numerically, for every derived case up to --links
+        /// links (`reference/CLAIMS.md`).
+        #[arg(long, value_name = "FILE")]
+        claims: Option<std::path::PathBuf>,
+        /// With --claims: the largest chain proven.
+        #[arg(long, default_value_t = 3, requires = "claims")]
+        links: usize,
     },
 }
 
@@ -36,7 +44,11 @@ fn main() -> anyhow::Result<()> {
             }
             None => xtask::verify::run(&options),
         },
-        Task::Reference { check } => xtask::regen::run(check),
+        Task::Reference { claims: Some(path), links, .. } => {
+            let cases = xtask::case::load_all(&xtask::cases_dir())?;
+            xtask::claims::proof::run(&path, &cases, links, 20, xtask::verify::DEFAULT_SEED)
+        }
+        Task::Reference { check, .. } => xtask::regen::run(check),
         Task::Bench(options) => xtask::bench::run(&options),
     }
 }

@@ -52,7 +52,7 @@ pub fn run(check: bool) -> Result<()> {
 }
 
 /// Fails unless `python3` runs and imports sympy [`SYMPY_VERSION`].
-fn check_python() -> Result<()> {
+pub(crate) fn check_python() -> Result<()> {
     let output = Command::new("python3")
         .args(["-c", "import sympy; print(sympy.__version__)"])
         .stdin(Stdio::null())

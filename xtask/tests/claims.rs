@@ -169,3 +169,26 @@ fn the_seed_claims_match_the_errata() {
         }
     }
 }
+
+/// `cargo xtask reference --claims`: sympy proves an identity and refutes a claim that
+/// only agrees to round-off. Needs python3 with sympy; skipped without it unless
+/// `PENDULUM_SYMPY_TEST=require` (as `.ci/run` sets).
+#[test]
+fn sympy_proves_identities_and_refutes_a_near_miss() {
+    let has_sympy = std::process::Command::new("python3")
+        .args(["-c", "import sympy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has_sympy {
+        assert!(std::env::var("PENDULUM_SYMPY_TEST").as_deref() != Ok("require"), "no python3 with sympy");
+        eprintln!("no python3 with sympy: the exact confirmation is not tested");
+        return;
+    }
+    let found = outcomes("almost.claims");
+    assert!(found.iter().all(|o| o.verdict().as_str() == "agrees"), "both agree numerically");
+    let error =
+        xtask::claims::proof::run(&file("almost.claims"), &cases(), 2, 6, SEED).unwrap_err().to_string();
+    assert!(error.starts_with("sympy does not confirm 2 identities:"), "{error}");
+    assert!(error.contains("nearly the mass matrix (as written): refuted"), "{error}");
+    assert!(!error.contains("velocity terms"), "the identity is proven: {error}");
+}

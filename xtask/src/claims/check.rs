@@ -130,7 +130,11 @@ pub fn quantity_of(entry: &Entry, kind: Kind) -> Result<Quantity, EvalError> {
 
 /// Every combination of the entry's indices for the quantity's shape, 1-based, with the
 /// bindings of its index names; a fixed index outside the shape is an error.
-fn combinations(entry: &Entry, shape: &[usize], n: usize) -> Result<Vec<(Vec<usize>, Bindings)>, EvalError> {
+pub(crate) fn combinations(
+    entry: &Entry,
+    shape: &[usize],
+    n: usize,
+) -> Result<Vec<(Vec<usize>, Bindings)>, EvalError> {
     let slots = entry_indices(entry)?;
     let mut all = vec![(Vec::new(), Bindings::new())];
     for (slot, &size) in slots.iter().zip(shape) {

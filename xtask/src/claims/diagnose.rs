@@ -4,7 +4,8 @@
 //!
 //! Tried in order: a constant factor (its sign included: an overall sign, ½, 2, …); the
 //! sign of one triangle (i > j or i < j); sin for cos or cos for sin at one place;
-//! transposed indices; an index off by one at one place; the wrong tail-mass index.
+//! transposed indices; an index off by one at one place; the wrong tail-mass index; a
+//! missing part of a sum (the rest of its index range).
 
 use super::check::{Samples, Tally, check_entry};
 use super::syntax::{Branch, Compare, Entry, Expr, Func, Index, Pos};
@@ -62,11 +63,6 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
     let mut out = Vec::new();
     // A constant factor, estimated from the largest disagreeing entry.
     if let Some((p, q)) = tally.largest.and_then(|(claimed, reference)| fraction(reference / claimed)) {
-        let factor = if q == 1 {
-            Expr::Num(p as f64)
-        } else {
-            Expr::Div(Box::new(Expr::Num(p as f64)), Box::new(Expr::Num(q as f64)))
-        };
         let slip = match (p, q) {
             (-1, 1) => "the overall sign: the reference is −1 × the claim".to_string(),
             (p, q) if p < 0 => {
@@ -77,7 +73,10 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
         let corrected = with_values(entry, |v| match (p, q) {
             (-1, 1) => negate(v),
             (p, 1) => times(p as f64, v),
-            _ => Expr::Mul(Box::new(factor.clone()), Box::new(v.clone()), false),
+            (p, q) => {
+                let factor = Expr::Div(Box::new(Expr::Num(p as f64)), Box::new(Expr::Num(q as f64)));
+                Expr::Mul(Box::new(factor), Box::new(v.clone()), false)
+            }
         });
         out.push((slip, corrected));
     }
@@ -86,8 +85,7 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
         let conditioned = entry.branches.iter().any(|b| b.when.is_some());
         if conditioned {
             for (k, b) in entry.branches.iter().enumerate() {
-                let mut e = entry.clone();
-                e.branches[k].value = negate(&b.value);
+                let e = with_branch(entry, k, negate(&b.value));
                 let when = b.when.as_ref().map_or("otherwise".to_string(), |w| {
                     format!("if {}", w.iter().map(Compare::to_string).collect::<Vec<_>>().join(" and "))
                 });

@@ -5,11 +5,13 @@
 //! [`syntax`] reads a file (every error with its line and column), [`eval`] gives its
 //! names their meaning and evaluates an entry at one state, [`check`] compares an entry
 //! with the reference at random states of every case it covers, [`diagnose`] tries the
-//! common slips on a disagreeing entry and prints the corrected entry.
+//! common slips on a disagreeing entry and prints the corrected entry; [`proof`] has
+//! sympy prove the agreeing ones exactly (`cargo xtask reference --claims FILE`).
 
 pub mod check;
 pub mod diagnose;
 pub mod eval;
+pub mod proof;
 pub(crate) mod state;
 pub mod syntax;
 
