@@ -47,6 +47,10 @@ fn each_slip_is_diagnosed_and_corrected() {
             "S[i,j] = -M[i] l[i] l[j] sin(theta[i] - theta[j])  if i >= j",
         ),
         ("sin for cos", "M[i,j] = M[max(i,j)] l[i] l[j] cos(theta[i] - theta[j])"),
+        (
+            "a coordinate confused with its rate: `theta[i]` should be `thetadot[i]`",
+            "Q[i] = sigma[i] - lambda[i] thetadot[i]",
+        ),
         ("transposed indices: i and j exchanged", "A12[i,j] = M[max(j,i)] l[j] l[i] sin(phi[i] - phi[j])"),
         ("an index off by one: `theta[2]` should be `theta[1]`", "k[1] = M[1] g l[1] sin(theta[1])"),
         (
@@ -161,8 +165,10 @@ fn the_seed_claims_match_the_errata() {
     }
     assert_eq!(diagnoses("43"), ["a constant factor and the sign: the reference is -2 × the claim"]);
     assert_eq!(diagnoses("50"), ["an index off by one: `θ[1]` should be `θ[2]` (+1)"]);
-    // Two slips at once (cos for sin and a missing θ̇_d), θ for θ̇: not common slips.
-    assert!(diagnoses("15").is_empty() && diagnoses("41").is_empty());
+    let forty_one = diagnoses("41");
+    assert_eq!(forty_one, ["a coordinate confused with its rate: every `θ[j]` should be `θ̇[j]`"]);
+    // Two slips at once (cos for sin and a missing θ̇_d): not one common slip.
+    assert!(diagnoses("15").is_empty());
     for o in &found {
         if let Some((verdict, worst)) = o.corrected() {
             assert_eq!(verdict.as_str(), "agrees", "{}: the corrected form, worst {worst:e}", o.claim.title);

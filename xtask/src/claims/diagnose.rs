@@ -4,8 +4,9 @@
 //!
 //! Tried in order: a constant factor (its sign included: an overall sign, ½, 2, …); the
 //! sign of one triangle (i > j or i < j); sin for cos or cos for sin at one place;
-//! transposed indices; an index off by one at one place; the wrong tail-mass index; a
-//! missing part of a sum (the rest of its index range).
+//! a coordinate for its rate (or the reverse) at one place; transposed indices; an index
+//! off by one at one place; the wrong tail-mass index; a missing part of a sum (the rest
+//! of its index range).
 
 use super::check::{Samples, Tally, check_entry};
 use super::syntax::{Branch, Compare, Entry, Expr, Func, Index, Pos};
@@ -43,6 +44,21 @@ fn fraction(r: f64) -> Option<(i64, i64)> {
     })
 }
 
+/// The rate of a coordinate, or the coordinate of a rate, in the same spelling.
+fn partner(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "theta" => "thetadot",
+        "thetadot" => "theta",
+        "θ" => "θ̇",
+        "θ̇" => "θ",
+        "phi" => "phidot",
+        "phidot" => "phi",
+        "φ" => "φ̇",
+        "φ̇" => "φ",
+        _ => return None,
+    })
+}
+
 /// `entry` with branch `k`'s value replaced.
 fn with_branch(entry: &Entry, k: usize, value: Expr) -> Entry {
     let mut changed = entry.clone();
@@ -50,7 +66,7 @@ fn with_branch(entry: &Entry, k: usize, value: Expr) -> Entry {
     changed
 }
 
-fn with_values(entry: &Entry, f: impl Fn(&Expr) -> Expr) -> Entry {
+fn with_values(entry: &Entry, mut f: impl FnMut(&Expr) -> Expr) -> Entry {
     let mut e = entry.clone();
     for b in &mut e.branches {
         b.value = f(&b.value);
@@ -124,6 +140,60 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
             });
             out.push((found, at(e)));
         }
+    }
+    // A coordinate for its rate, or a rate for its coordinate, at one place.
+    for (k, b) in entry.branches.iter().enumerate() {
+        let paired = |e: &Expr| matches!(e, Expr::Sym { name, .. } if partner(name).is_some());
+        for site in 0..count(&b.value, &paired) {
+            let mut found = String::new();
+            let e = replace_nth(&b.value, site, &mut 0, &paired, &mut |e| {
+                let Expr::Sym { name, index, pos } = e else { unreachable!() };
+                let other = partner(name).unwrap_or(name).to_string();
+                let changed = Expr::Sym { name: other, index: index.clone(), pos: *pos };
+                found = format!("a coordinate confused with its rate: `{e}` should be `{changed}`");
+                changed
+            });
+            out.push((found, with_branch(entry, k, e)));
+        }
+    }
+    // The same, at every place it is written the same way (in every branch).
+    let mut spellings: Vec<String> = Vec::new();
+    for b in &entry.branches {
+        let paired = |e: &Expr| matches!(e, Expr::Sym { name, .. } if partner(name).is_some());
+        for site in 0..count(&b.value, &paired) {
+            replace_nth(&b.value, site, &mut 0, &paired, &mut |e| {
+                spellings.push(e.to_string());
+                e.clone()
+            });
+        }
+    }
+    spellings.sort();
+    spellings.dedup();
+    for spelling in spellings {
+        let same = |e: &Expr| {
+            matches!(e, Expr::Sym { name, .. } if partner(name).is_some()) && e.to_string() == spelling
+        };
+        let mut changed_to = String::new();
+        let changed = with_values(entry, |v| {
+            let mut v = v.clone();
+            while count(&v, &same) > 0 {
+                v = replace_nth(&v, 0, &mut 0, &same, &mut |e| {
+                    let Expr::Sym { name, index, pos } = e else { unreachable!() };
+                    let other = Expr::Sym {
+                        name: partner(name).unwrap_or(name).into(),
+                        index: index.clone(),
+                        pos: *pos,
+                    };
+                    changed_to = other.to_string();
+                    other
+                });
+            }
+            v
+        });
+        out.push((
+            format!("a coordinate confused with its rate: every `{spelling}` should be `{changed_to}`"),
+            changed,
+        ));
     }
     // Transposed indices.
     if let [Index::Var(i, _), Index::Var(j, _)] = entry.indices.as_slice() {
