@@ -194,6 +194,44 @@ pub fn index_value(index: &Index, bound: &Bindings, n: usize) -> Result<i64, Eva
     })
 }
 
+/// Calls `term` on the body of the sum `sum` once for every value of its index where its
+/// condition holds, with the index bound to it (and unbound, or as before, after). A
+/// range of [`MAX_TERMS`] or more is an error.
+pub fn each_term(
+    sum: &Expr,
+    bound: &mut Bindings,
+    n: usize,
+    mut term: impl FnMut(&Expr, &mut Bindings) -> Result<(), EvalError>,
+) -> Result<(), EvalError> {
+    let Expr::Sum { var, from, to, body, when, pos } = sum else { return term(sum, bound) };
+    let (lo, hi) = (index_value(from, bound, n)?, index_value(to, bound, n)?);
+    if hi.saturating_sub(lo) >= MAX_TERMS {
+        return Err(EvalError {
+            pos: *pos,
+            found: format!("sum({var} = {from}..{to}) over {lo}..{hi}"),
+            message: format!("a sum of fewer than {MAX_TERMS} terms"),
+        });
+    }
+    let saved = bound.get(var).copied();
+    let mut outcome = Ok(());
+    for k in lo..=hi {
+        bound.insert(var.clone(), k);
+        outcome = match when.as_ref().map_or(Ok(true), |w| holds(w, bound, n)) {
+            Ok(true) => term(body, bound),
+            Ok(false) => Ok(()),
+            Err(e) => Err(e),
+        };
+        if outcome.is_err() {
+            break;
+        }
+    }
+    match saved {
+        Some(v) => bound.insert(var.clone(), v),
+        None => bound.remove(var),
+    };
+    outcome
+}
+
 /// Whether every comparison holds.
 pub fn holds(all: &[Compare], bound: &Bindings, n: usize) -> Result<bool, EvalError> {
     for c in all {
@@ -218,7 +256,6 @@ pub struct Truth<'a> {
     pub(crate) st: State<'a>,
     /// The accelerations `EL` is taken at.
     qdd: Vec<Scaled>,
-    qdd_values: Vec<f64>,
     n: usize,
     tail: Vec<Scaled>,
     /// Lazily: `c` at unit rates `e_j` (columns) and at `e_j + e_{n+j}` (spatial pairs).
@@ -234,23 +271,22 @@ impl<'a> Truth<'a> {
         let tail = tail_masses(&st.params.masses);
         let exact = qdd.iter().map(|&v| Scaled::exact(v)).collect();
         let (unit, pairs, accelerations) = (OnceCell::new(), OnceCell::new(), OnceCell::new());
-        Self { st, qdd: exact, qdd_values: qdd, n, tail, unit, pairs, accelerations }
+        Self { st, qdd: exact, n, tail, unit, pairs, accelerations }
     }
 
     /// The symbol's value at 1-based `index` (ignored for scalars); None out of range.
     fn symbol(&self, symbol: Symbol, index: i64) -> Option<Scaled> {
         let (n, st) = (self.n, &self.st);
-        let at = |v: &[f64], offset: usize| -> Option<Scaled> {
-            let k = usize::try_from(index - 1).ok()?;
-            if k < n { v.get(offset + k).map(|&x| Scaled::exact(x)) } else { None }
-        };
+        // The 0-based link of a per-link symbol, if in range.
+        let link = usize::try_from(index - 1).ok().filter(|&k| k < n);
+        let at = |v: &[f64], offset: usize| link.and_then(|k| v.get(offset + k)).map(|&x| Scaled::exact(x));
         match symbol {
             Symbol::Theta => at(&st.point.q, 0),
             Symbol::Phi => at(&st.point.q, n),
             Symbol::ThetaDot => at(&st.point.qd, 0),
             Symbol::PhiDot => at(&st.point.qd, n),
-            Symbol::ThetaDdot => at(&self.qdd_values, 0),
-            Symbol::PhiDdot => at(&self.qdd_values, n),
+            Symbol::ThetaDdot => link.and_then(|k| self.qdd.get(k)).copied(),
+            Symbol::PhiDdot => link.and_then(|k| self.qdd.get(n + k)).copied(),
             Symbol::Mass => at(&st.params.masses, 0),
             // M_{n+1} = 0: the sum over no masses.
             Symbol::TailMass => {
@@ -364,27 +400,12 @@ impl<'a> Truth<'a> {
                     }
                 }
             }
-            Expr::Sum { var, from, to, body, when, pos } => {
-                let (lo, hi) = (index_value(from, bound, n)?, index_value(to, bound, n)?);
-                if hi.saturating_sub(lo) >= MAX_TERMS {
-                    return Err(EvalError {
-                        pos: *pos,
-                        found: format!("sum({var} = {from}..{to}) over {lo}..{hi}"),
-                        message: format!("a sum of fewer than {MAX_TERMS} terms"),
-                    });
-                }
-                let saved = bound.get(var).copied();
+            Expr::Sum { .. } => {
                 let mut total = Scaled::zero();
-                for k in lo..=hi {
-                    bound.insert(var.clone(), k);
-                    if when.as_ref().map_or(Ok(true), |w| holds(w, bound, n))? {
-                        total = total + self.value(body, bound)?;
-                    }
-                }
-                match saved {
-                    Some(v) => bound.insert(var.clone(), v),
-                    None => bound.remove(var),
-                };
+                each_term(expr, bound, n, |body, bound| {
+                    total = total + self.value(body, bound)?;
+                    Ok(())
+                })?;
                 total
             }
         })

@@ -11,6 +11,8 @@
 pub mod check;
 pub mod diagnose;
 pub mod eval;
+mod lex;
+mod print;
 pub mod proof;
 pub(crate) mod state;
 pub mod syntax;

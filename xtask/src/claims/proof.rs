@@ -10,8 +10,8 @@ use std::process::{Command, Stdio};
 use anyhow::{Context, bail};
 
 use super::check::{combinations, covered, quantity_of};
-use super::eval::{Bindings, Quantity, Symbol, holds, index_value};
-use super::syntax::{Entry, Expr};
+use super::eval::{Bindings, EvalError, Quantity, Symbol, each_term, holds, index_value};
+use super::syntax::{Entry, Expr, Pos};
 use super::{Verdict, check_all, load};
 use crate::case::{Case, Kind};
 
@@ -36,13 +36,18 @@ fn python_name(q: Quantity) -> String {
 }
 
 /// `e` for `n` links of `kind` with the indices `bound`, in derive.py's symbol names.
-fn sympy(e: &Expr, bound: &mut Bindings, n: usize, kind: Kind) -> Result<String, String> {
-    let index = |i, bound: &Bindings| index_value(i, bound, n).map_err(|e| e.message);
+fn sympy(e: &Expr, bound: &mut Bindings, n: usize, kind: Kind) -> Result<String, EvalError> {
+    let index = |i, bound: &Bindings| index_value(i, bound, n);
+    let unknown = |name: &String, pos: &Pos, what: &str| EvalError {
+        pos: *pos,
+        found: name.clone(),
+        message: format!("a known {what}"),
+    };
     Ok(match e {
         Expr::Num(v) if v.fract() == 0.0 => format!("{}", *v as i64),
         Expr::Num(v) => format!("Rational('{v}')"),
-        Expr::Sym { name, index: at, .. } => {
-            let symbol = Symbol::named(name).ok_or_else(|| format!("unknown symbol {name}"))?;
+        Expr::Sym { name, index: at, pos } => {
+            let symbol = Symbol::named(name).ok_or_else(|| unknown(name, pos, "symbol"))?;
             let k = match at {
                 Some(i) => index(i, bound)?,
                 None => 0,
@@ -70,8 +75,8 @@ fn sympy(e: &Expr, bound: &mut Bindings, n: usize, kind: Kind) -> Result<String,
                 Symbol::Pivot(a) => format!("a{}", ["x", "y", "z"][a]),
             }
         }
-        Expr::Ref { name, indices, .. } => {
-            let q = Quantity::named(name).ok_or_else(|| format!("unknown matrix {name}"))?;
+        Expr::Ref { name, indices, pos } => {
+            let q = Quantity::named(name).ok_or_else(|| unknown(name, pos, "matrix"))?;
             let at: Vec<String> = indices
                 .iter()
                 .map(|i| index(i, bound).map(|k| (k - 1).to_string()))
@@ -85,20 +90,12 @@ fn sympy(e: &Expr, bound: &mut Bindings, n: usize, kind: Kind) -> Result<String,
         Expr::Div(a, b) => format!("({} / {})", sympy(a, bound, n, kind)?, sympy(b, bound, n, kind)?),
         Expr::Pow(a, k) => format!("({} ** ({k}))", sympy(a, bound, n, kind)?),
         Expr::Call(f, a) => format!("{}({})", f.name(), sympy(a, bound, n, kind)?),
-        Expr::Sum { var, from, to, body, when, .. } => {
-            let (lo, hi) = (index(from, bound)?, index(to, bound)?);
-            let saved = bound.get(var).copied();
+        Expr::Sum { .. } => {
             let mut terms = Vec::new();
-            for k in lo..=hi {
-                bound.insert(var.clone(), k);
-                if when.as_ref().map_or(Ok(true), |w| holds(w, bound, n).map_err(|e| e.message))? {
-                    terms.push(sympy(body, bound, n, kind)?);
-                }
-            }
-            match saved {
-                Some(v) => bound.insert(var.clone(), v),
-                None => bound.remove(var),
-            };
+            each_term(e, bound, n, |body, bound| {
+                terms.push(sympy(body, bound, n, kind)?);
+                Ok(())
+            })?;
             if terms.is_empty() { "0".into() } else { format!("({})", terms.join(" + ")) }
         }
     })

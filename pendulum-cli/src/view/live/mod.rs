@@ -199,11 +199,8 @@ async fn stream(mut socket: WebSocket, mut session: Session) {
                     load = Some(busy.as_secs_f64() / window.elapsed().as_secs_f64());
                     (busy, window) = (Duration::ZERO, Instant::now());
                 }
-                let mut frame = serde_json::to_value(session.frame(load)).unwrap_or_default();
-                if let Some(error) = error {
-                    frame["error"] = error.into();
-                }
-                if socket.send(Message::Text(frame.to_string().into())).await.is_err() {
+                let frame = serde_json::to_string(&session.frame(load, error)).unwrap_or_default();
+                if socket.send(Message::Text(frame.into())).await.is_err() {
                     return;
                 }
             }

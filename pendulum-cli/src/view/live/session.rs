@@ -69,27 +69,31 @@ pub struct Frame {
     pub load: Option<f64>,
     /// Links, kg and m, for the page's labels: n, total mass, reach.
     pub chain: [f64; 3],
+    /// What went wrong in this frame's steps, if anything.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
 /// A live chain and its steered pivot.
 pub struct Session {
-    chain: Chain<Dyn>,
     model: Directions<U3, Steered>,
     integrator: RodMidpoint,
     state: State<Dyn>,
-    reach: f64,
-    damping: f64,
 }
 
 impl Session {
+    /// The chain's length Σ l_i, m.
+    fn reach(&self) -> f64 {
+        self.model.chain().lengths().sum()
+    }
+
     /// The chain hanging at rest under a pivot at rest at the origin, the pivot heading
     /// for a circle of `radius` (m) at `omega` (rad/s), every link damped by `damping`.
     pub fn new(chain: Chain<Dyn>, damping: f64, radius: f64, omega: f64) -> Result<Self, String> {
-        let reach = chain.lengths().sum();
         let drive = Steered::new(HAND_RATE, CIRCLE_RATE).map_err(|e| e.to_string())?;
-        let model = Directions::new(chain.clone()).with_drive(drive);
+        let model = Directions::new(chain).with_drive(drive);
         let state = State::new(0.0, model.hanging());
-        let mut session = Self { chain, model, integrator: RodMidpoint::new(), state, reach, damping: 0.0 };
+        let mut session = Self { model, integrator: RodMidpoint::new(), state };
         for control in [Control::Damping(damping), Control::Radius(radius), Control::Omega(omega)] {
             session.apply(control)?;
         }
@@ -117,23 +121,22 @@ impl Session {
     /// Applies what the page asked for; a value out of range is refused with a sentence
     /// naming it, and changes nothing.
     pub fn apply(&mut self, control: Control) -> Result<(), String> {
-        let t = self.state.t();
+        let (t, reach) = (self.state.t(), self.reach());
         let drive = self.model.drive_mut();
         match control {
             Control::Omega(w) if w.is_finite() && w.abs() <= MAX_SPEED => drive.set_speed(t, w),
             Control::Omega(w) => {
                 return Err(format!("omega {w} rad/s is outside −{MAX_SPEED}…{MAX_SPEED} rad/s"));
             }
-            Control::Radius(r) if (0.0..=self.reach).contains(&r) => drive.set_radius(t, r),
+            Control::Radius(r) if (0.0..=reach).contains(&r) => drive.set_radius(t, r),
             Control::Radius(r) => {
-                return Err(format!("radius {r} m is outside 0…{:.4} m (the chain's length)", self.reach));
+                return Err(format!("radius {r} m is outside 0…{reach:.4} m (the chain's length)"));
             }
             Control::Damping(d) if (0.0..=MAX_DAMPING).contains(&d) => {
-                let chain = self.chain.clone().with_damping(&vec![d; self.chain.links()]);
-                let chain = chain.map_err(|e| e.to_string())?;
+                let chain = self.model.chain();
+                let chain = chain.clone().with_damping(&vec![d; chain.links()]).map_err(|e| e.to_string())?;
                 let drive = self.model.drive().clone();
                 self.model = Directions::new(chain).with_drive(drive);
-                self.damping = d;
                 Ok(())
             }
             Control::Damping(d) => return Err(format!("damping {d} N·m·s is outside 0…{MAX_DAMPING} N·m·s")),
@@ -143,7 +146,7 @@ impl Session {
                     return Err(format!("target {p:?} is not finite"));
                 }
                 // Within the chain's length of the origin: the chain stays in view.
-                let far = p.norm() / self.reach;
+                let far = p.norm() / reach;
                 drive.steer(t, if far > 1.0 { p / far } else { p })
             }
             Control::Restart => {
@@ -162,7 +165,7 @@ impl Session {
     }
 
     /// The frame to send, with the simulation's `load` (share of a core).
-    pub fn frame(&self, load: Option<f64>) -> Frame {
+    pub fn frame(&self, load: Option<f64>, error: Option<String>) -> Frame {
         let (t, x) = (self.state.t(), self.state.x());
         let drive = self.model.drive();
         let pivot = drive.position(t);
@@ -180,11 +183,12 @@ impl Session {
             radius,
             omega,
             aims: drive.circle_target().into(),
-            damping: self.damping,
+            damping: self.model.chain().damping().max(),
             energy: self.model.inertial_energy(t, x),
             halved: self.integrator.stats().halved_steps,
             load,
-            chain: [self.chain.links() as f64, self.chain.masses().sum(), self.reach],
+            chain: [self.model.chain().links() as f64, self.model.chain().masses().sum(), self.reach()],
+            error,
         }
     }
 
@@ -210,7 +214,7 @@ mod tests {
         s.apply(Control::Target([0.3, 0.0, 0.1])).unwrap();
         s.run_until(3.0).unwrap();
         assert!((s.t() - 3.0).abs() < 1e-9, "t = {}", s.t());
-        let f = s.frame(None);
+        let f = s.frame(None, None);
         assert!((Vector3::from(f.centre) - Vector3::new(0.3, 0.0, 0.1)).norm() < 1e-3, "{:?}", f.centre);
         assert!(
             (f.radius - 0.02).abs() < 0.02 * 0.05 && (f.omega - 6.0).abs() < 0.3,
@@ -250,9 +254,9 @@ mod tests {
     fn a_damping_change_keeps_the_motion() {
         let mut s = whirl();
         s.run_until(0.5).unwrap();
-        let before = s.frame(None);
+        let before = s.frame(None, None);
         s.apply(Control::Damping(0.01)).unwrap();
-        let after = s.frame(None);
+        let after = s.frame(None, None);
         assert_eq!(before.points, after.points);
         assert_eq!(after.damping, 0.01);
         s.run_until(1.0).unwrap();
