@@ -14,8 +14,12 @@ For each case (planar n = 1..8, spatial n = 1..5) this script
    the time derivative with .diff(t) and only then replacing the derivatives by
    plain symbols,
 5. splits E = M qdd + c + k + d - Q (mass matrix, velocity terms, gravity terms,
-   pivot terms, generalized forces), checks a list of identities (see `check_case`)
-   and writes one JSON file per case (format: reference/README.md).
+   pivot terms, generalized forces) and checks a list of identities (see
+   `check_case`),
+6. differentiates the parts, with F = Q - c - k - d the force side of
+   qdd = M^-1 F: dM/dq, dF/dq, dF/dqdot, dF/d(pivot acceleration), dF/dsig, each
+   reduced to the normal form, checks them against objects computed another way (see
+   `check_jacobians`) and writes one JSON file per case (format: reference/README.md).
 
 Nothing here is taken from the seed document's printed formulas or from the Rust code,
 except the expected form of Q in one cross-check (labelled as such in `check_case`),
@@ -35,7 +39,7 @@ from sympy import Add, Integer, Mul, Pow, Rational, Symbol, cos, sin
 from sympy.physics.vector import dynamicsymbols
 
 SYMPY_VERSION = "1.14.0"
-FORMAT = "pendulum-reference/1"
+FORMAT = "pendulum-reference/2"
 EQUATION = "mass_matrix * qdd + velocity_terms + gravity_terms + pivot_terms = generalized_forces"
 PLANAR_LINKS = range(1, 9)
 SPATIAL_LINKS = range(1, 6)
@@ -380,9 +384,7 @@ def check_case(case, r):
 
     # gravity terms: the potential written directly from the heights of the links,
     # h(r_k) - h(p) = -sum_{i<=k} l_i cos(th_i) (both kinds), summed link by link
-    U_links = -case.g * sum(
-        case.l[i] * trig.C[case.q[i]] * sum(case.m[i:], Integer(0)) for i in range(n)
-    )
+    U_links = potential_by_links(case)
     require(
         trig.reduce(U_links - U0) == 0,
         "%s: potential_energy != -g sum_i l_i cos(th_i) (m_i + ... + m_n)" % case.name,
@@ -413,12 +415,175 @@ def check_case(case, r):
         )
 
 
+def potential_by_links(case):
+    """U = -g sum_i l_i cos(th_i) (m_i + ... + m_n), from the heights of the links."""
+    return -case.g * sum(
+        case.l[i] * case.trig.C[case.q[i]] * sum(case.m[i:], Integer(0)) for i in range(case.n)
+    )
+
+
 def check_gradient(case, V, vec, what, formula):
     """Require vec[a] == dV/dq_a for every coordinate; V is a polynomial in the sin/cos
     symbols (no angle outside sin/cos), e.g. an expression from `Case.symbolize`."""
     for a in range(case.dof):
         grad = case.trig.diff(V, case.q[a])
         require(case.trig.reduce(grad - vec[a]) == 0, "%s: %s %d != %s" % (case.name, what, a, formula))
+
+
+# ---------------------------------------------------------------------------
+# Derivatives: what a check of the Jacobians of qdd = M^-1 F needs,
+# F = Q - c - k - d (the force side)
+# ---------------------------------------------------------------------------
+
+
+def derive_jacobians(case, r):
+    """Returns the derivatives of M and F, each entry reduced to the normal form.
+
+    The angles enter through sin/cos only, so d/dq is `Trig.diff` (the chain rule on
+    the normal form); rates, pivot accelerations and torques enter polynomially, so
+    d/dqd, d/da and d/dsig are plain sympy derivatives of the polynomial. Nothing is
+    re-derived from the Lagrangian: everything is a derivative of the case's own M, c,
+    k, d, Q. Separate from `derive` (which reference/prove.py also uses).
+    """
+    dof, trig = case.dof, case.trig
+    M, c, k, d, Q = (r[x] for x in ("M", "c", "k", "d", "Q"))
+    F = [trig.reduce(Q[a] - c[a] - k[a] - d[a]) for a in range(dof)]
+
+    def pdiff(expr, s):
+        return trig.reduce(sympy.diff(expr, s))
+
+    # dM[x][a][b] = dM_ab/dq_x, every entry from its own M_ab (not mirrored), so
+    # that the symmetry check in `check_jacobians` compares independent results
+    dM = [[[trig.diff(M[a][b], case.q[x]) for b in range(dof)] for a in range(dof)] for x in range(dof)]
+    out = dict(
+        dM=dM,
+        Jq=[[trig.diff(F[a], case.q[x]) for x in range(dof)] for a in range(dof)],
+        Jqd=[[pdiff(F[a], case.qd[x]) for x in range(dof)] for a in range(dof)],
+        Jp=[[pdiff(F[a], s) for s in case.a_sym] for a in range(dof)],
+        Js=[[pdiff(F[a], s) for s in case.sig] for a in range(dof)],
+    )
+    check_jacobians(case, r, out)
+    return out
+
+
+def check_jacobians(case, r, jac):
+    """Identities the derivatives must satisfy; any failure aborts the run.
+
+    The comparison objects come from the positions (Jacobians of the mass positions and
+    link directions), the potential written link by link and the Christoffel symbols of
+    the stored mass-matrix partials, not from F.
+    """
+    n, dof, trig = case.n, case.dof, case.trig
+    c, Q = r["c"], r["Q"]
+    dM, Jq, Jqd, Jp, Js = (jac[x] for x in ("dM", "Jq", "Jqd", "Jp", "Js"))
+    qd = case.qd
+
+    # kinematics, pivot-relative: rho_i = r_i - p (mass i), u_i (link i), their
+    # Jacobians Jr[i][k][a] = d rho_ik/dq_a, Ju[i][k][a] = d u_ik/dq_a and the second
+    # derivatives Hr[i][k][a][x] = d^2 rho_ik/dq_a dq_x
+    space = len(case.axes)
+    rho = [[case.symbolize(case.r[i + 1][kk] - case.r[0][kk]) for kk in range(space)] for i in range(n)]
+    u = [[case.symbolize(case.u[i][kk]) for kk in range(space)] for i in range(n)]
+    Jr = [[[trig.diff(rho[i][kk], q) for q in case.q] for kk in range(space)] for i in range(n)]
+    Ju = [[[trig.diff(u[i][kk], q) for q in case.q] for kk in range(space)] for i in range(n)]
+    Hr = [
+        [[[trig.diff(Jr[i][kk][a], q) for q in case.q] for a in range(dof)] for kk in range(space)]
+        for i in range(n)
+    ]
+
+    # mass-matrix partials: symmetric in (a, b), and equal to the derivative of
+    # M_ab = sum_i m_i Jr_i,a . Jr_i,b (M from the positions), by the product rule:
+    # dM_ab/dq_x = sum_i m_i (Hr_i,ax . Jr_i,b + Jr_i,a . Hr_i,bx)
+    for x in range(dof):
+        for a in range(dof):
+            for b in range(a, dof):
+                require(
+                    trig.reduce(dM[x][a][b] - dM[x][b][a]) == 0,
+                    "%s: dM_%d%d/dq_%d not symmetric in (a, b)" % (case.name, a, b, x),
+                )
+                kin = Add(*(
+                    case.m[i] * (Hr[i][kk][a][x] * Jr[i][kk][b] + Jr[i][kk][a] * Hr[i][kk][b][x])
+                    for i in range(n)
+                    for kk in range(space)
+                ))
+                require(
+                    trig.reduce(kin - dM[x][a][b]) == 0,
+                    "%s: dM_%d%d/dq_%d != d/dq_%d sum_i m_i (d rho_i/dq_a).(d rho_i/dq_b)"
+                    % (case.name, a, b, x, x),
+                )
+
+    # rate Jacobian: dF/dqd = -dc/dqd + dQ/dqd, with, independently,
+    # dc_a/dqd_b = sum_c G2_abc qd_c (G2 from the stored partials, as in `check_case`)
+    # and dQ_a/dqd_b = -d^2D/dqd_a dqd_b = -H_ab, H_ab = sum_i lam_i Ju_i,a . Ju_i,b
+    # (D = 1/2 sum_i lam_i |u_i'|^2 with the link-direction rates u_i' = sum_a Ju_i,a qd_a)
+    H = [[Add(*(case.lam[i] * Ju[i][kk][a] * Ju[i][kk][b] for i in range(n) for kk in range(space)))
+          for b in range(dof)] for a in range(dof)]
+    for a in range(dof):
+        for b in range(dof):
+            dc = Add(*((dM[cc][a][b] + dM[b][a][cc] - dM[a][b][cc]) * qd[cc] for cc in range(dof)))
+            require(
+                trig.reduce(Jqd[a][b] + dc + H[a][b]) == 0,
+                "%s: dF_%d/dqd_%d != -sum_c G2_abc qd_c - d^2D/dqd_a dqd_b" % (case.name, a, b),
+            )
+        # Euler's theorem: c is homogeneous of degree 2 in the rates, Q - sig of degree 1
+        euler = Add(*(Jqd[a][x] * qd[x] for x in range(dof)))
+        require(
+            trig.reduce(euler + 2 * c[a] - (Q[a] - case.sig[a])) == 0,
+            "%s: sum_x dF_%d/dqd_x qd_x != -2 c + (Q - sig)" % (case.name, a),
+        )
+
+    # torque Jacobian: the identity (Q = sig - dD/dqd, nothing else depends on sig)
+    for a in range(dof):
+        for b in range(dof):
+            require(Js[a][b] == (1 if a == b else 0), "%s: dF_%d/dsig_%d != delta" % (case.name, a, b))
+
+    # pivot Jacobian: -d(d_a)/d(a_k) = -sum_i m_i d rho_ik/dq_a (the inertial force
+    # -m_i a on each mass, mapped by the position Jacobian)
+    for a in range(dof):
+        for kk in range(space):
+            expect = -Add(*(case.m[i] * Jr[i][kk][a] for i in range(n)))
+            require(
+                trig.reduce(Jp[a][kk] - expect) == 0,
+                "%s: dF_%d/da_%s != -sum_i m_i d rho_i%s/dq_%d" % (case.name, a, case.axes[kk], case.axes[kk], a),
+            )
+
+    # angle Jacobian, entry by entry: dF/dq = dQ/dq - dc/dq - d(k + d)/dq with, each
+    # computed without F,
+    # - dQ_a/dq_x = -d/dq_x sum_b H_ab qd_b (Q = sig - H qd, H as above),
+    # - dc_a/dq_x = sum_bc 1/2 dG2_abc/dq_x qd_b qd_c, from the second partials
+    #   d^2M_ab/dq_c dq_x of the stored mass-matrix partials (Christoffel symbols),
+    # - k + d = grad V, V = U + U_a, with U written link by link and
+    #   U_a = sum_i m_i a . rho_i from the positions (pivot potential, as in `check_case`),
+    #   so d(k + d)/dq is the Hessian of V
+    V = potential_by_links(case) + Add(*(
+        case.m[i] * case.a_sym[kk] * rho[i][kk] for i in range(n) for kk in range(space)
+    ))
+    gradV = [trig.diff(V, q) for q in case.q]
+    H_qd = [trig.reduce(Add(*(H[a][b] * qd[b] for b in range(dof)))) for a in range(dof)]
+    # (a, b, c, x), a <= b, c <= x -> d^2 M_ab / dq_c dq_x (dM is symmetric in (a, b),
+    # checked above, and the chain rule on a polynomial commutes, so one of each)
+    d2M = {}
+
+    def d2m(a, b, cc, x):
+        key = (min(a, b), max(a, b), min(cc, x), max(cc, x))
+        if key not in d2M:
+            d2M[key] = trig.diff(dM[key[2]][key[0]][key[1]], case.q[key[3]])
+        return d2M[key]
+
+    for a in range(dof):
+        for x in range(dof):
+            dc = []
+            for b in range(dof):
+                for cc in range(b, dof):
+                    weight = 1 if b < cc else Rational(1, 2)
+                    G2x = d2m(a, b, cc, x) + d2m(a, cc, b, x) - d2m(b, cc, a, x)
+                    dc.append(weight * G2x * qd[b] * qd[cc])
+            expect = -trig.diff(H_qd[a], case.q[x]) - Add(*dc) - trig.diff(gradV[a], case.q[x])
+            require(
+                trig.reduce(Jq[a][x] - expect) == 0,
+                "%s: dF_%d/dq_%d != dQ/dq - sum_bc dG2_abc/dq_x qd_b qd_c / 2 - d^2(U + U_a)/dq dq"
+                % (case.name, a, x),
+            )
 
 
 # ---------------------------------------------------------------------------
@@ -430,7 +595,7 @@ def compact(tree):
     return json.dumps(tree, separators=(",", ":"))
 
 
-def render(case, r):
+def render(case, r, jac):
     n = case.n
     symbols = [
         ("coordinates", [s.name for s in case.q]),
@@ -470,19 +635,36 @@ def render(case, r):
             lines.append("  " + compact(pr(e)) + ("," if i + 1 < len(exprs) else ""))
         lines.append(" ]" + ("" if last else ","))
 
-    lines.append(' "mass_matrix": [')
-    for a, row in enumerate(r["M"]):
-        lines.append("  [")
-        for b, e in enumerate(row):
-            lines.append("   " + compact(pr(e)) + ("," if b + 1 < len(row) else ""))
-        lines.append("  ]" + ("," if a + 1 < len(r["M"]) else ""))
-    lines.append(" ],")
+    def nested(key, exprs, last=False):
+        """A nested list, one bracket per line and one expression per line, each level
+        indented by one more space."""
+
+        def walk(x, indent, sep):
+            if isinstance(x, list):
+                lines.append(indent + "[")
+                for i, y in enumerate(x):
+                    walk(y, indent + " ", "," if i + 1 < len(x) else "")
+                lines.append(indent + "]" + sep)
+            else:
+                lines.append(indent + compact(pr(x)) + sep)
+
+        lines.append(" %s: [" % json.dumps(key))
+        for i, x in enumerate(exprs):
+            walk(x, "  ", "," if i + 1 < len(exprs) else "")
+        lines.append(" ]" + ("" if last else ","))
+
+    nested("mass_matrix", r["M"])
     vector("velocity_terms", r["c"])
     vector("gravity_terms", r["k"])
     vector("pivot_terms", r["d"])
     vector("generalized_forces", r["Q"])
     lines.append(' "kinetic_energy": %s,' % compact(pr(r["T"])))
-    lines.append(' "potential_energy": %s' % compact(pr(r["U"])))
+    lines.append(' "potential_energy": %s,' % compact(pr(r["U"])))
+    nested("mass_matrix_partials", jac["dM"])  # [x][a][b] = dM_ab/dq_x
+    nested("force_jacobian_q", jac["Jq"])  # [a][x] = dF_a/dq_x
+    nested("force_jacobian_qd", jac["Jqd"])  # [a][x] = dF_a/dqd_x
+    nested("force_jacobian_pivot", jac["Jp"])  # [a][k] = dF_a/da_k
+    nested("force_jacobian_torque", jac["Js"], last=True)  # [a][b] = dF_a/dsig_b
     lines.append("}")
     text = "\n".join(lines) + "\n"
     json.loads(text)  # well-formed
@@ -522,7 +704,8 @@ def main(argv=None):
         t0 = time.monotonic()
         case = Case(kind, n)
         try:
-            text = render(case, derive(case))
+            r = derive(case)
+            text = render(case, r, derive_jacobians(case, r))
         except DerivationError as e:
             sys.exit("derive.py: check failed: %s" % e)
         path = os.path.join(args.out, case.name + ".json")

@@ -281,6 +281,55 @@ pub enum ModelKind {
     Spatial,
 }
 
+/// The input `pendulum linearize --lqr` designs a gain for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LqrInput {
+    /// Every generalized torque.
+    Torque,
+    /// The pivot's x acceleration (a cart).
+    PivotX,
+    /// The pivot's y acceleration.
+    PivotY,
+    /// The pivot's z acceleration (3D).
+    PivotZ,
+}
+
+impl LqrInput {
+    /// As on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LqrInput::Torque => "torque",
+            LqrInput::PivotX => "pivot-x",
+            LqrInput::PivotY => "pivot-y",
+            LqrInput::PivotZ => "pivot-z",
+        }
+    }
+}
+
+/// Options of `pendulum linearize`.
+#[derive(Debug, Args)]
+pub struct LinearizeArgs {
+    /// The chain and the state, as for `pendulum eval`.
+    #[command(flatten)]
+    pub state: EvalArgs,
+    /// Linearise even where the state is not steady (|q̈| above --tolerance): A is then
+    /// the Jacobian along the trajectory through the state.
+    #[arg(long)]
+    pub force: bool,
+    /// Largest |q̈_i| (rad/s²) of a steady state.
+    #[arg(long, default_value_t = pendulum_core::STEADY_TOLERANCE, allow_negative_numbers = true)]
+    pub tolerance: f64,
+    /// Also design the LQR gain K (u = −K (x − x₀)) for this input, with Q = q I, R = r I.
+    #[arg(long, value_enum)]
+    pub lqr: Option<LqrInput>,
+    /// The LQR state weight q.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    pub lqr_q: f64,
+    /// The LQR input weight r.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    pub lqr_r: f64,
+}
+
 /// Options of `pendulum eval`.
 #[derive(Debug, Args)]
 pub struct EvalArgs {

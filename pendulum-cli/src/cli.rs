@@ -1,9 +1,9 @@
-//! The command line: `pendulum simulate | eval | modes | steady | render | sweep | view`, the
+//! The command line: `pendulum simulate | eval | linearize | modes | steady | render | sweep | view`, the
 //! top of the CLI (it names every command's options; nothing imports it but `main`).
 
 use clap::{Parser, Subcommand};
 
-use crate::args::{EvalArgs, ModesArgs, SimulateArgs, SteadyArgs};
+use crate::args::{EvalArgs, LinearizeArgs, ModesArgs, SimulateArgs, SteadyArgs};
 use crate::render::RenderArgs;
 use crate::sweep::SweepArgs;
 use crate::view::ViewArgs;
@@ -44,6 +44,13 @@ pub enum Command {
     /// come from the O(n) rod-tension solve, spatial ones from the spherical-angle model
     /// (singular where a link points straight down or up).
     Eval(EvalArgs),
+    /// Linearise the chain about a steady state (an equilibrium, e.g. hanging or
+    /// inverted, or a steady rotation: q̈ = 0) and print, as JSON, A (state x = (q, q̇)),
+    /// B for the torques and for the pivot acceleration, and the eigenvalues of A, from
+    /// the models' analytic derivatives (no finite differences). --lqr INPUT adds the LQR
+    /// gain for one input (e.g. pivot-x: a cart). A state that is not steady is refused
+    /// unless --force.
+    Linearize(LinearizeArgs),
     /// Normal modes of the chain hanging at rest: a table of angular frequencies, periods
     /// and node counts (with Bernoulli's continuum frequencies for a uniform chain), and
     /// modes.csv and modes.png (the mode shapes) in the output directory.

@@ -59,8 +59,30 @@ pub fn eval(args: &EvalArgs) -> CliResult<()> {
     Ok(())
 }
 
-/// Evaluates the model the arguments describe.
-pub fn evaluate(args: &EvalArgs) -> CliResult<Evaluation> {
+/// A chain and one state of it, as `pendulum eval` and `pendulum linearize` take them.
+pub struct StateInput {
+    /// Number of links n.
+    pub n: usize,
+    /// Masses, lengths and damping per link.
+    pub masses: Vec<f64>,
+    /// Lengths, m.
+    pub lengths: Vec<f64>,
+    /// Damping λ_i, N·m·s.
+    pub damping: Vec<f64>,
+    /// The chain they make.
+    pub chain: pendulum_core::Chain<Dyn>,
+    /// Coordinates, rates, torques (dof entries each) and pivot acceleration.
+    pub q: Vec<f64>,
+    /// Rates q̇, rad/s.
+    pub qd: Vec<f64>,
+    /// Torques σ, N·m.
+    pub torque: Vec<f64>,
+    /// Pivot acceleration p̈, m/s².
+    pub pivot: Vec<f64>,
+}
+
+/// Reads the chain and the state of `args`, checking every length (one-line usage errors).
+pub fn parse_state(args: &EvalArgs) -> CliResult<StateInput> {
     let masses = per_link("--masses", &args.masses)?;
     let lengths = per_link("--lengths", &args.lengths)?;
     let q = parse_list("--q", &args.q)?;
@@ -101,6 +123,33 @@ pub fn evaluate(args: &EvalArgs) -> CliResult<Evaluation> {
     let qd = vector("--qd", &args.qd, dof)?;
     let torque = vector("--torque", &args.torque, dof)?;
     let pivot = vector("--pivot-acceleration", &args.pivot_acceleration, space)?;
+    Ok(StateInput { n, masses, lengths, damping, chain, q, qd, torque, pivot })
+}
+
+/// `q`, `q̇` and the inputs as a model's vectors.
+pub fn model_state<M: Model<Dof = Dyn>>(
+    q: &[f64],
+    qd: &[f64],
+    torque: &[f64],
+    pivot: &[f64],
+) -> (DVector<f64>, DVector<f64>, Inputs<Dyn, M::Space>)
+where
+    DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
+{
+    let inputs = Inputs {
+        torque: DVector::from_column_slice(torque),
+        pivot_acceleration: OVector::<f64, M::Space>::from_iterator_generic(
+            M::Space::name(),
+            nalgebra::U1,
+            pivot.iter().copied(),
+        ),
+    };
+    (DVector::from_column_slice(q), DVector::from_column_slice(qd), inputs)
+}
+
+/// Evaluates the model the arguments describe.
+pub fn evaluate(args: &EvalArgs) -> CliResult<Evaluation> {
+    let StateInput { n, masses, lengths, damping, chain, q, qd, torque, pivot } = parse_state(args)?;
     let terms = match args.model {
         ModelKind::Planar => terms(&planar_model(chain), &q, &qd, &torque, &pivot)?,
         ModelKind::Spatial => terms(&spatial_model(chain), &q, &qd, &torque, &pivot)?,
@@ -150,15 +199,7 @@ where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
     let dof = q.len();
-    let (q, qd) = (DVector::from_column_slice(q), DVector::from_column_slice(qd));
-    let inputs = Inputs {
-        torque: DVector::from_column_slice(torque),
-        pivot_acceleration: OVector::<f64, M::Space>::from_iterator_generic(
-            M::Space::name(),
-            nalgebra::U1,
-            pivot.iter().copied(),
-        ),
-    };
+    let (q, qd, inputs) = model_state::<M>(q, qd, torque, pivot);
     // The accelerations first: they check finiteness and the configuration.
     let mut accelerations = DVector::zeros(dof);
     model.accelerations(&q, &qd, &inputs, &mut accelerations)?;

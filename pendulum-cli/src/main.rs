@@ -12,6 +12,7 @@ mod eval;
 mod final_state;
 mod interrupt;
 mod json_file;
+mod linearize;
 mod models;
 mod modes;
 mod plot;
@@ -53,6 +54,7 @@ fn main() -> ExitCode {
             simulate::simulate(args, demo)
         }
         Command::Eval(args) => eval::eval(args),
+        Command::Linearize(args) => linearize::run(args),
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
         Command::Render(args) => render::render(args),

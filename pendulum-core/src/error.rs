@@ -181,6 +181,23 @@ pub enum Error {
         /// The residual norm reached, N·m.
         residual: f64,
     },
+    /// A linearisation was asked for at a state that is not steady: `q̈ ≠ 0`.
+    #[error("the state is not an equilibrium or a steady rotation: qdd[{index}] = {} rad/s², \
+         above the tolerance {}", num(.value), num(.tolerance))]
+    NotSteady {
+        /// 0-based coordinate index of the largest acceleration.
+        index: usize,
+        /// That acceleration, rad/s².
+        value: f64,
+        /// The tolerance it exceeds, rad/s².
+        tolerance: f64,
+    },
+    /// The algebraic Riccati equation of an LQR design has no stabilising solution.
+    #[error("LQR: {reason}")]
+    Riccati {
+        /// Why (not stabilisable, a weight not positive definite, ...).
+        reason: String,
+    },
 }
 
 /// A value for an error message: plain decimals (`-1`, `0.5`, `NaN`, `inf`) in the

@@ -5,7 +5,8 @@
 //! - [`Chain`]: validated parameters (masses, lengths, gravity, damping); [`Error`].
 //! - [`kinematics`]: the chain's geometry in angle coordinates ([`kinematics::Chart`]:
 //!   planar and spherical angles), the one place link directions are written.
-//! - [`Model`]: the equations of motion `M(q) q̈ + c + k + d = Q`, with its [`Inputs`];
+//! - [`Model`]: the equations of motion `M(q) q̈ + c + k + d = Q`, with its [`Inputs`],
+//!   and [`Derivatives`]: the analytic [`Jacobians`] of `q̈` by `q`, `q̇`, `σ` and `p̈`;
 //!   [`Drive`] ([`Fixed`], [`Harmonic`], [`Circle`], [`FnDrive`]) and [`TorqueAt`]: a
 //!   prescribed pivot motion `p(t)` and torques `σ(t)`, combined by [`Driven`].
 //! - [`models`]: the generic [`Planar`] and [`Spatial`] models (the fixed-N models
@@ -31,6 +32,7 @@
 pub mod chain;
 pub mod drive;
 pub mod error;
+pub mod jacobians;
 pub mod model;
 
 pub mod analysis;
@@ -47,6 +49,7 @@ pub use analysis::{
     fastest_decay_bound, fastest_frequency_bound, laguerre_zeros, linearise, normal_modes,
     relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
+pub use analysis::{Lqr, STEADY_TOLERANCE, StateSpace, linearize, lqr};
 pub use analysis::{
     NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,
     nearest_steady, shape_report, whirl_shape,
@@ -60,6 +63,7 @@ pub use energy::{
     pivot_momentum_rate, powers,
 };
 pub use error::{Error, Result};
+pub use jacobians::{Derivatives, Jacobians};
 pub use kinematics::{SINGULARITY_TOLERANCE, check_polar_angle, check_polar_sin};
 pub use model::{Inputs, InputsAt, Model, ModelAlloc, check_inputs};
 pub use models::{Directions, Planar, PlanarTension, RodMidpoint, Spatial};

@@ -312,7 +312,7 @@ const _: () = {
     use ::core::primitive::f64;
     use ::core::result::Result::{Err, Ok};
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U2};
-    use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+    use ::pendulum_core::{Chain, Derivatives, Error, Inputs, Model, Result};
     impl Planar12 {
         #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
         #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
@@ -2191,6 +2191,1298 @@ const _: () = {
             out[10] = x_th10;
             out[11] = x_th11;
             Ok(())
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl Derivatives for Planar12 {
+        fn mass_matrix_partials(
+            &self,
+            q: &SVector<f64, 12>,
+            v: &SVector<f64, 12>,
+            out: &mut SMatrix<f64, 12, 12>,
+        ) {
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let (st3, ct3) = q[3].sin_cos();
+            let (st4, ct4) = q[4].sin_cos();
+            let (st5, ct5) = q[5].sin_cos();
+            let (st6, ct6) = q[6].sin_cos();
+            let (st7, ct7) = q[7].sin_cos();
+            let (st8, ct8) = q[8].sin_cos();
+            let (st9, ct9) = q[9].sin_cos();
+            let (st10, ct10) = q[10].sin_cos();
+            let (st11, ct11) = q[11].sin_cos();
+            let pv0 = v[0];
+            let pv1 = v[1];
+            let pv2 = v[2];
+            let pv3 = v[3];
+            let pv4 = v[4];
+            let pv5 = v[5];
+            let pv6 = v[6];
+            let pv7 = v[7];
+            let pv8 = v[8];
+            let pv9 = v[9];
+            let pv10 = v[10];
+            let pv11 = v[11];
+            let sth0_1 = st0 * ct1 - ct0 * st1;
+            let sth0_2 = st0 * ct2 - ct0 * st2;
+            let sth0_3 = st0 * ct3 - ct0 * st3;
+            let sth0_4 = st0 * ct4 - ct0 * st4;
+            let sth0_5 = st0 * ct5 - ct0 * st5;
+            let sth0_6 = st0 * ct6 - ct0 * st6;
+            let sth0_7 = st0 * ct7 - ct0 * st7;
+            let sth0_8 = st0 * ct8 - ct0 * st8;
+            let sth0_9 = st0 * ct9 - ct0 * st9;
+            let sth0_10 = st0 * ct10 - ct0 * st10;
+            let sth0_11 = st0 * ct11 - ct0 * st11;
+            let sth1_2 = st1 * ct2 - ct1 * st2;
+            let sth1_3 = st1 * ct3 - ct1 * st3;
+            let sth1_4 = st1 * ct4 - ct1 * st4;
+            let sth1_5 = st1 * ct5 - ct1 * st5;
+            let sth1_6 = st1 * ct6 - ct1 * st6;
+            let sth1_7 = st1 * ct7 - ct1 * st7;
+            let sth1_8 = st1 * ct8 - ct1 * st8;
+            let sth1_9 = st1 * ct9 - ct1 * st9;
+            let sth1_10 = st1 * ct10 - ct1 * st10;
+            let sth1_11 = st1 * ct11 - ct1 * st11;
+            let sth2_3 = st2 * ct3 - ct2 * st3;
+            let sth2_4 = st2 * ct4 - ct2 * st4;
+            let sth2_5 = st2 * ct5 - ct2 * st5;
+            let sth2_6 = st2 * ct6 - ct2 * st6;
+            let sth2_7 = st2 * ct7 - ct2 * st7;
+            let sth2_8 = st2 * ct8 - ct2 * st8;
+            let sth2_9 = st2 * ct9 - ct2 * st9;
+            let sth2_10 = st2 * ct10 - ct2 * st10;
+            let sth2_11 = st2 * ct11 - ct2 * st11;
+            let sth3_4 = st3 * ct4 - ct3 * st4;
+            let sth3_5 = st3 * ct5 - ct3 * st5;
+            let sth3_6 = st3 * ct6 - ct3 * st6;
+            let sth3_7 = st3 * ct7 - ct3 * st7;
+            let sth3_8 = st3 * ct8 - ct3 * st8;
+            let sth3_9 = st3 * ct9 - ct3 * st9;
+            let sth3_10 = st3 * ct10 - ct3 * st10;
+            let sth3_11 = st3 * ct11 - ct3 * st11;
+            let sth4_5 = st4 * ct5 - ct4 * st5;
+            let sth4_6 = st4 * ct6 - ct4 * st6;
+            let sth4_7 = st4 * ct7 - ct4 * st7;
+            let sth4_8 = st4 * ct8 - ct4 * st8;
+            let sth4_9 = st4 * ct9 - ct4 * st9;
+            let sth4_10 = st4 * ct10 - ct4 * st10;
+            let sth4_11 = st4 * ct11 - ct4 * st11;
+            let sth5_6 = st5 * ct6 - ct5 * st6;
+            let sth5_7 = st5 * ct7 - ct5 * st7;
+            let sth5_8 = st5 * ct8 - ct5 * st8;
+            let sth5_9 = st5 * ct9 - ct5 * st9;
+            let sth5_10 = st5 * ct10 - ct5 * st10;
+            let sth5_11 = st5 * ct11 - ct5 * st11;
+            let sth6_7 = st6 * ct7 - ct6 * st7;
+            let sth6_8 = st6 * ct8 - ct6 * st8;
+            let sth6_9 = st6 * ct9 - ct6 * st9;
+            let sth6_10 = st6 * ct10 - ct6 * st10;
+            let sth6_11 = st6 * ct11 - ct6 * st11;
+            let sth7_8 = st7 * ct8 - ct7 * st8;
+            let sth7_9 = st7 * ct9 - ct7 * st9;
+            let sth7_10 = st7 * ct10 - ct7 * st10;
+            let sth7_11 = st7 * ct11 - ct7 * st11;
+            let sth8_9 = st8 * ct9 - ct8 * st9;
+            let sth8_10 = st8 * ct10 - ct8 * st10;
+            let sth8_11 = st8 * ct11 - ct8 * st11;
+            let sth9_10 = st9 * ct10 - ct9 * st10;
+            let sth9_11 = st9 * ct11 - ct9 * st11;
+            let sth10_11 = st10 * ct11 - ct10 * st11;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w0_3 = self.w0_3;
+            let w0_4 = self.w0_4;
+            let w0_5 = self.w0_5;
+            let w0_6 = self.w0_6;
+            let w0_7 = self.w0_7;
+            let w0_8 = self.w0_8;
+            let w0_9 = self.w0_9;
+            let w0_10 = self.w0_10;
+            let w0_11 = self.w0_11;
+            let w1_2 = self.w1_2;
+            let w1_3 = self.w1_3;
+            let w1_4 = self.w1_4;
+            let w1_5 = self.w1_5;
+            let w1_6 = self.w1_6;
+            let w1_7 = self.w1_7;
+            let w1_8 = self.w1_8;
+            let w1_9 = self.w1_9;
+            let w1_10 = self.w1_10;
+            let w1_11 = self.w1_11;
+            let w2_3 = self.w2_3;
+            let w2_4 = self.w2_4;
+            let w2_5 = self.w2_5;
+            let w2_6 = self.w2_6;
+            let w2_7 = self.w2_7;
+            let w2_8 = self.w2_8;
+            let w2_9 = self.w2_9;
+            let w2_10 = self.w2_10;
+            let w2_11 = self.w2_11;
+            let w3_4 = self.w3_4;
+            let w3_5 = self.w3_5;
+            let w3_6 = self.w3_6;
+            let w3_7 = self.w3_7;
+            let w3_8 = self.w3_8;
+            let w3_9 = self.w3_9;
+            let w3_10 = self.w3_10;
+            let w3_11 = self.w3_11;
+            let w4_5 = self.w4_5;
+            let w4_6 = self.w4_6;
+            let w4_7 = self.w4_7;
+            let w4_8 = self.w4_8;
+            let w4_9 = self.w4_9;
+            let w4_10 = self.w4_10;
+            let w4_11 = self.w4_11;
+            let w5_6 = self.w5_6;
+            let w5_7 = self.w5_7;
+            let w5_8 = self.w5_8;
+            let w5_9 = self.w5_9;
+            let w5_10 = self.w5_10;
+            let w5_11 = self.w5_11;
+            let w6_7 = self.w6_7;
+            let w6_8 = self.w6_8;
+            let w6_9 = self.w6_9;
+            let w6_10 = self.w6_10;
+            let w6_11 = self.w6_11;
+            let w7_8 = self.w7_8;
+            let w7_9 = self.w7_9;
+            let w7_10 = self.w7_10;
+            let w7_11 = self.w7_11;
+            let w8_9 = self.w8_9;
+            let w8_10 = self.w8_10;
+            let w8_11 = self.w8_11;
+            let w9_10 = self.w9_10;
+            let w9_11 = self.w9_11;
+            let w10_11 = self.w10_11;
+            let dm1_0_0 = -sth0_1 * w0_1;
+            let dm1_0_1 = sth0_1 * w0_1;
+            let dm2_0_0 = -sth0_2 * w0_2;
+            let dm2_0_2 = sth0_2 * w0_2;
+            let dm2_1_1 = -sth1_2 * w1_2;
+            let dm2_1_2 = sth1_2 * w1_2;
+            let dm3_0_0 = -sth0_3 * w0_3;
+            let dm3_0_3 = sth0_3 * w0_3;
+            let dm3_1_1 = -sth1_3 * w1_3;
+            let dm3_1_3 = sth1_3 * w1_3;
+            let dm3_2_2 = -sth2_3 * w2_3;
+            let dm3_2_3 = sth2_3 * w2_3;
+            let dm4_0_0 = -sth0_4 * w0_4;
+            let dm4_0_4 = sth0_4 * w0_4;
+            let dm4_1_1 = -sth1_4 * w1_4;
+            let dm4_1_4 = sth1_4 * w1_4;
+            let dm4_2_2 = -sth2_4 * w2_4;
+            let dm4_2_4 = sth2_4 * w2_4;
+            let dm4_3_3 = -sth3_4 * w3_4;
+            let dm4_3_4 = sth3_4 * w3_4;
+            let dm5_0_0 = -sth0_5 * w0_5;
+            let dm5_0_5 = sth0_5 * w0_5;
+            let dm5_1_1 = -sth1_5 * w1_5;
+            let dm5_1_5 = sth1_5 * w1_5;
+            let dm5_2_2 = -sth2_5 * w2_5;
+            let dm5_2_5 = sth2_5 * w2_5;
+            let dm5_3_3 = -sth3_5 * w3_5;
+            let dm5_3_5 = sth3_5 * w3_5;
+            let dm5_4_4 = -sth4_5 * w4_5;
+            let dm5_4_5 = sth4_5 * w4_5;
+            let dm6_0_0 = -sth0_6 * w0_6;
+            let dm6_0_6 = sth0_6 * w0_6;
+            let dm6_1_1 = -sth1_6 * w1_6;
+            let dm6_1_6 = sth1_6 * w1_6;
+            let dm6_2_2 = -sth2_6 * w2_6;
+            let dm6_2_6 = sth2_6 * w2_6;
+            let dm6_3_3 = -sth3_6 * w3_6;
+            let dm6_3_6 = sth3_6 * w3_6;
+            let dm6_4_4 = -sth4_6 * w4_6;
+            let dm6_4_6 = sth4_6 * w4_6;
+            let dm6_5_5 = -sth5_6 * w5_6;
+            let dm6_5_6 = sth5_6 * w5_6;
+            let dm7_0_0 = -sth0_7 * w0_7;
+            let dm7_0_7 = sth0_7 * w0_7;
+            let dm7_1_1 = -sth1_7 * w1_7;
+            let dm7_1_7 = sth1_7 * w1_7;
+            let dm7_2_2 = -sth2_7 * w2_7;
+            let dm7_2_7 = sth2_7 * w2_7;
+            let dm7_3_3 = -sth3_7 * w3_7;
+            let dm7_3_7 = sth3_7 * w3_7;
+            let dm7_4_4 = -sth4_7 * w4_7;
+            let dm7_4_7 = sth4_7 * w4_7;
+            let dm7_5_5 = -sth5_7 * w5_7;
+            let dm7_5_7 = sth5_7 * w5_7;
+            let dm7_6_6 = -sth6_7 * w6_7;
+            let dm7_6_7 = sth6_7 * w6_7;
+            let dm8_0_0 = -sth0_8 * w0_8;
+            let dm8_0_8 = sth0_8 * w0_8;
+            let dm8_1_1 = -sth1_8 * w1_8;
+            let dm8_1_8 = sth1_8 * w1_8;
+            let dm8_2_2 = -sth2_8 * w2_8;
+            let dm8_2_8 = sth2_8 * w2_8;
+            let dm8_3_3 = -sth3_8 * w3_8;
+            let dm8_3_8 = sth3_8 * w3_8;
+            let dm8_4_4 = -sth4_8 * w4_8;
+            let dm8_4_8 = sth4_8 * w4_8;
+            let dm8_5_5 = -sth5_8 * w5_8;
+            let dm8_5_8 = sth5_8 * w5_8;
+            let dm8_6_6 = -sth6_8 * w6_8;
+            let dm8_6_8 = sth6_8 * w6_8;
+            let dm8_7_7 = -sth7_8 * w7_8;
+            let dm8_7_8 = sth7_8 * w7_8;
+            let dm9_0_0 = -sth0_9 * w0_9;
+            let dm9_0_9 = sth0_9 * w0_9;
+            let dm9_1_1 = -sth1_9 * w1_9;
+            let dm9_1_9 = sth1_9 * w1_9;
+            let dm9_2_2 = -sth2_9 * w2_9;
+            let dm9_2_9 = sth2_9 * w2_9;
+            let dm9_3_3 = -sth3_9 * w3_9;
+            let dm9_3_9 = sth3_9 * w3_9;
+            let dm9_4_4 = -sth4_9 * w4_9;
+            let dm9_4_9 = sth4_9 * w4_9;
+            let dm9_5_5 = -sth5_9 * w5_9;
+            let dm9_5_9 = sth5_9 * w5_9;
+            let dm9_6_6 = -sth6_9 * w6_9;
+            let dm9_6_9 = sth6_9 * w6_9;
+            let dm9_7_7 = -sth7_9 * w7_9;
+            let dm9_7_9 = sth7_9 * w7_9;
+            let dm9_8_8 = -sth8_9 * w8_9;
+            let dm9_8_9 = sth8_9 * w8_9;
+            let dm10_0_0 = -sth0_10 * w0_10;
+            let dm10_0_10 = sth0_10 * w0_10;
+            let dm10_1_1 = -sth1_10 * w1_10;
+            let dm10_1_10 = sth1_10 * w1_10;
+            let dm10_2_2 = -sth2_10 * w2_10;
+            let dm10_2_10 = sth2_10 * w2_10;
+            let dm10_3_3 = -sth3_10 * w3_10;
+            let dm10_3_10 = sth3_10 * w3_10;
+            let dm10_4_4 = -sth4_10 * w4_10;
+            let dm10_4_10 = sth4_10 * w4_10;
+            let dm10_5_5 = -sth5_10 * w5_10;
+            let dm10_5_10 = sth5_10 * w5_10;
+            let dm10_6_6 = -sth6_10 * w6_10;
+            let dm10_6_10 = sth6_10 * w6_10;
+            let dm10_7_7 = -sth7_10 * w7_10;
+            let dm10_7_10 = sth7_10 * w7_10;
+            let dm10_8_8 = -sth8_10 * w8_10;
+            let dm10_8_10 = sth8_10 * w8_10;
+            let dm10_9_9 = -sth9_10 * w9_10;
+            let dm10_9_10 = sth9_10 * w9_10;
+            let dm11_0_0 = -sth0_11 * w0_11;
+            let dm11_0_11 = sth0_11 * w0_11;
+            let dm11_1_1 = -sth1_11 * w1_11;
+            let dm11_1_11 = sth1_11 * w1_11;
+            let dm11_2_2 = -sth2_11 * w2_11;
+            let dm11_2_11 = sth2_11 * w2_11;
+            let dm11_3_3 = -sth3_11 * w3_11;
+            let dm11_3_11 = sth3_11 * w3_11;
+            let dm11_4_4 = -sth4_11 * w4_11;
+            let dm11_4_11 = sth4_11 * w4_11;
+            let dm11_5_5 = -sth5_11 * w5_11;
+            let dm11_5_11 = sth5_11 * w5_11;
+            let dm11_6_6 = -sth6_11 * w6_11;
+            let dm11_6_11 = sth6_11 * w6_11;
+            let dm11_7_7 = -sth7_11 * w7_11;
+            let dm11_7_11 = sth7_11 * w7_11;
+            let dm11_8_8 = -sth8_11 * w8_11;
+            let dm11_8_11 = sth8_11 * w8_11;
+            let dm11_9_9 = -sth9_11 * w9_11;
+            let dm11_9_11 = sth9_11 * w9_11;
+            let dm11_10_10 = -sth10_11 * w10_11;
+            let dm11_10_11 = sth10_11 * w10_11;
+            out[(0, 0)] = dm1_0_0 * pv1
+                + dm2_0_0 * pv2
+                + dm3_0_0 * pv3
+                + dm4_0_0 * pv4
+                + dm5_0_0 * pv5
+                + dm6_0_0 * pv6
+                + dm7_0_0 * pv7
+                + dm8_0_0 * pv8
+                + dm9_0_0 * pv9
+                + dm10_0_0 * pv10
+                + dm11_0_0 * pv11;
+            out[(0, 1)] = dm1_0_1 * pv1;
+            out[(0, 2)] = dm2_0_2 * pv2;
+            out[(0, 3)] = dm3_0_3 * pv3;
+            out[(0, 4)] = dm4_0_4 * pv4;
+            out[(0, 5)] = dm5_0_5 * pv5;
+            out[(0, 6)] = dm6_0_6 * pv6;
+            out[(0, 7)] = dm7_0_7 * pv7;
+            out[(0, 8)] = dm8_0_8 * pv8;
+            out[(0, 9)] = dm9_0_9 * pv9;
+            out[(0, 10)] = dm10_0_10 * pv10;
+            out[(0, 11)] = dm11_0_11 * pv11;
+            out[(1, 0)] = dm1_0_0 * pv0;
+            out[(1, 1)] = dm1_0_1 * pv0
+                + dm2_1_1 * pv2
+                + dm3_1_1 * pv3
+                + dm4_1_1 * pv4
+                + dm5_1_1 * pv5
+                + dm6_1_1 * pv6
+                + dm7_1_1 * pv7
+                + dm8_1_1 * pv8
+                + dm9_1_1 * pv9
+                + dm10_1_1 * pv10
+                + dm11_1_1 * pv11;
+            out[(1, 2)] = dm2_1_2 * pv2;
+            out[(1, 3)] = dm3_1_3 * pv3;
+            out[(1, 4)] = dm4_1_4 * pv4;
+            out[(1, 5)] = dm5_1_5 * pv5;
+            out[(1, 6)] = dm6_1_6 * pv6;
+            out[(1, 7)] = dm7_1_7 * pv7;
+            out[(1, 8)] = dm8_1_8 * pv8;
+            out[(1, 9)] = dm9_1_9 * pv9;
+            out[(1, 10)] = dm10_1_10 * pv10;
+            out[(1, 11)] = dm11_1_11 * pv11;
+            out[(2, 0)] = dm2_0_0 * pv0;
+            out[(2, 1)] = dm2_1_1 * pv1;
+            out[(2, 2)] = dm2_0_2 * pv0
+                + dm2_1_2 * pv1
+                + dm3_2_2 * pv3
+                + dm4_2_2 * pv4
+                + dm5_2_2 * pv5
+                + dm6_2_2 * pv6
+                + dm7_2_2 * pv7
+                + dm8_2_2 * pv8
+                + dm9_2_2 * pv9
+                + dm10_2_2 * pv10
+                + dm11_2_2 * pv11;
+            out[(2, 3)] = dm3_2_3 * pv3;
+            out[(2, 4)] = dm4_2_4 * pv4;
+            out[(2, 5)] = dm5_2_5 * pv5;
+            out[(2, 6)] = dm6_2_6 * pv6;
+            out[(2, 7)] = dm7_2_7 * pv7;
+            out[(2, 8)] = dm8_2_8 * pv8;
+            out[(2, 9)] = dm9_2_9 * pv9;
+            out[(2, 10)] = dm10_2_10 * pv10;
+            out[(2, 11)] = dm11_2_11 * pv11;
+            out[(3, 0)] = dm3_0_0 * pv0;
+            out[(3, 1)] = dm3_1_1 * pv1;
+            out[(3, 2)] = dm3_2_2 * pv2;
+            out[(3, 3)] = dm3_0_3 * pv0
+                + dm3_1_3 * pv1
+                + dm3_2_3 * pv2
+                + dm4_3_3 * pv4
+                + dm5_3_3 * pv5
+                + dm6_3_3 * pv6
+                + dm7_3_3 * pv7
+                + dm8_3_3 * pv8
+                + dm9_3_3 * pv9
+                + dm10_3_3 * pv10
+                + dm11_3_3 * pv11;
+            out[(3, 4)] = dm4_3_4 * pv4;
+            out[(3, 5)] = dm5_3_5 * pv5;
+            out[(3, 6)] = dm6_3_6 * pv6;
+            out[(3, 7)] = dm7_3_7 * pv7;
+            out[(3, 8)] = dm8_3_8 * pv8;
+            out[(3, 9)] = dm9_3_9 * pv9;
+            out[(3, 10)] = dm10_3_10 * pv10;
+            out[(3, 11)] = dm11_3_11 * pv11;
+            out[(4, 0)] = dm4_0_0 * pv0;
+            out[(4, 1)] = dm4_1_1 * pv1;
+            out[(4, 2)] = dm4_2_2 * pv2;
+            out[(4, 3)] = dm4_3_3 * pv3;
+            out[(4, 4)] = dm4_0_4 * pv0
+                + dm4_1_4 * pv1
+                + dm4_2_4 * pv2
+                + dm4_3_4 * pv3
+                + dm5_4_4 * pv5
+                + dm6_4_4 * pv6
+                + dm7_4_4 * pv7
+                + dm8_4_4 * pv8
+                + dm9_4_4 * pv9
+                + dm10_4_4 * pv10
+                + dm11_4_4 * pv11;
+            out[(4, 5)] = dm5_4_5 * pv5;
+            out[(4, 6)] = dm6_4_6 * pv6;
+            out[(4, 7)] = dm7_4_7 * pv7;
+            out[(4, 8)] = dm8_4_8 * pv8;
+            out[(4, 9)] = dm9_4_9 * pv9;
+            out[(4, 10)] = dm10_4_10 * pv10;
+            out[(4, 11)] = dm11_4_11 * pv11;
+            out[(5, 0)] = dm5_0_0 * pv0;
+            out[(5, 1)] = dm5_1_1 * pv1;
+            out[(5, 2)] = dm5_2_2 * pv2;
+            out[(5, 3)] = dm5_3_3 * pv3;
+            out[(5, 4)] = dm5_4_4 * pv4;
+            out[(5, 5)] = dm5_0_5 * pv0
+                + dm5_1_5 * pv1
+                + dm5_2_5 * pv2
+                + dm5_3_5 * pv3
+                + dm5_4_5 * pv4
+                + dm6_5_5 * pv6
+                + dm7_5_5 * pv7
+                + dm8_5_5 * pv8
+                + dm9_5_5 * pv9
+                + dm10_5_5 * pv10
+                + dm11_5_5 * pv11;
+            out[(5, 6)] = dm6_5_6 * pv6;
+            out[(5, 7)] = dm7_5_7 * pv7;
+            out[(5, 8)] = dm8_5_8 * pv8;
+            out[(5, 9)] = dm9_5_9 * pv9;
+            out[(5, 10)] = dm10_5_10 * pv10;
+            out[(5, 11)] = dm11_5_11 * pv11;
+            out[(6, 0)] = dm6_0_0 * pv0;
+            out[(6, 1)] = dm6_1_1 * pv1;
+            out[(6, 2)] = dm6_2_2 * pv2;
+            out[(6, 3)] = dm6_3_3 * pv3;
+            out[(6, 4)] = dm6_4_4 * pv4;
+            out[(6, 5)] = dm6_5_5 * pv5;
+            out[(6, 6)] = dm6_0_6 * pv0
+                + dm6_1_6 * pv1
+                + dm6_2_6 * pv2
+                + dm6_3_6 * pv3
+                + dm6_4_6 * pv4
+                + dm6_5_6 * pv5
+                + dm7_6_6 * pv7
+                + dm8_6_6 * pv8
+                + dm9_6_6 * pv9
+                + dm10_6_6 * pv10
+                + dm11_6_6 * pv11;
+            out[(6, 7)] = dm7_6_7 * pv7;
+            out[(6, 8)] = dm8_6_8 * pv8;
+            out[(6, 9)] = dm9_6_9 * pv9;
+            out[(6, 10)] = dm10_6_10 * pv10;
+            out[(6, 11)] = dm11_6_11 * pv11;
+            out[(7, 0)] = dm7_0_0 * pv0;
+            out[(7, 1)] = dm7_1_1 * pv1;
+            out[(7, 2)] = dm7_2_2 * pv2;
+            out[(7, 3)] = dm7_3_3 * pv3;
+            out[(7, 4)] = dm7_4_4 * pv4;
+            out[(7, 5)] = dm7_5_5 * pv5;
+            out[(7, 6)] = dm7_6_6 * pv6;
+            out[(7, 7)] = dm7_0_7 * pv0
+                + dm7_1_7 * pv1
+                + dm7_2_7 * pv2
+                + dm7_3_7 * pv3
+                + dm7_4_7 * pv4
+                + dm7_5_7 * pv5
+                + dm7_6_7 * pv6
+                + dm8_7_7 * pv8
+                + dm9_7_7 * pv9
+                + dm10_7_7 * pv10
+                + dm11_7_7 * pv11;
+            out[(7, 8)] = dm8_7_8 * pv8;
+            out[(7, 9)] = dm9_7_9 * pv9;
+            out[(7, 10)] = dm10_7_10 * pv10;
+            out[(7, 11)] = dm11_7_11 * pv11;
+            out[(8, 0)] = dm8_0_0 * pv0;
+            out[(8, 1)] = dm8_1_1 * pv1;
+            out[(8, 2)] = dm8_2_2 * pv2;
+            out[(8, 3)] = dm8_3_3 * pv3;
+            out[(8, 4)] = dm8_4_4 * pv4;
+            out[(8, 5)] = dm8_5_5 * pv5;
+            out[(8, 6)] = dm8_6_6 * pv6;
+            out[(8, 7)] = dm8_7_7 * pv7;
+            out[(8, 8)] = dm8_0_8 * pv0
+                + dm8_1_8 * pv1
+                + dm8_2_8 * pv2
+                + dm8_3_8 * pv3
+                + dm8_4_8 * pv4
+                + dm8_5_8 * pv5
+                + dm8_6_8 * pv6
+                + dm8_7_8 * pv7
+                + dm9_8_8 * pv9
+                + dm10_8_8 * pv10
+                + dm11_8_8 * pv11;
+            out[(8, 9)] = dm9_8_9 * pv9;
+            out[(8, 10)] = dm10_8_10 * pv10;
+            out[(8, 11)] = dm11_8_11 * pv11;
+            out[(9, 0)] = dm9_0_0 * pv0;
+            out[(9, 1)] = dm9_1_1 * pv1;
+            out[(9, 2)] = dm9_2_2 * pv2;
+            out[(9, 3)] = dm9_3_3 * pv3;
+            out[(9, 4)] = dm9_4_4 * pv4;
+            out[(9, 5)] = dm9_5_5 * pv5;
+            out[(9, 6)] = dm9_6_6 * pv6;
+            out[(9, 7)] = dm9_7_7 * pv7;
+            out[(9, 8)] = dm9_8_8 * pv8;
+            out[(9, 9)] = dm9_0_9 * pv0
+                + dm9_1_9 * pv1
+                + dm9_2_9 * pv2
+                + dm9_3_9 * pv3
+                + dm9_4_9 * pv4
+                + dm9_5_9 * pv5
+                + dm9_6_9 * pv6
+                + dm9_7_9 * pv7
+                + dm9_8_9 * pv8
+                + dm10_9_9 * pv10
+                + dm11_9_9 * pv11;
+            out[(9, 10)] = dm10_9_10 * pv10;
+            out[(9, 11)] = dm11_9_11 * pv11;
+            out[(10, 0)] = dm10_0_0 * pv0;
+            out[(10, 1)] = dm10_1_1 * pv1;
+            out[(10, 2)] = dm10_2_2 * pv2;
+            out[(10, 3)] = dm10_3_3 * pv3;
+            out[(10, 4)] = dm10_4_4 * pv4;
+            out[(10, 5)] = dm10_5_5 * pv5;
+            out[(10, 6)] = dm10_6_6 * pv6;
+            out[(10, 7)] = dm10_7_7 * pv7;
+            out[(10, 8)] = dm10_8_8 * pv8;
+            out[(10, 9)] = dm10_9_9 * pv9;
+            out[(10, 10)] = dm10_0_10 * pv0
+                + dm10_1_10 * pv1
+                + dm10_2_10 * pv2
+                + dm10_3_10 * pv3
+                + dm10_4_10 * pv4
+                + dm10_5_10 * pv5
+                + dm10_6_10 * pv6
+                + dm10_7_10 * pv7
+                + dm10_8_10 * pv8
+                + dm10_9_10 * pv9
+                + dm11_10_10 * pv11;
+            out[(10, 11)] = dm11_10_11 * pv11;
+            out[(11, 0)] = dm11_0_0 * pv0;
+            out[(11, 1)] = dm11_1_1 * pv1;
+            out[(11, 2)] = dm11_2_2 * pv2;
+            out[(11, 3)] = dm11_3_3 * pv3;
+            out[(11, 4)] = dm11_4_4 * pv4;
+            out[(11, 5)] = dm11_5_5 * pv5;
+            out[(11, 6)] = dm11_6_6 * pv6;
+            out[(11, 7)] = dm11_7_7 * pv7;
+            out[(11, 8)] = dm11_8_8 * pv8;
+            out[(11, 9)] = dm11_9_9 * pv9;
+            out[(11, 10)] = dm11_10_10 * pv10;
+            out[(11, 11)] = dm11_0_11 * pv0
+                + dm11_1_11 * pv1
+                + dm11_2_11 * pv2
+                + dm11_3_11 * pv3
+                + dm11_4_11 * pv4
+                + dm11_5_11 * pv5
+                + dm11_6_11 * pv6
+                + dm11_7_11 * pv7
+                + dm11_8_11 * pv8
+                + dm11_9_11 * pv9
+                + dm11_10_11 * pv10;
+        }
+        fn force_jacobians(
+            &self,
+            q: &SVector<f64, 12>,
+            qd: &SVector<f64, 12>,
+            inputs: &Inputs<Const<12>, U2>,
+            dq: &mut SMatrix<f64, 12, 12>,
+            dqd: &mut SMatrix<f64, 12, 12>,
+            dp: &mut SMatrix<f64, 12, 2>,
+        ) {
+            let pivot_acceleration = &inputs.pivot_acceleration;
+            let damping = self.chain.damping();
+            let g = self.chain.gravity();
+            let lam0 = damping[0];
+            let lam1 = damping[1];
+            let lam2 = damping[2];
+            let lam3 = damping[3];
+            let lam4 = damping[4];
+            let lam5 = damping[5];
+            let lam6 = damping[6];
+            let lam7 = damping[7];
+            let lam8 = damping[8];
+            let lam9 = damping[9];
+            let lam10 = damping[10];
+            let lam11 = damping[11];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let (st3, ct3) = q[3].sin_cos();
+            let (st4, ct4) = q[4].sin_cos();
+            let (st5, ct5) = q[5].sin_cos();
+            let (st6, ct6) = q[6].sin_cos();
+            let (st7, ct7) = q[7].sin_cos();
+            let (st8, ct8) = q[8].sin_cos();
+            let (st9, ct9) = q[9].sin_cos();
+            let (st10, ct10) = q[10].sin_cos();
+            let (st11, ct11) = q[11].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dth2 = qd[2];
+            let dth3 = qd[3];
+            let dth4 = qd[4];
+            let dth5 = qd[5];
+            let dth6 = qd[6];
+            let dth7 = qd[7];
+            let dth8 = qd[8];
+            let dth9 = qd[9];
+            let dth10 = qd[10];
+            let dth11 = qd[11];
+            let ax = pivot_acceleration[0];
+            let ay = pivot_acceleration[1];
+            let cth0_1 = ct0 * ct1 + st0 * st1;
+            let cth0_2 = ct0 * ct2 + st0 * st2;
+            let cth0_3 = ct0 * ct3 + st0 * st3;
+            let cth0_4 = ct0 * ct4 + st0 * st4;
+            let cth0_5 = ct0 * ct5 + st0 * st5;
+            let cth0_6 = ct0 * ct6 + st0 * st6;
+            let cth0_7 = ct0 * ct7 + st0 * st7;
+            let cth0_8 = ct0 * ct8 + st0 * st8;
+            let cth0_9 = ct0 * ct9 + st0 * st9;
+            let cth0_10 = ct0 * ct10 + st0 * st10;
+            let cth0_11 = ct0 * ct11 + st0 * st11;
+            let cth1_2 = ct1 * ct2 + st1 * st2;
+            let cth1_3 = ct1 * ct3 + st1 * st3;
+            let cth1_4 = ct1 * ct4 + st1 * st4;
+            let cth1_5 = ct1 * ct5 + st1 * st5;
+            let cth1_6 = ct1 * ct6 + st1 * st6;
+            let cth1_7 = ct1 * ct7 + st1 * st7;
+            let cth1_8 = ct1 * ct8 + st1 * st8;
+            let cth1_9 = ct1 * ct9 + st1 * st9;
+            let cth1_10 = ct1 * ct10 + st1 * st10;
+            let cth1_11 = ct1 * ct11 + st1 * st11;
+            let cth2_3 = ct2 * ct3 + st2 * st3;
+            let cth2_4 = ct2 * ct4 + st2 * st4;
+            let cth2_5 = ct2 * ct5 + st2 * st5;
+            let cth2_6 = ct2 * ct6 + st2 * st6;
+            let cth2_7 = ct2 * ct7 + st2 * st7;
+            let cth2_8 = ct2 * ct8 + st2 * st8;
+            let cth2_9 = ct2 * ct9 + st2 * st9;
+            let cth2_10 = ct2 * ct10 + st2 * st10;
+            let cth2_11 = ct2 * ct11 + st2 * st11;
+            let cth3_4 = ct3 * ct4 + st3 * st4;
+            let cth3_5 = ct3 * ct5 + st3 * st5;
+            let cth3_6 = ct3 * ct6 + st3 * st6;
+            let cth3_7 = ct3 * ct7 + st3 * st7;
+            let cth3_8 = ct3 * ct8 + st3 * st8;
+            let cth3_9 = ct3 * ct9 + st3 * st9;
+            let cth3_10 = ct3 * ct10 + st3 * st10;
+            let cth3_11 = ct3 * ct11 + st3 * st11;
+            let cth4_5 = ct4 * ct5 + st4 * st5;
+            let cth4_6 = ct4 * ct6 + st4 * st6;
+            let cth4_7 = ct4 * ct7 + st4 * st7;
+            let cth4_8 = ct4 * ct8 + st4 * st8;
+            let cth4_9 = ct4 * ct9 + st4 * st9;
+            let cth4_10 = ct4 * ct10 + st4 * st10;
+            let cth4_11 = ct4 * ct11 + st4 * st11;
+            let cth5_6 = ct5 * ct6 + st5 * st6;
+            let cth5_7 = ct5 * ct7 + st5 * st7;
+            let cth5_8 = ct5 * ct8 + st5 * st8;
+            let cth5_9 = ct5 * ct9 + st5 * st9;
+            let cth5_10 = ct5 * ct10 + st5 * st10;
+            let cth5_11 = ct5 * ct11 + st5 * st11;
+            let cth6_7 = ct6 * ct7 + st6 * st7;
+            let cth6_8 = ct6 * ct8 + st6 * st8;
+            let cth6_9 = ct6 * ct9 + st6 * st9;
+            let cth6_10 = ct6 * ct10 + st6 * st10;
+            let cth6_11 = ct6 * ct11 + st6 * st11;
+            let cth7_8 = ct7 * ct8 + st7 * st8;
+            let cth7_9 = ct7 * ct9 + st7 * st9;
+            let cth7_10 = ct7 * ct10 + st7 * st10;
+            let cth7_11 = ct7 * ct11 + st7 * st11;
+            let cth8_9 = ct8 * ct9 + st8 * st9;
+            let cth8_10 = ct8 * ct10 + st8 * st10;
+            let cth8_11 = ct8 * ct11 + st8 * st11;
+            let cth9_10 = ct9 * ct10 + st9 * st10;
+            let cth9_11 = ct9 * ct11 + st9 * st11;
+            let cth10_11 = ct10 * ct11 + st10 * st11;
+            let sth0_1 = st0 * ct1 - ct0 * st1;
+            let sth0_2 = st0 * ct2 - ct0 * st2;
+            let sth0_3 = st0 * ct3 - ct0 * st3;
+            let sth0_4 = st0 * ct4 - ct0 * st4;
+            let sth0_5 = st0 * ct5 - ct0 * st5;
+            let sth0_6 = st0 * ct6 - ct0 * st6;
+            let sth0_7 = st0 * ct7 - ct0 * st7;
+            let sth0_8 = st0 * ct8 - ct0 * st8;
+            let sth0_9 = st0 * ct9 - ct0 * st9;
+            let sth0_10 = st0 * ct10 - ct0 * st10;
+            let sth0_11 = st0 * ct11 - ct0 * st11;
+            let sth1_2 = st1 * ct2 - ct1 * st2;
+            let sth1_3 = st1 * ct3 - ct1 * st3;
+            let sth1_4 = st1 * ct4 - ct1 * st4;
+            let sth1_5 = st1 * ct5 - ct1 * st5;
+            let sth1_6 = st1 * ct6 - ct1 * st6;
+            let sth1_7 = st1 * ct7 - ct1 * st7;
+            let sth1_8 = st1 * ct8 - ct1 * st8;
+            let sth1_9 = st1 * ct9 - ct1 * st9;
+            let sth1_10 = st1 * ct10 - ct1 * st10;
+            let sth1_11 = st1 * ct11 - ct1 * st11;
+            let sth2_3 = st2 * ct3 - ct2 * st3;
+            let sth2_4 = st2 * ct4 - ct2 * st4;
+            let sth2_5 = st2 * ct5 - ct2 * st5;
+            let sth2_6 = st2 * ct6 - ct2 * st6;
+            let sth2_7 = st2 * ct7 - ct2 * st7;
+            let sth2_8 = st2 * ct8 - ct2 * st8;
+            let sth2_9 = st2 * ct9 - ct2 * st9;
+            let sth2_10 = st2 * ct10 - ct2 * st10;
+            let sth2_11 = st2 * ct11 - ct2 * st11;
+            let sth3_4 = st3 * ct4 - ct3 * st4;
+            let sth3_5 = st3 * ct5 - ct3 * st5;
+            let sth3_6 = st3 * ct6 - ct3 * st6;
+            let sth3_7 = st3 * ct7 - ct3 * st7;
+            let sth3_8 = st3 * ct8 - ct3 * st8;
+            let sth3_9 = st3 * ct9 - ct3 * st9;
+            let sth3_10 = st3 * ct10 - ct3 * st10;
+            let sth3_11 = st3 * ct11 - ct3 * st11;
+            let sth4_5 = st4 * ct5 - ct4 * st5;
+            let sth4_6 = st4 * ct6 - ct4 * st6;
+            let sth4_7 = st4 * ct7 - ct4 * st7;
+            let sth4_8 = st4 * ct8 - ct4 * st8;
+            let sth4_9 = st4 * ct9 - ct4 * st9;
+            let sth4_10 = st4 * ct10 - ct4 * st10;
+            let sth4_11 = st4 * ct11 - ct4 * st11;
+            let sth5_6 = st5 * ct6 - ct5 * st6;
+            let sth5_7 = st5 * ct7 - ct5 * st7;
+            let sth5_8 = st5 * ct8 - ct5 * st8;
+            let sth5_9 = st5 * ct9 - ct5 * st9;
+            let sth5_10 = st5 * ct10 - ct5 * st10;
+            let sth5_11 = st5 * ct11 - ct5 * st11;
+            let sth6_7 = st6 * ct7 - ct6 * st7;
+            let sth6_8 = st6 * ct8 - ct6 * st8;
+            let sth6_9 = st6 * ct9 - ct6 * st9;
+            let sth6_10 = st6 * ct10 - ct6 * st10;
+            let sth6_11 = st6 * ct11 - ct6 * st11;
+            let sth7_8 = st7 * ct8 - ct7 * st8;
+            let sth7_9 = st7 * ct9 - ct7 * st9;
+            let sth7_10 = st7 * ct10 - ct7 * st10;
+            let sth7_11 = st7 * ct11 - ct7 * st11;
+            let sth8_9 = st8 * ct9 - ct8 * st9;
+            let sth8_10 = st8 * ct10 - ct8 * st10;
+            let sth8_11 = st8 * ct11 - ct8 * st11;
+            let sth9_10 = st9 * ct10 - ct9 * st10;
+            let sth9_11 = st9 * ct11 - ct9 * st11;
+            let sth10_11 = st10 * ct11 - ct10 * st11;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w0_3 = self.w0_3;
+            let w0_4 = self.w0_4;
+            let w0_5 = self.w0_5;
+            let w0_6 = self.w0_6;
+            let w0_7 = self.w0_7;
+            let w0_8 = self.w0_8;
+            let w0_9 = self.w0_9;
+            let w0_10 = self.w0_10;
+            let w0_11 = self.w0_11;
+            let w1_2 = self.w1_2;
+            let w1_3 = self.w1_3;
+            let w1_4 = self.w1_4;
+            let w1_5 = self.w1_5;
+            let w1_6 = self.w1_6;
+            let w1_7 = self.w1_7;
+            let w1_8 = self.w1_8;
+            let w1_9 = self.w1_9;
+            let w1_10 = self.w1_10;
+            let w1_11 = self.w1_11;
+            let w2_3 = self.w2_3;
+            let w2_4 = self.w2_4;
+            let w2_5 = self.w2_5;
+            let w2_6 = self.w2_6;
+            let w2_7 = self.w2_7;
+            let w2_8 = self.w2_8;
+            let w2_9 = self.w2_9;
+            let w2_10 = self.w2_10;
+            let w2_11 = self.w2_11;
+            let w3_4 = self.w3_4;
+            let w3_5 = self.w3_5;
+            let w3_6 = self.w3_6;
+            let w3_7 = self.w3_7;
+            let w3_8 = self.w3_8;
+            let w3_9 = self.w3_9;
+            let w3_10 = self.w3_10;
+            let w3_11 = self.w3_11;
+            let w4_5 = self.w4_5;
+            let w4_6 = self.w4_6;
+            let w4_7 = self.w4_7;
+            let w4_8 = self.w4_8;
+            let w4_9 = self.w4_9;
+            let w4_10 = self.w4_10;
+            let w4_11 = self.w4_11;
+            let w5_6 = self.w5_6;
+            let w5_7 = self.w5_7;
+            let w5_8 = self.w5_8;
+            let w5_9 = self.w5_9;
+            let w5_10 = self.w5_10;
+            let w5_11 = self.w5_11;
+            let w6_7 = self.w6_7;
+            let w6_8 = self.w6_8;
+            let w6_9 = self.w6_9;
+            let w6_10 = self.w6_10;
+            let w6_11 = self.w6_11;
+            let w7_8 = self.w7_8;
+            let w7_9 = self.w7_9;
+            let w7_10 = self.w7_10;
+            let w7_11 = self.w7_11;
+            let w8_9 = self.w8_9;
+            let w8_10 = self.w8_10;
+            let w8_11 = self.w8_11;
+            let w9_10 = self.w9_10;
+            let w9_11 = self.w9_11;
+            let w10_11 = self.w10_11;
+            let ml0 = self.ml0;
+            let ml1 = self.ml1;
+            let ml2 = self.ml2;
+            let ml3 = self.ml3;
+            let ml4 = self.ml4;
+            let ml5 = self.ml5;
+            let ml6 = self.ml6;
+            let ml7 = self.ml7;
+            let ml8 = self.ml8;
+            let ml9 = self.ml9;
+            let ml10 = self.ml10;
+            let ml11 = self.ml11;
+            dq[(0, 0)] = -dth1 * dth1 * cth0_1 * w0_1
+                - dth2 * dth2 * cth0_2 * w0_2
+                - dth3 * dth3 * cth0_3 * w0_3
+                - dth4 * dth4 * cth0_4 * w0_4
+                - dth5 * dth5 * cth0_5 * w0_5
+                - dth6 * dth6 * cth0_6 * w0_6
+                - dth7 * dth7 * cth0_7 * w0_7
+                - dth8 * dth8 * cth0_8 * w0_8
+                - dth9 * dth9 * cth0_9 * w0_9
+                - dth10 * dth10 * cth0_10 * w0_10
+                - dth11 * dth11 * cth0_11 * w0_11
+                + st0 * ax * ml0
+                - ct0 * ay * ml0
+                - g * ct0 * ml0;
+            dq[(0, 1)] = dth1 * dth1 * cth0_1 * w0_1;
+            dq[(0, 2)] = dth2 * dth2 * cth0_2 * w0_2;
+            dq[(0, 3)] = dth3 * dth3 * cth0_3 * w0_3;
+            dq[(0, 4)] = dth4 * dth4 * cth0_4 * w0_4;
+            dq[(0, 5)] = dth5 * dth5 * cth0_5 * w0_5;
+            dq[(0, 6)] = dth6 * dth6 * cth0_6 * w0_6;
+            dq[(0, 7)] = dth7 * dth7 * cth0_7 * w0_7;
+            dq[(0, 8)] = dth8 * dth8 * cth0_8 * w0_8;
+            dq[(0, 9)] = dth9 * dth9 * cth0_9 * w0_9;
+            dq[(0, 10)] = dth10 * dth10 * cth0_10 * w0_10;
+            dq[(0, 11)] = dth11 * dth11 * cth0_11 * w0_11;
+            dqd[(0, 0)] = -lam0;
+            dqd[(0, 1)] = -2.0 * dth1 * sth0_1 * w0_1;
+            dqd[(0, 2)] = -2.0 * dth2 * sth0_2 * w0_2;
+            dqd[(0, 3)] = -2.0 * dth3 * sth0_3 * w0_3;
+            dqd[(0, 4)] = -2.0 * dth4 * sth0_4 * w0_4;
+            dqd[(0, 5)] = -2.0 * dth5 * sth0_5 * w0_5;
+            dqd[(0, 6)] = -2.0 * dth6 * sth0_6 * w0_6;
+            dqd[(0, 7)] = -2.0 * dth7 * sth0_7 * w0_7;
+            dqd[(0, 8)] = -2.0 * dth8 * sth0_8 * w0_8;
+            dqd[(0, 9)] = -2.0 * dth9 * sth0_9 * w0_9;
+            dqd[(0, 10)] = -2.0 * dth10 * sth0_10 * w0_10;
+            dqd[(0, 11)] = -2.0 * dth11 * sth0_11 * w0_11;
+            dp[(0, 0)] = -ct0 * ml0;
+            dp[(0, 1)] = -st0 * ml0;
+            dq[(1, 0)] = dth0 * dth0 * cth0_1 * w0_1;
+            dq[(1, 1)] = -dth0 * dth0 * cth0_1 * w0_1
+                - dth2 * dth2 * cth1_2 * w1_2
+                - dth3 * dth3 * cth1_3 * w1_3
+                - dth4 * dth4 * cth1_4 * w1_4
+                - dth5 * dth5 * cth1_5 * w1_5
+                - dth6 * dth6 * cth1_6 * w1_6
+                - dth7 * dth7 * cth1_7 * w1_7
+                - dth8 * dth8 * cth1_8 * w1_8
+                - dth9 * dth9 * cth1_9 * w1_9
+                - dth10 * dth10 * cth1_10 * w1_10
+                - dth11 * dth11 * cth1_11 * w1_11
+                + st1 * ax * ml1
+                - ct1 * ay * ml1
+                - g * ct1 * ml1;
+            dq[(1, 2)] = dth2 * dth2 * cth1_2 * w1_2;
+            dq[(1, 3)] = dth3 * dth3 * cth1_3 * w1_3;
+            dq[(1, 4)] = dth4 * dth4 * cth1_4 * w1_4;
+            dq[(1, 5)] = dth5 * dth5 * cth1_5 * w1_5;
+            dq[(1, 6)] = dth6 * dth6 * cth1_6 * w1_6;
+            dq[(1, 7)] = dth7 * dth7 * cth1_7 * w1_7;
+            dq[(1, 8)] = dth8 * dth8 * cth1_8 * w1_8;
+            dq[(1, 9)] = dth9 * dth9 * cth1_9 * w1_9;
+            dq[(1, 10)] = dth10 * dth10 * cth1_10 * w1_10;
+            dq[(1, 11)] = dth11 * dth11 * cth1_11 * w1_11;
+            dqd[(1, 0)] = 2.0 * dth0 * sth0_1 * w0_1;
+            dqd[(1, 1)] = -lam1;
+            dqd[(1, 2)] = -2.0 * dth2 * sth1_2 * w1_2;
+            dqd[(1, 3)] = -2.0 * dth3 * sth1_3 * w1_3;
+            dqd[(1, 4)] = -2.0 * dth4 * sth1_4 * w1_4;
+            dqd[(1, 5)] = -2.0 * dth5 * sth1_5 * w1_5;
+            dqd[(1, 6)] = -2.0 * dth6 * sth1_6 * w1_6;
+            dqd[(1, 7)] = -2.0 * dth7 * sth1_7 * w1_7;
+            dqd[(1, 8)] = -2.0 * dth8 * sth1_8 * w1_8;
+            dqd[(1, 9)] = -2.0 * dth9 * sth1_9 * w1_9;
+            dqd[(1, 10)] = -2.0 * dth10 * sth1_10 * w1_10;
+            dqd[(1, 11)] = -2.0 * dth11 * sth1_11 * w1_11;
+            dp[(1, 0)] = -ct1 * ml1;
+            dp[(1, 1)] = -st1 * ml1;
+            dq[(2, 0)] = dth0 * dth0 * cth0_2 * w0_2;
+            dq[(2, 1)] = dth1 * dth1 * cth1_2 * w1_2;
+            dq[(2, 2)] = -dth0 * dth0 * cth0_2 * w0_2
+                - dth1 * dth1 * cth1_2 * w1_2
+                - dth3 * dth3 * cth2_3 * w2_3
+                - dth4 * dth4 * cth2_4 * w2_4
+                - dth5 * dth5 * cth2_5 * w2_5
+                - dth6 * dth6 * cth2_6 * w2_6
+                - dth7 * dth7 * cth2_7 * w2_7
+                - dth8 * dth8 * cth2_8 * w2_8
+                - dth9 * dth9 * cth2_9 * w2_9
+                - dth10 * dth10 * cth2_10 * w2_10
+                - dth11 * dth11 * cth2_11 * w2_11
+                + st2 * ax * ml2
+                - ct2 * ay * ml2
+                - g * ct2 * ml2;
+            dq[(2, 3)] = dth3 * dth3 * cth2_3 * w2_3;
+            dq[(2, 4)] = dth4 * dth4 * cth2_4 * w2_4;
+            dq[(2, 5)] = dth5 * dth5 * cth2_5 * w2_5;
+            dq[(2, 6)] = dth6 * dth6 * cth2_6 * w2_6;
+            dq[(2, 7)] = dth7 * dth7 * cth2_7 * w2_7;
+            dq[(2, 8)] = dth8 * dth8 * cth2_8 * w2_8;
+            dq[(2, 9)] = dth9 * dth9 * cth2_9 * w2_9;
+            dq[(2, 10)] = dth10 * dth10 * cth2_10 * w2_10;
+            dq[(2, 11)] = dth11 * dth11 * cth2_11 * w2_11;
+            dqd[(2, 0)] = 2.0 * dth0 * sth0_2 * w0_2;
+            dqd[(2, 1)] = 2.0 * dth1 * sth1_2 * w1_2;
+            dqd[(2, 2)] = -lam2;
+            dqd[(2, 3)] = -2.0 * dth3 * sth2_3 * w2_3;
+            dqd[(2, 4)] = -2.0 * dth4 * sth2_4 * w2_4;
+            dqd[(2, 5)] = -2.0 * dth5 * sth2_5 * w2_5;
+            dqd[(2, 6)] = -2.0 * dth6 * sth2_6 * w2_6;
+            dqd[(2, 7)] = -2.0 * dth7 * sth2_7 * w2_7;
+            dqd[(2, 8)] = -2.0 * dth8 * sth2_8 * w2_8;
+            dqd[(2, 9)] = -2.0 * dth9 * sth2_9 * w2_9;
+            dqd[(2, 10)] = -2.0 * dth10 * sth2_10 * w2_10;
+            dqd[(2, 11)] = -2.0 * dth11 * sth2_11 * w2_11;
+            dp[(2, 0)] = -ct2 * ml2;
+            dp[(2, 1)] = -st2 * ml2;
+            dq[(3, 0)] = dth0 * dth0 * cth0_3 * w0_3;
+            dq[(3, 1)] = dth1 * dth1 * cth1_3 * w1_3;
+            dq[(3, 2)] = dth2 * dth2 * cth2_3 * w2_3;
+            dq[(3, 3)] = -dth0 * dth0 * cth0_3 * w0_3
+                - dth1 * dth1 * cth1_3 * w1_3
+                - dth2 * dth2 * cth2_3 * w2_3
+                - dth4 * dth4 * cth3_4 * w3_4
+                - dth5 * dth5 * cth3_5 * w3_5
+                - dth6 * dth6 * cth3_6 * w3_6
+                - dth7 * dth7 * cth3_7 * w3_7
+                - dth8 * dth8 * cth3_8 * w3_8
+                - dth9 * dth9 * cth3_9 * w3_9
+                - dth10 * dth10 * cth3_10 * w3_10
+                - dth11 * dth11 * cth3_11 * w3_11
+                + st3 * ax * ml3
+                - ct3 * ay * ml3
+                - g * ct3 * ml3;
+            dq[(3, 4)] = dth4 * dth4 * cth3_4 * w3_4;
+            dq[(3, 5)] = dth5 * dth5 * cth3_5 * w3_5;
+            dq[(3, 6)] = dth6 * dth6 * cth3_6 * w3_6;
+            dq[(3, 7)] = dth7 * dth7 * cth3_7 * w3_7;
+            dq[(3, 8)] = dth8 * dth8 * cth3_8 * w3_8;
+            dq[(3, 9)] = dth9 * dth9 * cth3_9 * w3_9;
+            dq[(3, 10)] = dth10 * dth10 * cth3_10 * w3_10;
+            dq[(3, 11)] = dth11 * dth11 * cth3_11 * w3_11;
+            dqd[(3, 0)] = 2.0 * dth0 * sth0_3 * w0_3;
+            dqd[(3, 1)] = 2.0 * dth1 * sth1_3 * w1_3;
+            dqd[(3, 2)] = 2.0 * dth2 * sth2_3 * w2_3;
+            dqd[(3, 3)] = -lam3;
+            dqd[(3, 4)] = -2.0 * dth4 * sth3_4 * w3_4;
+            dqd[(3, 5)] = -2.0 * dth5 * sth3_5 * w3_5;
+            dqd[(3, 6)] = -2.0 * dth6 * sth3_6 * w3_6;
+            dqd[(3, 7)] = -2.0 * dth7 * sth3_7 * w3_7;
+            dqd[(3, 8)] = -2.0 * dth8 * sth3_8 * w3_8;
+            dqd[(3, 9)] = -2.0 * dth9 * sth3_9 * w3_9;
+            dqd[(3, 10)] = -2.0 * dth10 * sth3_10 * w3_10;
+            dqd[(3, 11)] = -2.0 * dth11 * sth3_11 * w3_11;
+            dp[(3, 0)] = -ct3 * ml3;
+            dp[(3, 1)] = -st3 * ml3;
+            dq[(4, 0)] = dth0 * dth0 * cth0_4 * w0_4;
+            dq[(4, 1)] = dth1 * dth1 * cth1_4 * w1_4;
+            dq[(4, 2)] = dth2 * dth2 * cth2_4 * w2_4;
+            dq[(4, 3)] = dth3 * dth3 * cth3_4 * w3_4;
+            dq[(4, 4)] = -dth0 * dth0 * cth0_4 * w0_4
+                - dth1 * dth1 * cth1_4 * w1_4
+                - dth2 * dth2 * cth2_4 * w2_4
+                - dth3 * dth3 * cth3_4 * w3_4
+                - dth5 * dth5 * cth4_5 * w4_5
+                - dth6 * dth6 * cth4_6 * w4_6
+                - dth7 * dth7 * cth4_7 * w4_7
+                - dth8 * dth8 * cth4_8 * w4_8
+                - dth9 * dth9 * cth4_9 * w4_9
+                - dth10 * dth10 * cth4_10 * w4_10
+                - dth11 * dth11 * cth4_11 * w4_11
+                + st4 * ax * ml4
+                - ct4 * ay * ml4
+                - g * ct4 * ml4;
+            dq[(4, 5)] = dth5 * dth5 * cth4_5 * w4_5;
+            dq[(4, 6)] = dth6 * dth6 * cth4_6 * w4_6;
+            dq[(4, 7)] = dth7 * dth7 * cth4_7 * w4_7;
+            dq[(4, 8)] = dth8 * dth8 * cth4_8 * w4_8;
+            dq[(4, 9)] = dth9 * dth9 * cth4_9 * w4_9;
+            dq[(4, 10)] = dth10 * dth10 * cth4_10 * w4_10;
+            dq[(4, 11)] = dth11 * dth11 * cth4_11 * w4_11;
+            dqd[(4, 0)] = 2.0 * dth0 * sth0_4 * w0_4;
+            dqd[(4, 1)] = 2.0 * dth1 * sth1_4 * w1_4;
+            dqd[(4, 2)] = 2.0 * dth2 * sth2_4 * w2_4;
+            dqd[(4, 3)] = 2.0 * dth3 * sth3_4 * w3_4;
+            dqd[(4, 4)] = -lam4;
+            dqd[(4, 5)] = -2.0 * dth5 * sth4_5 * w4_5;
+            dqd[(4, 6)] = -2.0 * dth6 * sth4_6 * w4_6;
+            dqd[(4, 7)] = -2.0 * dth7 * sth4_7 * w4_7;
+            dqd[(4, 8)] = -2.0 * dth8 * sth4_8 * w4_8;
+            dqd[(4, 9)] = -2.0 * dth9 * sth4_9 * w4_9;
+            dqd[(4, 10)] = -2.0 * dth10 * sth4_10 * w4_10;
+            dqd[(4, 11)] = -2.0 * dth11 * sth4_11 * w4_11;
+            dp[(4, 0)] = -ct4 * ml4;
+            dp[(4, 1)] = -st4 * ml4;
+            dq[(5, 0)] = dth0 * dth0 * cth0_5 * w0_5;
+            dq[(5, 1)] = dth1 * dth1 * cth1_5 * w1_5;
+            dq[(5, 2)] = dth2 * dth2 * cth2_5 * w2_5;
+            dq[(5, 3)] = dth3 * dth3 * cth3_5 * w3_5;
+            dq[(5, 4)] = dth4 * dth4 * cth4_5 * w4_5;
+            dq[(5, 5)] = -dth0 * dth0 * cth0_5 * w0_5
+                - dth1 * dth1 * cth1_5 * w1_5
+                - dth2 * dth2 * cth2_5 * w2_5
+                - dth3 * dth3 * cth3_5 * w3_5
+                - dth4 * dth4 * cth4_5 * w4_5
+                - dth6 * dth6 * cth5_6 * w5_6
+                - dth7 * dth7 * cth5_7 * w5_7
+                - dth8 * dth8 * cth5_8 * w5_8
+                - dth9 * dth9 * cth5_9 * w5_9
+                - dth10 * dth10 * cth5_10 * w5_10
+                - dth11 * dth11 * cth5_11 * w5_11
+                + st5 * ax * ml5
+                - ct5 * ay * ml5
+                - g * ct5 * ml5;
+            dq[(5, 6)] = dth6 * dth6 * cth5_6 * w5_6;
+            dq[(5, 7)] = dth7 * dth7 * cth5_7 * w5_7;
+            dq[(5, 8)] = dth8 * dth8 * cth5_8 * w5_8;
+            dq[(5, 9)] = dth9 * dth9 * cth5_9 * w5_9;
+            dq[(5, 10)] = dth10 * dth10 * cth5_10 * w5_10;
+            dq[(5, 11)] = dth11 * dth11 * cth5_11 * w5_11;
+            dqd[(5, 0)] = 2.0 * dth0 * sth0_5 * w0_5;
+            dqd[(5, 1)] = 2.0 * dth1 * sth1_5 * w1_5;
+            dqd[(5, 2)] = 2.0 * dth2 * sth2_5 * w2_5;
+            dqd[(5, 3)] = 2.0 * dth3 * sth3_5 * w3_5;
+            dqd[(5, 4)] = 2.0 * dth4 * sth4_5 * w4_5;
+            dqd[(5, 5)] = -lam5;
+            dqd[(5, 6)] = -2.0 * dth6 * sth5_6 * w5_6;
+            dqd[(5, 7)] = -2.0 * dth7 * sth5_7 * w5_7;
+            dqd[(5, 8)] = -2.0 * dth8 * sth5_8 * w5_8;
+            dqd[(5, 9)] = -2.0 * dth9 * sth5_9 * w5_9;
+            dqd[(5, 10)] = -2.0 * dth10 * sth5_10 * w5_10;
+            dqd[(5, 11)] = -2.0 * dth11 * sth5_11 * w5_11;
+            dp[(5, 0)] = -ct5 * ml5;
+            dp[(5, 1)] = -st5 * ml5;
+            dq[(6, 0)] = dth0 * dth0 * cth0_6 * w0_6;
+            dq[(6, 1)] = dth1 * dth1 * cth1_6 * w1_6;
+            dq[(6, 2)] = dth2 * dth2 * cth2_6 * w2_6;
+            dq[(6, 3)] = dth3 * dth3 * cth3_6 * w3_6;
+            dq[(6, 4)] = dth4 * dth4 * cth4_6 * w4_6;
+            dq[(6, 5)] = dth5 * dth5 * cth5_6 * w5_6;
+            dq[(6, 6)] = -dth0 * dth0 * cth0_6 * w0_6
+                - dth1 * dth1 * cth1_6 * w1_6
+                - dth2 * dth2 * cth2_6 * w2_6
+                - dth3 * dth3 * cth3_6 * w3_6
+                - dth4 * dth4 * cth4_6 * w4_6
+                - dth5 * dth5 * cth5_6 * w5_6
+                - dth7 * dth7 * cth6_7 * w6_7
+                - dth8 * dth8 * cth6_8 * w6_8
+                - dth9 * dth9 * cth6_9 * w6_9
+                - dth10 * dth10 * cth6_10 * w6_10
+                - dth11 * dth11 * cth6_11 * w6_11
+                + st6 * ax * ml6
+                - ct6 * ay * ml6
+                - g * ct6 * ml6;
+            dq[(6, 7)] = dth7 * dth7 * cth6_7 * w6_7;
+            dq[(6, 8)] = dth8 * dth8 * cth6_8 * w6_8;
+            dq[(6, 9)] = dth9 * dth9 * cth6_9 * w6_9;
+            dq[(6, 10)] = dth10 * dth10 * cth6_10 * w6_10;
+            dq[(6, 11)] = dth11 * dth11 * cth6_11 * w6_11;
+            dqd[(6, 0)] = 2.0 * dth0 * sth0_6 * w0_6;
+            dqd[(6, 1)] = 2.0 * dth1 * sth1_6 * w1_6;
+            dqd[(6, 2)] = 2.0 * dth2 * sth2_6 * w2_6;
+            dqd[(6, 3)] = 2.0 * dth3 * sth3_6 * w3_6;
+            dqd[(6, 4)] = 2.0 * dth4 * sth4_6 * w4_6;
+            dqd[(6, 5)] = 2.0 * dth5 * sth5_6 * w5_6;
+            dqd[(6, 6)] = -lam6;
+            dqd[(6, 7)] = -2.0 * dth7 * sth6_7 * w6_7;
+            dqd[(6, 8)] = -2.0 * dth8 * sth6_8 * w6_8;
+            dqd[(6, 9)] = -2.0 * dth9 * sth6_9 * w6_9;
+            dqd[(6, 10)] = -2.0 * dth10 * sth6_10 * w6_10;
+            dqd[(6, 11)] = -2.0 * dth11 * sth6_11 * w6_11;
+            dp[(6, 0)] = -ct6 * ml6;
+            dp[(6, 1)] = -st6 * ml6;
+            dq[(7, 0)] = dth0 * dth0 * cth0_7 * w0_7;
+            dq[(7, 1)] = dth1 * dth1 * cth1_7 * w1_7;
+            dq[(7, 2)] = dth2 * dth2 * cth2_7 * w2_7;
+            dq[(7, 3)] = dth3 * dth3 * cth3_7 * w3_7;
+            dq[(7, 4)] = dth4 * dth4 * cth4_7 * w4_7;
+            dq[(7, 5)] = dth5 * dth5 * cth5_7 * w5_7;
+            dq[(7, 6)] = dth6 * dth6 * cth6_7 * w6_7;
+            dq[(7, 7)] = -dth0 * dth0 * cth0_7 * w0_7
+                - dth1 * dth1 * cth1_7 * w1_7
+                - dth2 * dth2 * cth2_7 * w2_7
+                - dth3 * dth3 * cth3_7 * w3_7
+                - dth4 * dth4 * cth4_7 * w4_7
+                - dth5 * dth5 * cth5_7 * w5_7
+                - dth6 * dth6 * cth6_7 * w6_7
+                - dth8 * dth8 * cth7_8 * w7_8
+                - dth9 * dth9 * cth7_9 * w7_9
+                - dth10 * dth10 * cth7_10 * w7_10
+                - dth11 * dth11 * cth7_11 * w7_11
+                + st7 * ax * ml7
+                - ct7 * ay * ml7
+                - g * ct7 * ml7;
+            dq[(7, 8)] = dth8 * dth8 * cth7_8 * w7_8;
+            dq[(7, 9)] = dth9 * dth9 * cth7_9 * w7_9;
+            dq[(7, 10)] = dth10 * dth10 * cth7_10 * w7_10;
+            dq[(7, 11)] = dth11 * dth11 * cth7_11 * w7_11;
+            dqd[(7, 0)] = 2.0 * dth0 * sth0_7 * w0_7;
+            dqd[(7, 1)] = 2.0 * dth1 * sth1_7 * w1_7;
+            dqd[(7, 2)] = 2.0 * dth2 * sth2_7 * w2_7;
+            dqd[(7, 3)] = 2.0 * dth3 * sth3_7 * w3_7;
+            dqd[(7, 4)] = 2.0 * dth4 * sth4_7 * w4_7;
+            dqd[(7, 5)] = 2.0 * dth5 * sth5_7 * w5_7;
+            dqd[(7, 6)] = 2.0 * dth6 * sth6_7 * w6_7;
+            dqd[(7, 7)] = -lam7;
+            dqd[(7, 8)] = -2.0 * dth8 * sth7_8 * w7_8;
+            dqd[(7, 9)] = -2.0 * dth9 * sth7_9 * w7_9;
+            dqd[(7, 10)] = -2.0 * dth10 * sth7_10 * w7_10;
+            dqd[(7, 11)] = -2.0 * dth11 * sth7_11 * w7_11;
+            dp[(7, 0)] = -ct7 * ml7;
+            dp[(7, 1)] = -st7 * ml7;
+            dq[(8, 0)] = dth0 * dth0 * cth0_8 * w0_8;
+            dq[(8, 1)] = dth1 * dth1 * cth1_8 * w1_8;
+            dq[(8, 2)] = dth2 * dth2 * cth2_8 * w2_8;
+            dq[(8, 3)] = dth3 * dth3 * cth3_8 * w3_8;
+            dq[(8, 4)] = dth4 * dth4 * cth4_8 * w4_8;
+            dq[(8, 5)] = dth5 * dth5 * cth5_8 * w5_8;
+            dq[(8, 6)] = dth6 * dth6 * cth6_8 * w6_8;
+            dq[(8, 7)] = dth7 * dth7 * cth7_8 * w7_8;
+            dq[(8, 8)] = -dth0 * dth0 * cth0_8 * w0_8
+                - dth1 * dth1 * cth1_8 * w1_8
+                - dth2 * dth2 * cth2_8 * w2_8
+                - dth3 * dth3 * cth3_8 * w3_8
+                - dth4 * dth4 * cth4_8 * w4_8
+                - dth5 * dth5 * cth5_8 * w5_8
+                - dth6 * dth6 * cth6_8 * w6_8
+                - dth7 * dth7 * cth7_8 * w7_8
+                - dth9 * dth9 * cth8_9 * w8_9
+                - dth10 * dth10 * cth8_10 * w8_10
+                - dth11 * dth11 * cth8_11 * w8_11
+                + st8 * ax * ml8
+                - ct8 * ay * ml8
+                - g * ct8 * ml8;
+            dq[(8, 9)] = dth9 * dth9 * cth8_9 * w8_9;
+            dq[(8, 10)] = dth10 * dth10 * cth8_10 * w8_10;
+            dq[(8, 11)] = dth11 * dth11 * cth8_11 * w8_11;
+            dqd[(8, 0)] = 2.0 * dth0 * sth0_8 * w0_8;
+            dqd[(8, 1)] = 2.0 * dth1 * sth1_8 * w1_8;
+            dqd[(8, 2)] = 2.0 * dth2 * sth2_8 * w2_8;
+            dqd[(8, 3)] = 2.0 * dth3 * sth3_8 * w3_8;
+            dqd[(8, 4)] = 2.0 * dth4 * sth4_8 * w4_8;
+            dqd[(8, 5)] = 2.0 * dth5 * sth5_8 * w5_8;
+            dqd[(8, 6)] = 2.0 * dth6 * sth6_8 * w6_8;
+            dqd[(8, 7)] = 2.0 * dth7 * sth7_8 * w7_8;
+            dqd[(8, 8)] = -lam8;
+            dqd[(8, 9)] = -2.0 * dth9 * sth8_9 * w8_9;
+            dqd[(8, 10)] = -2.0 * dth10 * sth8_10 * w8_10;
+            dqd[(8, 11)] = -2.0 * dth11 * sth8_11 * w8_11;
+            dp[(8, 0)] = -ct8 * ml8;
+            dp[(8, 1)] = -st8 * ml8;
+            dq[(9, 0)] = dth0 * dth0 * cth0_9 * w0_9;
+            dq[(9, 1)] = dth1 * dth1 * cth1_9 * w1_9;
+            dq[(9, 2)] = dth2 * dth2 * cth2_9 * w2_9;
+            dq[(9, 3)] = dth3 * dth3 * cth3_9 * w3_9;
+            dq[(9, 4)] = dth4 * dth4 * cth4_9 * w4_9;
+            dq[(9, 5)] = dth5 * dth5 * cth5_9 * w5_9;
+            dq[(9, 6)] = dth6 * dth6 * cth6_9 * w6_9;
+            dq[(9, 7)] = dth7 * dth7 * cth7_9 * w7_9;
+            dq[(9, 8)] = dth8 * dth8 * cth8_9 * w8_9;
+            dq[(9, 9)] = -dth0 * dth0 * cth0_9 * w0_9
+                - dth1 * dth1 * cth1_9 * w1_9
+                - dth2 * dth2 * cth2_9 * w2_9
+                - dth3 * dth3 * cth3_9 * w3_9
+                - dth4 * dth4 * cth4_9 * w4_9
+                - dth5 * dth5 * cth5_9 * w5_9
+                - dth6 * dth6 * cth6_9 * w6_9
+                - dth7 * dth7 * cth7_9 * w7_9
+                - dth8 * dth8 * cth8_9 * w8_9
+                - dth10 * dth10 * cth9_10 * w9_10
+                - dth11 * dth11 * cth9_11 * w9_11
+                + st9 * ax * ml9
+                - ct9 * ay * ml9
+                - g * ct9 * ml9;
+            dq[(9, 10)] = dth10 * dth10 * cth9_10 * w9_10;
+            dq[(9, 11)] = dth11 * dth11 * cth9_11 * w9_11;
+            dqd[(9, 0)] = 2.0 * dth0 * sth0_9 * w0_9;
+            dqd[(9, 1)] = 2.0 * dth1 * sth1_9 * w1_9;
+            dqd[(9, 2)] = 2.0 * dth2 * sth2_9 * w2_9;
+            dqd[(9, 3)] = 2.0 * dth3 * sth3_9 * w3_9;
+            dqd[(9, 4)] = 2.0 * dth4 * sth4_9 * w4_9;
+            dqd[(9, 5)] = 2.0 * dth5 * sth5_9 * w5_9;
+            dqd[(9, 6)] = 2.0 * dth6 * sth6_9 * w6_9;
+            dqd[(9, 7)] = 2.0 * dth7 * sth7_9 * w7_9;
+            dqd[(9, 8)] = 2.0 * dth8 * sth8_9 * w8_9;
+            dqd[(9, 9)] = -lam9;
+            dqd[(9, 10)] = -2.0 * dth10 * sth9_10 * w9_10;
+            dqd[(9, 11)] = -2.0 * dth11 * sth9_11 * w9_11;
+            dp[(9, 0)] = -ct9 * ml9;
+            dp[(9, 1)] = -st9 * ml9;
+            dq[(10, 0)] = dth0 * dth0 * cth0_10 * w0_10;
+            dq[(10, 1)] = dth1 * dth1 * cth1_10 * w1_10;
+            dq[(10, 2)] = dth2 * dth2 * cth2_10 * w2_10;
+            dq[(10, 3)] = dth3 * dth3 * cth3_10 * w3_10;
+            dq[(10, 4)] = dth4 * dth4 * cth4_10 * w4_10;
+            dq[(10, 5)] = dth5 * dth5 * cth5_10 * w5_10;
+            dq[(10, 6)] = dth6 * dth6 * cth6_10 * w6_10;
+            dq[(10, 7)] = dth7 * dth7 * cth7_10 * w7_10;
+            dq[(10, 8)] = dth8 * dth8 * cth8_10 * w8_10;
+            dq[(10, 9)] = dth9 * dth9 * cth9_10 * w9_10;
+            dq[(10, 10)] = -dth0 * dth0 * cth0_10 * w0_10
+                - dth1 * dth1 * cth1_10 * w1_10
+                - dth2 * dth2 * cth2_10 * w2_10
+                - dth3 * dth3 * cth3_10 * w3_10
+                - dth4 * dth4 * cth4_10 * w4_10
+                - dth5 * dth5 * cth5_10 * w5_10
+                - dth6 * dth6 * cth6_10 * w6_10
+                - dth7 * dth7 * cth7_10 * w7_10
+                - dth8 * dth8 * cth8_10 * w8_10
+                - dth9 * dth9 * cth9_10 * w9_10
+                - dth11 * dth11 * cth10_11 * w10_11
+                + st10 * ax * ml10
+                - ct10 * ay * ml10
+                - g * ct10 * ml10;
+            dq[(10, 11)] = dth11 * dth11 * cth10_11 * w10_11;
+            dqd[(10, 0)] = 2.0 * dth0 * sth0_10 * w0_10;
+            dqd[(10, 1)] = 2.0 * dth1 * sth1_10 * w1_10;
+            dqd[(10, 2)] = 2.0 * dth2 * sth2_10 * w2_10;
+            dqd[(10, 3)] = 2.0 * dth3 * sth3_10 * w3_10;
+            dqd[(10, 4)] = 2.0 * dth4 * sth4_10 * w4_10;
+            dqd[(10, 5)] = 2.0 * dth5 * sth5_10 * w5_10;
+            dqd[(10, 6)] = 2.0 * dth6 * sth6_10 * w6_10;
+            dqd[(10, 7)] = 2.0 * dth7 * sth7_10 * w7_10;
+            dqd[(10, 8)] = 2.0 * dth8 * sth8_10 * w8_10;
+            dqd[(10, 9)] = 2.0 * dth9 * sth9_10 * w9_10;
+            dqd[(10, 10)] = -lam10;
+            dqd[(10, 11)] = -2.0 * dth11 * sth10_11 * w10_11;
+            dp[(10, 0)] = -ct10 * ml10;
+            dp[(10, 1)] = -st10 * ml10;
+            dq[(11, 0)] = dth0 * dth0 * cth0_11 * w0_11;
+            dq[(11, 1)] = dth1 * dth1 * cth1_11 * w1_11;
+            dq[(11, 2)] = dth2 * dth2 * cth2_11 * w2_11;
+            dq[(11, 3)] = dth3 * dth3 * cth3_11 * w3_11;
+            dq[(11, 4)] = dth4 * dth4 * cth4_11 * w4_11;
+            dq[(11, 5)] = dth5 * dth5 * cth5_11 * w5_11;
+            dq[(11, 6)] = dth6 * dth6 * cth6_11 * w6_11;
+            dq[(11, 7)] = dth7 * dth7 * cth7_11 * w7_11;
+            dq[(11, 8)] = dth8 * dth8 * cth8_11 * w8_11;
+            dq[(11, 9)] = dth9 * dth9 * cth9_11 * w9_11;
+            dq[(11, 10)] = dth10 * dth10 * cth10_11 * w10_11;
+            dq[(11, 11)] = -dth0 * dth0 * cth0_11 * w0_11
+                - dth1 * dth1 * cth1_11 * w1_11
+                - dth2 * dth2 * cth2_11 * w2_11
+                - dth3 * dth3 * cth3_11 * w3_11
+                - dth4 * dth4 * cth4_11 * w4_11
+                - dth5 * dth5 * cth5_11 * w5_11
+                - dth6 * dth6 * cth6_11 * w6_11
+                - dth7 * dth7 * cth7_11 * w7_11
+                - dth8 * dth8 * cth8_11 * w8_11
+                - dth9 * dth9 * cth9_11 * w9_11
+                - dth10 * dth10 * cth10_11 * w10_11
+                + st11 * ax * ml11
+                - ct11 * ay * ml11
+                - g * ct11 * ml11;
+            dqd[(11, 0)] = 2.0 * dth0 * sth0_11 * w0_11;
+            dqd[(11, 1)] = 2.0 * dth1 * sth1_11 * w1_11;
+            dqd[(11, 2)] = 2.0 * dth2 * sth2_11 * w2_11;
+            dqd[(11, 3)] = 2.0 * dth3 * sth3_11 * w3_11;
+            dqd[(11, 4)] = 2.0 * dth4 * sth4_11 * w4_11;
+            dqd[(11, 5)] = 2.0 * dth5 * sth5_11 * w5_11;
+            dqd[(11, 6)] = 2.0 * dth6 * sth6_11 * w6_11;
+            dqd[(11, 7)] = 2.0 * dth7 * sth7_11 * w7_11;
+            dqd[(11, 8)] = 2.0 * dth8 * sth8_11 * w8_11;
+            dqd[(11, 9)] = 2.0 * dth9 * sth9_11 * w9_11;
+            dqd[(11, 10)] = 2.0 * dth10 * sth10_11 * w10_11;
+            dqd[(11, 11)] = -lam11;
+            dp[(11, 0)] = -ct11 * ml11;
+            dp[(11, 1)] = -st11 * ml11;
         }
     }
 };

@@ -34,7 +34,7 @@ const _: () = {
     use ::core::primitive::f64;
     use ::core::result::Result::{Err, Ok};
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U2};
-    use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+    use ::pendulum_core::{Chain, Derivatives, Error, Inputs, Model, Result};
     impl Planar3 {
         #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
         #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
@@ -372,6 +372,110 @@ const _: () = {
             out[1] = x1;
             out[2] = x2;
             Ok(())
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl Derivatives for Planar3 {
+        fn mass_matrix_partials(
+            &self,
+            q: &SVector<f64, 3>,
+            v: &SVector<f64, 3>,
+            out: &mut SMatrix<f64, 3, 3>,
+        ) {
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let pv0 = v[0];
+            let pv1 = v[1];
+            let pv2 = v[2];
+            let sth0_1 = st0 * ct1 - ct0 * st1;
+            let sth0_2 = st0 * ct2 - ct0 * st2;
+            let sth1_2 = st1 * ct2 - ct1 * st2;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w1_2 = self.w1_2;
+            let dm1_0_0 = -sth0_1 * w0_1;
+            let dm1_0_1 = sth0_1 * w0_1;
+            let dm2_0_0 = -sth0_2 * w0_2;
+            let dm2_0_2 = sth0_2 * w0_2;
+            let dm2_1_1 = -sth1_2 * w1_2;
+            let dm2_1_2 = sth1_2 * w1_2;
+            out[(0, 0)] = dm1_0_0 * pv1 + dm2_0_0 * pv2;
+            out[(0, 1)] = dm1_0_1 * pv1;
+            out[(0, 2)] = dm2_0_2 * pv2;
+            out[(1, 0)] = dm1_0_0 * pv0;
+            out[(1, 1)] = dm1_0_1 * pv0 + dm2_1_1 * pv2;
+            out[(1, 2)] = dm2_1_2 * pv2;
+            out[(2, 0)] = dm2_0_0 * pv0;
+            out[(2, 1)] = dm2_1_1 * pv1;
+            out[(2, 2)] = dm2_0_2 * pv0 + dm2_1_2 * pv1;
+        }
+        fn force_jacobians(
+            &self,
+            q: &SVector<f64, 3>,
+            qd: &SVector<f64, 3>,
+            inputs: &Inputs<Const<3>, U2>,
+            dq: &mut SMatrix<f64, 3, 3>,
+            dqd: &mut SMatrix<f64, 3, 3>,
+            dp: &mut SMatrix<f64, 3, 2>,
+        ) {
+            let pivot_acceleration = &inputs.pivot_acceleration;
+            let damping = self.chain.damping();
+            let g = self.chain.gravity();
+            let lam0 = damping[0];
+            let lam1 = damping[1];
+            let lam2 = damping[2];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dth2 = qd[2];
+            let ax = pivot_acceleration[0];
+            let ay = pivot_acceleration[1];
+            let cth0_1 = ct0 * ct1 + st0 * st1;
+            let cth0_2 = ct0 * ct2 + st0 * st2;
+            let cth1_2 = ct1 * ct2 + st1 * st2;
+            let sth0_1 = st0 * ct1 - ct0 * st1;
+            let sth0_2 = st0 * ct2 - ct0 * st2;
+            let sth1_2 = st1 * ct2 - ct1 * st2;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w1_2 = self.w1_2;
+            let ml0 = self.ml0;
+            let ml1 = self.ml1;
+            let ml2 = self.ml2;
+            dq[(0, 0)] = -dth1 * dth1 * cth0_1 * w0_1 - dth2 * dth2 * cth0_2 * w0_2 + st0 * ax * ml0
+                - ct0 * ay * ml0
+                - g * ct0 * ml0;
+            dq[(0, 1)] = dth1 * dth1 * cth0_1 * w0_1;
+            dq[(0, 2)] = dth2 * dth2 * cth0_2 * w0_2;
+            dqd[(0, 0)] = -lam0;
+            dqd[(0, 1)] = -2.0 * dth1 * sth0_1 * w0_1;
+            dqd[(0, 2)] = -2.0 * dth2 * sth0_2 * w0_2;
+            dp[(0, 0)] = -ct0 * ml0;
+            dp[(0, 1)] = -st0 * ml0;
+            dq[(1, 0)] = dth0 * dth0 * cth0_1 * w0_1;
+            dq[(1, 1)] = -dth0 * dth0 * cth0_1 * w0_1 - dth2 * dth2 * cth1_2 * w1_2 + st1 * ax * ml1
+                - ct1 * ay * ml1
+                - g * ct1 * ml1;
+            dq[(1, 2)] = dth2 * dth2 * cth1_2 * w1_2;
+            dqd[(1, 0)] = 2.0 * dth0 * sth0_1 * w0_1;
+            dqd[(1, 1)] = -lam1;
+            dqd[(1, 2)] = -2.0 * dth2 * sth1_2 * w1_2;
+            dp[(1, 0)] = -ct1 * ml1;
+            dp[(1, 1)] = -st1 * ml1;
+            dq[(2, 0)] = dth0 * dth0 * cth0_2 * w0_2;
+            dq[(2, 1)] = dth1 * dth1 * cth1_2 * w1_2;
+            dq[(2, 2)] = -dth0 * dth0 * cth0_2 * w0_2 - dth1 * dth1 * cth1_2 * w1_2 + st2 * ax * ml2
+                - ct2 * ay * ml2
+                - g * ct2 * ml2;
+            dqd[(2, 0)] = 2.0 * dth0 * sth0_2 * w0_2;
+            dqd[(2, 1)] = 2.0 * dth1 * sth1_2 * w1_2;
+            dqd[(2, 2)] = -lam2;
+            dp[(2, 0)] = -ct2 * ml2;
+            dp[(2, 1)] = -st2 * ml2;
         }
     }
 };

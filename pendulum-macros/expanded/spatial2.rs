@@ -26,7 +26,7 @@ const _: () = {
     use ::core::primitive::f64;
     use ::core::result::Result::{Err, Ok};
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U3};
-    use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+    use ::pendulum_core::{Chain, Derivatives, Error, Inputs, Model, Result};
     impl Spatial2 {
         #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
         #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
@@ -418,6 +418,204 @@ const _: () = {
             out[2] = x2;
             out[3] = x3;
             Ok(())
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl Derivatives for Spatial2 {
+        fn mass_matrix_partials(
+            &self,
+            q: &SVector<f64, 4>,
+            v: &SVector<f64, 4>,
+            out: &mut SMatrix<f64, 4, 4>,
+        ) {
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (sp0, cp0) = q[2].sin_cos();
+            let (sp1, cp1) = q[3].sin_cos();
+            let pv0 = v[0];
+            let pv1 = v[1];
+            let pv2 = v[2];
+            let pv3 = v[3];
+            let cph0_1 = cp0 * cp1 + sp0 * sp1;
+            let sph0_1 = sp0 * cp1 - cp0 * sp1;
+            let w0_0 = self.w0_0;
+            let w0_1 = self.w0_1;
+            let w1_1 = self.w1_1;
+            let dm1_0_0 = -st0 * ct1 * cph0_1 * w0_1 + ct0 * st1 * w0_1;
+            let dm1_0_1 = -ct0 * st1 * cph0_1 * w0_1 + st0 * ct1 * w0_1;
+            let dm1_0_2 = -ct0 * ct1 * sph0_1 * w0_1;
+            let dm1_0_3 = ct0 * ct1 * sph0_1 * w0_1;
+            let dm2_1_0 = -ct0 * ct1 * sph0_1 * w0_1;
+            let dm2_1_1 = st0 * st1 * sph0_1 * w0_1;
+            let dm2_1_2 = -st0 * ct1 * cph0_1 * w0_1;
+            let dm2_1_3 = st0 * ct1 * cph0_1 * w0_1;
+            let dm2_2_0 = 2.0 * st0 * ct0 * w0_0;
+            let dm3_0_0 = -st0 * st1 * sph0_1 * w0_1;
+            let dm3_0_1 = ct0 * ct1 * sph0_1 * w0_1;
+            let dm3_0_2 = ct0 * st1 * cph0_1 * w0_1;
+            let dm3_0_3 = -ct0 * st1 * cph0_1 * w0_1;
+            let dm3_2_0 = ct0 * st1 * cph0_1 * w0_1;
+            let dm3_2_1 = st0 * ct1 * cph0_1 * w0_1;
+            let dm3_2_2 = -st0 * st1 * sph0_1 * w0_1;
+            let dm3_2_3 = st0 * st1 * sph0_1 * w0_1;
+            let dm3_3_1 = 2.0 * st1 * ct1 * w1_1;
+            out[(0, 0)] = dm1_0_0 * pv1 + dm3_0_0 * pv3;
+            out[(0, 1)] = dm1_0_1 * pv1 + dm3_0_1 * pv3;
+            out[(0, 2)] = dm1_0_2 * pv1 + dm3_0_2 * pv3;
+            out[(0, 3)] = dm1_0_3 * pv1 + dm3_0_3 * pv3;
+            out[(1, 0)] = dm1_0_0 * pv0 + dm2_1_0 * pv2;
+            out[(1, 1)] = dm1_0_1 * pv0 + dm2_1_1 * pv2;
+            out[(1, 2)] = dm1_0_2 * pv0 + dm2_1_2 * pv2;
+            out[(1, 3)] = dm1_0_3 * pv0 + dm2_1_3 * pv2;
+            out[(2, 0)] = dm2_1_0 * pv1 + dm2_2_0 * pv2 + dm3_2_0 * pv3;
+            out[(2, 1)] = dm2_1_1 * pv1 + dm3_2_1 * pv3;
+            out[(2, 2)] = dm2_1_2 * pv1 + dm3_2_2 * pv3;
+            out[(2, 3)] = dm2_1_3 * pv1 + dm3_2_3 * pv3;
+            out[(3, 0)] = dm3_0_0 * pv0 + dm3_2_0 * pv2;
+            out[(3, 1)] = dm3_0_1 * pv0 + dm3_2_1 * pv2 + dm3_3_1 * pv3;
+            out[(3, 2)] = dm3_0_2 * pv0 + dm3_2_2 * pv2;
+            out[(3, 3)] = dm3_0_3 * pv0 + dm3_2_3 * pv2;
+        }
+        fn force_jacobians(
+            &self,
+            q: &SVector<f64, 4>,
+            qd: &SVector<f64, 4>,
+            inputs: &Inputs<Const<4>, U3>,
+            dq: &mut SMatrix<f64, 4, 4>,
+            dqd: &mut SMatrix<f64, 4, 4>,
+            dp: &mut SMatrix<f64, 4, 3>,
+        ) {
+            let pivot_acceleration = &inputs.pivot_acceleration;
+            let damping = self.chain.damping();
+            let g = self.chain.gravity();
+            let lam0 = damping[0];
+            let lam1 = damping[1];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (sp0, cp0) = q[2].sin_cos();
+            let (sp1, cp1) = q[3].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dph0 = qd[2];
+            let dph1 = qd[3];
+            let ax = pivot_acceleration[0];
+            let ay = pivot_acceleration[1];
+            let az = pivot_acceleration[2];
+            let cph0_1 = cp0 * cp1 + sp0 * sp1;
+            let sph0_1 = sp0 * cp1 - cp0 * sp1;
+            let w0_0 = self.w0_0;
+            let w0_1 = self.w0_1;
+            let w1_1 = self.w1_1;
+            let ml0 = self.ml0;
+            let ml1 = self.ml1;
+            dq[(0, 0)] = ct0 * ct0 * dph0 * dph0 * w0_0
+                - st0 * st0 * dph0 * dph0 * w0_0
+                - ct0 * ct1 * dth1 * dth1 * w0_1
+                - st0 * st1 * dth1 * dth1 * cph0_1 * w0_1
+                - st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1
+                + st0 * cp0 * ax * ml0
+                + st0 * sp0 * ay * ml0
+                - ct0 * az * ml0
+                - g * ct0 * ml0;
+            dq[(0, 1)] = st0 * st1 * dth1 * dth1 * w0_1
+                + ct0 * ct1 * dth1 * dth1 * cph0_1 * w0_1
+                + ct0 * ct1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * ct0 * st1 * dth1 * dph1 * sph0_1 * w0_1;
+            dq[(0, 2)] = -ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                - ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1
+                + ct0 * sp0 * ax * ml0
+                - ct0 * cp0 * ay * ml0;
+            dq[(0, 3)] = ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                + ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1;
+            dqd[(0, 0)] = -lam0;
+            dqd[(0, 1)] = -2.0 * st0 * ct1 * dth1 * w0_1 + 2.0 * ct0 * st1 * dth1 * cph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dph1 * sph0_1 * w0_1;
+            dqd[(0, 2)] = 2.0 * st0 * ct0 * dph0 * w0_0;
+            dqd[(0, 3)] = 2.0 * ct0 * st1 * dph1 * cph0_1 * w0_1 - 2.0 * ct0 * ct1 * dth1 * sph0_1 * w0_1;
+            dp[(0, 0)] = -ct0 * cp0 * ml0;
+            dp[(0, 1)] = -ct0 * sp0 * ml0;
+            dp[(0, 2)] = -st0 * ml0;
+            dq[(1, 0)] = st0 * st1 * dth0 * dth0 * w0_1
+                + ct0 * ct1 * dth0 * dth0 * cph0_1 * w0_1
+                + ct0 * ct1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * st0 * ct1 * dth0 * dph0 * sph0_1 * w0_1;
+            dq[(1, 1)] = -ct0 * ct1 * dth0 * dth0 * w0_1
+                - st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                - st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1
+                + ct1 * ct1 * dph1 * dph1 * w1_1
+                - st1 * st1 * dph1 * dph1 * w1_1
+                + st1 * cp1 * ax * ml1
+                + st1 * sp1 * ay * ml1
+                - ct1 * az * ml1
+                - g * ct1 * ml1;
+            dq[(1, 2)] = -st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1 - st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1;
+            dq[(1, 3)] = st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1 + st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1
+                + ct1 * sp1 * ax * ml1
+                - ct1 * cp1 * ay * ml1;
+            dqd[(1, 0)] = -2.0 * ct0 * st1 * dth0 * w0_1
+                + 2.0 * st0 * ct1 * dth0 * cph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dph0 * sph0_1 * w0_1;
+            dqd[(1, 1)] = -lam1;
+            dqd[(1, 2)] = 2.0 * st0 * ct1 * dph0 * cph0_1 * w0_1 + 2.0 * ct0 * ct1 * dth0 * sph0_1 * w0_1;
+            dqd[(1, 3)] = 2.0 * st1 * ct1 * dph1 * w1_1;
+            dp[(1, 0)] = -ct1 * cp1 * ml1;
+            dp[(1, 1)] = -ct1 * sp1 * ml1;
+            dp[(1, 2)] = -st1 * ml1;
+            dq[(2, 0)] = -2.0 * lam0 * st0 * ct0 * dph0 - 2.0 * ct0 * ct0 * dth0 * dph0 * w0_0
+                + 2.0 * st0 * st0 * dth0 * dph0 * w0_0
+                - ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                - ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1
+                + ct0 * sp0 * ax * ml0
+                - ct0 * cp0 * ay * ml0;
+            dq[(2, 1)] = -st0 * ct1 * dth1 * dth1 * sph0_1 * w0_1 - st0 * ct1 * dph1 * dph1 * sph0_1 * w0_1
+                + 2.0 * st0 * st1 * dth1 * dph1 * cph0_1 * w0_1;
+            dq[(2, 2)] = -st0 * st1 * dth1 * dth1 * cph0_1 * w0_1 - st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1
+                + st0 * cp0 * ax * ml0
+                + st0 * sp0 * ay * ml0;
+            dq[(2, 3)] = st0 * st1 * dth1 * dth1 * cph0_1 * w0_1 + st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                - 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1;
+            dqd[(2, 0)] = -2.0 * st0 * ct0 * dph0 * w0_0;
+            dqd[(2, 1)] = -2.0 * st0 * st1 * dth1 * sph0_1 * w0_1 - 2.0 * st0 * ct1 * dph1 * cph0_1 * w0_1;
+            dqd[(2, 2)] = -lam0 * st0 * st0 - 2.0 * st0 * ct0 * dth0 * w0_0;
+            dqd[(2, 3)] = -2.0 * st0 * st1 * dph1 * sph0_1 * w0_1 - 2.0 * st0 * ct1 * dth1 * cph0_1 * w0_1;
+            dp[(2, 0)] = st0 * sp0 * ml0;
+            dp[(2, 1)] = -st0 * cp0 * ml0;
+            dp[(2, 2)] = 0.0;
+            dq[(3, 0)] = ct0 * st1 * dth0 * dth0 * sph0_1 * w0_1
+                + ct0 * st1 * dph0 * dph0 * sph0_1 * w0_1
+                + 2.0 * st0 * st1 * dth0 * dph0 * cph0_1 * w0_1;
+            dq[(3, 1)] = -2.0 * lam1 * st1 * ct1 * dph1
+                + st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1
+                + st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct1 * ct1 * dth1 * dph1 * w1_1
+                + 2.0 * st1 * st1 * dth1 * dph1 * w1_1
+                + ct1 * sp1 * ax * ml1
+                - ct1 * cp1 * ay * ml1;
+            dq[(3, 2)] = st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                + st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                + 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1;
+            dq[(3, 3)] = -st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                - st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1
+                + st1 * cp1 * ax * ml1
+                + st1 * sp1 * ay * ml1;
+            dqd[(3, 0)] = 2.0 * st0 * st1 * dth0 * sph0_1 * w0_1 - 2.0 * ct0 * st1 * dph0 * cph0_1 * w0_1;
+            dqd[(3, 1)] = -2.0 * st1 * ct1 * dph1 * w1_1;
+            dqd[(3, 2)] = 2.0 * st0 * st1 * dph0 * sph0_1 * w0_1 - 2.0 * ct0 * st1 * dth0 * cph0_1 * w0_1;
+            dqd[(3, 3)] = -lam1 * st1 * st1 - 2.0 * st1 * ct1 * dth1 * w1_1;
+            dp[(3, 0)] = st1 * sp1 * ml1;
+            dp[(3, 1)] = -st1 * cp1 * ml1;
+            dp[(3, 2)] = 0.0;
         }
     }
 };

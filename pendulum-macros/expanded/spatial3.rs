@@ -60,7 +60,7 @@ const _: () = {
     use ::core::primitive::f64;
     use ::core::result::Result::{Err, Ok};
     use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, U3};
-    use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+    use ::pendulum_core::{Chain, Derivatives, Error, Inputs, Model, Result};
     impl Spatial3 {
         #[doc = r#" How `accelerations` solves for `q̈`: `"dense"` (the mass matrix factored as"#]
         #[doc = r#" `L D Lᵀ`) or `"tension"` (the O(n) rod-tension solve), as chosen by"#]
@@ -715,6 +715,425 @@ const _: () = {
             out[4] = x_ph1;
             out[5] = x_ph2;
             Ok(())
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl Derivatives for Spatial3 {
+        fn mass_matrix_partials(
+            &self,
+            q: &SVector<f64, 6>,
+            v: &SVector<f64, 6>,
+            out: &mut SMatrix<f64, 6, 6>,
+        ) {
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let (sp0, cp0) = q[3].sin_cos();
+            let (sp1, cp1) = q[4].sin_cos();
+            let (sp2, cp2) = q[5].sin_cos();
+            let pv0 = v[0];
+            let pv1 = v[1];
+            let pv2 = v[2];
+            let pv3 = v[3];
+            let pv4 = v[4];
+            let pv5 = v[5];
+            let cph0_1 = cp0 * cp1 + sp0 * sp1;
+            let cph0_2 = cp0 * cp2 + sp0 * sp2;
+            let cph1_2 = cp1 * cp2 + sp1 * sp2;
+            let sph0_1 = sp0 * cp1 - cp0 * sp1;
+            let sph0_2 = sp0 * cp2 - cp0 * sp2;
+            let sph1_2 = sp1 * cp2 - cp1 * sp2;
+            let w0_0 = self.w0_0;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w1_1 = self.w1_1;
+            let w1_2 = self.w1_2;
+            let w2_2 = self.w2_2;
+            let dm1_0_0 = -st0 * ct1 * cph0_1 * w0_1 + ct0 * st1 * w0_1;
+            let dm1_0_1 = -ct0 * st1 * cph0_1 * w0_1 + st0 * ct1 * w0_1;
+            let dm1_0_3 = -ct0 * ct1 * sph0_1 * w0_1;
+            let dm1_0_4 = ct0 * ct1 * sph0_1 * w0_1;
+            let dm2_0_0 = -st0 * ct2 * cph0_2 * w0_2 + ct0 * st2 * w0_2;
+            let dm2_0_2 = -ct0 * st2 * cph0_2 * w0_2 + st0 * ct2 * w0_2;
+            let dm2_0_3 = -ct0 * ct2 * sph0_2 * w0_2;
+            let dm2_0_5 = ct0 * ct2 * sph0_2 * w0_2;
+            let dm2_1_1 = -st1 * ct2 * cph1_2 * w1_2 + ct1 * st2 * w1_2;
+            let dm2_1_2 = -ct1 * st2 * cph1_2 * w1_2 + st1 * ct2 * w1_2;
+            let dm2_1_4 = -ct1 * ct2 * sph1_2 * w1_2;
+            let dm2_1_5 = ct1 * ct2 * sph1_2 * w1_2;
+            let dm3_1_0 = -ct0 * ct1 * sph0_1 * w0_1;
+            let dm3_1_1 = st0 * st1 * sph0_1 * w0_1;
+            let dm3_1_3 = -st0 * ct1 * cph0_1 * w0_1;
+            let dm3_1_4 = st0 * ct1 * cph0_1 * w0_1;
+            let dm3_2_0 = -ct0 * ct2 * sph0_2 * w0_2;
+            let dm3_2_2 = st0 * st2 * sph0_2 * w0_2;
+            let dm3_2_3 = -st0 * ct2 * cph0_2 * w0_2;
+            let dm3_2_5 = st0 * ct2 * cph0_2 * w0_2;
+            let dm3_3_0 = 2.0 * st0 * ct0 * w0_0;
+            let dm4_0_0 = -st0 * st1 * sph0_1 * w0_1;
+            let dm4_0_1 = ct0 * ct1 * sph0_1 * w0_1;
+            let dm4_0_3 = ct0 * st1 * cph0_1 * w0_1;
+            let dm4_0_4 = -ct0 * st1 * cph0_1 * w0_1;
+            let dm4_2_1 = -ct1 * ct2 * sph1_2 * w1_2;
+            let dm4_2_2 = st1 * st2 * sph1_2 * w1_2;
+            let dm4_2_4 = -st1 * ct2 * cph1_2 * w1_2;
+            let dm4_2_5 = st1 * ct2 * cph1_2 * w1_2;
+            let dm4_3_0 = ct0 * st1 * cph0_1 * w0_1;
+            let dm4_3_1 = st0 * ct1 * cph0_1 * w0_1;
+            let dm4_3_3 = -st0 * st1 * sph0_1 * w0_1;
+            let dm4_3_4 = st0 * st1 * sph0_1 * w0_1;
+            let dm4_4_1 = 2.0 * st1 * ct1 * w1_1;
+            let dm5_0_0 = -st0 * st2 * sph0_2 * w0_2;
+            let dm5_0_2 = ct0 * ct2 * sph0_2 * w0_2;
+            let dm5_0_3 = ct0 * st2 * cph0_2 * w0_2;
+            let dm5_0_5 = -ct0 * st2 * cph0_2 * w0_2;
+            let dm5_1_1 = -st1 * st2 * sph1_2 * w1_2;
+            let dm5_1_2 = ct1 * ct2 * sph1_2 * w1_2;
+            let dm5_1_4 = ct1 * st2 * cph1_2 * w1_2;
+            let dm5_1_5 = -ct1 * st2 * cph1_2 * w1_2;
+            let dm5_3_0 = ct0 * st2 * cph0_2 * w0_2;
+            let dm5_3_2 = st0 * ct2 * cph0_2 * w0_2;
+            let dm5_3_3 = -st0 * st2 * sph0_2 * w0_2;
+            let dm5_3_5 = st0 * st2 * sph0_2 * w0_2;
+            let dm5_4_1 = ct1 * st2 * cph1_2 * w1_2;
+            let dm5_4_2 = st1 * ct2 * cph1_2 * w1_2;
+            let dm5_4_4 = -st1 * st2 * sph1_2 * w1_2;
+            let dm5_4_5 = st1 * st2 * sph1_2 * w1_2;
+            let dm5_5_2 = 2.0 * st2 * ct2 * w2_2;
+            out[(0, 0)] = dm1_0_0 * pv1 + dm2_0_0 * pv2 + dm4_0_0 * pv4 + dm5_0_0 * pv5;
+            out[(0, 1)] = dm1_0_1 * pv1 + dm4_0_1 * pv4;
+            out[(0, 2)] = dm2_0_2 * pv2 + dm5_0_2 * pv5;
+            out[(0, 3)] = dm1_0_3 * pv1 + dm2_0_3 * pv2 + dm4_0_3 * pv4 + dm5_0_3 * pv5;
+            out[(0, 4)] = dm1_0_4 * pv1 + dm4_0_4 * pv4;
+            out[(0, 5)] = dm2_0_5 * pv2 + dm5_0_5 * pv5;
+            out[(1, 0)] = dm1_0_0 * pv0 + dm3_1_0 * pv3;
+            out[(1, 1)] = dm1_0_1 * pv0 + dm2_1_1 * pv2 + dm3_1_1 * pv3 + dm5_1_1 * pv5;
+            out[(1, 2)] = dm2_1_2 * pv2 + dm5_1_2 * pv5;
+            out[(1, 3)] = dm1_0_3 * pv0 + dm3_1_3 * pv3;
+            out[(1, 4)] = dm1_0_4 * pv0 + dm2_1_4 * pv2 + dm3_1_4 * pv3 + dm5_1_4 * pv5;
+            out[(1, 5)] = dm2_1_5 * pv2 + dm5_1_5 * pv5;
+            out[(2, 0)] = dm2_0_0 * pv0 + dm3_2_0 * pv3;
+            out[(2, 1)] = dm2_1_1 * pv1 + dm4_2_1 * pv4;
+            out[(2, 2)] = dm2_0_2 * pv0 + dm2_1_2 * pv1 + dm3_2_2 * pv3 + dm4_2_2 * pv4;
+            out[(2, 3)] = dm2_0_3 * pv0 + dm3_2_3 * pv3;
+            out[(2, 4)] = dm2_1_4 * pv1 + dm4_2_4 * pv4;
+            out[(2, 5)] = dm2_0_5 * pv0 + dm2_1_5 * pv1 + dm3_2_5 * pv3 + dm4_2_5 * pv4;
+            out[(3, 0)] = dm3_1_0 * pv1 + dm3_2_0 * pv2 + dm3_3_0 * pv3 + dm4_3_0 * pv4 + dm5_3_0 * pv5;
+            out[(3, 1)] = dm3_1_1 * pv1 + dm4_3_1 * pv4;
+            out[(3, 2)] = dm3_2_2 * pv2 + dm5_3_2 * pv5;
+            out[(3, 3)] = dm3_1_3 * pv1 + dm3_2_3 * pv2 + dm4_3_3 * pv4 + dm5_3_3 * pv5;
+            out[(3, 4)] = dm3_1_4 * pv1 + dm4_3_4 * pv4;
+            out[(3, 5)] = dm3_2_5 * pv2 + dm5_3_5 * pv5;
+            out[(4, 0)] = dm4_0_0 * pv0 + dm4_3_0 * pv3;
+            out[(4, 1)] = dm4_0_1 * pv0 + dm4_2_1 * pv2 + dm4_3_1 * pv3 + dm4_4_1 * pv4 + dm5_4_1 * pv5;
+            out[(4, 2)] = dm4_2_2 * pv2 + dm5_4_2 * pv5;
+            out[(4, 3)] = dm4_0_3 * pv0 + dm4_3_3 * pv3;
+            out[(4, 4)] = dm4_0_4 * pv0 + dm4_2_4 * pv2 + dm4_3_4 * pv3 + dm5_4_4 * pv5;
+            out[(4, 5)] = dm4_2_5 * pv2 + dm5_4_5 * pv5;
+            out[(5, 0)] = dm5_0_0 * pv0 + dm5_3_0 * pv3;
+            out[(5, 1)] = dm5_1_1 * pv1 + dm5_4_1 * pv4;
+            out[(5, 2)] = dm5_0_2 * pv0 + dm5_1_2 * pv1 + dm5_3_2 * pv3 + dm5_4_2 * pv4 + dm5_5_2 * pv5;
+            out[(5, 3)] = dm5_0_3 * pv0 + dm5_3_3 * pv3;
+            out[(5, 4)] = dm5_1_4 * pv1 + dm5_4_4 * pv4;
+            out[(5, 5)] = dm5_0_5 * pv0 + dm5_1_5 * pv1 + dm5_3_5 * pv3 + dm5_4_5 * pv4;
+        }
+        fn force_jacobians(
+            &self,
+            q: &SVector<f64, 6>,
+            qd: &SVector<f64, 6>,
+            inputs: &Inputs<Const<6>, U3>,
+            dq: &mut SMatrix<f64, 6, 6>,
+            dqd: &mut SMatrix<f64, 6, 6>,
+            dp: &mut SMatrix<f64, 6, 3>,
+        ) {
+            let pivot_acceleration = &inputs.pivot_acceleration;
+            let damping = self.chain.damping();
+            let g = self.chain.gravity();
+            let lam0 = damping[0];
+            let lam1 = damping[1];
+            let lam2 = damping[2];
+            let (st0, ct0) = q[0].sin_cos();
+            let (st1, ct1) = q[1].sin_cos();
+            let (st2, ct2) = q[2].sin_cos();
+            let (sp0, cp0) = q[3].sin_cos();
+            let (sp1, cp1) = q[4].sin_cos();
+            let (sp2, cp2) = q[5].sin_cos();
+            let dth0 = qd[0];
+            let dth1 = qd[1];
+            let dth2 = qd[2];
+            let dph0 = qd[3];
+            let dph1 = qd[4];
+            let dph2 = qd[5];
+            let ax = pivot_acceleration[0];
+            let ay = pivot_acceleration[1];
+            let az = pivot_acceleration[2];
+            let cph0_1 = cp0 * cp1 + sp0 * sp1;
+            let cph0_2 = cp0 * cp2 + sp0 * sp2;
+            let cph1_2 = cp1 * cp2 + sp1 * sp2;
+            let sph0_1 = sp0 * cp1 - cp0 * sp1;
+            let sph0_2 = sp0 * cp2 - cp0 * sp2;
+            let sph1_2 = sp1 * cp2 - cp1 * sp2;
+            let w0_0 = self.w0_0;
+            let w0_1 = self.w0_1;
+            let w0_2 = self.w0_2;
+            let w1_1 = self.w1_1;
+            let w1_2 = self.w1_2;
+            let w2_2 = self.w2_2;
+            let ml0 = self.ml0;
+            let ml1 = self.ml1;
+            let ml2 = self.ml2;
+            dq[(0, 0)] = ct0 * ct0 * dph0 * dph0 * w0_0
+                - st0 * st0 * dph0 * dph0 * w0_0
+                - ct0 * ct1 * dth1 * dth1 * w0_1
+                - st0 * st1 * dth1 * dth1 * cph0_1 * w0_1
+                - st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1
+                - ct0 * ct2 * dth2 * dth2 * w0_2
+                - st0 * st2 * dth2 * dth2 * cph0_2 * w0_2
+                - st0 * st2 * dph2 * dph2 * cph0_2 * w0_2
+                + 2.0 * st0 * ct2 * dth2 * dph2 * sph0_2 * w0_2
+                + st0 * cp0 * ax * ml0
+                + st0 * sp0 * ay * ml0
+                - ct0 * az * ml0
+                - g * ct0 * ml0;
+            dq[(0, 1)] = st0 * st1 * dth1 * dth1 * w0_1
+                + ct0 * ct1 * dth1 * dth1 * cph0_1 * w0_1
+                + ct0 * ct1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * ct0 * st1 * dth1 * dph1 * sph0_1 * w0_1;
+            dq[(0, 2)] = st0 * st2 * dth2 * dth2 * w0_2
+                + ct0 * ct2 * dth2 * dth2 * cph0_2 * w0_2
+                + ct0 * ct2 * dph2 * dph2 * cph0_2 * w0_2
+                + 2.0 * ct0 * st2 * dth2 * dph2 * sph0_2 * w0_2;
+            dq[(0, 3)] = -ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                - ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1
+                - ct0 * st2 * dth2 * dth2 * sph0_2 * w0_2
+                - ct0 * st2 * dph2 * dph2 * sph0_2 * w0_2
+                - 2.0 * ct0 * ct2 * dth2 * dph2 * cph0_2 * w0_2
+                + ct0 * sp0 * ax * ml0
+                - ct0 * cp0 * ay * ml0;
+            dq[(0, 4)] = ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                + ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1;
+            dq[(0, 5)] = ct0 * st2 * dth2 * dth2 * sph0_2 * w0_2
+                + ct0 * st2 * dph2 * dph2 * sph0_2 * w0_2
+                + 2.0 * ct0 * ct2 * dth2 * dph2 * cph0_2 * w0_2;
+            dqd[(0, 0)] = -lam0;
+            dqd[(0, 1)] = -2.0 * st0 * ct1 * dth1 * w0_1 + 2.0 * ct0 * st1 * dth1 * cph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dph1 * sph0_1 * w0_1;
+            dqd[(0, 2)] = -2.0 * st0 * ct2 * dth2 * w0_2 + 2.0 * ct0 * st2 * dth2 * cph0_2 * w0_2
+                - 2.0 * ct0 * ct2 * dph2 * sph0_2 * w0_2;
+            dqd[(0, 3)] = 2.0 * st0 * ct0 * dph0 * w0_0;
+            dqd[(0, 4)] = 2.0 * ct0 * st1 * dph1 * cph0_1 * w0_1 - 2.0 * ct0 * ct1 * dth1 * sph0_1 * w0_1;
+            dqd[(0, 5)] = 2.0 * ct0 * st2 * dph2 * cph0_2 * w0_2 - 2.0 * ct0 * ct2 * dth2 * sph0_2 * w0_2;
+            dp[(0, 0)] = -ct0 * cp0 * ml0;
+            dp[(0, 1)] = -ct0 * sp0 * ml0;
+            dp[(0, 2)] = -st0 * ml0;
+            dq[(1, 0)] = st0 * st1 * dth0 * dth0 * w0_1
+                + ct0 * ct1 * dth0 * dth0 * cph0_1 * w0_1
+                + ct0 * ct1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * st0 * ct1 * dth0 * dph0 * sph0_1 * w0_1;
+            dq[(1, 1)] = -ct0 * ct1 * dth0 * dth0 * w0_1
+                - st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                - st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1
+                + ct1 * ct1 * dph1 * dph1 * w1_1
+                - st1 * st1 * dph1 * dph1 * w1_1
+                - ct1 * ct2 * dth2 * dth2 * w1_2
+                - st1 * st2 * dth2 * dth2 * cph1_2 * w1_2
+                - st1 * st2 * dph2 * dph2 * cph1_2 * w1_2
+                + 2.0 * st1 * ct2 * dth2 * dph2 * sph1_2 * w1_2
+                + st1 * cp1 * ax * ml1
+                + st1 * sp1 * ay * ml1
+                - ct1 * az * ml1
+                - g * ct1 * ml1;
+            dq[(1, 2)] = st1 * st2 * dth2 * dth2 * w1_2
+                + ct1 * ct2 * dth2 * dth2 * cph1_2 * w1_2
+                + ct1 * ct2 * dph2 * dph2 * cph1_2 * w1_2
+                + 2.0 * ct1 * st2 * dth2 * dph2 * sph1_2 * w1_2;
+            dq[(1, 3)] = -st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1 - st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1;
+            dq[(1, 4)] = st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1 + st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1
+                - ct1 * st2 * dth2 * dth2 * sph1_2 * w1_2
+                - ct1 * st2 * dph2 * dph2 * sph1_2 * w1_2
+                - 2.0 * ct1 * ct2 * dth2 * dph2 * cph1_2 * w1_2
+                + ct1 * sp1 * ax * ml1
+                - ct1 * cp1 * ay * ml1;
+            dq[(1, 5)] = ct1 * st2 * dth2 * dth2 * sph1_2 * w1_2
+                + ct1 * st2 * dph2 * dph2 * sph1_2 * w1_2
+                + 2.0 * ct1 * ct2 * dth2 * dph2 * cph1_2 * w1_2;
+            dqd[(1, 0)] = -2.0 * ct0 * st1 * dth0 * w0_1
+                + 2.0 * st0 * ct1 * dth0 * cph0_1 * w0_1
+                + 2.0 * ct0 * ct1 * dph0 * sph0_1 * w0_1;
+            dqd[(1, 1)] = -lam1;
+            dqd[(1, 2)] = -2.0 * st1 * ct2 * dth2 * w1_2 + 2.0 * ct1 * st2 * dth2 * cph1_2 * w1_2
+                - 2.0 * ct1 * ct2 * dph2 * sph1_2 * w1_2;
+            dqd[(1, 3)] = 2.0 * st0 * ct1 * dph0 * cph0_1 * w0_1 + 2.0 * ct0 * ct1 * dth0 * sph0_1 * w0_1;
+            dqd[(1, 4)] = 2.0 * st1 * ct1 * dph1 * w1_1;
+            dqd[(1, 5)] = 2.0 * ct1 * st2 * dph2 * cph1_2 * w1_2 - 2.0 * ct1 * ct2 * dth2 * sph1_2 * w1_2;
+            dp[(1, 0)] = -ct1 * cp1 * ml1;
+            dp[(1, 1)] = -ct1 * sp1 * ml1;
+            dp[(1, 2)] = -st1 * ml1;
+            dq[(2, 0)] = st0 * st2 * dth0 * dth0 * w0_2
+                + ct0 * ct2 * dth0 * dth0 * cph0_2 * w0_2
+                + ct0 * ct2 * dph0 * dph0 * cph0_2 * w0_2
+                - 2.0 * st0 * ct2 * dth0 * dph0 * sph0_2 * w0_2;
+            dq[(2, 1)] = st1 * st2 * dth1 * dth1 * w1_2
+                + ct1 * ct2 * dth1 * dth1 * cph1_2 * w1_2
+                + ct1 * ct2 * dph1 * dph1 * cph1_2 * w1_2
+                - 2.0 * st1 * ct2 * dth1 * dph1 * sph1_2 * w1_2;
+            dq[(2, 2)] = -ct0 * ct2 * dth0 * dth0 * w0_2
+                - st0 * st2 * dth0 * dth0 * cph0_2 * w0_2
+                - st0 * st2 * dph0 * dph0 * cph0_2 * w0_2
+                - 2.0 * ct0 * st2 * dth0 * dph0 * sph0_2 * w0_2
+                - ct1 * ct2 * dth1 * dth1 * w1_2
+                - st1 * st2 * dth1 * dth1 * cph1_2 * w1_2
+                - st1 * st2 * dph1 * dph1 * cph1_2 * w1_2
+                - 2.0 * ct1 * st2 * dth1 * dph1 * sph1_2 * w1_2
+                + ct2 * ct2 * dph2 * dph2 * w2_2
+                - st2 * st2 * dph2 * dph2 * w2_2
+                + st2 * cp2 * ax * ml2
+                + st2 * sp2 * ay * ml2
+                - ct2 * az * ml2
+                - g * ct2 * ml2;
+            dq[(2, 3)] = -st0 * ct2 * dth0 * dth0 * sph0_2 * w0_2 - st0 * ct2 * dph0 * dph0 * sph0_2 * w0_2
+                + 2.0 * ct0 * ct2 * dth0 * dph0 * cph0_2 * w0_2;
+            dq[(2, 4)] = -st1 * ct2 * dth1 * dth1 * sph1_2 * w1_2 - st1 * ct2 * dph1 * dph1 * sph1_2 * w1_2
+                + 2.0 * ct1 * ct2 * dth1 * dph1 * cph1_2 * w1_2;
+            dq[(2, 5)] = st0 * ct2 * dth0 * dth0 * sph0_2 * w0_2 + st0 * ct2 * dph0 * dph0 * sph0_2 * w0_2
+                - 2.0 * ct0 * ct2 * dth0 * dph0 * cph0_2 * w0_2
+                + st1 * ct2 * dth1 * dth1 * sph1_2 * w1_2
+                + st1 * ct2 * dph1 * dph1 * sph1_2 * w1_2
+                - 2.0 * ct1 * ct2 * dth1 * dph1 * cph1_2 * w1_2
+                + ct2 * sp2 * ax * ml2
+                - ct2 * cp2 * ay * ml2;
+            dqd[(2, 0)] = -2.0 * ct0 * st2 * dth0 * w0_2
+                + 2.0 * st0 * ct2 * dth0 * cph0_2 * w0_2
+                + 2.0 * ct0 * ct2 * dph0 * sph0_2 * w0_2;
+            dqd[(2, 1)] = -2.0 * ct1 * st2 * dth1 * w1_2
+                + 2.0 * st1 * ct2 * dth1 * cph1_2 * w1_2
+                + 2.0 * ct1 * ct2 * dph1 * sph1_2 * w1_2;
+            dqd[(2, 2)] = -lam2;
+            dqd[(2, 3)] = 2.0 * st0 * ct2 * dph0 * cph0_2 * w0_2 + 2.0 * ct0 * ct2 * dth0 * sph0_2 * w0_2;
+            dqd[(2, 4)] = 2.0 * st1 * ct2 * dph1 * cph1_2 * w1_2 + 2.0 * ct1 * ct2 * dth1 * sph1_2 * w1_2;
+            dqd[(2, 5)] = 2.0 * st2 * ct2 * dph2 * w2_2;
+            dp[(2, 0)] = -ct2 * cp2 * ml2;
+            dp[(2, 1)] = -ct2 * sp2 * ml2;
+            dp[(2, 2)] = -st2 * ml2;
+            dq[(3, 0)] = -2.0 * lam0 * st0 * ct0 * dph0 - 2.0 * ct0 * ct0 * dth0 * dph0 * w0_0
+                + 2.0 * st0 * st0 * dth0 * dph0 * w0_0
+                - ct0 * st1 * dth1 * dth1 * sph0_1 * w0_1
+                - ct0 * st1 * dph1 * dph1 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth1 * dph1 * cph0_1 * w0_1
+                - ct0 * st2 * dth2 * dth2 * sph0_2 * w0_2
+                - ct0 * st2 * dph2 * dph2 * sph0_2 * w0_2
+                - 2.0 * ct0 * ct2 * dth2 * dph2 * cph0_2 * w0_2
+                + ct0 * sp0 * ax * ml0
+                - ct0 * cp0 * ay * ml0;
+            dq[(3, 1)] = -st0 * ct1 * dth1 * dth1 * sph0_1 * w0_1 - st0 * ct1 * dph1 * dph1 * sph0_1 * w0_1
+                + 2.0 * st0 * st1 * dth1 * dph1 * cph0_1 * w0_1;
+            dq[(3, 2)] = -st0 * ct2 * dth2 * dth2 * sph0_2 * w0_2 - st0 * ct2 * dph2 * dph2 * sph0_2 * w0_2
+                + 2.0 * st0 * st2 * dth2 * dph2 * cph0_2 * w0_2;
+            dq[(3, 3)] = -st0 * st1 * dth1 * dth1 * cph0_1 * w0_1 - st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                + 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1
+                - st0 * st2 * dth2 * dth2 * cph0_2 * w0_2
+                - st0 * st2 * dph2 * dph2 * cph0_2 * w0_2
+                + 2.0 * st0 * ct2 * dth2 * dph2 * sph0_2 * w0_2
+                + st0 * cp0 * ax * ml0
+                + st0 * sp0 * ay * ml0;
+            dq[(3, 4)] = st0 * st1 * dth1 * dth1 * cph0_1 * w0_1 + st0 * st1 * dph1 * dph1 * cph0_1 * w0_1
+                - 2.0 * st0 * ct1 * dth1 * dph1 * sph0_1 * w0_1;
+            dq[(3, 5)] = st0 * st2 * dth2 * dth2 * cph0_2 * w0_2 + st0 * st2 * dph2 * dph2 * cph0_2 * w0_2
+                - 2.0 * st0 * ct2 * dth2 * dph2 * sph0_2 * w0_2;
+            dqd[(3, 0)] = -2.0 * st0 * ct0 * dph0 * w0_0;
+            dqd[(3, 1)] = -2.0 * st0 * st1 * dth1 * sph0_1 * w0_1 - 2.0 * st0 * ct1 * dph1 * cph0_1 * w0_1;
+            dqd[(3, 2)] = -2.0 * st0 * st2 * dth2 * sph0_2 * w0_2 - 2.0 * st0 * ct2 * dph2 * cph0_2 * w0_2;
+            dqd[(3, 3)] = -lam0 * st0 * st0 - 2.0 * st0 * ct0 * dth0 * w0_0;
+            dqd[(3, 4)] = -2.0 * st0 * st1 * dph1 * sph0_1 * w0_1 - 2.0 * st0 * ct1 * dth1 * cph0_1 * w0_1;
+            dqd[(3, 5)] = -2.0 * st0 * st2 * dph2 * sph0_2 * w0_2 - 2.0 * st0 * ct2 * dth2 * cph0_2 * w0_2;
+            dp[(3, 0)] = st0 * sp0 * ml0;
+            dp[(3, 1)] = -st0 * cp0 * ml0;
+            dp[(3, 2)] = 0.0;
+            dq[(4, 0)] = ct0 * st1 * dth0 * dth0 * sph0_1 * w0_1
+                + ct0 * st1 * dph0 * dph0 * sph0_1 * w0_1
+                + 2.0 * st0 * st1 * dth0 * dph0 * cph0_1 * w0_1;
+            dq[(4, 1)] = -2.0 * lam1 * st1 * ct1 * dph1
+                + st0 * ct1 * dth0 * dth0 * sph0_1 * w0_1
+                + st0 * ct1 * dph0 * dph0 * sph0_1 * w0_1
+                - 2.0 * ct0 * ct1 * dth0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct1 * ct1 * dth1 * dph1 * w1_1
+                + 2.0 * st1 * st1 * dth1 * dph1 * w1_1
+                - ct1 * st2 * dth2 * dth2 * sph1_2 * w1_2
+                - ct1 * st2 * dph2 * dph2 * sph1_2 * w1_2
+                - 2.0 * ct1 * ct2 * dth2 * dph2 * cph1_2 * w1_2
+                + ct1 * sp1 * ax * ml1
+                - ct1 * cp1 * ay * ml1;
+            dq[(4, 2)] = -st1 * ct2 * dth2 * dth2 * sph1_2 * w1_2 - st1 * ct2 * dph2 * dph2 * sph1_2 * w1_2
+                + 2.0 * st1 * st2 * dth2 * dph2 * cph1_2 * w1_2;
+            dq[(4, 3)] = st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                + st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                + 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1;
+            dq[(4, 4)] = -st0 * st1 * dth0 * dth0 * cph0_1 * w0_1
+                - st0 * st1 * dph0 * dph0 * cph0_1 * w0_1
+                - 2.0 * ct0 * st1 * dth0 * dph0 * sph0_1 * w0_1
+                - st1 * st2 * dth2 * dth2 * cph1_2 * w1_2
+                - st1 * st2 * dph2 * dph2 * cph1_2 * w1_2
+                + 2.0 * st1 * ct2 * dth2 * dph2 * sph1_2 * w1_2
+                + st1 * cp1 * ax * ml1
+                + st1 * sp1 * ay * ml1;
+            dq[(4, 5)] = st1 * st2 * dth2 * dth2 * cph1_2 * w1_2 + st1 * st2 * dph2 * dph2 * cph1_2 * w1_2
+                - 2.0 * st1 * ct2 * dth2 * dph2 * sph1_2 * w1_2;
+            dqd[(4, 0)] = 2.0 * st0 * st1 * dth0 * sph0_1 * w0_1 - 2.0 * ct0 * st1 * dph0 * cph0_1 * w0_1;
+            dqd[(4, 1)] = -2.0 * st1 * ct1 * dph1 * w1_1;
+            dqd[(4, 2)] = -2.0 * st1 * st2 * dth2 * sph1_2 * w1_2 - 2.0 * st1 * ct2 * dph2 * cph1_2 * w1_2;
+            dqd[(4, 3)] = 2.0 * st0 * st1 * dph0 * sph0_1 * w0_1 - 2.0 * ct0 * st1 * dth0 * cph0_1 * w0_1;
+            dqd[(4, 4)] = -lam1 * st1 * st1 - 2.0 * st1 * ct1 * dth1 * w1_1;
+            dqd[(4, 5)] = -2.0 * st1 * st2 * dph2 * sph1_2 * w1_2 - 2.0 * st1 * ct2 * dth2 * cph1_2 * w1_2;
+            dp[(4, 0)] = st1 * sp1 * ml1;
+            dp[(4, 1)] = -st1 * cp1 * ml1;
+            dp[(4, 2)] = 0.0;
+            dq[(5, 0)] = ct0 * st2 * dth0 * dth0 * sph0_2 * w0_2
+                + ct0 * st2 * dph0 * dph0 * sph0_2 * w0_2
+                + 2.0 * st0 * st2 * dth0 * dph0 * cph0_2 * w0_2;
+            dq[(5, 1)] = ct1 * st2 * dth1 * dth1 * sph1_2 * w1_2
+                + ct1 * st2 * dph1 * dph1 * sph1_2 * w1_2
+                + 2.0 * st1 * st2 * dth1 * dph1 * cph1_2 * w1_2;
+            dq[(5, 2)] = -2.0 * lam2 * st2 * ct2 * dph2
+                + st0 * ct2 * dth0 * dth0 * sph0_2 * w0_2
+                + st0 * ct2 * dph0 * dph0 * sph0_2 * w0_2
+                - 2.0 * ct0 * ct2 * dth0 * dph0 * cph0_2 * w0_2
+                + st1 * ct2 * dth1 * dth1 * sph1_2 * w1_2
+                + st1 * ct2 * dph1 * dph1 * sph1_2 * w1_2
+                - 2.0 * ct1 * ct2 * dth1 * dph1 * cph1_2 * w1_2
+                - 2.0 * ct2 * ct2 * dth2 * dph2 * w2_2
+                + 2.0 * st2 * st2 * dth2 * dph2 * w2_2
+                + ct2 * sp2 * ax * ml2
+                - ct2 * cp2 * ay * ml2;
+            dq[(5, 3)] = st0 * st2 * dth0 * dth0 * cph0_2 * w0_2
+                + st0 * st2 * dph0 * dph0 * cph0_2 * w0_2
+                + 2.0 * ct0 * st2 * dth0 * dph0 * sph0_2 * w0_2;
+            dq[(5, 4)] = st1 * st2 * dth1 * dth1 * cph1_2 * w1_2
+                + st1 * st2 * dph1 * dph1 * cph1_2 * w1_2
+                + 2.0 * ct1 * st2 * dth1 * dph1 * sph1_2 * w1_2;
+            dq[(5, 5)] = -st0 * st2 * dth0 * dth0 * cph0_2 * w0_2
+                - st0 * st2 * dph0 * dph0 * cph0_2 * w0_2
+                - 2.0 * ct0 * st2 * dth0 * dph0 * sph0_2 * w0_2
+                - st1 * st2 * dth1 * dth1 * cph1_2 * w1_2
+                - st1 * st2 * dph1 * dph1 * cph1_2 * w1_2
+                - 2.0 * ct1 * st2 * dth1 * dph1 * sph1_2 * w1_2
+                + st2 * cp2 * ax * ml2
+                + st2 * sp2 * ay * ml2;
+            dqd[(5, 0)] = 2.0 * st0 * st2 * dth0 * sph0_2 * w0_2 - 2.0 * ct0 * st2 * dph0 * cph0_2 * w0_2;
+            dqd[(5, 1)] = 2.0 * st1 * st2 * dth1 * sph1_2 * w1_2 - 2.0 * ct1 * st2 * dph1 * cph1_2 * w1_2;
+            dqd[(5, 2)] = -2.0 * st2 * ct2 * dph2 * w2_2;
+            dqd[(5, 3)] = 2.0 * st0 * st2 * dph0 * sph0_2 * w0_2 - 2.0 * ct0 * st2 * dth0 * cph0_2 * w0_2;
+            dqd[(5, 4)] = 2.0 * st1 * st2 * dph1 * sph1_2 * w1_2 - 2.0 * ct1 * st2 * dth1 * cph1_2 * w1_2;
+            dqd[(5, 5)] = -lam2 * st2 * st2 - 2.0 * st2 * ct2 * dth2 * w2_2;
+            dp[(5, 0)] = st2 * sp2 * ml2;
+            dp[(5, 1)] = -st2 * cp2 * ml2;
+            dp[(5, 2)] = 0.0;
         }
     }
 };

@@ -22,6 +22,7 @@ use std::fmt;
 
 use self::Angle::{Phi, Theta};
 use self::Trig::{Cos, Sin};
+pub use self::derivatives::Var;
 
 /// Which chain model to generate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,6 +127,8 @@ pub enum Sym {
     Torque(Angle),
     /// Pivot acceleration component (0 = x, 1 = y, 2 = z), m/s².
     Pivot(usize),
+    /// Entry `b` of the vector `v` that `∂(M v)/∂q` is taken at.
+    Probe(usize),
     /// `cos(a − b)` for two angles of the same kind, `a` on the lower link.
     CosDiff(Angle, Angle),
     /// `sin(a − b)` for two angles of the same kind, `a` on the lower link.
@@ -157,6 +160,10 @@ pub enum Sym {
     Force(usize),
     /// Right-hand side `Q_a − c_a − (k_a + d_a)` of `M q̈ = …`.
     Rhs(usize),
+    /// `∂M_rc/∂q_x` with `r ≥ c`.
+    MassPartial(usize, usize, usize),
+    /// `∂F_a/∂var` of the right-hand side `F_a` ([`Sym::Rhs`]).
+    RhsPartial(usize, Var),
 }
 
 impl Sym {
@@ -212,6 +219,9 @@ impl Sym {
             Sym::Load(a) => format!("kd{a}"),
             Sym::Force(a) => format!("f{a}"),
             Sym::Rhs(a) => format!("r{a}"),
+            Sym::Probe(b) => format!("pv{b}"),
+            Sym::MassPartial(r, c, x) => format!("dm{r}_{c}_{x}"),
+            Sym::RhsPartial(a, var) => format!("dr{a}_{}", var.tag()),
         }
     }
 }
@@ -443,6 +453,8 @@ impl Plan {
                     }
                 }
             }
+            Sym::MassPartial(r, c, x) => return Some(self.mass_partial_expr(r, c, x)),
+            Sym::RhsPartial(a, var) => return Some(self.rhs_partial_expr(a, var)),
             _ => unreachable!("{sym:?} is an input"),
         }
         Some(e)
@@ -628,5 +640,6 @@ impl Plan {
     }
 }
 
+mod derivatives;
 #[cfg(test)]
 mod tests;

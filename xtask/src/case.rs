@@ -17,8 +17,13 @@ use serde_json::{Map, Value};
 
 use crate::expr::{Expr, Scaled, Symbols};
 
+mod partials;
+
+use partials::Partials;
+pub use partials::PartialsAt;
+
 /// The format string every case file must carry.
-pub const FORMAT: &str = "pendulum-reference/1";
+pub const FORMAT: &str = "pendulum-reference/2";
 
 /// The equation every case file must state, in its sign convention.
 pub const EQUATION: &str =
@@ -152,6 +157,8 @@ pub struct Case {
     generalized_forces: Vec<Expr>,
     kinetic_energy: Expr,
     potential_energy: Expr,
+    /// The stored derivatives.
+    partials: Partials,
 }
 
 /// The symbol categories under `"symbols"`, in slot order, with their expected lengths.
@@ -216,7 +223,9 @@ impl Case {
                 mass_matrix.push(Expr::parse(e, &symbols, &format!("{at}: mass_matrix[{i}][{j}]"))?);
             }
         }
+        let partials = Partials::load(root, &symbols, dof, kind.space(), &at)?;
         Ok(Case {
+            partials,
             velocity_terms: vector("velocity_terms")?,
             gravity_terms: vector("gravity_terms")?,
             pivot_terms: vector("pivot_terms")?,
@@ -316,6 +325,14 @@ impl Case {
         let slots = self.slots(params, point);
         let both: Vec<Scaled> = self.exprs().map(|e| e.eval_with_scale(&slots)).collect();
         (self.assemble(both.iter().map(|x| x.v)), self.assemble(both.iter().map(|x| x.s)))
+    }
+
+    /// The stored derivatives (`∂M/∂q`, the force side's Jacobians) at `params` and
+    /// `point`, and their absolute scales.
+    ///
+    /// Panics if a vector of `params` or `point` has the wrong length for the case.
+    pub fn partials_with_scales(&self, params: &Params, point: &Point) -> (PartialsAt, PartialsAt) {
+        self.partials.evaluate_with_scales(&self.slots(params, point), self.dof(), self.kind.space())
     }
 
     /// The accelerations `q̈` solving `M q̈ = Q − c − k − d` (by LU with partial pivoting;
@@ -508,7 +525,7 @@ mod tests {
     fn validation_errors_name_file_case_and_entry() {
         type Edit = Box<dyn FnOnce(&mut Value)>;
         let cases: Vec<(Edit, &str)> = vec![
-            (Box::new(|v| v["format"] = json!("pendulum-reference/2")), "format is \"pendulum-reference/2\""),
+            (Box::new(|v| v["format"] = json!("pendulum-reference/9")), "format is \"pendulum-reference/9\""),
             (Box::new(|v| v["kind"] = json!("conical")), "case planar_n1: unknown kind \"conical\""),
             (Box::new(|v| v["links"] = json!(0)), "\"links\" must be a positive integer"),
             (Box::new(|v| v["links"] = json!(2)), "symbols.coordinates: has 1 entries, expected 2"),

@@ -5,18 +5,22 @@
 //! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
 //! with their spectrum (`relative_equilibrium`); the shape a whirled chain takes, seen in
 //! the frame turning with its pivot, whether it settled and the damped steady shape nearest
-//! it (`shape`).
+//! it (`shape`); the state-space linearisation about a steady state from the models'
+//! analytic derivatives (`state_space`) and the LQR gain for it (`lqr`).
 
 pub(crate) mod bessel;
 pub(crate) mod laguerre;
+pub(crate) mod lqr;
 pub(crate) mod modes;
 pub(crate) mod relative_equilibrium;
 pub(crate) mod shape;
 pub(crate) mod stability;
+pub(crate) mod state_space;
 pub(crate) mod steady_branches;
 
 pub use bessel::bessel_j0_zero;
 pub use laguerre::laguerre_zeros;
+pub use lqr::{Lqr, lqr};
 pub use modes::{
     NormalModes, bernoulli_frequency, equal_link_frequencies, fastest_decay_bound, fastest_frequency_bound,
     normal_modes, sign_changes,
@@ -27,4 +31,5 @@ pub use shape::{
     nearest_steady, shape_report, whirl_shape,
 };
 pub use stability::{Linearisation, Stability, Verdict, linearise, stability};
+pub use state_space::{STEADY_TOLERANCE, StateSpace, linearize};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};

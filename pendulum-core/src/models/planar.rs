@@ -3,8 +3,9 @@
 use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allocator};
 
 use crate::chain::Chain;
+use crate::jacobians::Derivatives;
 use crate::kinematics::PlanarAngles;
-use crate::model::Model;
+use crate::model::{Inputs, Model};
 
 /// A planar chain in absolute link angles `θ_i` from the downward vertical (eqs 1–2),
 /// for any number of links `L` (`Dyn` by default; `Const<N>` gives a fixed-size generic).
@@ -129,11 +130,69 @@ where
     }
 }
 
+/// With `Δ_ab = θ_a − θ_b`: `∂M_ab/∂θ_x = −W_ab sin Δ_ab (δ_ax − δ_bx)`, and of
+/// `F_a = σ_a − λ_a θ̇_a − Σ_j W_aj sin Δ_aj θ̇_j² − M_a l_a (g sin θ_a + p̈_x cos θ_a + p̈_y sin θ_a)`:
+/// `∂F_a/∂θ_x = W_ax cos Δ_ax θ̇_x²` (x ≠ a),
+/// `∂F_a/∂θ_a = −Σ_j W_aj cos Δ_aj θ̇_j² − M_a l_a ((g + p̈_y) cos θ_a − p̈_x sin θ_a)`,
+/// `∂F_a/∂θ̇_x = −λ_a δ_ax − 2 W_ax sin Δ_ax θ̇_x`, `∂F_a/∂p̈ = −M_a l_a (cos θ_a, sin θ_a)`.
+impl<L: Dim> Derivatives for Planar<L>
+where
+    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2> + Allocator<L, U2>,
+{
+    fn mass_matrix_partials(&self, q: &OVector<f64, L>, v: &OVector<f64, L>, out: &mut OMatrix<f64, L, L>) {
+        let n = self.chain.links();
+        for a in 0..n {
+            let mut diagonal = 0.0;
+            for x in 0..n {
+                if x != a {
+                    let w = self.chain.weight(a, x) * (q[a] - q[x]).sin();
+                    out[(a, x)] = w * v[x];
+                    diagonal -= w * v[x];
+                }
+            }
+            out[(a, a)] = diagonal;
+        }
+    }
+
+    fn force_jacobians(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        dq: &mut OMatrix<f64, L, L>,
+        dqd: &mut OMatrix<f64, L, L>,
+        dp: &mut OMatrix<f64, L, U2>,
+    ) {
+        let c = &self.chain;
+        let n = c.links();
+        let p = &inputs.pivot_acceleration;
+        for a in 0..n {
+            let (s, co) = q[a].sin_cos();
+            let moment = c.tail_masses()[a] * c.lengths()[a];
+            let mut diagonal = -moment * ((c.gravity() + p[1]) * co - p[0] * s);
+            for x in 0..n {
+                if x == a {
+                    continue;
+                }
+                let w = c.weight(a, x);
+                let (sd, cd) = (q[a] - q[x]).sin_cos();
+                let rate = qd[x];
+                dq[(a, x)] = w * cd * rate * rate;
+                diagonal -= w * cd * rate * rate;
+                dqd[(a, x)] = -2.0 * w * sd * rate;
+            }
+            dq[(a, a)] = diagonal;
+            dqd[(a, a)] = -c.damping()[a];
+            dp[(a, 0)] = -moment * co;
+            dp[(a, 1)] = -moment * s;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::error::Error;
-    use crate::model::Inputs;
     use approx::assert_relative_eq;
     use nalgebra::{DVector, Vector2};
 

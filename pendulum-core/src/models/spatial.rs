@@ -6,9 +6,10 @@ use nalgebra::{
 
 use crate::chain::Chain;
 use crate::error::Result;
+use crate::jacobians::Derivatives;
 use crate::kinematics::SphericalLink;
 use crate::kinematics::{Chart, SphericalAngles, check_polar_angle};
-use crate::model::Model;
+use crate::model::{Inputs, Model};
 
 /// A spatial chain in spherical angles: `θ_i` from the −z axis, `φ_i` the azimuth from
 /// +x (eqs 27–29), for any number of links `L`.
@@ -177,6 +178,130 @@ where
         }
         Ok(())
     }
+}
+
+/// Link `i`'s angle `α` (0 = θ, 1 = φ) is coordinate `i + α n`. With `J_α = ∂u/∂α`,
+/// `H_αβ = ∂²u/∂α∂β` and, for rates `v`, `w_j = Σ_α J_α(j) v_αj`:
+/// `Σ_b ∂M_ab/∂q_x v_b = δ_ik H_αβ(i)·Σ_j W_ij w_j + W_ik J_α(i)·∂w_k/∂β` for `a = (i, α)`,
+/// `x = (k, β)`. With `z_j = ü_j|_{q̈=0}`, `c_a = J_α(i)·Σ_j W_ij z_j` and
+/// `k_a + d_a = M_i l_i J_α(i)·(p̈ + g ẑ)`, the same product rule gives `∂F/∂q`, `∂F/∂q̇`
+/// (`z_k` by its angles and rates, [`centripetal_partials`]) and `∂F/∂p̈ = −M_i l_i J_α(i)`;
+/// `Q_φi = σ_φi − λ_i sin²θ_i φ̇_i` adds `−2 λ_i sin θ_i cos θ_i φ̇_i` by `θ_i`.
+impl<L> Derivatives for Spatial<L>
+where
+    L: Dim + DimMul<U2>,
+    DefaultAllocator: Allocator<L>
+        + Allocator<DimProd<L, U2>>
+        + Allocator<DimProd<L, U2>, DimProd<L, U2>>
+        + Allocator<U3>
+        + Allocator<DimProd<L, U2>, U3>,
+{
+    fn mass_matrix_partials(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        v: &OVector<f64, Self::Dof>,
+        out: &mut OMatrix<f64, Self::Dof, Self::Dof>,
+    ) {
+        let n = self.chain.links();
+        let f = self.frames(q);
+        let w: Vec<Vector3<f64>> = (0..n).map(|j| f[j].velocity(v[j], v[n + j])).collect();
+        let grad: Vec<[Vector3<f64>; 2]> = (0..n)
+            .map(|k| {
+                let (t, p) = f[k].velocity_gradient(v[k], v[n + k]);
+                [t, p]
+            })
+            .collect();
+        for i in 0..n {
+            let sum: Vector3<f64> = (0..n).map(|j| w[j] * self.chain.weight(i, j)).sum();
+            for alpha in 0..2 {
+                let ja = jacobian(&f[i], alpha);
+                for k in 0..n {
+                    let wik = self.chain.weight(i, k);
+                    for beta in 0..2 {
+                        let mut value = wik * ja.dot(&grad[k][beta]);
+                        if k == i {
+                            value += second(&f[i], alpha, beta).dot(&sum);
+                        }
+                        out[(i + alpha * n, k + beta * n)] = value;
+                    }
+                }
+            }
+        }
+    }
+
+    fn force_jacobians(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        inputs: &Inputs<Self::Dof, U3>,
+        dq: &mut OMatrix<f64, Self::Dof, Self::Dof>,
+        dqd: &mut OMatrix<f64, Self::Dof, Self::Dof>,
+        dp: &mut OMatrix<f64, Self::Dof, U3>,
+    ) {
+        let c = &self.chain;
+        let n = c.links();
+        let f = self.frames(q);
+        let p = &inputs.pivot_acceleration;
+        let lift = Vector3::new(p[0], p[1], p[2] + c.gravity());
+        let z: Vec<Vector3<f64>> = (0..n).map(|j| f[j].centripetal(qd[j], qd[n + j])).collect();
+        let partials: Vec<_> = (0..n).map(|k| centripetal_partials(&f[k], qd[k], qd[n + k])).collect();
+        for i in 0..n {
+            let moment = c.tail_masses()[i] * c.lengths()[i];
+            let load: Vector3<f64> =
+                (0..n).map(|j| z[j] * c.weight(i, j)).sum::<Vector3<f64>>() + lift * moment;
+            for alpha in 0..2 {
+                let a = i + alpha * n;
+                let ja = jacobian(&f[i], alpha);
+                for (k, (by_angle, by_rate)) in partials.iter().enumerate() {
+                    let wik = c.weight(i, k);
+                    for beta in 0..2 {
+                        let x = k + beta * n;
+                        let mut value = -wik * ja.dot(&by_angle[beta]);
+                        if k == i {
+                            value -= second(&f[i], alpha, beta).dot(&load);
+                        }
+                        dq[(a, x)] = value;
+                        dqd[(a, x)] = -wik * ja.dot(&by_rate[beta]);
+                    }
+                }
+                for axis in 0..3 {
+                    dp[(a, axis)] = -moment * ja[axis];
+                }
+            }
+            let (s, co, lambda) = (f[i].sin_theta, f[i].cos_theta, c.damping()[i]);
+            dq[(n + i, i)] -= 2.0 * lambda * s * co * qd[n + i];
+            dqd[(i, i)] -= lambda;
+            dqd[(n + i, n + i)] -= lambda * s * s;
+        }
+    }
+}
+
+/// `J_α = ∂u/∂α` of one link (`α` 0 = θ, 1 = φ).
+fn jacobian(f: &SphericalLink, alpha: usize) -> Vector3<f64> {
+    if alpha == 0 { f.d_theta } else { f.d_phi }
+}
+
+/// `H_αβ = ∂²u/∂α∂β` of one link.
+fn second(f: &SphericalLink, alpha: usize, beta: usize) -> Vector3<f64> {
+    match alpha + beta {
+        0 => f.d_theta2(),
+        1 => f.d_theta_phi(),
+        _ => f.d_phi2(),
+    }
+}
+
+/// The partial derivatives of `z = ü|_{q̈=0} = H_θθ θ̇² + H_φφ φ̇² + 2 H_θφ θ̇ φ̇` (1/s²) by
+/// the link's angles `(θ, φ)` and by its rates `(θ̇, φ̇)`, from the third derivatives
+/// `∂³u/∂θ³ = −J_θ`, `∂³u/∂θ²∂φ = ∂³u/∂φ³ = −J_φ`, `∂³u/∂θ∂φ² = −cos θ (cos φ, sin φ, 0)`.
+fn centripetal_partials(f: &SphericalLink, td: f64, pd: f64) -> ([Vector3<f64>; 2], [Vector3<f64>; 2]) {
+    let theta_phi2 = Vector3::new(f.e_phi.y, -f.e_phi.x, 0.0) * -f.cos_theta;
+    let by_angle = [
+        -f.d_theta * (td * td) + theta_phi2 * (pd * pd) - f.d_phi * (2.0 * td * pd),
+        -f.d_phi * (td * td + pd * pd) + theta_phi2 * (2.0 * td * pd),
+    ];
+    let (tt, tp, pp) = (f.d_theta2(), f.d_theta_phi(), f.d_phi2());
+    let by_rate = [(tt * td + tp * pd) * 2.0, (pp * pd + tp * td) * 2.0];
+    (by_angle, by_rate)
 }
 
 #[cfg(test)]

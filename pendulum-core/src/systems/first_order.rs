@@ -1,10 +1,11 @@
 //! The adapter that turns a chain [`Model`] into a first-order [`System`]
 //! `x' = f(t, x)` with `x = (q, q̇)`, for the integrators.
 
-use nalgebra::{DefaultAllocator, Dim, DimMul, DimProd, OVector, U1, U2, allocator::Allocator};
+use nalgebra::{DefaultAllocator, Dim, DimMul, DimProd, OMatrix, OVector, U1, U2, allocator::Allocator};
 
 use crate::error::Result;
 use crate::integrate::{System, SystemAlloc};
+use crate::jacobians::{Derivatives, Jacobians};
 use crate::model::{Inputs, InputsAt, Model, ModelAlloc};
 
 /// A chain model as the first-order system
@@ -16,12 +17,23 @@ use crate::model::{Inputs, InputsAt, Model, ModelAlloc};
 /// double pendulum). `I` supplies the inputs at each time ([`InputsAt`]);
 /// [`new`](FirstOrder::new) uses none (no torque, pivot at rest).
 ///
-/// The Jacobian is the finite-difference default of [`System::jacobian`].
+/// The Jacobian is the finite-difference default of [`System::jacobian`], or, after
+/// [`analytic`](FirstOrder::analytic), the model's own [`Derivatives`]:
+/// `∂x'/∂x = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]]`.
 #[derive(Debug, Clone)]
-pub struct FirstOrder<M, I> {
+pub struct FirstOrder<M, I, J = Differences> {
     model: M,
     inputs: I,
+    _jacobian: J,
 }
+
+/// [`FirstOrder`]'s Jacobian by central differences of the right-hand side.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Differences;
+
+/// [`FirstOrder`]'s Jacobian from the model's analytic [`Derivatives`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Analytic;
 
 impl<M: Model> FirstOrder<M, Inputs<M::Dof, M::Space>>
 where
@@ -30,16 +42,23 @@ where
     /// The free chain: no torque, pivot at rest.
     pub fn new(model: M) -> Self {
         let inputs = model.zero_inputs();
-        Self { model, inputs }
+        Self { model, inputs, _jacobian: Differences }
     }
 }
 
 impl<M, I> FirstOrder<M, I> {
     /// The chain driven by `inputs` (constant [`Inputs`] or a closure of time).
     pub fn with_inputs(model: M, inputs: I) -> Self {
-        Self { model, inputs }
+        Self { model, inputs, _jacobian: Differences }
     }
 
+    /// The same system with the model's analytic Jacobian instead of differences.
+    pub fn analytic(self) -> FirstOrder<M, I, Analytic> {
+        FirstOrder { model: self.model, inputs: self.inputs, _jacobian: Analytic }
+    }
+}
+
+impl<M, I, J> FirstOrder<M, I, J> {
     /// The model.
     pub fn model(&self) -> &M {
         &self.model
@@ -51,7 +70,7 @@ impl<M, I> FirstOrder<M, I> {
     }
 }
 
-impl<M: Model, I> FirstOrder<M, I>
+impl<M: Model, I, J> FirstOrder<M, I, J>
 where
     M::Dof: DimMul<U2>,
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<DimProd<M::Dof, U2>>,
@@ -107,7 +126,31 @@ where
     (q, r)
 }
 
-impl<M: Model, I: InputsAt<M::Dof, M::Space>> System for FirstOrder<M, I>
+impl<M: Model, I: InputsAt<M::Dof, M::Space>, J> FirstOrder<M, I, J>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<DimProd<M::Dof, U2>>,
+{
+    /// `(q̇, q̈)` at `(t, x)`: both impls' [`System::rhs`].
+    fn velocity_and_acceleration(
+        &self,
+        t: f64,
+        x: &OVector<f64, DimProd<M::Dof, U2>>,
+        out: &mut OVector<f64, DimProd<M::Dof, U2>>,
+    ) -> Result<()> {
+        let (q, qd) = self.split(x);
+        let mut qdd = OVector::zeros_generic(self.model.dof(), U1);
+        self.model.accelerations(&q, &qd, &self.inputs.inputs_at(t), &mut qdd)?;
+        let n = qd.len();
+        for i in 0..n {
+            out[i] = qd[i];
+            out[n + i] = qdd[i];
+        }
+        Ok(())
+    }
+}
+
+impl<M: Model, I: InputsAt<M::Dof, M::Space>> System for FirstOrder<M, I, Differences>
 where
     M::Dof: DimMul<U2>,
     DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<DimProd<M::Dof, U2>>,
@@ -125,13 +168,51 @@ where
 
     /// `(q̇, q̈)`; errors of [`Model::accelerations`] pass through.
     fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()> {
+        self.velocity_and_acceleration(t, x, out)
+    }
+}
+
+impl<M: Derivatives, I: InputsAt<M::Dof, M::Space>> System for FirstOrder<M, I, Analytic>
+where
+    M::Dof: DimMul<U2>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>
+        + Allocator<M::Dof, M::Space>
+        + SystemAlloc<DimProd<M::Dof, U2>>,
+{
+    type Dim = DimProd<M::Dof, U2>;
+
+    fn dim(&self) -> Self::Dim {
+        self.model.dof().mul(U2)
+    }
+
+    /// `x = (q, q̇)`, `q' = q̇`.
+    fn second_order(&self) -> Option<usize> {
+        Some(self.model.dof().value())
+    }
+
+    /// `(q̇, q̈)`; errors of [`Model::accelerations`] pass through.
+    fn rhs(&self, t: f64, x: &OVector<f64, Self::Dim>, out: &mut OVector<f64, Self::Dim>) -> Result<()> {
+        self.velocity_and_acceleration(t, x, out)
+    }
+
+    /// `[[0, I], [∂q̈/∂q, ∂q̈/∂q̇]]` from [`Derivatives::acceleration_jacobians`].
+    fn jacobian(
+        &self,
+        t: f64,
+        x: &OVector<f64, Self::Dim>,
+        out: &mut OMatrix<f64, Self::Dim, Self::Dim>,
+    ) -> Result<()> {
         let (q, qd) = self.split(x);
-        let mut qdd = OVector::zeros_generic(self.model.dof(), U1);
-        self.model.accelerations(&q, &qd, &self.inputs.inputs_at(t), &mut qdd)?;
-        let n = qd.len();
+        let mut jac = Jacobians::zeros(&self.model);
+        self.model.acceleration_jacobians(&q, &qd, &self.inputs.inputs_at(t), &mut jac)?;
+        let n = q.len();
+        out.fill(0.0);
         for i in 0..n {
-            out[i] = qd[i];
-            out[n + i] = qdd[i];
+            out[(i, n + i)] = 1.0;
+            for j in 0..n {
+                out[(n + i, j)] = jac.q[(i, j)];
+                out[(n + i, n + j)] = jac.qd[(i, j)];
+            }
         }
         Ok(())
     }
@@ -158,6 +239,22 @@ mod tests {
         model.accelerations(&q, &qd, &model.zero_inputs(), &mut qdd).unwrap();
         assert_eq!(f, Vector4::new(qd[0], qd[1], qdd[0], qdd[1]));
         assert_eq!(system.split(&x), (q, qd));
+    }
+
+    #[test]
+    fn the_analytic_jacobian_agrees_with_central_differences() {
+        let chain = Chain::<Const<2>>::new(&[1.0, 2.0], &[0.5, 1.5], 9.81)
+            .unwrap()
+            .with_damping(&[0.2, 0.1])
+            .unwrap();
+        let numeric = FirstOrder::new(Planar::new(chain));
+        let analytic = numeric.clone().analytic();
+        let x = Vector4::new(0.3, -1.1, 2.0, 0.4);
+        let (mut a, mut b) = (nalgebra::Matrix4::zeros(), nalgebra::Matrix4::zeros());
+        analytic.jacobian(0.0, &x, &mut a).unwrap();
+        numeric.jacobian(0.0, &x, &mut b).unwrap();
+        assert!((a - b).amax() < 1e-8 * b.amax(), "{a} {b}");
+        assert_eq!(a.fixed_view::<2, 2>(0, 2), nalgebra::Matrix2::identity());
     }
 
     #[test]

@@ -5,4 +5,4 @@ pub(crate) mod canonical;
 pub(crate) mod first_order;
 
 pub use canonical::Canonical;
-pub use first_order::FirstOrder;
+pub use first_order::{Analytic, Differences, FirstOrder};

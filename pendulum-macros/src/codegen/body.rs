@@ -116,6 +116,7 @@ pub(super) fn lets_from(
             Sym::Rate(angle) => vector_entry(&name, "qd", plan.index(angle)),
             Sym::Torque(angle) => vector_entry(&name, "torque", plan.index(angle)),
             Sym::Pivot(axis) => vector_entry(&name, "pivot_acceleration", axis),
+            Sym::Probe(b) => vector_entry(&name, "v", b),
             _ => {
                 let value = expr(&plan.definition(sym).expect("computed symbols have a definition"));
                 quote!(let #name = #value;)
@@ -197,6 +198,11 @@ impl Body {
     /// The name of the `q` parameter: `_q` when the body does not read it.
     pub(super) fn q(&self) -> Ident {
         param("q", self.uses(|s| matches!(s, Sym::Trig(..))))
+    }
+
+    /// The name of a vector parameter: `_name` when the body reads no symbol `f` holds for.
+    pub(super) fn param(&self, name: &str, f: fn(&Sym) -> bool) -> Ident {
+        param(name, self.uses(f))
     }
 
     /// The name of the `qd` parameter: `_qd` when the body does not read it.

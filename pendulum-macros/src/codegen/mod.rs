@@ -10,6 +10,7 @@
 
 mod accelerations;
 mod body;
+mod derivatives;
 #[cfg(test)]
 mod expansions;
 mod guards;
@@ -51,6 +52,7 @@ fn model(def: &ModelDef) -> TokenStream {
         items::partial_eq_impl(name),
         items::from_impl(name, &plan),
         model_impl(name, &plan, algorithm),
+        derivatives::derivatives_impl(name, &plan),
     ];
     quote! {
         #struct_item
@@ -71,7 +73,7 @@ fn imports(plan: &Plan) -> TokenStream {
         use ::core::primitive::f64;
         use ::core::result::Result::{Err, Ok};
         use ::pendulum_core::__private::nalgebra::{Const, SMatrix, SVector, #space};
-        use ::pendulum_core::{Chain, Error, Inputs, Model, Result};
+        use ::pendulum_core::{Chain, Derivatives, Error, Inputs, Model, Result};
     }
 }
 

@@ -79,13 +79,59 @@ pub fn acceleration_error(
     rhs: &DVector<f64>,
     a: &DVector<f64>,
 ) -> (usize, f64, f64) {
+    backward_error(mass_scale, rhs_scale, mass_matrix, rhs, a, 0.0)
+}
+
+/// [`acceleration_error`] with each row's scale floored by `floor`.
+fn backward_error(
+    mass_scale: &DMatrix<f64>,
+    rhs_scale: &DVector<f64>,
+    mass_matrix: &DMatrix<f64>,
+    rhs: &DVector<f64>,
+    a: &DVector<f64>,
+    floor: f64,
+) -> (usize, f64, f64) {
     let residual = mass_matrix * a - rhs;
     let scale = mass_scale * a.abs() + rhs_scale;
     let mut worst = (0, 0.0, 0.0);
     for (i, (r, s)) in residual.iter().zip(scale.iter()).enumerate() {
-        let error = ratio(r.abs(), *s);
+        let error = ratio(r.abs(), s.max(floor));
         if worse(error, worst.1) {
             worst = (i, error, r.abs());
+        }
+    }
+    worst
+}
+
+/// [`acceleration_error`] of every column of a Jacobian `J` for the reference systems
+/// `M J = R` (one right-hand side per column, with its own entry scales): the worst
+/// column, its row, error and residual.
+///
+/// Each row's scale is floored by [`SCALE_FLOOR`] times the column's natural scale
+/// `‖S(M)‖_∞ ‖J_x‖_∞ + ‖S(R_x)‖_∞`: a row whose reference entries all cancel
+/// symbolically (the zero `M[φ_1][θ_1]` against a torque on `θ_1`) has scale zero, while a
+/// model computes its zeros with round-off.
+pub fn jacobian_error(
+    mass_scale: &DMatrix<f64>,
+    rhs_scale: &DMatrix<f64>,
+    mass_matrix: &DMatrix<f64>,
+    rhs: &DMatrix<f64>,
+    jacobian: &DMatrix<f64>,
+) -> (usize, usize, f64, f64) {
+    let mut worst = (0, 0, 0.0, 0.0);
+    for x in 0..jacobian.ncols() {
+        let (column, column_scale) = (jacobian.column(x).into_owned(), rhs_scale.column(x).into_owned());
+        let floor = SCALE_FLOOR * (row_sum_norm(mass_scale) * column.amax() + column_scale.amax());
+        let (row, error, residual) = backward_error(
+            mass_scale,
+            &column_scale,
+            mass_matrix,
+            &rhs.column(x).into_owned(),
+            &column,
+            floor,
+        );
+        if worse(error, worst.2) {
+            worst = (x, row, error, residual);
         }
     }
     worst

@@ -2,10 +2,12 @@
 //! (`check_model`), and whether a spatial model reports the singularity at `θ_1 = 0`, `π`.
 
 use anyhow::{Result, bail};
-use nalgebra::{DVector, DefaultAllocator, Dim, DimName, OMatrix, OVector, U1};
-use pendulum_core::{Error, Inputs, Model, ModelAlloc};
+use nalgebra::{
+    DMatrix, DVector, DefaultAllocator, Dim, DimName, OMatrix, OVector, U1, allocator::Allocator,
+};
+use pendulum_core::{Derivatives, Error, Inputs, Jacobians, Model, ModelAlloc};
 
-use super::bounds::{acceleration_error, entry_errors};
+use super::bounds::{acceleration_error, entry_errors, jacobian_error};
 use super::models::ModelVisitor;
 use super::reference::Reference;
 use crate::case::{Case, Point};
@@ -29,11 +31,20 @@ pub enum Quantity {
     PotentialEnergy,
     /// `q̈`, by the backward error ([`acceleration_error`]).
     Accelerations,
+    /// `∂q̈/∂q`, column by column by the backward error of the differentiated equation
+    /// `M ∂q̈/∂q_x = ∂F/∂q_x − (∂M/∂q_x) q̈` ([`jacobian_error`]).
+    JacobianQ,
+    /// `∂q̈/∂q̇`: `M ∂q̈/∂q̇_x = ∂F/∂q̇_x`.
+    JacobianQd,
+    /// `∂q̈/∂σ`: `M ∂q̈/∂σ_x = ∂F/∂σ_x`.
+    JacobianTorque,
+    /// `∂q̈/∂p̈`: `M ∂q̈/∂p̈_k = ∂F/∂p̈_k`.
+    JacobianPivot,
 }
 
 impl Quantity {
     /// Every quantity, in table order.
-    pub const ALL: [Quantity; 8] = [
+    pub const ALL: [Quantity; 12] = [
         Quantity::MassMatrix,
         Quantity::VelocityTerms,
         Quantity::GravityTerms,
@@ -42,6 +53,10 @@ impl Quantity {
         Quantity::KineticEnergy,
         Quantity::PotentialEnergy,
         Quantity::Accelerations,
+        Quantity::JacobianQ,
+        Quantity::JacobianQd,
+        Quantity::JacobianTorque,
+        Quantity::JacobianPivot,
     ];
 
     /// The name used in the case files and the table.
@@ -55,6 +70,10 @@ impl Quantity {
             Quantity::KineticEnergy => "kinetic_energy",
             Quantity::PotentialEnergy => "potential_energy",
             Quantity::Accelerations => "accelerations",
+            Quantity::JacobianQ => "d(qdd)/dq",
+            Quantity::JacobianQd => "d(qdd)/dqd",
+            Quantity::JacobianTorque => "d(qdd)/dsigma",
+            Quantity::JacobianPivot => "d(qdd)/dpivot",
         }
     }
 }
@@ -118,14 +137,14 @@ where
 ///
 /// Outputs are filled with NaN before each call, so an entry a model fails to write
 /// shows up as an infinite error. Errors if the model's dimensions do not fit the case.
-fn check_model<M: Model>(
+fn check_model<M: Derivatives>(
     case: &Case,
     model: &M,
     point: &Point,
     reference: &Reference,
 ) -> Result<Vec<Measured>>
 where
-    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
 {
     let dof = model.dof();
     let n = case.dof();
@@ -264,7 +283,69 @@ where
             }
         }
     });
+    out.extend(check_jacobians(model, &q, &qd, &inputs, reference));
     Ok(out)
+}
+
+/// The four Jacobian rows of [`check_model`], in [`Quantity::ALL`] order: each column of
+/// the model's Jacobian against the reference's differentiated equation, at the model's
+/// own `q̈` (whose error the accelerations row measures).
+fn check_jacobians<M: Derivatives>(
+    model: &M,
+    q: &OVector<f64, M::Dof>,
+    qd: &OVector<f64, M::Dof>,
+    inputs: &Inputs<M::Dof, M::Space>,
+    reference: &Reference,
+) -> Vec<Measured>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
+{
+    let mut jac = Jacobians::zeros(model);
+    for m in [&mut jac.q, &mut jac.qd, &mut jac.torque] {
+        m.fill(f64::NAN);
+    }
+    jac.pivot.fill(f64::NAN);
+    if let Err(e) = model.acceleration_jacobians(q, qd, inputs, &mut jac) {
+        let failed =
+            Measured { error: f64::INFINITY, entry: String::new(), detail: format!("the model failed: {e}") };
+        return vec![failed; 4];
+    }
+    let (values, scales) = (&reference.partials, &reference.partial_scales);
+    let qdd = DVector::from_column_slice(jac.accelerations.as_slice());
+    let dense = |m: &[f64], cols: usize| DMatrix::from_column_slice(m.len() / cols, cols, m);
+    let dof = qdd.len();
+    // ∂F/∂q_x − (∂M/∂q_x) q̈, and its scale S(∂F/∂q_x) + S(∂M/∂q_x) |q̈|.
+    let mut rhs_q = values.q.clone();
+    let mut scale_q = scales.q.clone();
+    for x in 0..dof {
+        rhs_q.set_column(x, &(values.q.column(x) - &values.mass_matrix[x] * &qdd));
+        scale_q.set_column(x, &(scales.q.column(x) + &scales.mass_matrix[x] * qdd.abs()));
+    }
+    let systems: [(DMatrix<f64>, &DMatrix<f64>, &DMatrix<f64>); 4] = [
+        (dense(jac.q.as_slice(), dof), &rhs_q, &scale_q),
+        (dense(jac.qd.as_slice(), dof), &values.qd, &scales.qd),
+        (dense(jac.torque.as_slice(), dof), &values.torque, &scales.torque),
+        (dense(jac.pivot.as_slice(), M::Space::dim()), &values.pivot, &scales.pivot),
+    ];
+    systems
+        .iter()
+        .map(|(got, rhs, rhs_scale)| {
+            let (column, row, error, residual) =
+                jacobian_error(&reference.scales.mass_matrix, rhs_scale, &reference.values.mass_matrix, rhs, got);
+            if error == 0.0 {
+                Measured::zero()
+            } else {
+                Measured {
+                    error,
+                    entry: format!("[{row}][{column}]"),
+                    detail: format!(
+                        "residual {residual:.3e} of M_ref J - rhs_ref in column {column}; implementation column {:?}",
+                        got.column(column).as_slice()
+                    ),
+                }
+            }
+        })
+        .collect()
 }
 
 /// [`check_model`] as a [`ModelVisitor`].
@@ -277,9 +358,9 @@ pub(super) struct Check<'a> {
 impl ModelVisitor for Check<'_> {
     type Output = Result<Vec<Measured>>;
 
-    fn visit<M: Model>(self, model: &M) -> Self::Output
+    fn visit<M: Derivatives>(self, model: &M) -> Self::Output
     where
-        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
     {
         check_model(self.case, model, self.point, self.reference)
     }
@@ -293,9 +374,9 @@ pub(super) struct CheckSingular<'a> {
 impl ModelVisitor for CheckSingular<'_> {
     type Output = Reported;
 
-    fn visit<M: Model>(self, model: &M) -> Self::Output
+    fn visit<M: Derivatives>(self, model: &M) -> Self::Output
     where
-        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
     {
         let ModelPoint { q, qd, inputs } = ModelPoint::new(model, self.point);
         let mut a = q.clone();

@@ -7,7 +7,7 @@
 
 use anyhow::{Context, Result};
 use nalgebra::{DefaultAllocator, Dim, Dyn, allocator::Allocator};
-use pendulum_core::{Chain, Model, ModelAlloc, Planar, Spatial};
+use pendulum_core::{Chain, Derivatives, ModelAlloc, Planar, Spatial};
 
 use crate::case::{Kind, Params};
 
@@ -99,9 +99,9 @@ pub trait ModelVisitor {
     type Output;
 
     /// Runs on `model`.
-    fn visit<M: Model>(self, model: &M) -> Self::Output
+    fn visit<M: Derivatives>(self, model: &M) -> Self::Output
     where
-        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>;
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>;
 }
 
 /// The chain of `params`, with `L = Dyn` or `Const<N>`.

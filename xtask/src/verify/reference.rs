@@ -4,7 +4,7 @@
 use nalgebra::{DVector, DVectorView};
 
 use super::bounds::{SCALE_FLOOR, row_sum_norm};
-use crate::case::{Case, Evaluated, Params, Point};
+use crate::case::{Case, Evaluated, Params, PartialsAt, Point};
 
 /// The reference at one state: values, entry scales, floors, and the right-hand side.
 pub(crate) struct Reference {
@@ -16,6 +16,10 @@ pub(crate) struct Reference {
     pub(crate) rhs: DVector<f64>,
     /// Its scale `S(Q) + S(c) + S(k) + S(d)`.
     pub(crate) rhs_scale: DVector<f64>,
+    /// The stored derivatives (`∂M/∂q`, the Jacobians of `Q − c − k − d`).
+    pub(crate) partials: PartialsAt,
+    /// Their scales.
+    pub(crate) partial_scales: PartialsAt,
 }
 
 impl Reference {
@@ -36,6 +40,7 @@ impl Reference {
         .map(|n| SCALE_FLOOR * n);
         let rhs_scale =
             &scales.generalized_forces + &scales.velocity_terms + &scales.gravity_terms + &scales.pivot_terms;
-        Reference { rhs: values.rhs(), values, scales, floors, rhs_scale }
+        let (partials, partial_scales) = case.partials_with_scales(params, point);
+        Reference { rhs: values.rhs(), values, scales, floors, rhs_scale, partials, partial_scales }
     }
 }

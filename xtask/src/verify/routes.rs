@@ -9,8 +9,8 @@
 //! `Directions` takes no torques: its states have `σ = 0` (the reference is evaluated so).
 
 use anyhow::{Context, Result, bail};
-use nalgebra::{DVector, DefaultAllocator, U2, U3, Vector2, Vector3};
-use pendulum_core::{Directions, FnDrive, Inputs, Model, ModelAlloc, PlanarTension};
+use nalgebra::{DVector, DefaultAllocator, U2, U3, Vector2, Vector3, allocator::Allocator};
+use pendulum_core::{Derivatives, Directions, FnDrive, Inputs, Model, ModelAlloc, PlanarTension};
 
 use super::bounds::{BOUND, acceleration_error};
 use super::compare::ModelPoint;
@@ -51,9 +51,9 @@ struct Accelerations<'a>(&'a Point);
 impl models::ModelVisitor for Accelerations<'_> {
     type Output = pendulum_core::Result<DVector<f64>>;
 
-    fn visit<M: Model>(self, model: &M) -> Self::Output
+    fn visit<M: Derivatives>(self, model: &M) -> Self::Output
     where
-        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space>,
+        DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
     {
         let ModelPoint { q, qd, inputs } = ModelPoint::new(model, self.0);
         let mut a = q.clone();

@@ -47,8 +47,23 @@ enum Bug {
     /// The last coordinate's acceleration off by this relative amount (all building
     /// blocks correct).
     LastAccelerationOff(f64),
+    /// Planar `∂F/∂q̇` off the diagonal without the factor 2 of `∂θ̇²/∂θ̇`.
+    RateJacobianFactorOne,
+    /// `∂(M v)/∂q` left out of `∂q̈/∂q` (as if `M` were constant).
+    NoMassPartials,
+    /// `∂F/∂p̈` with the sign of its last component flipped.
+    PivotJacobianSign,
     /// No bug at all.
     None,
+}
+
+impl Bug {
+    /// Whether the bug is in the derivatives only (the mutant's other building blocks are
+    /// correct, so every quantity can be asserted); a bug elsewhere leaves the mutant's
+    /// derivatives those of the correct model, and the Jacobian rows are not asserted.
+    fn in_derivatives(self) -> bool {
+        matches!(self, Bug::RateJacobianFactorOne | Bug::NoMassPartials | Bug::PivotJacobianSign | Bug::None)
+    }
 }
 
 /// A correct model with one [`Bug`].
@@ -244,6 +259,45 @@ where
     }
 }
 
+impl<M> Derivatives for Mutant<M>
+where
+    M: Derivatives + Model<Links = Dyn, Dof = Dyn>,
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + Allocator<Dyn, M::Space>,
+{
+    fn mass_matrix_partials(&self, q: &DVector<f64>, v: &DVector<f64>, out: &mut DMatrix<f64>) {
+        self.inner.mass_matrix_partials(q, v, out);
+        if self.bug == Bug::NoMassPartials {
+            out.fill(0.0);
+        }
+    }
+
+    fn force_jacobians(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        inputs: &Inputs<Dyn, M::Space>,
+        dq: &mut DMatrix<f64>,
+        dqd: &mut DMatrix<f64>,
+        dp: &mut OMatrix<f64, Dyn, M::Space>,
+    ) {
+        self.inner.force_jacobians(q, qd, inputs, dq, dqd, dp);
+        match self.bug {
+            Bug::RateJacobianFactorOne => {
+                for a in 0..dqd.nrows() {
+                    for x in (0..dqd.ncols()).filter(|&x| x != a) {
+                        dqd[(a, x)] *= 0.5;
+                    }
+                }
+            }
+            Bug::PivotJacobianSign => {
+                let last = dp.ncols() - 1;
+                dp.column_mut(last).neg_mut();
+            }
+            _ => {}
+        }
+    }
+}
+
 /// The worst error of a mutant of the generic model on each quantity of `case`.
 fn mutant_errors(case: &Case, bug: Bug, states: usize) -> Vec<f64> {
     let mut worst = vec![0.0f64; Quantity::ALL.len()];
@@ -274,7 +328,7 @@ fn planted_bugs_fail_the_bound_where_they_are() {
     let real = |name: &str| committed.iter().find(|c| c.name == name).unwrap();
     let (planar3, planar8, spatial2, spatial4) =
         (real("planar_n3"), real("planar_n8"), real("spatial_n2"), real("spatial_n4"));
-    let expectations: [(&Case, Bug, &[Quantity]); 36] = [
+    let expectations: [(&Case, Bug, &[Quantity]); 43] = [
         (planar2, Bug::DocumentVelocitySign, &[VelocityTerms, Accelerations]),
         (planar2, Bug::OwnMassGravity, &[GravityTerms, Accelerations]),
         (planar1, Bug::NoDamping, &[GeneralizedForces, Accelerations]),
@@ -314,6 +368,14 @@ fn planted_bugs_fail_the_bound_where_they_are() {
         (spatial4, Bug::PhiCoriolisFactorOne, &[VelocityTerms, Accelerations]),
         (planar8, Bug::None, &[]),
         (spatial4, Bug::None, &[]),
+        // Planted in the derivatives: the Jacobian rows.
+        (planar2, Bug::RateJacobianFactorOne, &[JacobianQd]),
+        (planar8, Bug::RateJacobianFactorOne, &[JacobianQd]),
+        (planar3, Bug::NoMassPartials, &[JacobianQ]),
+        (spatial1, Bug::NoMassPartials, &[JacobianQ]),
+        (spatial4, Bug::NoMassPartials, &[JacobianQ]),
+        (planar1, Bug::PivotJacobianSign, &[JacobianPivot]),
+        (spatial2, Bug::PivotJacobianSign, &[JacobianPivot]),
     ];
     for (case, bug, flagged) in expectations {
         let errors = mutant_errors(case, bug, 20);
@@ -328,7 +390,8 @@ fn planted_bugs_fail_the_bound_where_they_are() {
                 .collect::<Vec<_>>()
                 .join(", ")
         );
-        for (quantity, error) in Quantity::ALL.iter().zip(errors) {
+        let asserted = if bug.in_derivatives() { Quantity::ALL.len() } else { 8 };
+        for (quantity, error) in Quantity::ALL.iter().zip(errors).take(asserted) {
             if flagged.contains(quantity) {
                 assert!(error > 1e4 * BOUND, "{} {bug:?}: {} only {error:e}", case.name, quantity.name());
             } else {
@@ -446,6 +509,22 @@ fn a_model_that_leaves_an_entry_unwritten_fails() {
         }
         fn potential_energy(&self, q: &DVector<f64>) -> f64 {
             self.0.potential_energy(q)
+        }
+    }
+    impl Derivatives for Lazy {
+        fn mass_matrix_partials(&self, q: &DVector<f64>, v: &DVector<f64>, out: &mut DMatrix<f64>) {
+            self.0.mass_matrix_partials(q, v, out)
+        }
+        fn force_jacobians(
+            &self,
+            q: &DVector<f64>,
+            qd: &DVector<f64>,
+            inputs: &Inputs<Dyn, nalgebra::U3>,
+            dq: &mut DMatrix<f64>,
+            dqd: &mut DMatrix<f64>,
+            dp: &mut OMatrix<f64, Dyn, nalgebra::U3>,
+        ) {
+            self.0.force_jacobians(q, qd, inputs, dq, dqd, dp)
         }
     }
     let case = &fixtures()[2];
