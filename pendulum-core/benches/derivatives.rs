@@ -17,9 +17,10 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use nalgebra::U3;
 use nalgebra::{DVector, Dyn, SVector};
 use pendulum_core::integrate::{GaussLegendre, GaussOptions, Integrator, State, System};
-use pendulum_core::{Chain, Derivatives, FirstOrder, Jacobians, Model, Planar};
+use pendulum_core::{Chain, Derivatives, Directions, FirstOrder, Jacobians, Model, Planar, PlanarTension};
 
 pendulum_macros::model! {
     /// Generated planar model, 2 links.
@@ -126,7 +127,61 @@ where
     group.bench_function("analytic_fresh", |b| b.iter(|| black_box(run(&analytic, &x0, fresh))));
 }
 
+/// The O(n) routes at n links: `PlanarTension` accelerations, one JVP (the linearised
+/// solve and one tangent), one more tangent of a kept solve, and the full Jacobians;
+/// `Directions` (3D) rhs, JVP and the first-order system's full Jacobian.
+fn bench_linear(c: &mut Criterion, n: usize) {
+    let model = PlanarTension::new(chain::<Dyn>(n));
+    let q = DVector::from_fn(n, |i, _| 0.3 + (i as f64 * 0.77) % 2.5);
+    let qd = DVector::from_fn(n, |i, _| ((i as f64) * 1.3).sin() * 3.0);
+    let inputs = model.zero_inputs();
+    let dq = DVector::from_fn(n, |i, _| ((i as f64) * 0.9).cos());
+    let zero = vec![0.0; n];
+    let mut out = vec![0.0; n];
+    let mut group = c.benchmark_group("linear");
+    let mut qdd = DVector::zeros(n);
+    group.bench_function(BenchmarkId::new("tension_accelerations", n), |b| {
+        b.iter(|| model.accelerations(black_box(&q), black_box(&qd), &inputs, &mut qdd).unwrap())
+    });
+    group.bench_function(BenchmarkId::new("tension_jvp", n), |b| {
+        b.iter(|| {
+            let mut t = model.tangents(black_box(&q), black_box(&qd), &inputs).unwrap();
+            t.jvp(dq.as_slice(), &zero, &zero, [0.0; 2], &mut out);
+            black_box(&out);
+        })
+    });
+    let mut kept = model.tangents(&q, &qd, &inputs).unwrap();
+    group.bench_function(BenchmarkId::new("tension_tangent_of_kept_solve", n), |b| {
+        b.iter(|| {
+            kept.jvp(black_box(dq.as_slice()), &zero, &zero, [0.0; 2], &mut out);
+            black_box(&out);
+        })
+    });
+    let mut jac = Jacobians::zeros(&model);
+    group.bench_function(BenchmarkId::new("tension_jacobians", n), |b| {
+        b.iter(|| model.acceleration_jacobians(black_box(&q), black_box(&qd), &inputs, &mut jac).unwrap())
+    });
+    let directions = Directions::<U3>::new(chain::<Dyn>(n));
+    let qs = DVector::from_fn(2 * n, |i, _| 0.3 + (i as f64 * 0.77) % 2.5);
+    let qsd = DVector::from_fn(2 * n, |i, _| ((i as f64) * 1.3).sin() * 3.0);
+    let x = directions.from_spherical(qs.as_slice(), qsd.as_slice()).unwrap();
+    let dx = DVector::from_fn(x.len(), |i, _| ((i as f64) * 0.9).cos());
+    let mut f = DVector::zeros(x.len());
+    group.bench_function(BenchmarkId::new("directions_rhs", n), |b| {
+        b.iter(|| directions.rhs(0.0, black_box(&x), &mut f).unwrap())
+    });
+    let mut udd = vec![0.0; 3 * n];
+    group.bench_function(BenchmarkId::new("directions_jvp", n), |b| {
+        b.iter(|| directions.jvp(0.0, black_box(&x), &dx, &mut udd).unwrap())
+    });
+    let mut full = nalgebra::DMatrix::zeros(x.len(), x.len());
+    group.bench_function(BenchmarkId::new("directions_jacobian", n), |b| {
+        b.iter(|| directions.analytic_jacobian(0.0, black_box(&x), &mut full).unwrap())
+    });
+}
+
 fn benches(c: &mut Criterion) {
+    bench_linear(c, 100);
     bench_size::<_, 2>(c, Planar2::new(chain(2)));
     bench_size::<_, 4>(c, Planar4::new(chain(4)));
     bench_size::<_, 8>(c, Planar8::new(chain(8)));

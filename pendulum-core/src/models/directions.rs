@@ -14,6 +14,8 @@ use crate::kinematics::{Chart, PlanarAngles, SphericalAngles, SphericalLink, che
 use crate::model::check_vector;
 use crate::models::rods::{Load, Rods, with_scratch};
 
+mod tangents;
+
 /// A chain of `n` point masses on rigid rods in the plane (`S = U2`, y up) or in space
 /// (`S = U3`, z up), described by the unit direction `u_i` of each rod (from mass `i−1` to
 /// mass `i`, mass 0 the pivot) and its rate `w_i = u̇_i` (1/s), with the pivot moved by
@@ -448,6 +450,12 @@ where
     /// `x' = (w, ü(t, x))`: one O(n) tension solve.
     fn rhs(&self, t: f64, x: &DVector<f64>, out: &mut DVector<f64>) -> Result<()> {
         self.flow(t, x.as_slice(), out.as_mut_slice())
+    }
+
+    /// `[[0, I], [∂ü/∂u, ∂ü/∂w]]` from the tangents of the solve
+    /// ([`analytic_jacobian`](Self::analytic_jacobian)), not by differences.
+    fn jacobian(&self, t: f64, x: &DVector<f64>, out: &mut nalgebra::DMatrix<f64>) -> Result<()> {
+        self.analytic_jacobian(t, x, out)
     }
 }
 

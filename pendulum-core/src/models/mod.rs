@@ -18,4 +18,4 @@ pub use directions::Directions;
 pub use planar::Planar;
 pub use rod_midpoint::RodMidpoint;
 pub use spatial::Spatial;
-pub use tension::PlanarTension;
+pub use tension::{PlanarTangents, PlanarTension};

@@ -42,6 +42,10 @@
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
+mod tangent;
+
+pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
+
 /// Per-chain constants of the solve: reciprocal masses and lengths, and the drag
 /// coefficients `λ_i / l_i` the models use to build the force pairs.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,11 +4,12 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allo
 
 use crate::chain::Chain;
 use crate::error::Result;
+use crate::jacobians::{Derivatives, Jacobians};
 use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, check_inputs};
 use crate::models::planar::Planar;
-use crate::models::rods::{Load, Rods, with_scratch};
+use crate::models::rods::{Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
 use crate::models::trig::sin_cos_into;
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
@@ -131,9 +132,159 @@ where
     }
 }
 
+/// [`PlanarTension`]'s tension solve at one state, kept for its tangents: the
+/// directional derivatives (Jacobian-vector products) of `θ̈` in O(n) each.
+///
+/// With `u_i = (sin θ_i, −cos θ_i)`, `n_i = (cos θ_i, sin θ_i)` and the pull
+/// `σ_i/l_i − (λ_i/l_i) θ̇_i`, a direction `(δθ, δθ̇, δσ, δp̈)` moves rod `i`'s load by
+/// `δu_i = n_i δθ_i`, `δ|u̇_i|² = 2 θ̇_i δθ̇_i`, `δF_i = δpull_i n_i − pull_i u_i δθ_i`; the
+/// tangent of the solve (`rods` module) gives `δü_i`, and
+/// `δθ̈_i = n_i·δü_i − (u_i·ü_i) δθ_i`.
+#[derive(Debug, Clone)]
+pub struct PlanarTangents<'a> {
+    solve: Linearised<2>,
+    rods: &'a Rods,
+    sin_cos: Vec<[f64; 2]>,
+    rates: Vec<f64>,
+    pulls: Vec<f64>,
+    accelerations: Vec<f64>,
+    work: Vec<TangentRow<2>>,
+    udd: Vec<[f64; 2]>,
+}
+
+impl PlanarTangents<'_> {
+    /// `θ̈` at the state (rad/s²).
+    pub fn accelerations(&self) -> &[f64] {
+        &self.accelerations
+    }
+
+    /// `δθ̈` (rad/s²) along `(δθ, δθ̇, δσ, δp̈)`, written into `out`; every slice has `n`
+    /// entries. O(n), allocation-free.
+    pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
+        let (sc, rates, pulls) = (&self.sin_cos, &self.rates, &self.pulls);
+        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
+        let dload = |i: usize| {
+            let [s, c] = sc[i];
+            let dpull = dtorque[i] * inverse_length[i] - drag[i] * dqd[i];
+            LoadTangent {
+                direction: [c * dq[i], s * dq[i]],
+                rate_squared: 2.0 * rates[i] * dqd[i],
+                pair: [dpull * c - pulls[i] * s * dq[i], dpull * s + pulls[i] * c * dq[i]],
+            }
+        };
+        self.solve.tangent(self.rods, dload, dpivot, &mut self.work, &mut self.udd);
+        for (i, (o, (d, a))) in
+            out.iter_mut().zip(self.udd.iter().zip(self.solve.accelerations())).enumerate()
+        {
+            let [s, c] = sc[i];
+            // n·δü − (u·ü) δθ with u = (s, −c).
+            *o = c * d[0] + s * d[1] - (s * a[0] - c * a[1]) * dq[i];
+        }
+    }
+}
+
 /// Whether every entry of `v` is zero (no early exit, so that it vectorises).
 fn all_zero(v: &[f64]) -> bool {
     v.iter().fold(true, |zero, x| zero & (*x == 0.0))
+}
+
+impl<L: Dim> PlanarTension<L>
+where
+    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2>,
+{
+    /// The solve at `(q, q̇, inputs)` kept for its tangents ([`PlanarTangents`]): O(n).
+    ///
+    /// Errors: [`crate::error::Error::LengthMismatch`] or [`crate::error::Error::NonFinite`]
+    /// for bad inputs, [`crate::error::Error::NotPositiveDefinite`] for a non-finite result.
+    pub fn tangents(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+    ) -> Result<PlanarTangents<'_>> {
+        let chain = self.dense.chain();
+        let n = chain.links();
+        check_inputs(n, q, qd, inputs)?;
+        let mut sin_cos = vec![[0.0; 2]; n];
+        sin_cos_into(q.as_slice(), &mut sin_cos);
+        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
+        let rates = qd.as_slice().to_vec();
+        let pulls: Vec<f64> =
+            (0..n).map(|i| inputs.torque[i] * inverse_length[i] - drag[i] * rates[i]).collect();
+        let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
+        let solve = Linearised::new(&self.rods, [0.0, -chain.gravity()], pivot, |i| {
+            let [s, c] = sin_cos[i];
+            Load { direction: [s, -c], rate_squared: rates[i] * rates[i], pair: [pulls[i] * c, pulls[i] * s] }
+        });
+        let accelerations: Vec<f64> =
+            solve.accelerations().zip(&sin_cos).map(|(a, [s, c])| c * a[0] + s * a[1]).collect();
+        if !all_finite(&accelerations) {
+            return Err(crate::error::Error::NotPositiveDefinite);
+        }
+        Ok(PlanarTangents {
+            solve,
+            rods: &self.rods,
+            sin_cos,
+            rates,
+            pulls,
+            accelerations,
+            work: TangentRow::scratch(n),
+            udd: vec![[0.0; 2]; n],
+        })
+    }
+}
+
+/// The dense building blocks are [`Planar`]'s; the Jacobians come from the tangents of
+/// the O(n) solve instead ([`PlanarTangents`]): one O(n) pass per column, O(n²) in all.
+impl<L: Dim> Derivatives for PlanarTension<L>
+where
+    DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2> + Allocator<L, U2>,
+{
+    fn mass_matrix_partials(&self, q: &OVector<f64, L>, v: &OVector<f64, L>, out: &mut OMatrix<f64, L, L>) {
+        self.dense.mass_matrix_partials(q, v, out)
+    }
+
+    fn force_jacobians(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        dq: &mut OMatrix<f64, L, L>,
+        dqd: &mut OMatrix<f64, L, L>,
+        dp: &mut OMatrix<f64, L, U2>,
+    ) {
+        self.dense.force_jacobians(q, qd, inputs, dq, dqd, dp)
+    }
+
+    fn acceleration_jacobians(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        out: &mut Jacobians<Self>,
+    ) -> Result<()> {
+        let mut tangents = self.tangents(q, qd, inputs)?;
+        let n = q.len();
+        out.accelerations.as_mut_slice().copy_from_slice(tangents.accelerations());
+        let (mut unit, zero, mut column) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        for x in 0..n {
+            unit[x] = 1.0;
+            tangents.jvp(&unit, &zero, &zero, [0.0; 2], &mut column);
+            out.q.column_mut(x).copy_from_slice(&column);
+            tangents.jvp(&zero, &unit, &zero, [0.0; 2], &mut column);
+            out.qd.column_mut(x).copy_from_slice(&column);
+            tangents.jvp(&zero, &zero, &unit, [0.0; 2], &mut column);
+            out.torque.column_mut(x).copy_from_slice(&column);
+            unit[x] = 0.0;
+        }
+        for k in 0..2 {
+            let mut dp = [0.0; 2];
+            dp[k] = 1.0;
+            tangents.jvp(&zero, &zero, &zero, dp, &mut column);
+            out.pivot.column_mut(k).copy_from_slice(&column);
+        }
+        Ok(())
+    }
 }
 
 impl<L: Dim> From<Chain<L>> for PlanarTension<L>
@@ -264,6 +415,29 @@ mod tests {
             fast.dense().accelerations(&q, &qd, &inputs, &mut b).unwrap();
             assert_relative_eq!(a, b, epsilon = 1e-10, max_relative = 1e-10);
         }
+    }
+
+    #[test]
+    fn the_tangents_agree_with_the_dense_jacobians() {
+        let n = 12;
+        let masses: Vec<f64> = (0..n).map(|i| 0.5 + (i as f64 * 0.37).sin().abs()).collect();
+        let lengths: Vec<f64> = (0..n).map(|i| 0.2 + (i as f64 * 0.71).cos().abs()).collect();
+        let chain = Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap().with_damping(&vec![0.05; n]).unwrap();
+        let fast = PlanarTension::new(chain);
+        let q = DVector::from_fn(n, |i, _| 0.3 + (i as f64 * 0.77) % 2.5);
+        let qd = DVector::from_fn(n, |i, _| (i as f64 * 1.3).sin() * 3.0);
+        let inputs = Inputs {
+            torque: DVector::from_fn(n, |i, _| 0.1 * i as f64 - 0.4),
+            pivot_acceleration: Vector2::new(1.5, -2.0),
+        };
+        let (mut a, mut b) = (Jacobians::zeros(&fast), Jacobians::zeros(fast.dense()));
+        fast.acceleration_jacobians(&q, &qd, &inputs, &mut a).unwrap();
+        fast.dense().acceleration_jacobians(&q, &qd, &inputs, &mut b).unwrap();
+        for (x, y) in [(&a.q, &b.q), (&a.qd, &b.qd), (&a.torque, &b.torque)] {
+            assert!((x - y).amax() < 1e-9 * y.amax(), "{x} {y}");
+        }
+        assert!((&a.pivot - &b.pivot).amax() < 1e-9 * b.pivot.amax());
+        assert!((&a.accelerations - &b.accelerations).amax() < 1e-10 * b.accelerations.amax());
     }
 
     #[test]

@@ -310,42 +310,56 @@ where
             Measured { error: f64::INFINITY, entry: String::new(), detail: format!("the model failed: {e}") };
         return vec![failed; 4];
     }
-    let (values, scales) = (&reference.partials, &reference.partial_scales);
     let qdd = DVector::from_column_slice(jac.accelerations.as_slice());
     let dense = |m: &[f64], cols: usize| DMatrix::from_column_slice(m.len() / cols, cols, m);
     let dof = qdd.len();
-    // ∂F/∂q_x − (∂M/∂q_x) q̈, and its scale S(∂F/∂q_x) + S(∂M/∂q_x) |q̈|.
-    let mut rhs_q = values.q.clone();
-    let mut scale_q = scales.q.clone();
-    for x in 0..dof {
-        rhs_q.set_column(x, &(values.q.column(x) - &values.mass_matrix[x] * &qdd));
-        scale_q.set_column(x, &(scales.q.column(x) + &scales.mass_matrix[x] * qdd.abs()));
-    }
-    let systems: [(DMatrix<f64>, &DMatrix<f64>, &DMatrix<f64>); 4] = [
-        (dense(jac.q.as_slice(), dof), &rhs_q, &scale_q),
-        (dense(jac.qd.as_slice(), dof), &values.qd, &scales.qd),
-        (dense(jac.torque.as_slice(), dof), &values.torque, &scales.torque),
-        (dense(jac.pivot.as_slice(), M::Space::dim()), &values.pivot, &scales.pivot),
+    let jacobians = [
+        dense(jac.q.as_slice(), dof),
+        dense(jac.qd.as_slice(), dof),
+        dense(jac.torque.as_slice(), dof),
+        dense(jac.pivot.as_slice(), M::Space::dim()),
     ];
-    systems
-        .iter()
-        .map(|(got, rhs, rhs_scale)| {
-            let (column, row, error, residual) =
-                jacobian_error(&reference.scales.mass_matrix, rhs_scale, &reference.values.mass_matrix, rhs, got);
-            if error == 0.0 {
-                Measured::zero()
-            } else {
-                Measured {
-                    error,
-                    entry: format!("[{row}][{column}]"),
-                    detail: format!(
-                        "residual {residual:.3e} of M_ref J - rhs_ref in column {column}; implementation column {:?}",
-                        got.column(column).as_slice()
-                    ),
-                }
-            }
-        })
-        .collect()
+    jacobians.iter().enumerate().map(|(k, j)| jacobian_row(k, j, &qdd, reference)).collect()
+}
+
+/// One Jacobian row: `got` is `∂q̈/∂q` (`which` 0), `∂q̈/∂q̇` (1), `∂q̈/∂σ` (2) or `∂q̈/∂p̈`
+/// (3) of an implementation whose accelerations are `qdd`, measured column by column by
+/// the backward error of the reference's differentiated equation ([`jacobian_error`]).
+pub(super) fn jacobian_row(
+    which: usize,
+    got: &DMatrix<f64>,
+    qdd: &DVector<f64>,
+    reference: &Reference,
+) -> Measured {
+    let (values, scales) = (&reference.partials, &reference.partial_scales);
+    // ∂F/∂q_x − (∂M/∂q_x) q̈, and its scale S(∂F/∂q_x) + S(∂M/∂q_x) |q̈|.
+    let by_q = || {
+        let (mut rhs, mut scale) = (values.q.clone(), scales.q.clone());
+        for x in 0..qdd.len() {
+            rhs.set_column(x, &(values.q.column(x) - &values.mass_matrix[x] * qdd));
+            scale.set_column(x, &(scales.q.column(x) + &scales.mass_matrix[x] * qdd.abs()));
+        }
+        (rhs, scale)
+    };
+    let (rhs, rhs_scale) = match which {
+        0 => by_q(),
+        1 => (values.qd.clone(), scales.qd.clone()),
+        2 => (values.torque.clone(), scales.torque.clone()),
+        _ => (values.pivot.clone(), scales.pivot.clone()),
+    };
+    let (column, row, error, residual) =
+        jacobian_error(&reference.scales.mass_matrix, &rhs_scale, &reference.values.mass_matrix, &rhs, got);
+    if error == 0.0 {
+        return Measured::zero();
+    }
+    Measured {
+        error,
+        entry: format!("[{row}][{column}]"),
+        detail: format!(
+            "residual {residual:.3e} of M_ref J - rhs_ref in column {column}; implementation column {:?}",
+            got.column(column).as_slice()
+        ),
+    }
 }
 
 /// [`check_model`] as a [`ModelVisitor`].

@@ -24,6 +24,7 @@ mod fixtures;
 pub mod models;
 mod reference;
 pub mod report;
+mod route_jacobians;
 pub mod routes;
 
 use std::time::Instant;

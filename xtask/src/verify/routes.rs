@@ -9,13 +9,14 @@
 //! `Directions` takes no torques: its states have `σ = 0` (the reference is evaluated so).
 
 use anyhow::{Context, Result, bail};
-use nalgebra::{DVector, DefaultAllocator, U2, U3, Vector2, Vector3, allocator::Allocator};
-use pendulum_core::{Derivatives, Directions, FnDrive, Inputs, Model, ModelAlloc, PlanarTension};
+use nalgebra::{DMatrix, DVector, DefaultAllocator, U2, U3, Vector2, Vector3, allocator::Allocator};
+use pendulum_core::{Derivatives, Directions, FnDrive, Inputs, Jacobians, Model, ModelAlloc, PlanarTension};
 
 use super::bounds::{BOUND, acceleration_error};
-use super::compare::ModelPoint;
+use super::compare::{ModelPoint, jacobian_row};
 use super::models;
 use super::reference::Reference;
+use super::route_jacobians;
 use crate::case::{Case, Kind, Point};
 use crate::sample;
 
@@ -107,6 +108,20 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
                 let mut a = DVector::zeros(case.links);
                 model.accelerations(&q, &qd, &inputs, &mut a).with_context(context)?;
                 record("PlanarTension", backward_error(case, &params, &point, &a), state);
+                let reference = Reference::new(case, &params, &point);
+                let mut jac = Jacobians::zeros(&model);
+                model.acceleration_jacobians(&q, &qd, &inputs, &mut jac).with_context(context)?;
+                for (k, (route, j)) in
+                    JACOBIAN_ROUTES[0].iter().zip([&jac.q, &jac.qd, &jac.torque]).enumerate()
+                {
+                    record(route, jacobian_row(k, j, &jac.accelerations, &reference).error, state);
+                }
+                let pivot = DMatrix::from_column_slice(case.links, 2, jac.pivot.as_slice());
+                record(
+                    JACOBIAN_ROUTES[0][3],
+                    jacobian_row(3, &pivot, &jac.accelerations, &reference).error,
+                    state,
+                );
 
                 let p = Vector2::from_column_slice(&point.pivot_acceleration);
                 let drive = FnDrive::new(move |t: f64| p * (0.5 * t * t), move |t: f64| p * t, move |_| p);
@@ -114,6 +129,9 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
                 let x = directions.from_angles(&point.q, &point.qd).with_context(context)?;
                 let a = directions.angle_accelerations(0.0, &x).with_context(context)?;
                 record("Directions", backward_error(case, &params, &without_torque(&point), &a), state);
+                let (qdd, jq, jqd) =
+                    route_jacobians::planar(&directions, &point.q, &point.qd).with_context(context)?;
+                directions_rows(&mut record, case, &params, &point, &qdd, &jq, &jqd, state);
             }
             Kind::Spatial => {
                 let p = Vector3::from_column_slice(&point.pivot_acceleration);
@@ -121,10 +139,38 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
                 let directions = Directions::<U3>::new(chain).with_drive(drive);
                 let a = directions.spherical_accelerations(0.0, &point.q, &point.qd).with_context(context)?;
                 record("Directions", backward_error(case, &params, &without_torque(&point), &a), state);
+                let (qdd, jq, jqd) =
+                    route_jacobians::spatial(&directions, &point.q, &point.qd).with_context(context)?;
+                directions_rows(&mut record, case, &params, &point, &qdd, &jq, &jqd, state);
             }
         }
     }
     Ok(rows)
+}
+
+/// The Jacobian rows of the routes: `PlanarTension`'s four, `Directions`' two.
+const JACOBIAN_ROUTES: [[&str; 4]; 2] = [
+    ["PlanarTension d/dq", "PlanarTension d/dqd", "PlanarTension d/dsig", "PlanarTension d/dp"],
+    ["Directions d/dq", "Directions d/dqd", "", ""],
+];
+
+/// Records `Directions`' `∂q̈/∂q` and `∂q̈/∂q̇` (in angles) against the reference at the
+/// torque-free `point`.
+#[allow(clippy::too_many_arguments)]
+fn directions_rows(
+    record: &mut impl FnMut(&'static str, f64, usize),
+    case: &Case,
+    params: &crate::case::Params,
+    point: &Point,
+    qdd: &DVector<f64>,
+    jq: &DMatrix<f64>,
+    jqd: &DMatrix<f64>,
+    state: usize,
+) {
+    let reference = Reference::new(case, params, &without_torque(point));
+    for (k, j) in [jq, jqd].into_iter().enumerate() {
+        record(JACOBIAN_ROUTES[1][k], jacobian_row(k, j, qdd, &reference).error, state);
+    }
 }
 
 /// Every case's rows.
@@ -142,11 +188,11 @@ pub fn report(rows: &[RouteRow]) -> Result<()> {
         "O(n) routes and each generated algorithm, accelerations (componentwise backward error \
          against the reference, bound {BOUND:e}):"
     );
-    println!("{:<12} {:<17} {:>10}  verdict", "case", "route", "worst");
+    println!("{:<12} {:<20} {:>10}  verdict", "case", "route", "worst");
     for row in rows {
         let ok = row.error <= BOUND;
         println!(
-            "{:<12} {:<17} {:>10.1e}  {}",
+            "{:<12} {:<20} {:>10.1e}  {}",
             row.case,
             row.route,
             row.error,
@@ -176,7 +222,7 @@ mod tests {
         let rows = verify_cases(&cases, 20, 0x5eed).unwrap();
         assert_eq!(
             rows.len(),
-            cases.iter().map(|c| if c.kind == Kind::Planar { 4 } else { 3 }).sum::<usize>()
+            cases.iter().map(|c| if c.kind == Kind::Planar { 10 } else { 5 }).sum::<usize>()
         );
         report(&rows).unwrap();
     }

@@ -1,0 +1,174 @@
+//! The tangents of [`Directions`]' tension solve: `δü` along a change `δx = (δu, δw)` of
+//! the state in O(n) (a Jacobian-vector product), and the full Jacobian of the
+//! first-order system `x' = (w, ü)` in O(n²), one tangent per column.
+//!
+//! Rod `i`'s load is `u_i`, `|u̇_i|² = w_i·w_i` and the damping's pair `−(λ_i/l_i) w_i`, so
+//! `δ` moves it by `δu_i`, `2 w_i·δw_i` and `−(λ_i/l_i) δw_i`; the rest is the tangent of
+//! the solve (`rods` module).
+
+use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, allocator::Allocator};
+
+use super::Directions;
+use crate::drive::Drive;
+use crate::error::{Error, Result};
+use crate::models::rods::{Linearised, Load, LoadTangent, TangentRow};
+
+impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// The solve at `(t, x)` kept for its tangents, in `C = S::DIM` dimensions.
+    fn linearised<const C: usize>(&self, t: f64, x: &[f64]) -> Linearised<C> {
+        let n = self.links();
+        let drag = self.rods.drag();
+        let mut gravity = [0.0; C];
+        gravity[C - 1] = -self.chain.gravity();
+        let p = self.drive.acceleration(t);
+        let pivot: [f64; C] = std::array::from_fn(|k| p[k]);
+        let (directions, rates) = x.split_at(C * n);
+        Linearised::new(&self.rods, gravity, pivot, |i| {
+            let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
+            Load {
+                direction: std::array::from_fn(|k| u[k]),
+                rate_squared: w.iter().map(|v| v * v).sum(),
+                pair: std::array::from_fn(|k| -drag[i] * w[k]),
+            }
+        })
+    }
+
+    /// One tangent of a kept solve: `δü` (written into `out`, `C·n` entries) along
+    /// `dx = (δu, δw)` (`2·C·n` entries) at the state `x`.
+    fn tangent_of<const C: usize>(
+        &self,
+        solve: &Linearised<C>,
+        x: &[f64],
+        dx: &[f64],
+        work: &mut [TangentRow<C>],
+        udd: &mut [[f64; C]],
+        out: &mut [f64],
+    ) {
+        let n = self.links();
+        let drag = self.rods.drag();
+        let rates = &x[C * n..];
+        let (du, dw) = dx.split_at(C * n);
+        let dload = |i: usize| {
+            let (w, dwi) = (&rates[i * C..(i + 1) * C], &dw[i * C..(i + 1) * C]);
+            LoadTangent {
+                direction: std::array::from_fn(|k| du[i * C + k]),
+                rate_squared: 2.0 * (0..C).map(|k| w[k] * dwi[k]).sum::<f64>(),
+                pair: std::array::from_fn(|k| -drag[i] * dwi[k]),
+            }
+        };
+        solve.tangent(&self.rods, dload, [0.0; C], work, udd);
+        for (o, d) in out.chunks_exact_mut(C).zip(udd.iter()) {
+            o.copy_from_slice(d);
+        }
+    }
+
+    /// `δü = (∂ü/∂u) δu + (∂ü/∂w) δw` (1/s²) at `(t, x)` along `dx = (δu, δw)`, written
+    /// into `out` (`S·n` entries): one O(n) linearised solve and one tangent pass.
+    ///
+    /// Errors: [`Error::LengthMismatch`] / [`Error::NonFinite`] for a bad state, direction
+    /// or buffer.
+    pub fn jvp(&self, t: f64, x: &DVector<f64>, dx: &DVector<f64>, out: &mut [f64]) -> Result<()> {
+        self.check_state(x)?;
+        crate::model::check_vector("dx", dx.as_slice(), self.state_len())?;
+        let n = self.links();
+        if out.len() != S::DIM * n {
+            return Err(Error::LengthMismatch { what: "out", expected: S::DIM * n, got: out.len() });
+        }
+        match S::DIM {
+            2 => {
+                let solve = self.linearised::<2>(t, x.as_slice());
+                let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; 2]; n]);
+                self.tangent_of(&solve, x.as_slice(), dx.as_slice(), &mut work, &mut udd, out);
+            }
+            _ => {
+                let solve = self.linearised::<3>(t, x.as_slice());
+                let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; 3]; n]);
+                self.tangent_of(&solve, x.as_slice(), dx.as_slice(), &mut work, &mut udd, out);
+            }
+        }
+        Ok(())
+    }
+
+    /// The Jacobian `∂x'/∂x = [[0, I], [∂ü/∂u, ∂ü/∂w]]` of the first-order system at
+    /// `(t, x)`: one linearised solve and one O(n) tangent per column, O(n²) in all.
+    pub fn analytic_jacobian(&self, t: f64, x: &DVector<f64>, out: &mut DMatrix<f64>) -> Result<()> {
+        self.check_state(x)?;
+        let len = self.state_len();
+        if out.shape() != (len, len) {
+            return Err(Error::LengthMismatch { what: "jacobian", expected: len * len, got: out.len() });
+        }
+        match S::DIM {
+            2 => self.jacobian_in::<2>(t, x.as_slice(), out),
+            _ => self.jacobian_in::<3>(t, x.as_slice(), out),
+        }
+        Ok(())
+    }
+
+    fn jacobian_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut DMatrix<f64>) {
+        let n = self.links();
+        let half = C * n;
+        let solve = self.linearised::<C>(t, x);
+        let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; C]; n]);
+        let mut dx = vec![0.0; 2 * half];
+        let mut column = vec![0.0; half];
+        out.fill(0.0);
+        for j in 0..2 * half {
+            dx[j] = 1.0;
+            self.tangent_of(&solve, x, &dx, &mut work, &mut udd, &mut column);
+            dx[j] = 0.0;
+            out.view_mut((half, j), (half, 1)).copy_from_slice(&column);
+        }
+        for i in 0..half {
+            out[(i, half + i)] = 1.0;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{U2, U3};
+
+    use super::*;
+    use crate::chain::Chain;
+    use crate::drive::Circle;
+    use crate::integrate::central_difference_jacobian;
+
+    /// The analytic Jacobian against central differences, and the JVP against it.
+    macro_rules! agrees {
+        ($model:expr, $x:expr) => {{
+            let (model, x) = (&$model, &$x);
+            let len = model.state_len();
+            let (mut analytic, mut numeric) = (DMatrix::zeros(len, len), DMatrix::zeros(len, len));
+            model.analytic_jacobian(0.7, x, &mut analytic).unwrap();
+            central_difference_jacobian(model, 0.7, x, &mut numeric).unwrap();
+            assert!((&analytic - &numeric).amax() < 1e-6 * numeric.amax(), "{analytic} {numeric}");
+            let dx = DVector::from_fn(len, |i, _| ((i as f64) * 0.9).cos());
+            let mut jvp = vec![0.0; len / 2];
+            model.jvp(0.7, x, &dx, &mut jvp).unwrap();
+            let product = analytic.rows(len / 2, len / 2) * &dx;
+            assert!((DVector::from_vec(jvp) - product).amax() < 1e-9 * analytic.amax());
+        }};
+    }
+
+    #[test]
+    fn planar_and_spatial_tangents_agree_with_central_differences() {
+        let chain = Chain::new(&[1.0, 0.5, 2.0, 0.7], &[0.7, 1.2, 0.4, 0.9], 9.81)
+            .unwrap()
+            .with_damping(&[0.1, 0.2, 0.3, 0.05])
+            .unwrap();
+        let planar = Directions::<U2>::new(chain.clone());
+        let x = planar.from_angles(&[0.4, -1.3, 2.2, 0.9], &[1.5, -0.7, 2.1, 0.3]).unwrap();
+        agrees!(planar, x);
+        let spatial = Directions::<U3>::new(chain).with_drive(Circle::new(0.1, 3.0).unwrap());
+        let x = spatial
+            .from_spherical(
+                &[0.9, 1.7, 2.3, 0.5, 0.2, -1.0, 2.8, 0.3],
+                &[1.5, -0.7, 2.1, 0.4, 1.2, -0.9, 0.3, 0.8],
+            )
+            .unwrap();
+        agrees!(spatial, x);
+    }
+}

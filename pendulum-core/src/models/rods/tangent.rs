@@ -1,0 +1,228 @@
+//! The tangent of the tension solve: how the direction accelerations `ü_i` change along a
+//! change of the rods' loads (`δu_i`, `δ|u̇_i|²`, `δF_i`) and of the pivot acceleration
+//! `δp̈`, in O(n) per direction.
+//!
+//! Differentiating the solve of the parent module (`A T = b`, then
+//! `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i`, `ü_i = (a_i − a_{i−1})/l_i`):
+//! ```text
+//! δa°_i = (δF_i − δF_{i+1})/m_i                      (δa°_0 = δp̈)
+//! δb_i  = l_i δ|u̇_i|² + δu_i·(a°_i − a°_{i−1}) + u_i·(δa°_i − δa°_{i−1})
+//! δA_ii = 2 (1/m_i + 1/m_{i−1}) u_i·δu_i,   δA_{i,i−1} = −(δu_{i−1}·u_i + u_{i−1}·δu_i)/m_{i−1}
+//! A δT  = δb − δA T                                   (the same A: its factors are kept)
+//! δa_i  = δa°_i + (δT_{i+1} u_{i+1} + T_{i+1} δu_{i+1} − δT_i u_i − T_i δu_i)/m_i
+//! δü_i  = (δa_i − δa_{i−1})/l_i
+//! ```
+//! The primal pass ([`Linearised::new`]) is the classical elimination (`D_i = A_ii − f_i
+//! A_{i,i−1}`, `f_i = A_{i,i−1}/D_{i−1}`), keeping per rod what the tangents need; each
+//! [`Linearised::tangent`] is then one down and one up pass, allocation-free.
+
+// The per-component loops read and write several `[f64; S]` at one index, like the solve's.
+#![allow(clippy::needless_range_loop)]
+
+use super::{Load, Rods, dot, entries};
+
+/// The change of one rod's [`Load`] along a direction.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LoadTangent<const S: usize> {
+    /// `δu_i`.
+    pub direction: [f64; S],
+    /// `δ|u̇_i|²` (1/s²).
+    pub rate_squared: f64,
+    /// `δF_i` (N).
+    pub pair: [f64; S],
+}
+
+/// One rod of a solve kept for its tangents.
+#[derive(Debug, Clone, Copy)]
+struct Kept<const S: usize> {
+    load: Load<S>,
+    /// `a°_i`.
+    free: [f64; S],
+    /// `f_i = A_{i,i−1}/D_{i−1}` and `1/D_i`.
+    factor: f64,
+    inverse_pivot: f64,
+    tension: f64,
+    /// `ü_i`.
+    acceleration: [f64; S],
+}
+
+/// A tension solve at one state, kept for its tangents (module docs).
+#[derive(Debug, Clone)]
+pub(crate) struct Linearised<const S: usize> {
+    rods: Vec<Kept<S>>,
+    pivot: [f64; S],
+}
+
+impl<const S: usize> Linearised<S> {
+    /// The solve of `rods` with these loads, gravity `g⃗` and pivot acceleration `p̈`.
+    pub fn new(rods: &Rods, gravity: [f64; S], pivot: [f64; S], load: impl Fn(usize) -> Load<S>) -> Self {
+        let n = rods.len();
+        let loads: Vec<Load<S>> = (0..n).map(load).collect();
+        let mut kept = Vec::with_capacity(n);
+        let (mut free_above, mut im_above, mut u_above) = (pivot, 0.0, [0.0; S]);
+        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+        let mut eliminated = vec![0.0; n];
+        for i in 0..n {
+            let here = loads[i];
+            let pair_below = if i + 1 < n { loads[i + 1].pair } else { [0.0; S] };
+            let im = rods.inverse_mass[i];
+            let mut a = gravity;
+            let mut rhs = rods.length[i] * here.rate_squared;
+            for k in 0..S {
+                a[k] += (here.pair[k] - pair_below[k]) * im;
+                rhs += here.direction[k] * (a[k] - free_above[k]);
+            }
+            let (diagonal, off) = entries(im, im_above, &u_above, &here.direction);
+            let factor = off * inverse_pivot_above;
+            let inverse_pivot = 1.0 / (diagonal - factor * off);
+            eliminated[i] = rhs - factor * eliminated_above;
+            kept.push(Kept {
+                load: here,
+                free: a,
+                factor,
+                inverse_pivot,
+                tension: 0.0,
+                acceleration: [0.0; S],
+            });
+            (free_above, im_above, u_above) = (a, im, here.direction);
+            (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated[i]);
+        }
+        let mut out = Self { rods: kept, pivot };
+        out.substitute(rods, &eliminated);
+        out
+    }
+
+    /// `ü_i` (1/s²) per rod.
+    pub fn accelerations(&self) -> impl Iterator<Item = &[f64; S]> {
+        self.rods.iter().map(|k| &k.acceleration)
+    }
+
+    /// The primal back substitution: `T_i = e_i/D_i − f_{i+1} T_{i+1}`, then
+    /// `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i` and `ü_i = (a_i − a_{i−1})/l_i`.
+    fn substitute(&mut self, rods: &Rods, eliminated: &[f64]) {
+        let n = self.rods.len();
+        let mut tension_below = 0.0;
+        for i in (0..n).rev() {
+            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
+            let t = eliminated[i] * self.rods[i].inverse_pivot - below_factor * tension_below;
+            self.rods[i].tension = t;
+            tension_below = t;
+        }
+        let mut a_above = self.pivot;
+        for i in 0..n {
+            let im = rods.inverse_mass[i];
+            let here = self.rods[i];
+            let mut a = here.free;
+            for k in 0..S {
+                a[k] -= here.tension * here.load.direction[k] * im;
+            }
+            if i + 1 < n {
+                let below = &self.rods[i + 1];
+                for k in 0..S {
+                    a[k] += below.tension * below.load.direction[k] * im;
+                }
+            }
+            let il = rods.inverse_length[i];
+            for k in 0..S {
+                self.rods[i].acceleration[k] = (a[k] - a_above[k]) * il;
+            }
+            a_above = a;
+        }
+    }
+
+    /// `δü_i` (1/s²) along the load tangents `dload(i)` and the pivot tangent `dpivot`,
+    /// written into `out` (`n` entries); `work` holds `n` entries of scratch.
+    pub fn tangent(
+        &self,
+        rods: &Rods,
+        dload: impl Fn(usize) -> LoadTangent<S>,
+        dpivot: [f64; S],
+        work: &mut [TangentRow<S>],
+        out: &mut [[f64; S]],
+    ) {
+        let n = self.rods.len();
+        // Down: δF, δa°, δb − δA T eliminated with the kept factors.
+        let (mut dfree_above, mut free_above) = (dpivot, self.pivot);
+        let mut dload_here = dload(0);
+        for i in 0..n {
+            let dload_below = if i + 1 < n { Some(dload(i + 1)) } else { None };
+            let kept = &self.rods[i];
+            let im = rods.inverse_mass[i];
+            let im_above = if i > 0 { rods.inverse_mass[i - 1] } else { 0.0 };
+            let u = kept.load.direction;
+            let du = dload_here.direction;
+            let dpair_below = dload_below.map_or([0.0; S], |d| d.pair);
+            let mut dfree = [0.0; S];
+            let mut rhs = rods.length[i] * dload_here.rate_squared;
+            for k in 0..S {
+                dfree[k] = (dload_here.pair[k] - dpair_below[k]) * im;
+                rhs += du[k] * (kept.free[k] - free_above[k]) + u[k] * (dfree[k] - dfree_above[k]);
+            }
+            // −δA T: the diagonal, and the two off-diagonal entries of row i.
+            rhs -= 2.0 * (im + im_above) * dot(&u, &du) * kept.tension;
+            if i > 0 {
+                let above = &self.rods[i - 1];
+                let doff = -(dot(&work[i - 1].direction, &u) + dot(&above.load.direction, &du)) * im_above;
+                rhs -= doff * above.tension;
+                work[i - 1].rhs -= doff * kept.tension;
+            }
+            work[i] = TangentRow { direction: du, free: dfree, rhs, tension: 0.0 };
+            (dfree_above, free_above) = (dfree, kept.free);
+            if let Some(d) = dload_below {
+                dload_here = d;
+            }
+        }
+        // The right-hand sides are complete only now (row i − 1 gets a term from row i):
+        // eliminate, then substitute.
+        let mut e_above = 0.0;
+        for i in 0..n {
+            let e = work[i].rhs - self.rods[i].factor * e_above;
+            work[i].rhs = e;
+            e_above = e;
+        }
+        let mut dt_below = 0.0;
+        for i in (0..n).rev() {
+            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
+            let dt = work[i].rhs * self.rods[i].inverse_pivot - below_factor * dt_below;
+            work[i].tension = dt;
+            dt_below = dt;
+        }
+        // δa_i, then δü_i.
+        let mut da_above = dpivot;
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            let im = rods.inverse_mass[i];
+            let (kept, row) = (&self.rods[i], &work[i]);
+            let mut da = row.free;
+            for k in 0..S {
+                da[k] -= (row.tension * kept.load.direction[k] + kept.tension * row.direction[k]) * im;
+            }
+            if i + 1 < n {
+                let (kb, rb) = (&self.rods[i + 1], &work[i + 1]);
+                for k in 0..S {
+                    da[k] += (rb.tension * kb.load.direction[k] + kb.tension * rb.direction[k]) * im;
+                }
+            }
+            let il = rods.inverse_length[i];
+            for k in 0..S {
+                o[k] = (da[k] - da_above[k]) * il;
+            }
+            da_above = da;
+        }
+    }
+}
+
+/// Scratch of one [`Linearised::tangent`], per rod.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TangentRow<const S: usize> {
+    direction: [f64; S],
+    free: [f64; S],
+    rhs: f64,
+    tension: f64,
+}
+
+impl<const S: usize> TangentRow<S> {
+    /// Scratch for `n` rods.
+    pub fn scratch(n: usize) -> Vec<Self> {
+        vec![Self { direction: [0.0; S], free: [0.0; S], rhs: 0.0, tension: 0.0 }; n]
+    }
+}
