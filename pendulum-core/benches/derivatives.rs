@@ -4,6 +4,10 @@
 //!   model's `accelerations` and its `acceleration_jacobians` (`q̈` with `∂q̈/∂q`, `∂q̈/∂q̇`,
 //!   `∂q̈/∂σ`, `∂q̈/∂p̈`), n = 2, 4, 8; `derivatives/jacobians_generic/<n>` the same for
 //!   `Planar<Dyn>`.
+//! - `linear/<what>/100`: the O(n) routes at n = 100: `PlanarTension` accelerations, a
+//!   JVP (the kept solve and one tangent), one more tangent of a kept solve, the state
+//!   Jacobians `∂θ̈/∂θ`, `∂θ̈/∂θ̇` and all four; `Directions` (3D) rhs, JVP and the
+//!   first-order system's Jacobian.
 //! - `newton/<chain>/<jacobian>`: 200 steps (h = 10 ms) of the two-stage Gauss–Legendre
 //!   method from the same state, for the chaotic double pendulum (both links horizontal,
 //!   released) and a planar chain of 8 links, with the Jacobian by central differences
@@ -155,6 +159,14 @@ fn bench_linear(c: &mut Criterion, n: usize) {
         b.iter(|| {
             kept.jvp(black_box(dq.as_slice()), &zero, &zero, [0.0; 2], &mut out);
             black_box(&out);
+        })
+    });
+    let (mut dqm, mut dqdm) = (vec![0.0; n * n], vec![0.0; n * n]);
+    group.bench_function(BenchmarkId::new("tension_state_jacobians", n), |b| {
+        b.iter(|| {
+            let t = model.tangents(black_box(&q), black_box(&qd), &inputs).unwrap();
+            t.state_jacobians(&mut dqm, &mut dqdm);
+            black_box(&dqm);
         })
     });
     let mut jac = Jacobians::zeros(&model);

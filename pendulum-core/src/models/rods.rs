@@ -42,8 +42,10 @@
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
+mod green;
 mod tangent;
 
+pub(crate) use green::Column;
 pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
 
 /// Per-chain constants of the solve: reciprocal masses and lengths, and the drag

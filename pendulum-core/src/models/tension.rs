@@ -9,7 +9,7 @@ use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, check_inputs};
 use crate::models::planar::Planar;
-use crate::models::rods::{Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
+use crate::models::rods::{Column, Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
 use crate::models::trig::sin_cos_into;
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
@@ -183,6 +183,70 @@ impl PlanarTangents<'_> {
     }
 }
 
+impl PlanarTangents<'_> {
+    /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇`, `∂θ̈/∂σ` (column-major n × n each) and `∂θ̈/∂p̈` (n × 2), all
+    /// at once: the load change of each column sits on one rod, so each column is three
+    /// multiply-adds per entry after one O(n) solve per output (`rods::green`), O(n²) in
+    /// all.
+    pub fn jacobians(&self, dq: &mut [f64], dqd: &mut [f64], dtorque: &mut [f64], dpivot: &mut [f64]) {
+        self.blocks(dq, dqd, Some((dtorque, dpivot)));
+    }
+
+    /// [`jacobians`](Self::jacobians) by `θ` and `θ̇` only: the state Jacobians a
+    /// linearisation or an implicit integrator needs.
+    pub fn state_jacobians(&self, dq: &mut [f64], dqd: &mut [f64]) {
+        self.blocks(dq, dqd, None);
+    }
+
+    fn blocks(&self, dq: &mut [f64], dqd: &mut [f64], inputs: Option<(&mut [f64], &mut [f64])>) {
+        let n = self.sin_cos.len();
+        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
+        let normal = |i: usize| [self.sin_cos[i][1], self.sin_cos[i][0]];
+        let rows: Vec<(usize, [f64; 2])> = (0..n).map(|i| (i, normal(i))).collect();
+        let zero = [0.0; 2];
+        let column = |rod: usize, direction: [f64; 2], rate_squared: f64, pair: [f64; 2]| Column {
+            rod,
+            load: LoadTangent { direction, rate_squared, pair },
+            pivot: zero,
+        };
+        let mut columns = Vec::with_capacity(3 * n + 2);
+        // δθ_x: δu = n, δF = −pull u; δθ̇_x: δ|u̇|² = 2 θ̇, δF = −(λ/l) n; δσ_x: δF = n/l.
+        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
+            columns.push(column(x, [c, s], 0.0, [-self.pulls[x] * s, self.pulls[x] * c]));
+        }
+        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
+            columns.push(column(x, zero, 2.0 * self.rates[x], [-drag[x] * c, -drag[x] * s]));
+        }
+        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
+            columns.push(column(x, zero, 0.0, [inverse_length[x] * c, inverse_length[x] * s]));
+        }
+        for k in 0..2 {
+            let mut pivot = zero;
+            pivot[k] = 1.0;
+            columns.push(Column {
+                rod: 0,
+                load: LoadTangent { direction: zero, rate_squared: 0.0, pair: zero },
+                pivot,
+            });
+        }
+        let green = self.solve.green(self.rods, &rows);
+        let (by_angle, rest) = columns.split_at(n);
+        let (by_rate, rest) = rest.split_at(n);
+        let (by_torque, by_pivot) = rest.split_at(n);
+        self.solve.columns(self.rods, &rows, &green, by_angle, dq);
+        self.solve.columns(self.rods, &rows, &green, by_rate, dqd);
+        if let Some((dtorque, dpivot)) = inputs {
+            self.solve.columns(self.rods, &rows, &green, by_torque, dtorque);
+            self.solve.columns(self.rods, &rows, &green, by_pivot, dpivot);
+        }
+        // δθ̈_i = n_i·δü_i + δn_i·ü_i: the last term for δθ_i only, δn_i = −u_i.
+        for (x, a) in self.solve.accelerations().enumerate() {
+            let [s, c] = self.sin_cos[x];
+            dq[x * n + x] -= s * a[0] - c * a[1];
+        }
+    }
+}
+
 /// Whether every entry of `v` is zero (no early exit, so that it vectorises).
 fn all_zero(v: &[f64]) -> bool {
     v.iter().fold(true, |zero, x| zero & (*x == 0.0))
@@ -256,6 +320,7 @@ where
         self.dense.force_jacobians(q, qd, inputs, dq, dqd, dp)
     }
 
+    /// Every column at once from the kept solve ([`PlanarTangents::jacobians`]).
     fn acceleration_jacobians(
         &self,
         q: &OVector<f64, L>,
@@ -263,26 +328,14 @@ where
         inputs: &Inputs<L, U2>,
         out: &mut Jacobians<Self>,
     ) -> Result<()> {
-        let mut tangents = self.tangents(q, qd, inputs)?;
-        let n = q.len();
+        let tangents = self.tangents(q, qd, inputs)?;
         out.accelerations.as_mut_slice().copy_from_slice(tangents.accelerations());
-        let (mut unit, zero, mut column) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        for x in 0..n {
-            unit[x] = 1.0;
-            tangents.jvp(&unit, &zero, &zero, [0.0; 2], &mut column);
-            out.q.column_mut(x).copy_from_slice(&column);
-            tangents.jvp(&zero, &unit, &zero, [0.0; 2], &mut column);
-            out.qd.column_mut(x).copy_from_slice(&column);
-            tangents.jvp(&zero, &zero, &unit, [0.0; 2], &mut column);
-            out.torque.column_mut(x).copy_from_slice(&column);
-            unit[x] = 0.0;
-        }
-        for k in 0..2 {
-            let mut dp = [0.0; 2];
-            dp[k] = 1.0;
-            tangents.jvp(&zero, &zero, &zero, dp, &mut column);
-            out.pivot.column_mut(k).copy_from_slice(&column);
-        }
+        tangents.jacobians(
+            out.q.as_mut_slice(),
+            out.qd.as_mut_slice(),
+            out.torque.as_mut_slice(),
+            out.pivot.as_mut_slice(),
+        );
         Ok(())
     }
 }

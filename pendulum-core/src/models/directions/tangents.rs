@@ -4,14 +4,15 @@
 //!
 //! Rod `i`'s load is `u_i`, `|u̇_i|² = w_i·w_i` and the damping's pair `−(λ_i/l_i) w_i`, so
 //! `δ` moves it by `δu_i`, `2 w_i·δw_i` and `−(λ_i/l_i) δw_i`; the rest is the tangent of
-//! the solve (`rods` module).
+//! the solve (`rods` module). The full Jacobian takes every column at once
+//! (`rods::green`): each column's load change sits on one rod.
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, allocator::Allocator};
 
 use super::Directions;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
-use crate::models::rods::{Linearised, Load, LoadTangent, TangentRow};
+use crate::models::rods::{Column, Linearised, Load, LoadTangent, TangentRow};
 
 impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
 where
@@ -93,7 +94,8 @@ where
     }
 
     /// The Jacobian `∂x'/∂x = [[0, I], [∂ü/∂u, ∂ü/∂w]]` of the first-order system at
-    /// `(t, x)`: one linearised solve and one O(n) tangent per column, O(n²) in all.
+    /// `(t, x)`: one linearised solve, one O(n) solve per row of `ü`, and three
+    /// multiply-adds per entry (`rods::green`), O(n²) in all.
     pub fn analytic_jacobian(&self, t: f64, x: &DVector<f64>, out: &mut DMatrix<f64>) -> Result<()> {
         self.check_state(x)?;
         let len = self.state_len();
@@ -111,19 +113,30 @@ where
         let n = self.links();
         let half = C * n;
         let solve = self.linearised::<C>(t, x);
-        let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; C]; n]);
-        let mut dx = vec![0.0; 2 * half];
-        let mut column = vec![0.0; half];
-        out.fill(0.0);
-        for j in 0..2 * half {
-            dx[j] = 1.0;
-            self.tangent_of(&solve, x, &dx, &mut work, &mut udd, &mut column);
-            dx[j] = 0.0;
-            out.view_mut((half, j), (half, 1)).copy_from_slice(&column);
+        let drag = self.rods.drag();
+        let rates = &x[half..];
+        let unit = |k: usize| std::array::from_fn::<f64, C, _>(|m| if m == k { 1.0 } else { 0.0 });
+        let rows: Vec<(usize, [f64; C])> = (0..half).map(|r| (r / C, unit(r % C))).collect();
+        let zero = [0.0; C];
+        let mut columns = Vec::with_capacity(2 * half);
+        for j in 0..half {
+            let load = LoadTangent { direction: unit(j % C), rate_squared: 0.0, pair: zero };
+            columns.push(Column { rod: j / C, load, pivot: zero });
         }
+        for (j, &rate) in rates.iter().enumerate().take(half) {
+            let (rod, k) = (j / C, j % C);
+            let pair = std::array::from_fn(|m| if m == k { -drag[rod] } else { 0.0 });
+            let load = LoadTangent { direction: zero, rate_squared: 2.0 * rate, pair };
+            columns.push(Column { rod, load, pivot: zero });
+        }
+        let green = solve.green(&self.rods, &rows);
+        let mut lower = vec![0.0; half * 2 * half];
+        solve.columns(&self.rods, &rows, &green, &columns, &mut lower);
+        out.fill(0.0);
         for i in 0..half {
             out[(i, half + i)] = 1.0;
         }
+        out.view_mut((half, 0), (half, 2 * half)).copy_from_slice(&lower);
     }
 }
 

@@ -97,6 +97,41 @@ impl<const S: usize> Linearised<S> {
         self.rods.iter().map(|k| &k.acceleration)
     }
 
+    /// Number of rods.
+    pub(super) fn len(&self) -> usize {
+        self.rods.len()
+    }
+
+    /// `u_i`.
+    pub(super) fn direction(&self, i: usize) -> [f64; S] {
+        self.rods[i].load.direction
+    }
+
+    /// `T_i` (N).
+    pub(super) fn tension(&self, i: usize) -> f64 {
+        self.rods[i].tension
+    }
+
+    /// `a°_i` (m/s²).
+    pub(super) fn free(&self, i: usize) -> [f64; S] {
+        self.rods[i].free
+    }
+
+    /// `p̈` (m/s²).
+    pub(super) fn pivot(&self) -> [f64; S] {
+        self.pivot
+    }
+
+    /// `f_i = A_{i,i−1}/D_{i−1}`.
+    pub(super) fn factor(&self, i: usize) -> f64 {
+        self.rods[i].factor
+    }
+
+    /// `1/D_i`.
+    pub(super) fn inverse_pivot(&self, i: usize) -> f64 {
+        self.rods[i].inverse_pivot
+    }
+
     /// The primal back substitution: `T_i = e_i/D_i − f_{i+1} T_{i+1}`, then
     /// `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i` and `ü_i = (a_i − a_{i−1})/l_i`.
     fn substitute(&mut self, rods: &Rods, eliminated: &[f64]) {
