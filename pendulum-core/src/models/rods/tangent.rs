@@ -176,8 +176,10 @@ impl<const S: usize> Linearised<S> {
         out: &mut [[f64; S]],
     ) {
         let n = self.rods.len();
-        // Down: δF, δa°, δb − δA T eliminated with the kept factors.
+        // Down: δF, δa°, r = δb − δA T, eliminated with the kept factors one row behind
+        // (row i − 1's r is complete once row i has added its −δA_{i−1,i} T_i).
         let (mut dfree_above, mut free_above) = (dpivot, self.pivot);
+        let (mut du_above, mut rhs_above, mut e_above) = ([0.0; S], 0.0, 0.0);
         let mut dload_here = dload(0);
         for i in 0..n {
             let dload_below = if i + 1 < n { Some(dload(i + 1)) } else { None };
@@ -197,67 +199,66 @@ impl<const S: usize> Linearised<S> {
             rhs -= 2.0 * (im + im_above) * dot(&u, &du) * kept.tension;
             if i > 0 {
                 let above = &self.rods[i - 1];
-                let doff = -(dot(&work[i - 1].direction, &u) + dot(&above.load.direction, &du)) * im_above;
+                let doff = -(dot(&du_above, &u) + dot(&above.load.direction, &du)) * im_above;
                 rhs -= doff * above.tension;
-                work[i - 1].rhs -= doff * kept.tension;
+                rhs_above -= doff * kept.tension;
+                e_above = rhs_above - above.factor * e_above;
+                work[i - 1].rhs = e_above;
             }
-            work[i] = TangentRow { direction: du, free: dfree, rhs, tension: 0.0 };
-            (dfree_above, free_above) = (dfree, kept.free);
+            work[i] = TangentRow { direction: du, free: dfree, rhs: 0.0 };
+            (dfree_above, free_above, du_above, rhs_above) = (dfree, kept.free, du, rhs);
             if let Some(d) = dload_below {
                 dload_here = d;
             }
         }
-        // The right-hand sides are complete only now (row i − 1 gets a term from row i):
-        // eliminate, then substitute.
-        let mut e_above = 0.0;
-        for i in 0..n {
-            let e = work[i].rhs - self.rods[i].factor * e_above;
-            work[i].rhs = e;
-            e_above = e;
+        if n > 0 {
+            work[n - 1].rhs = rhs_above - self.rods[n - 1].factor * e_above;
         }
-        let mut dt_below = 0.0;
+        // Up: δT_i = e_i/D_i − f_{i+1} δT_{i+1}, δa_i with it, and δü_{i+1} once δa_i is known.
+        let (mut dt_below, mut da_below) = (0.0, [0.0; S]);
         for i in (0..n).rev() {
-            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
-            let dt = work[i].rhs * self.rods[i].inverse_pivot - below_factor * dt_below;
-            work[i].tension = dt;
-            dt_below = dt;
-        }
-        // δa_i, then δü_i.
-        let mut da_above = dpivot;
-        for (i, o) in out.iter_mut().enumerate().take(n) {
             let im = rods.inverse_mass[i];
-            let (kept, row) = (&self.rods[i], &work[i]);
+            let kept = &self.rods[i];
+            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
+            let dt = work[i].rhs * kept.inverse_pivot - below_factor * dt_below;
+            let row = &work[i];
             let mut da = row.free;
             for k in 0..S {
-                da[k] -= (row.tension * kept.load.direction[k] + kept.tension * row.direction[k]) * im;
+                da[k] -= (dt * kept.load.direction[k] + kept.tension * row.direction[k]) * im;
             }
             if i + 1 < n {
                 let (kb, rb) = (&self.rods[i + 1], &work[i + 1]);
                 for k in 0..S {
-                    da[k] += (rb.tension * kb.load.direction[k] + kb.tension * rb.direction[k]) * im;
+                    da[k] += (dt_below * kb.load.direction[k] + kb.tension * rb.direction[k]) * im;
+                }
+                let il = rods.inverse_length[i + 1];
+                for k in 0..S {
+                    out[i + 1][k] = (da_below[k] - da[k]) * il;
                 }
             }
-            let il = rods.inverse_length[i];
+            (dt_below, da_below) = (dt, da);
+        }
+        if n > 0 {
+            let il = rods.inverse_length[0];
             for k in 0..S {
-                o[k] = (da[k] - da_above[k]) * il;
+                out[0][k] = (da_below[k] - dpivot[k]) * il;
             }
-            da_above = da;
         }
     }
 }
 
-/// Scratch of one [`Linearised::tangent`], per rod.
+/// Scratch of one [`Linearised::tangent`], per rod: `δu_i`, `δa°_i` and the eliminated
+/// right-hand side.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TangentRow<const S: usize> {
     direction: [f64; S],
     free: [f64; S],
     rhs: f64,
-    tension: f64,
 }
 
 impl<const S: usize> TangentRow<S> {
     /// Scratch for `n` rods.
     pub fn scratch(n: usize) -> Vec<Self> {
-        vec![Self { direction: [0.0; S], free: [0.0; S], rhs: 0.0, tension: 0.0 }; n]
+        vec![Self { direction: [0.0; S], free: [0.0; S], rhs: 0.0 }; n]
     }
 }
