@@ -61,17 +61,9 @@ pub fn eval(args: &EvalArgs) -> CliResult<()> {
 
 /// A chain and one state of it, as `pendulum eval` and `pendulum linearize` take them.
 pub struct StateInput {
-    /// Number of links n.
-    pub n: usize,
-    /// Masses, lengths and damping per link.
-    pub masses: Vec<f64>,
-    /// Lengths, m.
-    pub lengths: Vec<f64>,
-    /// Damping λ_i, N·m·s.
-    pub damping: Vec<f64>,
-    /// The chain they make.
+    /// The chain (masses, lengths, gravity, damping).
     pub chain: pendulum_core::Chain<Dyn>,
-    /// Coordinates, rates, torques (dof entries each) and pivot acceleration.
+    /// Coordinates q, rad (dof entries).
     pub q: Vec<f64>,
     /// Rates q̇, rad/s.
     pub qd: Vec<f64>,
@@ -123,7 +115,7 @@ pub fn parse_state(args: &EvalArgs) -> CliResult<StateInput> {
     let qd = vector("--qd", &args.qd, dof)?;
     let torque = vector("--torque", &args.torque, dof)?;
     let pivot = vector("--pivot-acceleration", &args.pivot_acceleration, space)?;
-    Ok(StateInput { n, masses, lengths, damping, chain, q, qd, torque, pivot })
+    Ok(StateInput { chain, q, qd, torque, pivot })
 }
 
 /// `q`, `q̇` and the inputs as a model's vectors.
@@ -149,7 +141,10 @@ where
 
 /// Evaluates the model the arguments describe.
 pub fn evaluate(args: &EvalArgs) -> CliResult<Evaluation> {
-    let StateInput { n, masses, lengths, damping, chain, q, qd, torque, pivot } = parse_state(args)?;
+    let StateInput { chain, q, qd, torque, pivot } = parse_state(args)?;
+    let per_link = |v: &nalgebra::DVector<f64>| v.as_slice().to_vec();
+    let (n, masses, lengths, damping) =
+        (chain.links(), per_link(chain.masses()), per_link(chain.lengths()), per_link(chain.damping()));
     let terms = match args.model {
         ModelKind::Planar => terms(&planar_model(chain), &q, &qd, &torque, &pivot)?,
         ModelKind::Spatial => terms(&spatial_model(chain), &q, &qd, &torque, &pivot)?,

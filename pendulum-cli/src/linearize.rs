@@ -103,7 +103,7 @@ pub fn linearization(args: &LinearizeArgs) -> CliResult<Linearization> {
     let stable = space.growth_rate() <= 1e-9;
     Ok(Linearization {
         model: args.state.model,
-        links: state.n,
+        links: state.chain.links(),
         q: state.q,
         qd: state.qd,
         residual: space.residual,
@@ -149,14 +149,11 @@ fn design(space: &StateSpace, input: LqrInput, args: &LinearizeArgs) -> CliResul
     let q = DMatrix::identity(n, n) * args.lqr_q;
     let r = DMatrix::identity(m, m) * args.lqr_r;
     let design = lqr(&space.a, &b, &q, &r).map_err(|e| CliError::usage(e.to_string()))?;
-    let closed = &space.a - &b * &design.gain;
-    let mut closed_loop: Vec<_> = closed.complex_eigenvalues().iter().copied().collect();
-    closed_loop.sort_by(|x, y| y.re.total_cmp(&x.re).then(y.im.total_cmp(&x.im)));
     Ok(Gain {
         input: input.name().to_owned(),
         q_weight: args.lqr_q,
         r_weight: args.lqr_r,
         gain: rows(&design.gain),
-        closed_loop_eigenvalues: eigenvalues(closed_loop),
+        closed_loop_eigenvalues: eigenvalues(design.closed_loop.iter().copied()),
     })
 }

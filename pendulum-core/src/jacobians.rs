@@ -17,7 +17,7 @@
 
 use nalgebra::{DefaultAllocator, OMatrix, OVector, U1, allocator::Allocator};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::{Inputs, Model, ModelAlloc};
 
 /// The partial derivatives of `q̈(q, q̇, σ, p̈)` at one state, and `q̈` itself.
@@ -55,6 +55,28 @@ where
     }
 }
 
+impl<M: Model + ?Sized> Jacobians<M>
+where
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + Allocator<M::Dof, M::Space>,
+{
+    /// The Jacobian `[[0, I], [∂q̈/∂q, ∂q̈/∂q̇]]` of the first-order system `x = (q, q̇)`,
+    /// `x' = (q̇, q̈)`, written into `out` (`2·dof` square).
+    pub fn first_order<D: nalgebra::Dim>(&self, out: &mut OMatrix<f64, D, D>)
+    where
+        DefaultAllocator: Allocator<D, D>,
+    {
+        let n = self.accelerations.len();
+        out.fill(0.0);
+        for i in 0..n {
+            out[(i, n + i)] = 1.0;
+            for j in 0..n {
+                out[(n + i, j)] = self.q[(i, j)];
+                out[(n + i, n + j)] = self.qd[(i, j)];
+            }
+        }
+    }
+}
+
 /// A [`Model`] whose accelerations can be differentiated analytically.
 ///
 /// The building blocks write into `&mut` outputs and, like the model's, assume sizes that
@@ -85,7 +107,8 @@ where
     );
 
     /// `q̈` and its Jacobians by `q`, `q̇`, `σ` and `p̈` (module docs), from one Cholesky
-    /// factorisation of `M`.
+    /// factorisation of `M` (`q̈` by [`Model::factor_and_solve`], the default route of
+    /// the accelerations, whatever route the model's own `accelerations` takes).
     ///
     /// Errors: those of [`Model::accelerations`].
     fn acceleration_jacobians(
@@ -95,11 +118,8 @@ where
         inputs: &Inputs<Self::Dof, Self::Space>,
         out: &mut Jacobians<Self>,
     ) -> Result<()> {
-        self.accelerations(q, qd, inputs, &mut out.accelerations)?;
-        let dof = self.dof();
-        let mut mass = OMatrix::<f64, Self::Dof, Self::Dof>::zeros_generic(dof, dof);
-        self.mass_matrix(q, &mut mass);
-        let cholesky = nalgebra::Cholesky::new(mass).ok_or(Error::NotPositiveDefinite)?;
+        // q̈ by the default route, whose factorisation of M the solves below reuse.
+        let cholesky = self.factor_and_solve(q, qd, inputs, &mut out.accelerations)?;
         self.force_jacobians(q, qd, inputs, &mut out.q, &mut out.qd, &mut out.pivot);
         // out.torque is scratch for ∂(M q̈)/∂q until it receives M⁻¹.
         self.mass_matrix_partials(q, &out.accelerations, &mut out.torque);

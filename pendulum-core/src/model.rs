@@ -181,12 +181,19 @@ where
         inputs: &Inputs<Self::Dof, Self::Space>,
         out: &mut OVector<f64, Self::Dof>,
     ) -> Result<()> {
-        check_inputs(self.dof().value(), q, qd, inputs)?;
-        self.check_configuration(q)?;
-        let dof = self.dof();
-        let mut mass = OMatrix::<f64, Self::Dof, Self::Dof>::zeros_generic(dof, dof);
-        self.mass_matrix(q, &mut mass);
-        let mut tmp = OVector::<f64, Self::Dof>::zeros_generic(dof, nalgebra::U1);
+        self.factor_and_solve(q, qd, inputs, out).map(|_| ())
+    }
+
+    /// The force side `F = Q − c − k − d` (N·m) of `M q̈ = F` from the building blocks,
+    /// written into `out`.
+    fn force_side(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        inputs: &Inputs<Self::Dof, Self::Space>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) {
+        let mut tmp = OVector::<f64, Self::Dof>::zeros_generic(self.dof(), nalgebra::U1);
         self.generalized_forces(q, qd, &inputs.torque, out);
         self.velocity_terms(q, qd, &mut tmp);
         *out -= &tmp;
@@ -194,9 +201,27 @@ where
         *out -= &tmp;
         self.pivot_terms(q, &inputs.pivot_acceleration, &mut tmp);
         *out -= &tmp;
+    }
+
+    /// The default route of [`accelerations`](Model::accelerations): checks the inputs
+    /// and the configuration, factors `M` (Cholesky) and solves `M q̈ = F` into `out`;
+    /// returns the factorisation for further solves with the same `M` (the Jacobians').
+    fn factor_and_solve(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        inputs: &Inputs<Self::Dof, Self::Space>,
+        out: &mut OVector<f64, Self::Dof>,
+    ) -> Result<nalgebra::Cholesky<f64, Self::Dof>> {
+        check_inputs(self.dof().value(), q, qd, inputs)?;
+        self.check_configuration(q)?;
+        let dof = self.dof();
+        let mut mass = OMatrix::<f64, Self::Dof, Self::Dof>::zeros_generic(dof, dof);
+        self.mass_matrix(q, &mut mass);
+        self.force_side(q, qd, inputs, out);
         let cholesky = nalgebra::Cholesky::new(mass).ok_or(Error::NotPositiveDefinite)?;
         cholesky.solve_mut(out);
-        if out.iter().all(|a| a.is_finite()) { Ok(()) } else { Err(Error::NotPositiveDefinite) }
+        if out.iter().all(|a| a.is_finite()) { Ok(cholesky) } else { Err(Error::NotPositiveDefinite) }
     }
 
     /// The gradient `∂T/∂q` of the kinetic energy at fixed rates `q̇` (N·m), written into

@@ -7,7 +7,9 @@
 //! `Z ← (c Z + (c Z)⁻¹)/2` with determinant scaling `c = |det Z|^{−1/2n}`): the subspace is
 //! the null space of `sign(H) + I`, spanned by `[I; P]`.
 
-use nalgebra::DMatrix;
+use nalgebra::{Complex, DMatrix};
+
+use super::state_space::spectrum;
 
 use crate::error::{Error, Result};
 
@@ -20,6 +22,8 @@ pub struct Lqr {
     pub riccati: DMatrix<f64>,
     /// `max |Aᵀ P + P A − P B R⁻¹ Bᵀ P + Q|` relative to `max |Q|`.
     pub residual: f64,
+    /// The eigenvalues of the closed loop `A − B K` (1/s), by decreasing real part.
+    pub closed_loop: Vec<Complex<f64>>,
 }
 
 fn fail(reason: impl Into<String>) -> Error {
@@ -83,15 +87,15 @@ pub fn lqr(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64
     let gain = &r_inverse * b.transpose() * &p;
     let care = a.transpose() * &p + &p * a - &p * &s * &p + q;
     let residual = care.amax() / q.amax().max(f64::MIN_POSITIVE);
-    let closed = a - b * &gain;
-    let unstable = closed.complex_eigenvalues().iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max);
+    let closed_loop = spectrum(&(a - b * &gain));
+    let unstable = closed_loop.first().map_or(f64::NEG_INFINITY, |e| e.re);
     let stabilised = unstable < 0.0 && residual < 1e-6;
     if !stabilised {
         return Err(fail(format!(
             "no stabilising solution (closed-loop growth rate {unstable:e} 1/s, Riccati residual {residual:e})"
         )));
     }
-    Ok(Lqr { gain, riccati: p, residual })
+    Ok(Lqr { gain, riccati: p, residual, closed_loop })
 }
 
 #[cfg(test)]

@@ -69,24 +69,25 @@ where
         return Err(Error::NotSteady { index, value: jac.accelerations[index], tolerance });
     }
     let n = q.len();
-    let space = M::Space::dim();
     let mut a = DMatrix::zeros(2 * n, 2 * n);
-    let mut b_torque = DMatrix::zeros(2 * n, n);
-    let mut b_pivot = DMatrix::zeros(2 * n, space);
-    for i in 0..n {
-        a[(i, n + i)] = 1.0;
-        for j in 0..n {
-            a[(n + i, j)] = jac.q[(i, j)];
-            a[(n + i, n + j)] = jac.qd[(i, j)];
-            b_torque[(n + i, j)] = jac.torque[(i, j)];
-        }
-        for k in 0..space {
-            b_pivot[(n + i, k)] = jac.pivot[(i, k)];
-        }
-    }
+    jac.first_order::<nalgebra::Dyn>(&mut a);
+    // B = [[0], [∂q̈/∂u]] for an input u.
+    let below = |m: &[f64], cols: usize| {
+        let mut b = DMatrix::zeros(2 * n, cols);
+        b.view_mut((n, 0), (n, cols)).copy_from_slice(m);
+        b
+    };
+    let b_torque = below(jac.torque.as_slice(), n);
+    let b_pivot = below(jac.pivot.as_slice(), M::Space::dim());
+    let eigenvalues = spectrum(&a);
+    Ok(StateSpace { a, b_torque, b_pivot, eigenvalues, residual })
+}
+
+/// The eigenvalues of `a` (1/s) by decreasing real part (then imaginary part).
+pub fn spectrum(a: &DMatrix<f64>) -> Vec<Complex<f64>> {
     let mut eigenvalues: Vec<Complex<f64>> = a.complex_eigenvalues().iter().copied().collect();
     eigenvalues.sort_by(|x, y| y.re.total_cmp(&x.re).then(y.im.total_cmp(&x.im)));
-    Ok(StateSpace { a, b_torque, b_pivot, eigenvalues, residual })
+    eigenvalues
 }
 
 #[cfg(test)]

@@ -205,15 +205,7 @@ where
         let (q, qd) = self.split(x);
         let mut jac = Jacobians::zeros(&self.model);
         self.model.acceleration_jacobians(&q, &qd, &self.inputs.inputs_at(t), &mut jac)?;
-        let n = q.len();
-        out.fill(0.0);
-        for i in 0..n {
-            out[(i, n + i)] = 1.0;
-            for j in 0..n {
-                out[(n + i, j)] = jac.q[(i, j)];
-                out[(n + i, n + j)] = jac.qd[(i, j)];
-            }
-        }
+        jac.first_order(out);
         Ok(())
     }
 }

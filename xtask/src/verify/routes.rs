@@ -112,13 +112,13 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
                 let mut jac = Jacobians::zeros(&model);
                 model.acceleration_jacobians(&q, &qd, &inputs, &mut jac).with_context(context)?;
                 for (k, (route, j)) in
-                    JACOBIAN_ROUTES[0].iter().zip([&jac.q, &jac.qd, &jac.torque]).enumerate()
+                    TENSION_JACOBIANS.iter().zip([&jac.q, &jac.qd, &jac.torque]).enumerate()
                 {
                     record(route, jacobian_row(k, j, &jac.accelerations, &reference).error, state);
                 }
                 let pivot = DMatrix::from_column_slice(case.links, 2, jac.pivot.as_slice());
                 record(
-                    JACOBIAN_ROUTES[0][3],
+                    TENSION_JACOBIANS[3],
                     jacobian_row(3, &pivot, &jac.accelerations, &reference).error,
                     state,
                 );
@@ -148,11 +148,12 @@ pub fn verify_case(case: &Case, states: usize, seed: u64) -> Result<Vec<RouteRow
     Ok(rows)
 }
 
-/// The Jacobian rows of the routes: `PlanarTension`'s four, `Directions`' two.
-const JACOBIAN_ROUTES: [[&str; 4]; 2] = [
-    ["PlanarTension d/dq", "PlanarTension d/dqd", "PlanarTension d/dsig", "PlanarTension d/dp"],
-    ["Directions d/dq", "Directions d/dqd", "", ""],
-];
+/// `PlanarTension`'s Jacobian rows, in the order of [`jacobian_row`]'s `which`.
+const TENSION_JACOBIANS: [&str; 4] =
+    ["PlanarTension d/dq", "PlanarTension d/dqd", "PlanarTension d/dsig", "PlanarTension d/dp"];
+
+/// `Directions`' Jacobian rows (no torques; its pivot follows a drive).
+const DIRECTIONS_JACOBIANS: [&str; 2] = ["Directions d/dq", "Directions d/dqd"];
 
 /// Records `Directions`' `∂q̈/∂q` and `∂q̈/∂q̇` (in angles) against the reference at the
 /// torque-free `point`.
@@ -169,7 +170,7 @@ fn directions_rows(
 ) {
     let reference = Reference::new(case, params, &without_torque(point));
     for (k, j) in [jq, jqd].into_iter().enumerate() {
-        record(JACOBIAN_ROUTES[1][k], jacobian_row(k, j, qdd, &reference).error, state);
+        record(DIRECTIONS_JACOBIANS[k], jacobian_row(k, j, qdd, &reference).error, state);
     }
 }
 
