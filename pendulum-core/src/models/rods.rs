@@ -207,6 +207,16 @@ impl Rods {
         self.length.len()
     }
 
+    /// `1 / m_i` (1/kg) per rod.
+    pub fn inverse_mass(&self) -> &[f64] {
+        &self.inverse_mass
+    }
+
+    /// `l_i` (m) per rod.
+    pub fn length(&self) -> &[f64] {
+        &self.length
+    }
+
     /// `1 / l_i` (1/m) per rod.
     pub fn inverse_length(&self) -> &[f64] {
         &self.inverse_length

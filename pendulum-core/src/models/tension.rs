@@ -9,8 +9,10 @@ use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, check_inputs};
 use crate::models::planar::Planar;
-use crate::models::rods::{Column, Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
+use crate::models::rods::{Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
 use crate::models::trig::sin_cos_into;
+
+mod jacobians;
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
 /// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric
@@ -144,6 +146,8 @@ where
 pub struct PlanarTangents<'a> {
     solve: Linearised<2>,
     rods: &'a Rods,
+    /// `g` (m/s²).
+    gravity: f64,
     sin_cos: Vec<[f64; 2]>,
     rates: Vec<f64>,
     pulls: Vec<f64>,
@@ -185,9 +189,9 @@ impl PlanarTangents<'_> {
 
 impl PlanarTangents<'_> {
     /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇`, `∂θ̈/∂σ` (column-major n × n each) and `∂θ̈/∂p̈` (n × 2), all
-    /// at once: the load change of each column sits on one rod, so each column is three
-    /// multiply-adds per entry after one O(n) solve per output (`rods::green`), O(n²) in
-    /// all.
+    /// at once, in the links' own angles: each column changes the solve in three rows, so
+    /// after `G = H A⁻¹` (n solves with the kept factors, all at once) each entry is three
+    /// multiply-adds, O(n²) in all (`tension::jacobians` module docs).
     pub fn jacobians(&self, dq: &mut [f64], dqd: &mut [f64], dtorque: &mut [f64], dpivot: &mut [f64]) {
         self.blocks(dq, dqd, Some((dtorque, dpivot)));
     }
@@ -196,54 +200,6 @@ impl PlanarTangents<'_> {
     /// linearisation or an implicit integrator needs.
     pub fn state_jacobians(&self, dq: &mut [f64], dqd: &mut [f64]) {
         self.blocks(dq, dqd, None);
-    }
-
-    fn blocks(&self, dq: &mut [f64], dqd: &mut [f64], inputs: Option<(&mut [f64], &mut [f64])>) {
-        let n = self.sin_cos.len();
-        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
-        let normal = |i: usize| [self.sin_cos[i][1], self.sin_cos[i][0]];
-        let rows: Vec<(usize, [f64; 2])> = (0..n).map(|i| (i, normal(i))).collect();
-        let zero = [0.0; 2];
-        let column = |rod: usize, direction: [f64; 2], rate_squared: f64, pair: [f64; 2]| Column {
-            rod,
-            load: LoadTangent { direction, rate_squared, pair },
-            pivot: zero,
-        };
-        let mut columns = Vec::with_capacity(3 * n + 2);
-        // δθ_x: δu = n, δF = −pull u; δθ̇_x: δ|u̇|² = 2 θ̇, δF = −(λ/l) n; δσ_x: δF = n/l.
-        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
-            columns.push(column(x, [c, s], 0.0, [-self.pulls[x] * s, self.pulls[x] * c]));
-        }
-        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
-            columns.push(column(x, zero, 2.0 * self.rates[x], [-drag[x] * c, -drag[x] * s]));
-        }
-        for (x, &[s, c]) in self.sin_cos.iter().enumerate() {
-            columns.push(column(x, zero, 0.0, [inverse_length[x] * c, inverse_length[x] * s]));
-        }
-        for k in 0..2 {
-            let mut pivot = zero;
-            pivot[k] = 1.0;
-            columns.push(Column {
-                rod: 0,
-                load: LoadTangent { direction: zero, rate_squared: 0.0, pair: zero },
-                pivot,
-            });
-        }
-        let green = self.solve.green(self.rods, &rows);
-        let (by_angle, rest) = columns.split_at(n);
-        let (by_rate, rest) = rest.split_at(n);
-        let (by_torque, by_pivot) = rest.split_at(n);
-        self.solve.columns(self.rods, &rows, &green, by_angle, dq);
-        self.solve.columns(self.rods, &rows, &green, by_rate, dqd);
-        if let Some((dtorque, dpivot)) = inputs {
-            self.solve.columns(self.rods, &rows, &green, by_torque, dtorque);
-            self.solve.columns(self.rods, &rows, &green, by_pivot, dpivot);
-        }
-        // δθ̈_i = n_i·δü_i + δn_i·ü_i: the last term for δθ_i only, δn_i = −u_i.
-        for (x, a) in self.solve.accelerations().enumerate() {
-            let [s, c] = self.sin_cos[x];
-            dq[x * n + x] -= s * a[0] - c * a[1];
-        }
     }
 }
 
@@ -288,6 +244,7 @@ where
         Ok(PlanarTangents {
             solve,
             rods: &self.rods,
+            gravity: chain.gravity(),
             sin_cos,
             rates,
             pulls,
@@ -472,7 +429,12 @@ mod tests {
 
     #[test]
     fn the_tangents_agree_with_the_dense_jacobians() {
-        let n = 12;
+        for n in [1, 2, 3, 12] {
+            jacobians_agree_with_the_dense_route(n);
+        }
+    }
+
+    fn jacobians_agree_with_the_dense_route(n: usize) {
         let masses: Vec<f64> = (0..n).map(|i| 0.5 + (i as f64 * 0.37).sin().abs()).collect();
         let lengths: Vec<f64> = (0..n).map(|i| 0.2 + (i as f64 * 0.71).cos().abs()).collect();
         let chain = Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap().with_damping(&vec![0.05; n]).unwrap();

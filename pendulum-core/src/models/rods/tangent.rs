@@ -108,7 +108,7 @@ impl<const S: usize> Linearised<S> {
     }
 
     /// `T_i` (N).
-    pub(super) fn tension(&self, i: usize) -> f64 {
+    pub(crate) fn tension(&self, i: usize) -> f64 {
         self.rods[i].tension
     }
 
@@ -118,17 +118,17 @@ impl<const S: usize> Linearised<S> {
     }
 
     /// `p̈` (m/s²).
-    pub(super) fn pivot(&self) -> [f64; S] {
+    pub(crate) fn pivot(&self) -> [f64; S] {
         self.pivot
     }
 
     /// `f_i = A_{i,i−1}/D_{i−1}`.
-    pub(super) fn factor(&self, i: usize) -> f64 {
+    pub(crate) fn factor(&self, i: usize) -> f64 {
         self.rods[i].factor
     }
 
     /// `1/D_i`.
-    pub(super) fn inverse_pivot(&self, i: usize) -> f64 {
+    pub(crate) fn inverse_pivot(&self, i: usize) -> f64 {
         self.rods[i].inverse_pivot
     }
 
