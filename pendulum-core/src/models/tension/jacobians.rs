@@ -27,7 +27,7 @@ impl PlanarTangents<'_> {
         let (im, il, length, drag) = (rods.inverse_mass(), rods.inverse_length(), rods.length(), rods.drag());
         let (sc, f, rates) = (&self.sin_cos, &self.pulls, &self.rates);
         let t = |i: usize| self.solve.tension(i);
-        // Joint j between links j − 1 and j (j = 1..n; entry 0 unused): C_j, S_j and the
+        // Joint j between links j − 1 and j (j = 1..n; entries 0 and n zeros): C_j, S_j and the
         // derivatives of r_{j−1}, r_j, h_{j−1}, h_j by φ_j = θ_j − θ_{j−1}.
         let mut joints = vec![Joint::default(); n + 1];
         for j in 1..n {
@@ -72,30 +72,13 @@ impl PlanarTangents<'_> {
                 *g = *g * inverse_pivot - factor * b;
             }
         }
+        // Column x of the Jacobian from G's columns x − 1, x, x + 1; a coefficient outside
+        // the chain is zero (the joints there are), so its column may be any.
         let mix = |out: &mut [f64], x: usize, r: [f64; 3], h: [f64; 3]| {
             let column = |j: usize| &green[j * n..(j + 1) * n];
-            let here = column(x);
-            match (x.checked_sub(1).map(column), (x + 1 < n).then(|| column(x + 1))) {
-                (Some(a), Some(b)) => {
-                    for (o, ((a, g), b)) in out.iter_mut().zip(a.iter().zip(here).zip(b)) {
-                        *o = r[0] * a + r[1] * g + r[2] * b;
-                    }
-                }
-                (Some(a), None) => {
-                    for (o, (a, g)) in out.iter_mut().zip(a.iter().zip(here)) {
-                        *o = r[0] * a + r[1] * g;
-                    }
-                }
-                (None, Some(b)) => {
-                    for (o, (g, b)) in out.iter_mut().zip(here.iter().zip(b)) {
-                        *o = r[1] * g + r[2] * b;
-                    }
-                }
-                (None, None) => {
-                    for (o, g) in out.iter_mut().zip(here) {
-                        *o = r[1] * g;
-                    }
-                }
+            let (above, here, below) = (column(x.saturating_sub(1)), column(x), column((x + 1).min(n - 1)));
+            for (o, ((a, g), b)) in out.iter_mut().zip(above.iter().zip(here).zip(below)) {
+                *o = r[0] * a + r[1] * g + r[2] * b;
             }
             if x >= 1 {
                 out[x - 1] += h[0];
@@ -110,7 +93,7 @@ impl PlanarTangents<'_> {
         let [s0, c0] = sc[0];
         // By θ_x: through φ_x (+1) and φ_{x+1} (−1); link 0's u_0·(g⃗ − p̈) and −n_0·(p̈ − g⃗)/l_0.
         for x in 0..n {
-            let (a, b) = (joints[x], if x + 1 < n { joints[x + 1] } else { Joint::default() });
+            let (a, b) = (joints[x], joints[x + 1]);
             let (mut r, mut h) = (
                 [a.r_above, a.r_below - b.r_above, -b.r_below],
                 [a.h_above, a.h_below - b.h_above, -b.h_below],
@@ -123,17 +106,13 @@ impl PlanarTangents<'_> {
         }
         // By the pull f_x, then θ̇_x = −(λ_x/l_x) f_x plus 2 l_x θ̇_x in b_x, and σ_x = f_x/l_x.
         let pull = |x: usize| {
-            let r = [
-                if x >= 1 { im[x - 1] * joints[x].sin } else { 0.0 },
-                0.0,
-                if x + 1 < n { -im[x] * joints[x + 1].sin } else { 0.0 },
-            ];
-            let above = if x >= 1 { im[x - 1] } else { 0.0 };
-            let h = [
-                if x >= 1 { -il[x - 1] * above * joints[x].cos } else { 0.0 },
-                il[x] * (im[x] + above),
-                if x + 1 < n { -il[x + 1] * im[x] * joints[x + 1].cos } else { 0.0 },
-            ];
+            // Joints 0 and n are zeros: the entries outside the chain vanish with them.
+            let (above, below) = (joints[x], joints[x + 1]);
+            let (im_above, il_above) = if x >= 1 { (im[x - 1], il[x - 1]) } else { (0.0, 0.0) };
+            let il_below = il.get(x + 1).copied().unwrap_or(0.0);
+            let r = [im_above * above.sin, 0.0, -im[x] * below.sin];
+            let h =
+                [-il_above * im_above * above.cos, il[x] * (im[x] + im_above), -il_below * im[x] * below.cos];
             (r, h)
         };
         let scale = |k: f64, v: [f64; 3]| v.map(|e| k * e);
