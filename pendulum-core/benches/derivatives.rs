@@ -1,9 +1,10 @@
 //! The analytic derivatives against what they replace.
 //!
-//! - `derivatives/accelerations/<n>` and `derivatives/jacobians/<n>`: a generated planar
-//!   model's `accelerations` and its `acceleration_jacobians` (`q̈` with `∂q̈/∂q`, `∂q̈/∂q̇`,
-//!   `∂q̈/∂σ`, `∂q̈/∂p̈`), n = 2, 4, 8; `derivatives/jacobians_generic/<n>` the same for
-//!   `Planar<Dyn>`.
+//! - `derivatives/accelerations/<n>`, `derivatives/state_jacobians/<n>` and
+//!   `derivatives/jacobians/<n>`: a generated planar model's `accelerations`, its
+//!   `state_jacobians` (`q̈` with `∂q̈/∂q`, `∂q̈/∂q̇`) and its `acceleration_jacobians`
+//!   (also `∂q̈/∂σ`, `∂q̈/∂p̈`), n = 2, 4, 8 (dense route at 2, tension route at 4 and 8);
+//!   `derivatives/jacobians_generic/<n>` the four for `Planar<Dyn>`.
 //! - `linear/<what>/100`: the O(n) routes at n = 100: `PlanarTension` accelerations, a
 //!   JVP (the kept solve and one tangent), one more tangent of a kept solve, the state
 //!   Jacobians `∂θ̈/∂θ`, `∂θ̈/∂θ̇` and all four; `Directions` (3D) rhs, JVP and the
@@ -66,6 +67,9 @@ where
         b.iter(|| model.accelerations(black_box(&q), black_box(&qd), &inputs, &mut qdd).unwrap())
     });
     let mut jac = Jacobians::zeros(&model);
+    group.bench_function(BenchmarkId::new("state_jacobians", N), |b| {
+        b.iter(|| model.state_jacobians(black_box(&q), black_box(&qd), &inputs, &mut jac).unwrap())
+    });
     group.bench_function(BenchmarkId::new("jacobians", N), |b| {
         b.iter(|| model.acceleration_jacobians(black_box(&q), black_box(&qd), &inputs, &mut jac).unwrap())
     });

@@ -131,6 +131,23 @@ where
         cholesky.solve_mut(&mut out.torque);
         Ok(())
     }
+
+    /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` into `out.accelerations`, `out.q` and `out.qd`: what
+    /// an implicit integrator's Newton iteration needs. The rest of `out` is unspecified
+    /// (the default computes it too, by
+    /// [`acceleration_jacobians`](Derivatives::acceleration_jacobians); a model with a
+    /// cheaper route for the state alone skips it).
+    ///
+    /// Errors: those of [`Model::accelerations`].
+    fn state_jacobians(
+        &self,
+        q: &OVector<f64, Self::Dof>,
+        qd: &OVector<f64, Self::Dof>,
+        inputs: &Inputs<Self::Dof, Self::Space>,
+        out: &mut Jacobians<Self>,
+    ) -> Result<()> {
+        self.acceleration_jacobians(q, qd, inputs, out)
+    }
 }
 
 #[cfg(test)]

@@ -75,5 +75,6 @@ pub mod __private {
     pub use nalgebra;
 
     pub use crate::models::rods::CONTINUANT_RANGE;
+    pub use crate::models::tension::{Parts, RodConstants, planar_tension_jacobians};
     pub use crate::models::trig::sin_cos_into;
 }

@@ -187,126 +187,16 @@ pub struct Planar12 {
     ml10: ::core::primitive::f64,
     #[doc = " `M_11 l_11` (0-based), kg·m."]
     ml11: ::core::primitive::f64,
-    #[doc = " `1/m_0` (0-based), 1/kg."]
-    rod_im0: ::core::primitive::f64,
-    #[doc = " `l_0` (0-based), m."]
-    rod_l0: ::core::primitive::f64,
-    #[doc = " `1/l_0` (0-based), 1/m."]
-    rod_il0: ::core::primitive::f64,
-    #[doc = " `λ_0/l_0` (0-based), N·s."]
-    rod_drag0: ::core::primitive::f64,
-    #[doc = " `1/m_0` (0-based), 1/kg: the tension system's first diagonal entry."]
-    rod_diag0: ::core::primitive::f64,
-    #[doc = " `1/m_1` (0-based), 1/kg."]
-    rod_im1: ::core::primitive::f64,
-    #[doc = " `l_1` (0-based), m."]
-    rod_l1: ::core::primitive::f64,
-    #[doc = " `1/l_1` (0-based), 1/m."]
-    rod_il1: ::core::primitive::f64,
-    #[doc = " `λ_1/l_1` (0-based), N·s."]
-    rod_drag1: ::core::primitive::f64,
-    #[doc = " `1/m_1 + 1/m_0` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag1: ::core::primitive::f64,
-    #[doc = " `1/m_2` (0-based), 1/kg."]
-    rod_im2: ::core::primitive::f64,
-    #[doc = " `l_2` (0-based), m."]
-    rod_l2: ::core::primitive::f64,
-    #[doc = " `1/l_2` (0-based), 1/m."]
-    rod_il2: ::core::primitive::f64,
-    #[doc = " `λ_2/l_2` (0-based), N·s."]
-    rod_drag2: ::core::primitive::f64,
-    #[doc = " `1/m_2 + 1/m_1` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag2: ::core::primitive::f64,
-    #[doc = " `1/m_3` (0-based), 1/kg."]
-    rod_im3: ::core::primitive::f64,
-    #[doc = " `l_3` (0-based), m."]
-    rod_l3: ::core::primitive::f64,
-    #[doc = " `1/l_3` (0-based), 1/m."]
-    rod_il3: ::core::primitive::f64,
-    #[doc = " `λ_3/l_3` (0-based), N·s."]
-    rod_drag3: ::core::primitive::f64,
-    #[doc = " `1/m_3 + 1/m_2` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag3: ::core::primitive::f64,
-    #[doc = " `1/m_4` (0-based), 1/kg."]
-    rod_im4: ::core::primitive::f64,
-    #[doc = " `l_4` (0-based), m."]
-    rod_l4: ::core::primitive::f64,
-    #[doc = " `1/l_4` (0-based), 1/m."]
-    rod_il4: ::core::primitive::f64,
-    #[doc = " `λ_4/l_4` (0-based), N·s."]
-    rod_drag4: ::core::primitive::f64,
-    #[doc = " `1/m_4 + 1/m_3` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag4: ::core::primitive::f64,
-    #[doc = " `1/m_5` (0-based), 1/kg."]
-    rod_im5: ::core::primitive::f64,
-    #[doc = " `l_5` (0-based), m."]
-    rod_l5: ::core::primitive::f64,
-    #[doc = " `1/l_5` (0-based), 1/m."]
-    rod_il5: ::core::primitive::f64,
-    #[doc = " `λ_5/l_5` (0-based), N·s."]
-    rod_drag5: ::core::primitive::f64,
-    #[doc = " `1/m_5 + 1/m_4` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag5: ::core::primitive::f64,
-    #[doc = " `1/m_6` (0-based), 1/kg."]
-    rod_im6: ::core::primitive::f64,
-    #[doc = " `l_6` (0-based), m."]
-    rod_l6: ::core::primitive::f64,
-    #[doc = " `1/l_6` (0-based), 1/m."]
-    rod_il6: ::core::primitive::f64,
-    #[doc = " `λ_6/l_6` (0-based), N·s."]
-    rod_drag6: ::core::primitive::f64,
-    #[doc = " `1/m_6 + 1/m_5` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag6: ::core::primitive::f64,
-    #[doc = " `1/m_7` (0-based), 1/kg."]
-    rod_im7: ::core::primitive::f64,
-    #[doc = " `l_7` (0-based), m."]
-    rod_l7: ::core::primitive::f64,
-    #[doc = " `1/l_7` (0-based), 1/m."]
-    rod_il7: ::core::primitive::f64,
-    #[doc = " `λ_7/l_7` (0-based), N·s."]
-    rod_drag7: ::core::primitive::f64,
-    #[doc = " `1/m_7 + 1/m_6` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag7: ::core::primitive::f64,
-    #[doc = " `1/m_8` (0-based), 1/kg."]
-    rod_im8: ::core::primitive::f64,
-    #[doc = " `l_8` (0-based), m."]
-    rod_l8: ::core::primitive::f64,
-    #[doc = " `1/l_8` (0-based), 1/m."]
-    rod_il8: ::core::primitive::f64,
-    #[doc = " `λ_8/l_8` (0-based), N·s."]
-    rod_drag8: ::core::primitive::f64,
-    #[doc = " `1/m_8 + 1/m_7` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag8: ::core::primitive::f64,
-    #[doc = " `1/m_9` (0-based), 1/kg."]
-    rod_im9: ::core::primitive::f64,
-    #[doc = " `l_9` (0-based), m."]
-    rod_l9: ::core::primitive::f64,
-    #[doc = " `1/l_9` (0-based), 1/m."]
-    rod_il9: ::core::primitive::f64,
-    #[doc = " `λ_9/l_9` (0-based), N·s."]
-    rod_drag9: ::core::primitive::f64,
-    #[doc = " `1/m_9 + 1/m_8` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag9: ::core::primitive::f64,
-    #[doc = " `1/m_10` (0-based), 1/kg."]
-    rod_im10: ::core::primitive::f64,
-    #[doc = " `l_10` (0-based), m."]
-    rod_l10: ::core::primitive::f64,
-    #[doc = " `1/l_10` (0-based), 1/m."]
-    rod_il10: ::core::primitive::f64,
-    #[doc = " `λ_10/l_10` (0-based), N·s."]
-    rod_drag10: ::core::primitive::f64,
-    #[doc = " `1/m_10 + 1/m_9` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag10: ::core::primitive::f64,
-    #[doc = " `1/m_11` (0-based), 1/kg."]
-    rod_im11: ::core::primitive::f64,
-    #[doc = " `l_11` (0-based), m."]
-    rod_l11: ::core::primitive::f64,
-    #[doc = " `1/l_11` (0-based), 1/m."]
-    rod_il11: ::core::primitive::f64,
-    #[doc = " `λ_11/l_11` (0-based), N·s."]
-    rod_drag11: ::core::primitive::f64,
-    #[doc = " `1/m_11 + 1/m_10` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag11: ::core::primitive::f64,
+    #[doc = " `1/m_i` per link (0-based), 1/kg."]
+    rod_im: [::core::primitive::f64; 12],
+    #[doc = " `l_i` per link, m."]
+    rod_l: [::core::primitive::f64; 12],
+    #[doc = " `1/l_i` per link, 1/m."]
+    rod_il: [::core::primitive::f64; 12],
+    #[doc = " `λ_i/l_i` per link, N·s."]
+    rod_drag: [::core::primitive::f64; 12],
+    #[doc = " `1/m_i + 1/m_{i−1}` per link (`1/m_0` for the first), 1/kg: the tension system's diagonal."]
+    rod_diag: [::core::primitive::f64; 12],
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -436,68 +326,7 @@ const _: () = {
             let ml9 = mt9 * l9;
             let ml10 = mt10 * l10;
             let ml11 = mt11 * l11;
-            let (
-                rod_im0,
-                rod_l0,
-                rod_il0,
-                rod_drag0,
-                rod_diag0,
-                rod_im1,
-                rod_l1,
-                rod_il1,
-                rod_drag1,
-                rod_diag1,
-                rod_im2,
-                rod_l2,
-                rod_il2,
-                rod_drag2,
-                rod_diag2,
-                rod_im3,
-                rod_l3,
-                rod_il3,
-                rod_drag3,
-                rod_diag3,
-                rod_im4,
-                rod_l4,
-                rod_il4,
-                rod_drag4,
-                rod_diag4,
-                rod_im5,
-                rod_l5,
-                rod_il5,
-                rod_drag5,
-                rod_diag5,
-                rod_im6,
-                rod_l6,
-                rod_il6,
-                rod_drag6,
-                rod_diag6,
-                rod_im7,
-                rod_l7,
-                rod_il7,
-                rod_drag7,
-                rod_diag7,
-                rod_im8,
-                rod_l8,
-                rod_il8,
-                rod_drag8,
-                rod_diag8,
-                rod_im9,
-                rod_l9,
-                rod_il9,
-                rod_drag9,
-                rod_diag9,
-                rod_im10,
-                rod_l10,
-                rod_il10,
-                rod_drag10,
-                rod_diag10,
-                rod_im11,
-                rod_l11,
-                rod_il11,
-                rod_drag11,
-                rod_diag11,
-            ) = {
+            let (rod_im, rod_l, rod_il, rod_drag, rod_diag) = {
                 let masses = chain.masses();
                 let lengths = chain.lengths();
                 let damping = chain.damping();
@@ -538,66 +367,63 @@ const _: () = {
                 let lam10 = damping[10];
                 let lam11 = damping[11];
                 (
-                    1.0 / m0,
-                    l0,
-                    1.0 / l0,
-                    lam0 / l0,
-                    1.0 / m0,
-                    1.0 / m1,
-                    l1,
-                    1.0 / l1,
-                    lam1 / l1,
-                    1.0 / m1 + 1.0 / m0,
-                    1.0 / m2,
-                    l2,
-                    1.0 / l2,
-                    lam2 / l2,
-                    1.0 / m2 + 1.0 / m1,
-                    1.0 / m3,
-                    l3,
-                    1.0 / l3,
-                    lam3 / l3,
-                    1.0 / m3 + 1.0 / m2,
-                    1.0 / m4,
-                    l4,
-                    1.0 / l4,
-                    lam4 / l4,
-                    1.0 / m4 + 1.0 / m3,
-                    1.0 / m5,
-                    l5,
-                    1.0 / l5,
-                    lam5 / l5,
-                    1.0 / m5 + 1.0 / m4,
-                    1.0 / m6,
-                    l6,
-                    1.0 / l6,
-                    lam6 / l6,
-                    1.0 / m6 + 1.0 / m5,
-                    1.0 / m7,
-                    l7,
-                    1.0 / l7,
-                    lam7 / l7,
-                    1.0 / m7 + 1.0 / m6,
-                    1.0 / m8,
-                    l8,
-                    1.0 / l8,
-                    lam8 / l8,
-                    1.0 / m8 + 1.0 / m7,
-                    1.0 / m9,
-                    l9,
-                    1.0 / l9,
-                    lam9 / l9,
-                    1.0 / m9 + 1.0 / m8,
-                    1.0 / m10,
-                    l10,
-                    1.0 / l10,
-                    lam10 / l10,
-                    1.0 / m10 + 1.0 / m9,
-                    1.0 / m11,
-                    l11,
-                    1.0 / l11,
-                    lam11 / l11,
-                    1.0 / m11 + 1.0 / m10,
+                    [
+                        1.0 / m0,
+                        1.0 / m1,
+                        1.0 / m2,
+                        1.0 / m3,
+                        1.0 / m4,
+                        1.0 / m5,
+                        1.0 / m6,
+                        1.0 / m7,
+                        1.0 / m8,
+                        1.0 / m9,
+                        1.0 / m10,
+                        1.0 / m11,
+                    ],
+                    [l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11],
+                    [
+                        1.0 / l0,
+                        1.0 / l1,
+                        1.0 / l2,
+                        1.0 / l3,
+                        1.0 / l4,
+                        1.0 / l5,
+                        1.0 / l6,
+                        1.0 / l7,
+                        1.0 / l8,
+                        1.0 / l9,
+                        1.0 / l10,
+                        1.0 / l11,
+                    ],
+                    [
+                        lam0 / l0,
+                        lam1 / l1,
+                        lam2 / l2,
+                        lam3 / l3,
+                        lam4 / l4,
+                        lam5 / l5,
+                        lam6 / l6,
+                        lam7 / l7,
+                        lam8 / l8,
+                        lam9 / l9,
+                        lam10 / l10,
+                        lam11 / l11,
+                    ],
+                    [
+                        1.0 / m0,
+                        1.0 / m1 + 1.0 / m0,
+                        1.0 / m2 + 1.0 / m1,
+                        1.0 / m3 + 1.0 / m2,
+                        1.0 / m4 + 1.0 / m3,
+                        1.0 / m5 + 1.0 / m4,
+                        1.0 / m6 + 1.0 / m5,
+                        1.0 / m7 + 1.0 / m6,
+                        1.0 / m8 + 1.0 / m7,
+                        1.0 / m9 + 1.0 / m8,
+                        1.0 / m10 + 1.0 / m9,
+                        1.0 / m11 + 1.0 / m10,
+                    ],
                 )
             };
             Self {
@@ -692,66 +518,11 @@ const _: () = {
                 ml9,
                 ml10,
                 ml11,
-                rod_im0,
-                rod_l0,
-                rod_il0,
-                rod_drag0,
-                rod_diag0,
-                rod_im1,
-                rod_l1,
-                rod_il1,
-                rod_drag1,
-                rod_diag1,
-                rod_im2,
-                rod_l2,
-                rod_il2,
-                rod_drag2,
-                rod_diag2,
-                rod_im3,
-                rod_l3,
-                rod_il3,
-                rod_drag3,
-                rod_diag3,
-                rod_im4,
-                rod_l4,
-                rod_il4,
-                rod_drag4,
-                rod_diag4,
-                rod_im5,
-                rod_l5,
-                rod_il5,
-                rod_drag5,
-                rod_diag5,
-                rod_im6,
-                rod_l6,
-                rod_il6,
-                rod_drag6,
-                rod_diag6,
-                rod_im7,
-                rod_l7,
-                rod_il7,
-                rod_drag7,
-                rod_diag7,
-                rod_im8,
-                rod_l8,
-                rod_il8,
-                rod_drag8,
-                rod_diag8,
-                rod_im9,
-                rod_l9,
-                rod_il9,
-                rod_drag9,
-                rod_diag9,
-                rod_im10,
-                rod_l10,
-                rod_il10,
-                rod_drag10,
-                rod_diag10,
-                rod_im11,
-                rod_l11,
-                rod_il11,
-                rod_drag11,
-                rod_diag11,
+                rod_im,
+                rod_l,
+                rod_il,
+                rod_drag,
+                rod_diag,
             }
         }
     }
@@ -1906,86 +1677,97 @@ const _: () = {
             let pa_y = pivot[1];
             let [st0, ct0] = trig[0];
             let dth0 = qd[0];
-            let pull0 = torque[0] * self.rod_il0 - self.rod_drag0 * dth0;
+            let pull0 = torque[0] * self.rod_il[0] - self.rod_drag[0] * dth0;
             let [st1, ct1] = trig[1];
             let dth1 = qd[1];
-            let pull1 = torque[1] * self.rod_il1 - self.rod_drag1 * dth1;
+            let pull1 = torque[1] * self.rod_il[1] - self.rod_drag[1] * dth1;
             let cd1 = ct0 * ct1 + st0 * st1;
             let sd1 = st1 * ct0 - ct1 * st0;
-            let off1 = -cd1 * self.rod_im0;
+            let off1 = -cd1 * self.rod_im[0];
             let [st2, ct2] = trig[2];
             let dth2 = qd[2];
-            let pull2 = torque[2] * self.rod_il2 - self.rod_drag2 * dth2;
+            let pull2 = torque[2] * self.rod_il[2] - self.rod_drag[2] * dth2;
             let cd2 = ct1 * ct2 + st1 * st2;
             let sd2 = st2 * ct1 - ct2 * st1;
-            let off2 = -cd2 * self.rod_im1;
+            let off2 = -cd2 * self.rod_im[1];
             let [st3, ct3] = trig[3];
             let dth3 = qd[3];
-            let pull3 = torque[3] * self.rod_il3 - self.rod_drag3 * dth3;
+            let pull3 = torque[3] * self.rod_il[3] - self.rod_drag[3] * dth3;
             let cd3 = ct2 * ct3 + st2 * st3;
             let sd3 = st3 * ct2 - ct3 * st2;
-            let off3 = -cd3 * self.rod_im2;
+            let off3 = -cd3 * self.rod_im[2];
             let [st4, ct4] = trig[4];
             let dth4 = qd[4];
-            let pull4 = torque[4] * self.rod_il4 - self.rod_drag4 * dth4;
+            let pull4 = torque[4] * self.rod_il[4] - self.rod_drag[4] * dth4;
             let cd4 = ct3 * ct4 + st3 * st4;
             let sd4 = st4 * ct3 - ct4 * st3;
-            let off4 = -cd4 * self.rod_im3;
+            let off4 = -cd4 * self.rod_im[3];
             let [st5, ct5] = trig[5];
             let dth5 = qd[5];
-            let pull5 = torque[5] * self.rod_il5 - self.rod_drag5 * dth5;
+            let pull5 = torque[5] * self.rod_il[5] - self.rod_drag[5] * dth5;
             let cd5 = ct4 * ct5 + st4 * st5;
             let sd5 = st5 * ct4 - ct5 * st4;
-            let off5 = -cd5 * self.rod_im4;
+            let off5 = -cd5 * self.rod_im[4];
             let [st6, ct6] = trig[6];
             let dth6 = qd[6];
-            let pull6 = torque[6] * self.rod_il6 - self.rod_drag6 * dth6;
+            let pull6 = torque[6] * self.rod_il[6] - self.rod_drag[6] * dth6;
             let cd6 = ct5 * ct6 + st5 * st6;
             let sd6 = st6 * ct5 - ct6 * st5;
-            let off6 = -cd6 * self.rod_im5;
+            let off6 = -cd6 * self.rod_im[5];
             let [st7, ct7] = trig[7];
             let dth7 = qd[7];
-            let pull7 = torque[7] * self.rod_il7 - self.rod_drag7 * dth7;
+            let pull7 = torque[7] * self.rod_il[7] - self.rod_drag[7] * dth7;
             let cd7 = ct6 * ct7 + st6 * st7;
             let sd7 = st7 * ct6 - ct7 * st6;
-            let off7 = -cd7 * self.rod_im6;
+            let off7 = -cd7 * self.rod_im[6];
             let [st8, ct8] = trig[8];
             let dth8 = qd[8];
-            let pull8 = torque[8] * self.rod_il8 - self.rod_drag8 * dth8;
+            let pull8 = torque[8] * self.rod_il[8] - self.rod_drag[8] * dth8;
             let cd8 = ct7 * ct8 + st7 * st8;
             let sd8 = st8 * ct7 - ct8 * st7;
-            let off8 = -cd8 * self.rod_im7;
+            let off8 = -cd8 * self.rod_im[7];
             let [st9, ct9] = trig[9];
             let dth9 = qd[9];
-            let pull9 = torque[9] * self.rod_il9 - self.rod_drag9 * dth9;
+            let pull9 = torque[9] * self.rod_il[9] - self.rod_drag[9] * dth9;
             let cd9 = ct8 * ct9 + st8 * st9;
             let sd9 = st9 * ct8 - ct9 * st8;
-            let off9 = -cd9 * self.rod_im8;
+            let off9 = -cd9 * self.rod_im[8];
             let [st10, ct10] = trig[10];
             let dth10 = qd[10];
-            let pull10 = torque[10] * self.rod_il10 - self.rod_drag10 * dth10;
+            let pull10 = torque[10] * self.rod_il[10] - self.rod_drag[10] * dth10;
             let cd10 = ct9 * ct10 + st9 * st10;
             let sd10 = st10 * ct9 - ct10 * st9;
-            let off10 = -cd10 * self.rod_im9;
+            let off10 = -cd10 * self.rod_im[9];
             let [st11, ct11] = trig[11];
             let dth11 = qd[11];
-            let pull11 = torque[11] * self.rod_il11 - self.rod_drag11 * dth11;
+            let pull11 = torque[11] * self.rod_il[11] - self.rod_drag[11] * dth11;
             let cd11 = ct10 * ct11 + st10 * st11;
             let sd11 = st11 * ct10 - ct11 * st10;
-            let off11 = -cd11 * self.rod_im10;
-            let b0 = self.rod_l0 * dth0 * dth0 + ct0 * (g + pa_y) - st0 * pa_x + pull1 * sd1 * self.rod_im0;
-            let b1 = self.rod_l1 * dth1 * dth1 + -pull0 * sd1 * self.rod_im0 + pull2 * sd2 * self.rod_im1;
-            let b2 = self.rod_l2 * dth2 * dth2 + -pull1 * sd2 * self.rod_im1 + pull3 * sd3 * self.rod_im2;
-            let b3 = self.rod_l3 * dth3 * dth3 + -pull2 * sd3 * self.rod_im2 + pull4 * sd4 * self.rod_im3;
-            let b4 = self.rod_l4 * dth4 * dth4 + -pull3 * sd4 * self.rod_im3 + pull5 * sd5 * self.rod_im4;
-            let b5 = self.rod_l5 * dth5 * dth5 + -pull4 * sd5 * self.rod_im4 + pull6 * sd6 * self.rod_im5;
-            let b6 = self.rod_l6 * dth6 * dth6 + -pull5 * sd6 * self.rod_im5 + pull7 * sd7 * self.rod_im6;
-            let b7 = self.rod_l7 * dth7 * dth7 + -pull6 * sd7 * self.rod_im6 + pull8 * sd8 * self.rod_im7;
-            let b8 = self.rod_l8 * dth8 * dth8 + -pull7 * sd8 * self.rod_im7 + pull9 * sd9 * self.rod_im8;
-            let b9 = self.rod_l9 * dth9 * dth9 + -pull8 * sd9 * self.rod_im8 + pull10 * sd10 * self.rod_im9;
-            let b10 =
-                self.rod_l10 * dth10 * dth10 + -pull9 * sd10 * self.rod_im9 + pull11 * sd11 * self.rod_im10;
-            let b11 = self.rod_l11 * dth11 * dth11 + -pull10 * sd11 * self.rod_im10;
+            let off11 = -cd11 * self.rod_im[10];
+            let b0 =
+                self.rod_l[0] * dth0 * dth0 + ct0 * (g + pa_y) - st0 * pa_x + pull1 * sd1 * self.rod_im[0];
+            let b1 =
+                self.rod_l[1] * dth1 * dth1 + -pull0 * sd1 * self.rod_im[0] + pull2 * sd2 * self.rod_im[1];
+            let b2 =
+                self.rod_l[2] * dth2 * dth2 + -pull1 * sd2 * self.rod_im[1] + pull3 * sd3 * self.rod_im[2];
+            let b3 =
+                self.rod_l[3] * dth3 * dth3 + -pull2 * sd3 * self.rod_im[2] + pull4 * sd4 * self.rod_im[3];
+            let b4 =
+                self.rod_l[4] * dth4 * dth4 + -pull3 * sd4 * self.rod_im[3] + pull5 * sd5 * self.rod_im[4];
+            let b5 =
+                self.rod_l[5] * dth5 * dth5 + -pull4 * sd5 * self.rod_im[4] + pull6 * sd6 * self.rod_im[5];
+            let b6 =
+                self.rod_l[6] * dth6 * dth6 + -pull5 * sd6 * self.rod_im[5] + pull7 * sd7 * self.rod_im[6];
+            let b7 =
+                self.rod_l[7] * dth7 * dth7 + -pull6 * sd7 * self.rod_im[6] + pull8 * sd8 * self.rod_im[7];
+            let b8 =
+                self.rod_l[8] * dth8 * dth8 + -pull7 * sd8 * self.rod_im[7] + pull9 * sd9 * self.rod_im[8];
+            let b9 =
+                self.rod_l[9] * dth9 * dth9 + -pull8 * sd9 * self.rod_im[8] + pull10 * sd10 * self.rod_im[9];
+            let b10 = self.rod_l[10] * dth10 * dth10
+                + -pull9 * sd10 * self.rod_im[9]
+                + pull11 * sd11 * self.rod_im[10];
+            let b11 = self.rod_l[11] * dth11 * dth11 + -pull10 * sd11 * self.rod_im[10];
             #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
             #[doc = r" continuants leave `CONTINUANT_RANGE`."]
             #[cold]
@@ -2053,27 +1835,27 @@ const _: () = {
                 [t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11]
             }
             let (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11) = {
-                let p0 = self.rod_diag0;
+                let p0 = self.rod_diag[0];
                 let yt0 = b0;
-                let q11 = self.rod_diag11;
+                let q11 = self.rod_diag[11];
                 let zb11 = b11;
-                let p1 = self.rod_diag1 * p0 - off1 * off1;
+                let p1 = self.rod_diag[1] * p0 - off1 * off1;
                 let yt1 = b1 * p0 - off1 * yt0;
-                let q10 = self.rod_diag10 * q11 - off11 * off11;
+                let q10 = self.rod_diag[10] * q11 - off11 * off11;
                 let zb10 = b10 * q11 - off11 * zb11;
-                let p2 = self.rod_diag2 * p1 - (off2 * off2) * p0;
+                let p2 = self.rod_diag[2] * p1 - (off2 * off2) * p0;
                 let yt2 = b2 * p1 - off2 * yt1;
-                let q9 = self.rod_diag9 * q10 - (off10 * off10) * q11;
+                let q9 = self.rod_diag[9] * q10 - (off10 * off10) * q11;
                 let zb9 = b9 * q10 - off10 * zb10;
-                let p3 = self.rod_diag3 * p2 - (off3 * off3) * p1;
+                let p3 = self.rod_diag[3] * p2 - (off3 * off3) * p1;
                 let yt3 = b3 * p2 - off3 * yt2;
-                let q8 = self.rod_diag8 * q9 - (off9 * off9) * q10;
+                let q8 = self.rod_diag[8] * q9 - (off9 * off9) * q10;
                 let zb8 = b8 * q9 - off9 * zb9;
-                let p4 = self.rod_diag4 * p3 - (off4 * off4) * p2;
+                let p4 = self.rod_diag[4] * p3 - (off4 * off4) * p2;
                 let yt4 = b4 * p3 - off4 * yt3;
-                let q7 = self.rod_diag7 * q8 - (off8 * off8) * q9;
+                let q7 = self.rod_diag[7] * q8 - (off8 * off8) * q9;
                 let zb7 = b7 * q8 - off8 * zb8;
-                let p5 = self.rod_diag5 * p4 - (off5 * off5) * p3;
+                let p5 = self.rod_diag[5] * p4 - (off5 * off5) * p3;
                 let yt5 = b5 * p4 - off5 * yt4;
                 let rp0 = 1.0 / p0;
                 let rp1 = 1.0 / p1;
@@ -2087,7 +1869,7 @@ const _: () = {
                 let rq8 = 1.0 / q8;
                 let rq7 = 1.0 / q7;
                 let t6 = (b6 - off6 * yt5 * rp5 - off7 * zb7 * rq7)
-                    / (self.rod_diag6 - (off6 * off6) * p4 * rp5 - (off7 * off7) * q8 * rq7);
+                    / (self.rod_diag[6] - (off6 * off6) * p4 * rp5 - (off7 * off7) * q8 * rq7);
                 let t5 = yt5 * rp5 - off6 * p4 * rp5 * t6;
                 let t7 = zb7 * rq7 - off7 * q8 * rq7 * t6;
                 let t4 = yt4 * rp4 - off5 * p3 * rp4 * t5;
@@ -2115,18 +1897,18 @@ const _: () = {
                 {
                     let t = pivots(
                         [
-                            self.rod_diag0,
-                            self.rod_diag1,
-                            self.rod_diag2,
-                            self.rod_diag3,
-                            self.rod_diag4,
-                            self.rod_diag5,
-                            self.rod_diag6,
-                            self.rod_diag7,
-                            self.rod_diag8,
-                            self.rod_diag9,
-                            self.rod_diag10,
-                            self.rod_diag11,
+                            self.rod_diag[0],
+                            self.rod_diag[1],
+                            self.rod_diag[2],
+                            self.rod_diag[3],
+                            self.rod_diag[4],
+                            self.rod_diag[5],
+                            self.rod_diag[6],
+                            self.rod_diag[7],
+                            self.rod_diag[8],
+                            self.rod_diag[9],
+                            self.rod_diag[10],
+                            self.rod_diag[11],
                         ],
                         [0.0, off1, off2, off3, off4, off5, off6, off7, off8, off9, off10, off11],
                         [b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, b11],
@@ -2136,40 +1918,40 @@ const _: () = {
                     (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11)
                 }
             };
-            let x_th0 = ((pull0 - pull1 * cd1 + t1 * sd1) * self.rod_im0 - (ct0 * pa_x + st0 * (pa_y + g)))
-                * self.rod_il0;
-            let x_th1 = ((pull1 - pull2 * cd2 + t2 * sd2) * self.rod_im1
-                - (pull0 * cd1 - pull1 + t0 * sd1) * self.rod_im0)
-                * self.rod_il1;
-            let x_th2 = ((pull2 - pull3 * cd3 + t3 * sd3) * self.rod_im2
-                - (pull1 * cd2 - pull2 + t1 * sd2) * self.rod_im1)
-                * self.rod_il2;
-            let x_th3 = ((pull3 - pull4 * cd4 + t4 * sd4) * self.rod_im3
-                - (pull2 * cd3 - pull3 + t2 * sd3) * self.rod_im2)
-                * self.rod_il3;
-            let x_th4 = ((pull4 - pull5 * cd5 + t5 * sd5) * self.rod_im4
-                - (pull3 * cd4 - pull4 + t3 * sd4) * self.rod_im3)
-                * self.rod_il4;
-            let x_th5 = ((pull5 - pull6 * cd6 + t6 * sd6) * self.rod_im5
-                - (pull4 * cd5 - pull5 + t4 * sd5) * self.rod_im4)
-                * self.rod_il5;
-            let x_th6 = ((pull6 - pull7 * cd7 + t7 * sd7) * self.rod_im6
-                - (pull5 * cd6 - pull6 + t5 * sd6) * self.rod_im5)
-                * self.rod_il6;
-            let x_th7 = ((pull7 - pull8 * cd8 + t8 * sd8) * self.rod_im7
-                - (pull6 * cd7 - pull7 + t6 * sd7) * self.rod_im6)
-                * self.rod_il7;
-            let x_th8 = ((pull8 - pull9 * cd9 + t9 * sd9) * self.rod_im8
-                - (pull7 * cd8 - pull8 + t7 * sd8) * self.rod_im7)
-                * self.rod_il8;
-            let x_th9 = ((pull9 - pull10 * cd10 + t10 * sd10) * self.rod_im9
-                - (pull8 * cd9 - pull9 + t8 * sd9) * self.rod_im8)
-                * self.rod_il9;
-            let x_th10 = ((pull10 - pull11 * cd11 + t11 * sd11) * self.rod_im10
-                - (pull9 * cd10 - pull10 + t9 * sd10) * self.rod_im9)
-                * self.rod_il10;
-            let x_th11 = (pull11 * self.rod_im11 - (pull10 * cd11 - pull11 + t10 * sd11) * self.rod_im10)
-                * self.rod_il11;
+            let x_th0 = ((pull0 - pull1 * cd1 + t1 * sd1) * self.rod_im[0] - (ct0 * pa_x + st0 * (pa_y + g)))
+                * self.rod_il[0];
+            let x_th1 = ((pull1 - pull2 * cd2 + t2 * sd2) * self.rod_im[1]
+                - (pull0 * cd1 - pull1 + t0 * sd1) * self.rod_im[0])
+                * self.rod_il[1];
+            let x_th2 = ((pull2 - pull3 * cd3 + t3 * sd3) * self.rod_im[2]
+                - (pull1 * cd2 - pull2 + t1 * sd2) * self.rod_im[1])
+                * self.rod_il[2];
+            let x_th3 = ((pull3 - pull4 * cd4 + t4 * sd4) * self.rod_im[3]
+                - (pull2 * cd3 - pull3 + t2 * sd3) * self.rod_im[2])
+                * self.rod_il[3];
+            let x_th4 = ((pull4 - pull5 * cd5 + t5 * sd5) * self.rod_im[4]
+                - (pull3 * cd4 - pull4 + t3 * sd4) * self.rod_im[3])
+                * self.rod_il[4];
+            let x_th5 = ((pull5 - pull6 * cd6 + t6 * sd6) * self.rod_im[5]
+                - (pull4 * cd5 - pull5 + t4 * sd5) * self.rod_im[4])
+                * self.rod_il[5];
+            let x_th6 = ((pull6 - pull7 * cd7 + t7 * sd7) * self.rod_im[6]
+                - (pull5 * cd6 - pull6 + t5 * sd6) * self.rod_im[5])
+                * self.rod_il[6];
+            let x_th7 = ((pull7 - pull8 * cd8 + t8 * sd8) * self.rod_im[7]
+                - (pull6 * cd7 - pull7 + t6 * sd7) * self.rod_im[6])
+                * self.rod_il[7];
+            let x_th8 = ((pull8 - pull9 * cd9 + t9 * sd9) * self.rod_im[8]
+                - (pull7 * cd8 - pull8 + t7 * sd8) * self.rod_im[7])
+                * self.rod_il[8];
+            let x_th9 = ((pull9 - pull10 * cd10 + t10 * sd10) * self.rod_im[9]
+                - (pull8 * cd9 - pull9 + t8 * sd9) * self.rod_im[8])
+                * self.rod_il[9];
+            let x_th10 = ((pull10 - pull11 * cd11 + t11 * sd11) * self.rod_im[10]
+                - (pull9 * cd10 - pull10 + t9 * sd10) * self.rod_im[9])
+                * self.rod_il[10];
+            let x_th11 = (pull11 * self.rod_im[11] - (pull10 * cd11 - pull11 + t10 * sd11) * self.rod_im[10])
+                * self.rod_il[11];
             if ((((x_th0 - x_th0) + ((x_th1 - x_th1) + (x_th2 - x_th2)))
                 + ((x_th3 - x_th3) + ((x_th4 - x_th4) + (x_th5 - x_th5))))
                 + (((x_th6 - x_th6) + ((x_th7 - x_th7) + (x_th8 - x_th8)))
@@ -3483,6 +3265,52 @@ const _: () = {
             dqd[(11, 11)] = -lam11;
             dp[(11, 0)] = -ct11 * ml11;
             dp[(11, 1)] = -st11 * ml11;
+        }
+        #[doc = " `q\u{308}` and its Jacobians by the kept tension solve in the links' own angles (`pendulum_core::PlanarTangents`): O(n²), no factorisation of `M`."]
+        fn acceleration_jacobians(
+            &self,
+            q: &SVector<f64, 12>,
+            qd: &SVector<f64, 12>,
+            inputs: &Inputs<Const<12>, U2>,
+            out: &mut ::pendulum_core::Jacobians<Self>,
+        ) -> Result<()> {
+            ::pendulum_core::__private::planar_tension_jacobians(
+                self,
+                ::pendulum_core::__private::RodConstants {
+                    inverse_mass: &self.rod_im,
+                    length: &self.rod_l,
+                    inverse_length: &self.rod_il,
+                    drag: &self.rod_drag,
+                },
+                q,
+                qd,
+                inputs,
+                out,
+                ::pendulum_core::__private::Parts::All,
+            )
+        }
+        #[doc = " `q\u{308}`, `∂q\u{308}/∂q` and `∂q\u{308}/∂q\u{307}` alone, by the same solve."]
+        fn state_jacobians(
+            &self,
+            q: &SVector<f64, 12>,
+            qd: &SVector<f64, 12>,
+            inputs: &Inputs<Const<12>, U2>,
+            out: &mut ::pendulum_core::Jacobians<Self>,
+        ) -> Result<()> {
+            ::pendulum_core::__private::planar_tension_jacobians(
+                self,
+                ::pendulum_core::__private::RodConstants {
+                    inverse_mass: &self.rod_im,
+                    length: &self.rod_l,
+                    inverse_length: &self.rod_il,
+                    drag: &self.rod_drag,
+                },
+                q,
+                qd,
+                inputs,
+                out,
+                ::pendulum_core::__private::Parts::State,
+            )
         }
     }
 };

@@ -25,36 +25,16 @@ pub struct Spatial3 {
     ml1: ::core::primitive::f64,
     #[doc = " `M_2 l_2` (0-based), kg·m."]
     ml2: ::core::primitive::f64,
-    #[doc = " `1/m_0` (0-based), 1/kg."]
-    rod_im0: ::core::primitive::f64,
-    #[doc = " `l_0` (0-based), m."]
-    rod_l0: ::core::primitive::f64,
-    #[doc = " `1/l_0` (0-based), 1/m."]
-    rod_il0: ::core::primitive::f64,
-    #[doc = " `λ_0/l_0` (0-based), N·s."]
-    rod_drag0: ::core::primitive::f64,
-    #[doc = " `1/m_0` (0-based), 1/kg: the tension system's first diagonal entry."]
-    rod_diag0: ::core::primitive::f64,
-    #[doc = " `1/m_1` (0-based), 1/kg."]
-    rod_im1: ::core::primitive::f64,
-    #[doc = " `l_1` (0-based), m."]
-    rod_l1: ::core::primitive::f64,
-    #[doc = " `1/l_1` (0-based), 1/m."]
-    rod_il1: ::core::primitive::f64,
-    #[doc = " `λ_1/l_1` (0-based), N·s."]
-    rod_drag1: ::core::primitive::f64,
-    #[doc = " `1/m_1 + 1/m_0` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag1: ::core::primitive::f64,
-    #[doc = " `1/m_2` (0-based), 1/kg."]
-    rod_im2: ::core::primitive::f64,
-    #[doc = " `l_2` (0-based), m."]
-    rod_l2: ::core::primitive::f64,
-    #[doc = " `1/l_2` (0-based), 1/m."]
-    rod_il2: ::core::primitive::f64,
-    #[doc = " `λ_2/l_2` (0-based), N·s."]
-    rod_drag2: ::core::primitive::f64,
-    #[doc = " `1/m_2 + 1/m_1` (0-based), 1/kg: the tension system's diagonal."]
-    rod_diag2: ::core::primitive::f64,
+    #[doc = " `1/m_i` per link (0-based), 1/kg."]
+    rod_im: [::core::primitive::f64; 3],
+    #[doc = " `l_i` per link, m."]
+    rod_l: [::core::primitive::f64; 3],
+    #[doc = " `1/l_i` per link, 1/m."]
+    rod_il: [::core::primitive::f64; 3],
+    #[doc = " `λ_i/l_i` per link, N·s."]
+    rod_drag: [::core::primitive::f64; 3],
+    #[doc = " `1/m_i + 1/m_{i−1}` per link (`1/m_0` for the first), 1/kg: the tension system's diagonal."]
+    rod_diag: [::core::primitive::f64; 3],
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -85,23 +65,7 @@ const _: () = {
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
             let ml2 = mt2 * l2;
-            let (
-                rod_im0,
-                rod_l0,
-                rod_il0,
-                rod_drag0,
-                rod_diag0,
-                rod_im1,
-                rod_l1,
-                rod_il1,
-                rod_drag1,
-                rod_diag1,
-                rod_im2,
-                rod_l2,
-                rod_il2,
-                rod_drag2,
-                rod_diag2,
-            ) = {
+            let (rod_im, rod_l, rod_il, rod_drag, rod_diag) = {
                 let masses = chain.masses();
                 let lengths = chain.lengths();
                 let damping = chain.damping();
@@ -115,21 +79,11 @@ const _: () = {
                 let lam1 = damping[1];
                 let lam2 = damping[2];
                 (
-                    1.0 / m0,
-                    l0,
-                    1.0 / l0,
-                    lam0 / l0,
-                    1.0 / m0,
-                    1.0 / m1,
-                    l1,
-                    1.0 / l1,
-                    lam1 / l1,
-                    1.0 / m1 + 1.0 / m0,
-                    1.0 / m2,
-                    l2,
-                    1.0 / l2,
-                    lam2 / l2,
-                    1.0 / m2 + 1.0 / m1,
+                    [1.0 / m0, 1.0 / m1, 1.0 / m2],
+                    [l0, l1, l2],
+                    [1.0 / l0, 1.0 / l1, 1.0 / l2],
+                    [lam0 / l0, lam1 / l1, lam2 / l2],
+                    [1.0 / m0, 1.0 / m1 + 1.0 / m0, 1.0 / m2 + 1.0 / m1],
                 )
             };
             Self {
@@ -143,21 +97,11 @@ const _: () = {
                 ml0,
                 ml1,
                 ml2,
-                rod_im0,
-                rod_l0,
-                rod_il0,
-                rod_drag0,
-                rod_diag0,
-                rod_im1,
-                rod_l1,
-                rod_il1,
-                rod_drag1,
-                rod_diag1,
-                rod_im2,
-                rod_l2,
-                rod_il2,
-                rod_drag2,
-                rod_diag2,
+                rod_im,
+                rod_l,
+                rod_il,
+                rod_drag,
+                rod_diag,
             }
         }
     }
@@ -568,8 +512,8 @@ const _: () = {
             let etx0 = ct0 * cp0;
             let ety0 = ct0 * sp0;
             let rate2_0 = dth0 * dth0 + st0 * st0 * dph0 * dph0;
-            let pull_th0 = torque[0] * self.rod_il0 - self.rod_drag0 * dth0;
-            let pull_ph0 = torque[3] * self.rod_il0 * is0 - self.rod_drag0 * st0 * dph0;
+            let pull_th0 = torque[0] * self.rod_il[0] - self.rod_drag[0] * dth0;
+            let pull_ph0 = torque[3] * self.rod_il[0] * is0 - self.rod_drag[0] * st0 * dph0;
             let fx0 = pull_th0 * etx0 - pull_ph0 * sp0;
             let fy0 = pull_th0 * ety0 + pull_ph0 * cp0;
             let fz0 = pull_th0 * st0;
@@ -587,8 +531,8 @@ const _: () = {
             let etx1 = ct1 * cp1;
             let ety1 = ct1 * sp1;
             let rate2_1 = dth1 * dth1 + st1 * st1 * dph1 * dph1;
-            let pull_th1 = torque[1] * self.rod_il1 - self.rod_drag1 * dth1;
-            let pull_ph1 = torque[4] * self.rod_il1 * is1 - self.rod_drag1 * st1 * dph1;
+            let pull_th1 = torque[1] * self.rod_il[1] - self.rod_drag[1] * dth1;
+            let pull_ph1 = torque[4] * self.rod_il[1] * is1 - self.rod_drag[1] * st1 * dph1;
             let fx1 = pull_th1 * etx1 - pull_ph1 * sp1;
             let fy1 = pull_th1 * ety1 + pull_ph1 * cp1;
             let fz1 = pull_th1 * st1;
@@ -606,34 +550,34 @@ const _: () = {
             let etx2 = ct2 * cp2;
             let ety2 = ct2 * sp2;
             let rate2_2 = dth2 * dth2 + st2 * st2 * dph2 * dph2;
-            let pull_th2 = torque[2] * self.rod_il2 - self.rod_drag2 * dth2;
-            let pull_ph2 = torque[5] * self.rod_il2 * is2 - self.rod_drag2 * st2 * dph2;
+            let pull_th2 = torque[2] * self.rod_il[2] - self.rod_drag[2] * dth2;
+            let pull_ph2 = torque[5] * self.rod_il[2] * is2 - self.rod_drag[2] * st2 * dph2;
             let fx2 = pull_th2 * etx2 - pull_ph2 * sp2;
             let fy2 = pull_th2 * ety2 + pull_ph2 * cp2;
             let fz2 = pull_th2 * st2;
-            let free_x0 = (fx0 - fx1) * self.rod_im0;
-            let free_y0 = (fy0 - fy1) * self.rod_im0;
-            let free_z0 = -g + (fz0 - fz1) * self.rod_im0;
-            let b0 = self.rod_l0 * rate2_0
+            let free_x0 = (fx0 - fx1) * self.rod_im[0];
+            let free_y0 = (fy0 - fy1) * self.rod_im[0];
+            let free_z0 = -g + (fz0 - fz1) * self.rod_im[0];
+            let b0 = self.rod_l[0] * rate2_0
                 + ux0 * (free_x0 - pa_x)
                 + uy0 * (free_y0 - pa_y)
                 + uz0 * (free_z0 - pa_z);
-            let free_x1 = (fx1 - fx2) * self.rod_im1;
-            let free_y1 = (fy1 - fy2) * self.rod_im1;
-            let free_z1 = -g + (fz1 - fz2) * self.rod_im1;
-            let b1 = self.rod_l1 * rate2_1
+            let free_x1 = (fx1 - fx2) * self.rod_im[1];
+            let free_y1 = (fy1 - fy2) * self.rod_im[1];
+            let free_z1 = -g + (fz1 - fz2) * self.rod_im[1];
+            let b1 = self.rod_l[1] * rate2_1
                 + ux1 * (free_x1 - free_x0)
                 + uy1 * (free_y1 - free_y0)
                 + uz1 * (free_z1 - free_z0);
-            let free_x2 = fx2 * self.rod_im2;
-            let free_y2 = fy2 * self.rod_im2;
-            let free_z2 = -g + fz2 * self.rod_im2;
-            let b2 = self.rod_l2 * rate2_2
+            let free_x2 = fx2 * self.rod_im[2];
+            let free_y2 = fy2 * self.rod_im[2];
+            let free_z2 = -g + fz2 * self.rod_im[2];
+            let b2 = self.rod_l[2] * rate2_2
                 + ux2 * (free_x2 - free_x1)
                 + uy2 * (free_y2 - free_y1)
                 + uz2 * (free_z2 - free_z1);
-            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * self.rod_im0;
-            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * self.rod_im1;
+            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * self.rod_im[0];
+            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * self.rod_im[1];
             #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
             #[doc = r" continuants leave `CONTINUANT_RANGE`."]
             #[cold]
@@ -656,20 +600,20 @@ const _: () = {
                 [t0, t1, t2]
             }
             let (t0, t1, t2) = {
-                let p0 = self.rod_diag0;
+                let p0 = self.rod_diag[0];
                 let yt0 = b0;
-                let q2 = self.rod_diag2;
+                let q2 = self.rod_diag[2];
                 let zb2 = b2;
                 let rp0 = 1.0 / p0;
                 let rq2 = 1.0 / q2;
                 let t1 = (b1 - off1 * yt0 * rp0 - off2 * zb2 * rq2)
-                    / (self.rod_diag1 - (off1 * off1) * rp0 - (off2 * off2) * rq2);
+                    / (self.rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
                 let t0 = yt0 * rp0 - off1 * rp0 * t1;
                 let t2 = zb2 * rq2 - off2 * rq2 * t1;
                 let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
                 if false | (p0.to_bits().wrapping_sub(low) > span) | (q2.to_bits().wrapping_sub(low) > span) {
                     let t = pivots(
-                        [self.rod_diag0, self.rod_diag1, self.rod_diag2],
+                        [self.rod_diag[0], self.rod_diag[1], self.rod_diag[2]],
                         [0.0, off1, off2],
                         [b0, b1, b2],
                     );
@@ -678,28 +622,28 @@ const _: () = {
                     (t0, t1, t2)
                 }
             };
-            let a_x2 = free_x2 + (-t2 * ux2) * self.rod_im2;
-            let a_y2 = free_y2 + (-t2 * uy2) * self.rod_im2;
-            let a_z2 = free_z2 + (-t2 * uz2) * self.rod_im2;
-            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * self.rod_im1;
-            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * self.rod_im1;
-            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * self.rod_im1;
-            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * self.rod_im0;
-            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * self.rod_im0;
-            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * self.rod_im0;
-            let udd_x0 = (a_x0 - pa_x) * self.rod_il0;
-            let udd_y0 = (a_y0 - pa_y) * self.rod_il0;
-            let udd_z0 = (a_z0 - pa_z) * self.rod_il0;
+            let a_x2 = free_x2 + (-t2 * ux2) * self.rod_im[2];
+            let a_y2 = free_y2 + (-t2 * uy2) * self.rod_im[2];
+            let a_z2 = free_z2 + (-t2 * uz2) * self.rod_im[2];
+            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * self.rod_im[1];
+            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * self.rod_im[1];
+            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * self.rod_im[1];
+            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * self.rod_im[0];
+            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * self.rod_im[0];
+            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * self.rod_im[0];
+            let udd_x0 = (a_x0 - pa_x) * self.rod_il[0];
+            let udd_y0 = (a_y0 - pa_y) * self.rod_il[0];
+            let udd_z0 = (a_z0 - pa_z) * self.rod_il[0];
             let x_th0 = etx0 * udd_x0 + ety0 * udd_y0 + st0 * udd_z0 + dph0 * dph0 * st0 * ct0;
             let x_ph0 = (cp0 * udd_y0 - sp0 * udd_x0 - 2.0 * dth0 * dph0 * ct0) * is0;
-            let udd_x1 = (a_x1 - a_x0) * self.rod_il1;
-            let udd_y1 = (a_y1 - a_y0) * self.rod_il1;
-            let udd_z1 = (a_z1 - a_z0) * self.rod_il1;
+            let udd_x1 = (a_x1 - a_x0) * self.rod_il[1];
+            let udd_y1 = (a_y1 - a_y0) * self.rod_il[1];
+            let udd_z1 = (a_z1 - a_z0) * self.rod_il[1];
             let x_th1 = etx1 * udd_x1 + ety1 * udd_y1 + st1 * udd_z1 + dph1 * dph1 * st1 * ct1;
             let x_ph1 = (cp1 * udd_y1 - sp1 * udd_x1 - 2.0 * dth1 * dph1 * ct1) * is1;
-            let udd_x2 = (a_x2 - a_x1) * self.rod_il2;
-            let udd_y2 = (a_y2 - a_y1) * self.rod_il2;
-            let udd_z2 = (a_z2 - a_z1) * self.rod_il2;
+            let udd_x2 = (a_x2 - a_x1) * self.rod_il[2];
+            let udd_y2 = (a_y2 - a_y1) * self.rod_il[2];
+            let udd_z2 = (a_z2 - a_z1) * self.rod_il[2];
             let x_th2 = etx2 * udd_x2 + ety2 * udd_y2 + st2 * udd_z2 + dph2 * dph2 * st2 * ct2;
             let x_ph2 = (cp2 * udd_y2 - sp2 * udd_x2 - 2.0 * dth2 * dph2 * ct2) * is2;
             if (((x_th0 - x_th0) + ((x_th1 - x_th1) + (x_th2 - x_th2)))

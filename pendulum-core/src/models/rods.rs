@@ -58,6 +58,16 @@ pub(crate) struct Rods {
     drag: Vec<f64>,
 }
 
+/// A chain's per-link constants as the tension solve reads them, `n` entries each:
+/// `1/m_i` (1/kg), `l_i` (m), `1/l_i` (1/m) and the drag `λ_i/l_i` (N·s).
+#[derive(Debug, Clone, Copy)]
+pub struct RodConstants<'a> {
+    pub inverse_mass: &'a [f64],
+    pub length: &'a [f64],
+    pub inverse_length: &'a [f64],
+    pub drag: &'a [f64],
+}
+
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
 /// force pair `F_i` (N) acting on it (on mass `i`; the opposite on mass `i−1`).
 #[derive(Debug, Clone, Copy)]
@@ -182,6 +192,45 @@ pub const CONTINUANT_RANGE: (u64, u64) = {
     (low, high - low)
 };
 
+/// The pivots `1/D_i` of a tridiagonal elimination as ratios of continuants (module docs),
+/// row by row: one multiply and one subtraction per row on the serial chain, the division
+/// off it; both continuants multiplied every [`BLOCK`] rows by the power of two that brings
+/// `P_{i−1}` into `[1, 2)`. The pivots are valid while [`in_range`](Self::in_range).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Continuants {
+    /// `P_{i−1}`, `P_{i−2}` (`P_{−1} = 1`; `P_{−2}` only meets `c_0 = 0`).
+    above: f64,
+    above2: f64,
+    out_of_range: bool,
+}
+
+impl Continuants {
+    pub fn new() -> Self {
+        Self { above: 1.0, above2: 0.0, out_of_range: false }
+    }
+
+    /// `1/D_i` of row `i` (rows in order from 0) with `A_ii = diagonal`, `A_{i,i−1} = off`.
+    #[inline(always)]
+    pub fn inverse_pivot(&mut self, i: usize, diagonal: f64, off: f64) -> f64 {
+        if i.is_multiple_of(BLOCK) {
+            let scale = normalizer(self.above);
+            self.above *= scale;
+            self.above2 *= scale;
+        }
+        let p = diagonal * self.above - (off * off) * self.above2;
+        let (low, span) = CONTINUANT_RANGE;
+        self.out_of_range |= p.to_bits().wrapping_sub(low) > span;
+        let inverse_pivot = self.above / p;
+        (self.above2, self.above) = (self.above, p);
+        inverse_pivot
+    }
+
+    /// Whether every continuant so far stayed inside [`CONTINUANT_RANGE`].
+    pub fn in_range(&self) -> bool {
+        !self.out_of_range
+    }
+}
+
 /// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`: the exact power of two that brings a positive
 /// normal `x` into `[1, 2)`. (Only reached with `x` in [`CONTINUANT_RANGE`].)
 #[inline(always)]
@@ -207,14 +256,14 @@ impl Rods {
         self.length.len()
     }
 
-    /// `1 / m_i` (1/kg) per rod.
-    pub fn inverse_mass(&self) -> &[f64] {
-        &self.inverse_mass
-    }
-
-    /// `l_i` (m) per rod.
-    pub fn length(&self) -> &[f64] {
-        &self.length
+    /// The per-rod constants as one view.
+    pub fn constants(&self) -> RodConstants<'_> {
+        RodConstants {
+            inverse_mass: &self.inverse_mass,
+            length: &self.length,
+            inverse_length: &self.inverse_length,
+            drag: &self.drag,
+        }
     }
 
     /// `1 / l_i` (1/m) per rod.
@@ -264,14 +313,12 @@ impl Rods {
         mut load: impl FnMut(usize) -> Load<S>,
     ) -> bool {
         let n = rows.len();
-        let (low, span) = CONTINUANT_RANGE;
         let mut free_above = pivot_acceleration;
         let mut inverse_mass_above = 0.0;
         let mut u_above = [0.0; S];
-        // P_{i−1}, P_{i−2} (P_{−1} = 1; P_{−2} only meets c_0 = 0), 1/D_{i−1}, e_{i−1}.
-        let (mut p_above, mut p_above2) = (1.0, 0.0);
+        let mut continuants = Continuants::new();
+        // 1/D_{i−1}, e_{i−1}.
         let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
-        let mut out_of_range = false;
         let mut here = load(0);
         for (i, row) in rows.iter_mut().enumerate() {
             let below = if i + 1 < n { Some(load(i + 1)) } else { None };
@@ -285,28 +332,19 @@ impl Rods {
                 rhs += u[k] * (a[k] - free_above[k]);
             }
             let (diagonal, off) = entries(im, inverse_mass_above, &u_above, &u);
-            if i % BLOCK == 0 {
-                let scale = normalizer(p_above);
-                p_above *= scale;
-                p_above2 *= scale;
-            }
-            // The serial chain: one multiply and one subtraction per rod.
-            let p = diagonal * p_above - (off * off) * p_above2;
-            out_of_range |= p.to_bits().wrapping_sub(low) > span;
-            let inverse_pivot = p_above / p;
+            let inverse_pivot = continuants.inverse_pivot(i, diagonal, off);
             let factor = off * inverse_pivot_above;
             let eliminated = rhs - factor * eliminated_above;
             *row = Row { direction: u, free: a, factor, scaled: eliminated * inverse_pivot, rhs };
             free_above = a;
             inverse_mass_above = im;
             u_above = u;
-            (p_above2, p_above) = (p_above, p);
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
             if let Some(b) = below {
                 here = b;
             }
         }
-        !out_of_range
+        continuants.in_range()
     }
 
     /// The elimination by pivots, `D_i = A_ii − c_i² / D_{i−1}`, for the rows left by

@@ -7,12 +7,15 @@ use crate::error::Result;
 use crate::jacobians::{Derivatives, Jacobians};
 use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
-use crate::model::{Inputs, Model, check_inputs};
+use crate::model::{Inputs, Model, ModelAlloc, check_inputs};
 use crate::models::planar::Planar;
-use crate::models::rods::{Linearised, Load, LoadTangent, Rods, TangentRow, with_scratch};
+use crate::models::rods::{Load, Rods, with_scratch};
 use crate::models::trig::sin_cos_into;
 
 mod jacobians;
+mod tangents;
+
+pub use tangents::{PlanarTangents, RodConstants};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
 /// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric
@@ -134,75 +137,6 @@ where
     }
 }
 
-/// [`PlanarTension`]'s tension solve at one state, kept for its tangents: the
-/// directional derivatives (Jacobian-vector products) of `θ̈` in O(n) each.
-///
-/// With `u_i = (sin θ_i, −cos θ_i)`, `n_i = (cos θ_i, sin θ_i)` and the pull
-/// `σ_i/l_i − (λ_i/l_i) θ̇_i`, a direction `(δθ, δθ̇, δσ, δp̈)` moves rod `i`'s load by
-/// `δu_i = n_i δθ_i`, `δ|u̇_i|² = 2 θ̇_i δθ̇_i`, `δF_i = δpull_i n_i − pull_i u_i δθ_i`; the
-/// tangent of the solve (`rods` module) gives `δü_i`, and
-/// `δθ̈_i = n_i·δü_i − (u_i·ü_i) δθ_i`.
-#[derive(Debug, Clone)]
-pub struct PlanarTangents<'a> {
-    solve: Linearised<2>,
-    rods: &'a Rods,
-    /// `g` (m/s²).
-    gravity: f64,
-    sin_cos: Vec<[f64; 2]>,
-    rates: Vec<f64>,
-    pulls: Vec<f64>,
-    accelerations: Vec<f64>,
-    work: Vec<TangentRow<2>>,
-    udd: Vec<[f64; 2]>,
-}
-
-impl PlanarTangents<'_> {
-    /// `θ̈` at the state (rad/s²).
-    pub fn accelerations(&self) -> &[f64] {
-        &self.accelerations
-    }
-
-    /// `δθ̈` (rad/s²) along `(δθ, δθ̇, δσ, δp̈)`, written into `out`; every slice has `n`
-    /// entries. O(n), allocation-free.
-    pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
-        let (sc, rates, pulls) = (&self.sin_cos, &self.rates, &self.pulls);
-        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
-        let dload = |i: usize| {
-            let [s, c] = sc[i];
-            let dpull = dtorque[i] * inverse_length[i] - drag[i] * dqd[i];
-            LoadTangent {
-                direction: [c * dq[i], s * dq[i]],
-                rate_squared: 2.0 * rates[i] * dqd[i],
-                pair: [dpull * c - pulls[i] * s * dq[i], dpull * s + pulls[i] * c * dq[i]],
-            }
-        };
-        self.solve.tangent(self.rods, dload, dpivot, &mut self.work, &mut self.udd);
-        for (i, (o, (d, a))) in
-            out.iter_mut().zip(self.udd.iter().zip(self.solve.accelerations())).enumerate()
-        {
-            let [s, c] = sc[i];
-            // n·δü − (u·ü) δθ with u = (s, −c).
-            *o = c * d[0] + s * d[1] - (s * a[0] - c * a[1]) * dq[i];
-        }
-    }
-}
-
-impl PlanarTangents<'_> {
-    /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇`, `∂θ̈/∂σ` (column-major n × n each) and `∂θ̈/∂p̈` (n × 2), all
-    /// at once, in the links' own angles: each column changes the solve in three rows, so
-    /// after `G = H A⁻¹` (n solves with the kept factors, all at once) each entry is three
-    /// multiply-adds, O(n²) in all (`tension::jacobians` module docs).
-    pub fn jacobians(&self, dq: &mut [f64], dqd: &mut [f64], dtorque: &mut [f64], dpivot: &mut [f64]) {
-        self.blocks(dq, dqd, Some((dtorque, dpivot)));
-    }
-
-    /// [`jacobians`](Self::jacobians) by `θ` and `θ̇` only: the state Jacobians a
-    /// linearisation or an implicit integrator needs.
-    pub fn state_jacobians(&self, dq: &mut [f64], dqd: &mut [f64]) {
-        self.blocks(dq, dqd, None);
-    }
-}
-
 /// Whether every entry of `v` is zero (no early exit, so that it vectorises).
 fn all_zero(v: &[f64]) -> bool {
     v.iter().fold(true, |zero, x| zero & (*x == 0.0))
@@ -221,42 +155,89 @@ where
         q: &OVector<f64, L>,
         qd: &OVector<f64, L>,
         inputs: &Inputs<L, U2>,
-    ) -> Result<PlanarTangents<'_>> {
+    ) -> Result<PlanarTangents<'_, L>> {
         let chain = self.dense.chain();
-        let n = chain.links();
-        check_inputs(n, q, qd, inputs)?;
-        let mut sin_cos = vec![[0.0; 2]; n];
-        sin_cos_into(q.as_slice(), &mut sin_cos);
-        let (inverse_length, drag) = (self.rods.inverse_length(), self.rods.drag());
-        let rates = qd.as_slice().to_vec();
-        let pulls: Vec<f64> =
-            (0..n).map(|i| inputs.torque[i] * inverse_length[i] - drag[i] * rates[i]).collect();
-        let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
-        let solve = Linearised::new(&self.rods, [0.0, -chain.gravity()], pivot, |i| {
-            let [s, c] = sin_cos[i];
-            Load { direction: [s, -c], rate_squared: rates[i] * rates[i], pair: [pulls[i] * c, pulls[i] * s] }
-        });
-        let accelerations: Vec<f64> =
-            solve.accelerations().zip(&sin_cos).map(|(a, [s, c])| c * a[0] + s * a[1]).collect();
-        if !all_finite(&accelerations) {
-            return Err(crate::error::Error::NotPositiveDefinite);
+        check_inputs(chain.links(), q, qd, inputs)?;
+        let tangents = kept(self.rods.constants(), chain.gravity(), self.dof(), q, qd, inputs);
+        if tangents.accelerations().all(f64::is_finite) {
+            Ok(tangents)
+        } else {
+            Err(crate::error::Error::NotPositiveDefinite)
         }
-        Ok(PlanarTangents {
-            solve,
-            rods: &self.rods,
-            gravity: chain.gravity(),
-            sin_cos,
-            rates,
-            pulls,
-            accelerations,
-            work: TangentRow::scratch(n),
-            udd: vec![[0.0; 2]; n],
-        })
     }
 }
 
-/// The dense building blocks are [`Planar`]'s; the Jacobians come from the tangents of
-/// the O(n) solve instead ([`PlanarTangents`]): one O(n) pass per column, O(n²) in all.
+/// The kept solve of [`PlanarTangents::new`] at `(q, q̇, inputs)`, sizes unchecked.
+#[inline(always)]
+fn kept<'a, L: Dim>(
+    rods: RodConstants<'a>,
+    gravity: f64,
+    dim: L,
+    q: &OVector<f64, L>,
+    qd: &OVector<f64, L>,
+    inputs: &Inputs<L, U2>,
+) -> PlanarTangents<'a, L>
+where
+    DefaultAllocator: Allocator<L> + Allocator<U2>,
+{
+    let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
+    PlanarTangents::new(rods, gravity, dim, q.as_slice(), qd.as_slice(), inputs.torque.as_slice(), pivot)
+}
+
+/// Which Jacobians [`planar_tension_jacobians`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parts {
+    /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇`, `∂θ̈/∂σ` and `∂θ̈/∂p̈`.
+    All,
+    /// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` only ([`Derivatives::state_jacobians`]).
+    State,
+}
+
+/// `θ̈` and its Jacobians (`parts`) for a planar chain of these rods by the kept tension
+/// solve ([`PlanarTangents`]: O(n) solve, O(n²) Jacobians, fixed sizes on the stack): the
+/// [`Derivatives::acceleration_jacobians`] and [`Derivatives::state_jacobians`] of
+/// [`PlanarTension`] and of the generated planar models that take the tension route.
+///
+/// Errors: [`crate::error::Error::LengthMismatch`] or [`crate::error::Error::NonFinite`]
+/// for bad inputs, [`crate::error::Error::NotPositiveDefinite`] for a non-finite result.
+pub fn planar_tension_jacobians<M, L>(
+    model: &M,
+    rods: RodConstants<'_>,
+    q: &OVector<f64, L>,
+    qd: &OVector<f64, L>,
+    inputs: &Inputs<L, U2>,
+    out: &mut Jacobians<M>,
+    parts: Parts,
+) -> Result<()>
+where
+    L: Dim,
+    M: Model<Dof = L, Space = U2> + ?Sized,
+    DefaultAllocator: ModelAlloc<M::Links, L, U2> + Allocator<L, U2>,
+{
+    let dim = model.dof();
+    let n = dim.value();
+    // Sizes first (a fixed-size model's always match); finiteness only on failure.
+    if q.len() != n || qd.len() != n || inputs.torque.len() != n {
+        check_inputs(n, q, qd, inputs)?;
+    }
+    let tangents = kept(rods, model.chain().gravity(), dim, q, qd, inputs);
+    for (o, a) in out.accelerations.iter_mut().zip(tangents.accelerations()) {
+        *o = a;
+    }
+    if !all_finite(out.accelerations.as_slice()) {
+        check_inputs(n, q, qd, inputs)?;
+        return Err(crate::error::Error::NotPositiveDefinite);
+    }
+    let (dq, dqd) = (out.q.as_mut_slice(), out.qd.as_mut_slice());
+    match parts {
+        Parts::All => tangents.jacobians(dq, dqd, out.torque.as_mut_slice(), out.pivot.as_mut_slice()),
+        Parts::State => tangents.state_jacobians(dq, dqd),
+    }
+    Ok(())
+}
+
+/// The dense building blocks are [`Planar`]'s; the Jacobians come from the kept O(n) solve
+/// instead ([`PlanarTangents`]): O(n²) in all.
 impl<L: Dim> Derivatives for PlanarTension<L>
 where
     DefaultAllocator: Allocator<L> + Allocator<L, L> + Allocator<U2> + Allocator<L, U2>,
@@ -277,7 +258,7 @@ where
         self.dense.force_jacobians(q, qd, inputs, dq, dqd, dp)
     }
 
-    /// Every column at once from the kept solve ([`PlanarTangents::jacobians`]).
+    /// Every column at once from the kept solve ([`planar_tension_jacobians`]).
     fn acceleration_jacobians(
         &self,
         q: &OVector<f64, L>,
@@ -285,15 +266,18 @@ where
         inputs: &Inputs<L, U2>,
         out: &mut Jacobians<Self>,
     ) -> Result<()> {
-        let tangents = self.tangents(q, qd, inputs)?;
-        out.accelerations.as_mut_slice().copy_from_slice(tangents.accelerations());
-        tangents.jacobians(
-            out.q.as_mut_slice(),
-            out.qd.as_mut_slice(),
-            out.torque.as_mut_slice(),
-            out.pivot.as_mut_slice(),
-        );
-        Ok(())
+        planar_tension_jacobians(self, self.rods.constants(), q, qd, inputs, out, Parts::All)
+    }
+
+    /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇` alone from the kept solve ([`planar_tension_jacobians`]).
+    fn state_jacobians(
+        &self,
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+        out: &mut Jacobians<Self>,
+    ) -> Result<()> {
+        planar_tension_jacobians(self, self.rods.constants(), q, qd, inputs, out, Parts::State)
     }
 }
 
@@ -375,7 +359,7 @@ where
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use nalgebra::{DVector, Vector2};
+    use nalgebra::{DMatrix, DVector, Vector2};
 
     #[test]
     fn triple_pendulum_matches_the_dense_route() {
@@ -453,6 +437,44 @@ mod tests {
         }
         assert!((&a.pivot - &b.pivot).amax() < 1e-9 * b.pivot.amax());
         assert!((&a.accelerations - &b.accelerations).amax() < 1e-10 * b.accelerations.amax());
+        // The JVP along every part at once is the dense Jacobians' product, twice from one
+        // kept solve.
+        let mut kept = fast.tangents(&q, &qd, &inputs).unwrap();
+        for k in [1.0, -0.5] {
+            let dq = DVector::from_fn(n, |i, _| k * (i as f64 * 0.9).cos());
+            let dqd = DVector::from_fn(n, |i, _| k * (0.4 - (i as f64 * 0.3).sin()));
+            let dtorque = DVector::from_fn(n, |i, _| k * (0.2 + 0.05 * i as f64));
+            let dpivot = Vector2::new(0.7 * k, -1.1 * k);
+            let mut jvp = vec![0.0; n];
+            kept.jvp(dq.as_slice(), dqd.as_slice(), dtorque.as_slice(), [dpivot[0], dpivot[1]], &mut jvp);
+            let product = &b.q * &dq + &b.qd * &dqd + &b.torque * &dtorque + &b.pivot * dpivot;
+            let jvp = DVector::from_vec(jvp);
+            assert!((&jvp - &product).amax() < 1e-9 * product.amax(), "n = {n}: {jvp} {product}");
+        }
+    }
+
+    /// Masses of 1e-150 kg take the kept solve's continuants out of their range within two
+    /// links; the classical pivots then give what the same chain at 1 kg gives (the motion
+    /// without torques or damping does not depend on the masses' scale).
+    #[test]
+    fn the_kept_solve_falls_back_to_pivots_for_extreme_masses() {
+        let (masses, lengths) = ([1.0, 3.0, 2.0, 1.0], [1.0, 0.5, 2.0, 1.0]);
+        let tiny: Vec<f64> = masses.iter().map(|m| m * 1e-150).collect();
+        let normal = PlanarTension::new(Chain::<Dyn>::new(&masses, &lengths, 9.81).unwrap());
+        let extreme = PlanarTension::new(Chain::<Dyn>::new(&tiny, &lengths, 9.81).unwrap());
+        let q = DVector::from_vec(vec![0.4, -1.3, 2.2, 0.9]);
+        let qd = DVector::from_vec(vec![1.5, -0.7, 2.1, 0.3]);
+        let inputs = Inputs { torque: DVector::zeros(4), pivot_acceleration: Vector2::new(0.8, -0.3) };
+        let (mut a, mut b) = (Jacobians::zeros(&normal), Jacobians::zeros(&extreme));
+        normal.acceleration_jacobians(&q, &qd, &inputs, &mut a).unwrap();
+        extreme.acceleration_jacobians(&q, &qd, &inputs, &mut b).unwrap();
+        let close = |x: &DMatrix<f64>, y: &DMatrix<f64>| (x - y).amax() < 1e-12 * y.amax();
+        assert!(close(&b.q, &a.q) && close(&b.qd, &a.qd), "{} {}", b.q, a.q);
+        assert!(close(&(&b.torque * 1e-150), &a.torque));
+        assert!((&b.accelerations - &a.accelerations).amax() < 1e-12 * a.accelerations.amax());
+        let mut direct = DVector::zeros(4);
+        extreme.accelerations(&q, &qd, &inputs, &mut direct).unwrap();
+        assert!((&b.accelerations - &direct).amax() < 1e-12 * direct.amax());
     }
 
     #[test]

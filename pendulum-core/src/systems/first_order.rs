@@ -195,7 +195,7 @@ where
         self.velocity_and_acceleration(t, x, out)
     }
 
-    /// `[[0, I], [∂q̈/∂q, ∂q̈/∂q̇]]` from [`Derivatives::acceleration_jacobians`].
+    /// `[[0, I], [∂q̈/∂q, ∂q̈/∂q̇]]` from [`Derivatives::state_jacobians`].
     fn jacobian(
         &self,
         t: f64,
@@ -204,7 +204,7 @@ where
     ) -> Result<()> {
         let (q, qd) = self.split(x);
         let mut jac = Jacobians::zeros(&self.model);
-        self.model.acceleration_jacobians(&q, &qd, &self.inputs.inputs_at(t), &mut jac)?;
+        self.model.state_jacobians(&q, &qd, &self.inputs.inputs_at(t), &mut jac)?;
         jac.first_order(out);
         Ok(())
     }

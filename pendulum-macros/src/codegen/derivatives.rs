@@ -3,24 +3,60 @@
 //! `acceleration_jacobians` combines them with one Cholesky factorisation of `M`.
 
 use proc_macro2::{Ident, TokenStream};
-use quote::quote;
+use quote::{format_ident, quote};
 
 use super::body::{Body, expr};
 use super::names::index;
-use crate::plan::{Expr, Plan, Sym, Var};
+use crate::plan::{Algorithm, Expr, Kind, Plan, Sym, Var};
 
-/// The `Derivatives` impl.
-pub(super) fn derivatives_impl(name: &Ident, plan: &Plan) -> TokenStream {
+/// The `Derivatives` impl; a planar model on the tension route takes its Jacobians from the
+/// kept tension solve instead of factoring `M` ([`tension_jacobians`]).
+pub(super) fn derivatives_impl(name: &Ident, plan: &Plan, algorithm: Algorithm) -> TokenStream {
     let mass = mass_matrix_partials(plan);
     let force = force_jacobians(plan);
+    let jacobians =
+        (algorithm == Algorithm::Tension && plan.kind == Kind::Planar).then(|| tension_jacobians(plan));
     quote! {
         #[automatically_derived]
         #[allow(clippy::suboptimal_flops, clippy::eq_op)]
         impl Derivatives for #name {
             #mass
             #force
+            #jacobians
         }
     }
+}
+
+/// `fn acceleration_jacobians` and `fn state_jacobians` by `pendulum_core`'s kept planar tension solve in the links'
+/// own angles (O(n) solve, O(n²) Jacobians, stack arrays), from the stored rod constants.
+fn tension_jacobians(plan: &Plan) -> TokenStream {
+    let d = index(plan.dof());
+    let rods = super::rod_constants::constants_view();
+    let method = |name: &str, parts: &str, doc: &str| {
+        let (name, parts) = (format_ident!("{name}"), format_ident!("{parts}"));
+        quote! {
+            #[doc = #doc]
+            fn #name(
+                &self,
+                q: &SVector<f64, #d>,
+                qd: &SVector<f64, #d>,
+                inputs: &Inputs<Const<#d>, U2>,
+                out: &mut ::pendulum_core::Jacobians<Self>,
+            ) -> Result<()> {
+                ::pendulum_core::__private::planar_tension_jacobians(
+                    self, #rods, q, qd, inputs, out, ::pendulum_core::__private::Parts::#parts,
+                )
+            }
+        }
+    };
+    let all = method(
+        "acceleration_jacobians",
+        "All",
+        " `q̈` and its Jacobians by the kept tension solve in the links' own angles \
+         (`pendulum_core::PlanarTangents`): O(n²), no factorisation of `M`.",
+    );
+    let state = method("state_jacobians", "State", " `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` alone, by the same solve.");
+    quote!(#all #state)
 }
 
 /// `fn mass_matrix_partials`: `out[(a, x)] = Σ_b ∂M_ab/∂q_x v_b`, the partials as lets.

@@ -45,7 +45,7 @@ pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
         Algorithm::Tension => {
             let (fields, docs): (Vec<Ident>, Vec<String>) =
                 rod_constants::stored(plan).into_iter().map(|(f, _, d)| (f, d)).unzip();
-            quote!(#(#[doc = #docs] #fields: ::core::primitive::f64,)*)
+            quote!(#(#[doc = #docs] #fields: [::core::primitive::f64; #n],)*)
         }
     };
     quote! {
@@ -116,10 +116,11 @@ pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
         }
         Algorithm::Tension => {
             let inputs = rod_constants::constructor_lets(plan);
-            let (fields, values): (Vec<Ident>, Vec<TokenStream>) =
+            let (fields, values): (Vec<Ident>, Vec<Vec<TokenStream>>) =
                 rod_constants::stored(plan).into_iter().map(|(f, v, _)| (f, v)).unzip();
+            let arrays = values.iter().map(|v| quote!([#(#v),*]));
             // In a block of its own: its lets may share names with the stored symbols'.
-            (quote!(let (#(#fields,)*) = { #inputs (#(#values,)*) };), quote!(#(#fields),*))
+            (quote!(let (#(#fields,)*) = { #inputs (#(#arrays,)*) };), quote!(#(#fields),*))
         }
     };
     let algorithm_name = match algorithm {

@@ -52,7 +52,7 @@ fn model(def: &ModelDef) -> TokenStream {
         items::partial_eq_impl(name),
         items::from_impl(name, &plan),
         model_impl(name, &plan, algorithm),
-        derivatives::derivatives_impl(name, &plan),
+        derivatives::derivatives_impl(name, &plan, algorithm),
     ];
     quote! {
         #struct_item

@@ -174,10 +174,10 @@ pub(super) fn accelerations(plan: &Plan) -> TokenStream {
     }
 }
 
-/// `self.<name><i>`: a per-link constant stored by `new` ([`rod_constants`](super::rod_constants)).
+/// `self.<name>[i]`: a per-link constant stored by `new` ([`rod_constants`](super::rod_constants)).
 fn field(name: &str, i: usize) -> TokenStream {
-    let f = id(name, i);
-    quote!(self.#f)
+    let (f, i) = (format_ident!("{name}"), index(i));
+    quote!(self.#f[#i])
 }
 
 /// The spatial route in Cartesian components (module docs): directions, force pairs and

@@ -27,70 +27,63 @@ where
         let p = self.drive.acceleration(t);
         let pivot: [f64; C] = std::array::from_fn(|k| p[k]);
         let (directions, rates) = x.split_at(C * n);
+        let (directions, rates) = (directions.as_chunks::<C>().0, rates.as_chunks::<C>().0);
         Linearised::new(&self.rods, gravity, pivot, |i| {
-            let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
-            Load {
-                direction: std::array::from_fn(|k| u[k]),
-                rate_squared: w.iter().map(|v| v * v).sum(),
-                pair: std::array::from_fn(|k| -drag[i] * w[k]),
+            let (u, w) = (directions[i], &rates[i]);
+            let mut load = Load { direction: u, rate_squared: 0.0, pair: [0.0; C] };
+            for (pair, w) in load.pair.iter_mut().zip(w) {
+                load.rate_squared += w * w;
+                *pair = -drag[i] * w;
             }
+            load
         })
-    }
-
-    /// One tangent of a kept solve: `δü` (written into `out`, `C·n` entries) along
-    /// `dx = (δu, δw)` (`2·C·n` entries) at the state `x`.
-    fn tangent_of<const C: usize>(
-        &self,
-        solve: &Linearised<C>,
-        x: &[f64],
-        dx: &[f64],
-        work: &mut [TangentRow<C>],
-        udd: &mut [[f64; C]],
-        out: &mut [f64],
-    ) {
-        let n = self.links();
-        let drag = self.rods.drag();
-        let rates = &x[C * n..];
-        let (du, dw) = dx.split_at(C * n);
-        let dload = |i: usize| {
-            let (w, dwi) = (&rates[i * C..(i + 1) * C], &dw[i * C..(i + 1) * C]);
-            LoadTangent {
-                direction: std::array::from_fn(|k| du[i * C + k]),
-                rate_squared: 2.0 * (0..C).map(|k| w[k] * dwi[k]).sum::<f64>(),
-                pair: std::array::from_fn(|k| -drag[i] * dwi[k]),
-            }
-        };
-        solve.tangent(&self.rods, dload, [0.0; C], work, udd);
-        for (o, d) in out.chunks_exact_mut(C).zip(udd.iter()) {
-            o.copy_from_slice(d);
-        }
     }
 
     /// `δü = (∂ü/∂u) δu + (∂ü/∂w) δw` (1/s²) at `(t, x)` along `dx = (δu, δw)`, written
     /// into `out` (`S·n` entries): one O(n) linearised solve and one tangent pass.
     ///
     /// Errors: [`Error::LengthMismatch`] / [`Error::NonFinite`] for a bad state, direction
-    /// or buffer.
+    /// or buffer (the direction's entries checked only when the result is not finite).
     pub fn jvp(&self, t: f64, x: &DVector<f64>, dx: &DVector<f64>, out: &mut [f64]) -> Result<()> {
         self.check_state(x)?;
-        crate::model::check_vector("dx", dx.as_slice(), self.state_len())?;
         let n = self.links();
+        if dx.len() != self.state_len() {
+            return Err(Error::LengthMismatch { what: "dx", expected: self.state_len(), got: dx.len() });
+        }
         if out.len() != S::DIM * n {
             return Err(Error::LengthMismatch { what: "out", expected: S::DIM * n, got: out.len() });
         }
         match S::DIM {
-            2 => {
-                let solve = self.linearised::<2>(t, x.as_slice());
-                let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; 2]; n]);
-                self.tangent_of(&solve, x.as_slice(), dx.as_slice(), &mut work, &mut udd, out);
-            }
-            _ => {
-                let solve = self.linearised::<3>(t, x.as_slice());
-                let (mut work, mut udd) = (TangentRow::scratch(n), vec![[0.0; 3]; n]);
-                self.tangent_of(&solve, x.as_slice(), dx.as_slice(), &mut work, &mut udd, out);
-            }
+            2 => self.jvp_in::<2>(t, x.as_slice(), dx.as_slice(), out),
+            _ => self.jvp_in::<3>(t, x.as_slice(), dx.as_slice(), out),
+        }
+        if !crate::model::all_finite(out) {
+            crate::model::check_vector("dx", dx.as_slice(), self.state_len())?;
         }
         Ok(())
+    }
+
+    /// [`jvp`](Self::jvp) in `C = S::DIM` dimensions: rod `i`'s load moves by `δu_i`,
+    /// `2 w_i·δw_i` and `−(λ_i/l_i) δw_i` (module docs).
+    fn jvp_in<const C: usize>(&self, t: f64, x: &[f64], dx: &[f64], out: &mut [f64]) {
+        let n = self.links();
+        let solve = self.linearised::<C>(t, x);
+        let drag = self.rods.drag();
+        let rates = x[C * n..].as_chunks::<C>().0;
+        let (du, dw) = dx.split_at(C * n);
+        let (du, dw) = (du.as_chunks::<C>().0, dw.as_chunks::<C>().0);
+        let mut rows: Vec<TangentRow<C>> = (0..n)
+            .map(|i| {
+                let (w, dwi) = (&rates[i], &dw[i]);
+                let mut load = LoadTangent { direction: du[i], rate_squared: 0.0, pair: [0.0; C] };
+                for ((pair, w), dw) in load.pair.iter_mut().zip(w).zip(dwi) {
+                    load.rate_squared += 2.0 * w * dw;
+                    *pair = -drag[i] * dw;
+                }
+                TangentRow::new(load)
+            })
+            .collect();
+        solve.tangent(&self.rods, [0.0; C], &mut rows, out.as_chunks_mut::<C>().0);
     }
 
     /// The Jacobian `∂x'/∂x = [[0, I], [∂ü/∂u, ∂ü/∂w]]` of the first-order system at
@@ -121,13 +114,13 @@ where
         let mut columns = Vec::with_capacity(2 * half);
         for j in 0..half {
             let load = LoadTangent { direction: unit(j % C), rate_squared: 0.0, pair: zero };
-            columns.push(Column { rod: j / C, load, pivot: zero });
+            columns.push(Column { rod: j / C, load });
         }
         for (j, &rate) in rates.iter().enumerate().take(half) {
             let (rod, k) = (j / C, j % C);
             let pair = std::array::from_fn(|m| if m == k { -drag[rod] } else { 0.0 });
             let load = LoadTangent { direction: zero, rate_squared: 2.0 * rate, pair };
-            columns.push(Column { rod, load, pivot: zero });
+            columns.push(Column { rod, load });
         }
         let green = solve.green(&self.rods, &rows);
         let mut lower = vec![0.0; half * 2 * half];
@@ -183,5 +176,45 @@ mod tests {
             )
             .unwrap();
         agrees!(spatial, x);
+    }
+
+    /// Masses of 1e-150 kg take the linearised solve's continuants out of their range; the
+    /// classical pivots then give the JVP of the same chain at 1 kg (no damping: the motion
+    /// does not depend on the masses' scale).
+    #[test]
+    fn the_linearised_solve_falls_back_to_pivots_for_extreme_masses() {
+        let (masses, lengths) = ([1.0, 3.0, 2.0, 1.0], [1.0, 0.5, 2.0, 1.0]);
+        let tiny: Vec<f64> = masses.iter().map(|m| m * 1e-150).collect();
+        let model = |m: &[f64]| {
+            Directions::<U3>::new(Chain::new(m, &lengths, 9.81).unwrap())
+                .with_drive(Circle::new(0.1, 3.0).unwrap())
+        };
+        let (normal, extreme) = (model(&masses), model(&tiny));
+        let x = normal
+            .from_spherical(
+                &[0.9, 1.7, 2.3, 0.5, 0.2, -1.0, 2.8, 0.3],
+                &[1.5, -0.7, 2.1, 0.4, 1.2, -0.9, 0.3, 0.8],
+            )
+            .unwrap();
+        let dx = DVector::from_fn(x.len(), |i, _| ((i as f64) * 0.9).cos());
+        let (mut a, mut b) = (vec![0.0; 12], vec![0.0; 12]);
+        normal.jvp(0.7, &x, &dx, &mut a).unwrap();
+        extreme.jvp(0.7, &x, &dx, &mut b).unwrap();
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(a.iter().zip(&b).all(|(p, q)| (p - q).abs() < 1e-12 * scale), "{a:?} {b:?}");
+    }
+
+    #[test]
+    fn a_bad_direction_is_an_error() {
+        let model = Directions::<U2>::new(Chain::uniform(3, 1.0, 1.0, 9.81).unwrap());
+        let x = model.from_angles(&[0.4, -1.3, 2.2], &[1.5, -0.7, 2.1]).unwrap();
+        let mut out = vec![0.0; 6];
+        let mut dx = DVector::from_element(x.len(), 0.5);
+        dx[7] = f64::NAN;
+        let err = model.jvp(0.0, &x, &dx, &mut out).unwrap_err();
+        assert!(matches!(err, Error::NonFinite { what: "dx", index: 7, .. }), "{err:?}");
+        let short = DVector::from_element(x.len() - 1, 0.5);
+        let err = model.jvp(0.0, &x, &short, &mut out).unwrap_err();
+        assert_eq!(err, Error::LengthMismatch { what: "dx", expected: 12, got: 11 });
     }
 }

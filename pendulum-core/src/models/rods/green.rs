@@ -1,7 +1,7 @@
 //! Every column of a tension solve's Jacobian at once, in O(n²) with a small constant.
 //!
 //! A column whose load change sits on one rod `x` (a coordinate, rate or torque of link
-//! `x`; or the pivot, on rod 0) changes the right-hand side of `A δT = r` in rows
+//! `x`) changes the right-hand side of `A δT = r` in rows
 //! `x − 1 … x + 1` only, and the part of `δü` that does not go through `δT` only on rods
 //! `x − 1 … x + 1` (tangent module: `r = δb − δA T`, and the local part from `δa°`, `δu`).
 //! With `δü_i = Σ_j V_ij δT_j + local_i`, `V` block tridiagonal:
@@ -18,12 +18,11 @@
 use super::tangent::{Linearised, LoadTangent};
 use super::{Rods, dot};
 
-/// One column's load change: on rod `rod` (`load`), and the pivot's (`pivot`).
+/// One column's load change: `load` on rod `rod` (the pivot's acceleration unchanged).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Column<const S: usize> {
     pub rod: usize,
     pub load: LoadTangent<S>,
-    pub pivot: [f64; S],
 }
 
 /// The sparse parts of one column (module docs): `r` in rows `x − 1, x, x + 1` and the
@@ -41,12 +40,12 @@ impl<const S: usize> Linearised<S> {
         let im = |i: usize| rods.inverse_mass[i];
         let im_above = if x > 0 { im(x - 1) } else { 0.0 };
         let (du, dpair) = (c.load.direction, c.load.pair);
-        // δa° at masses x − 1 (the pivot for x = 0) and x.
+        // δa° at masses x − 1 (none above rod 0: the pivot's is unchanged) and x.
         let mut dfree_above = [0.0; S];
         let mut dfree = [0.0; S];
         for k in 0..S {
             dfree[k] = dpair[k] * im(x);
-            dfree_above[k] = if x > 0 { -dpair[k] * im_above } else { c.pivot[k] };
+            dfree_above[k] = if x > 0 { -dpair[k] * im_above } else { 0.0 };
         }
         let u = |i: usize| self.direction(i);
         let t = |i: usize| self.tension(i);
@@ -80,7 +79,7 @@ impl<const S: usize> Linearised<S> {
             rhs[2] = r_below;
         }
         rhs[1] = r;
-        // local_a at masses x − 1 (the pivot's δp̈ for x = 0) and x, zero elsewhere;
+        // local_a at masses x − 1 and x, zero elsewhere (the pivot's too);
         // local ü_i = (local_a_i − local_a_{i−1}) / l_i on rods x − 1, x, x + 1.
         let mut a_x = dfree;
         let mut a_above = dfree_above;
@@ -93,12 +92,11 @@ impl<const S: usize> Linearised<S> {
         let mut local = [[0.0; S]; 3];
         for k in 0..S {
             if x > 0 {
-                // Rod x − 1: (local_a_{x−1} − local_a_{x−2}) with local_a_{x−2} = δp̈ if x = 1.
-                let before = if x == 1 { c.pivot[k] } else { 0.0 };
-                local[0][k] = (a_above[k] - before) * rods.inverse_length[x - 1];
+                // Rod x − 1: local_a_{x−1} − local_a_{x−2}, the latter zero.
+                local[0][k] = a_above[k] * rods.inverse_length[x - 1];
                 local[1][k] = (a_x[k] - a_above[k]) * rods.inverse_length[x];
             } else {
-                local[1][k] = (a_x[k] - c.pivot[k]) * rods.inverse_length[0];
+                local[1][k] = a_x[k] * rods.inverse_length[0];
             }
             if x + 1 < n {
                 local[2][k] = -a_x[k] * rods.inverse_length[x + 1];

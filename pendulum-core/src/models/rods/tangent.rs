@@ -19,7 +19,7 @@
 // The per-component loops read and write several `[f64; S]` at one index, like the solve's.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Load, Rods, dot, entries};
+use super::{Continuants, Load, Rods, dot, entries};
 
 /// The change of one rod's [`Load`] along a direction.
 #[derive(Debug, Clone, Copy)]
@@ -38,9 +38,12 @@ struct Kept<const S: usize> {
     load: Load<S>,
     /// `a°_i`.
     free: [f64; S],
+    /// `b_i`, kept for [`Linearised::eliminate_by_pivots`].
+    rhs: f64,
     /// `f_i = A_{i,i−1}/D_{i−1}` and `1/D_i`.
     factor: f64,
     inverse_pivot: f64,
+    /// `T_i` (N); `e_i = b_i − f_i e_{i−1}` until [`Linearised::substitute`].
     tension: f64,
     /// `ü_i`.
     acceleration: [f64; S],
@@ -54,17 +57,20 @@ pub(crate) struct Linearised<const S: usize> {
 }
 
 impl<const S: usize> Linearised<S> {
-    /// The solve of `rods` with these loads, gravity `g⃗` and pivot acceleration `p̈`.
+    /// The solve of `rods` with these loads, gravity `g⃗` and pivot acceleration `p̈`: the
+    /// pivots by continuants ([`Continuants`]), the classical way should one leave its
+    /// range.
     pub fn new(rods: &Rods, gravity: [f64; S], pivot: [f64; S], load: impl Fn(usize) -> Load<S>) -> Self {
         let n = rods.len();
-        let loads: Vec<Load<S>> = (0..n).map(load).collect();
         let mut kept = Vec::with_capacity(n);
+        let mut continuants = Continuants::new();
         let (mut free_above, mut im_above, mut u_above) = (pivot, 0.0, [0.0; S]);
         let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
-        let mut eliminated = vec![0.0; n];
+        let mut below = (n > 0).then(|| load(0));
         for i in 0..n {
-            let here = loads[i];
-            let pair_below = if i + 1 < n { loads[i + 1].pair } else { [0.0; S] };
+            let here = below.expect("rod i");
+            below = (i + 1 < n).then(|| load(i + 1));
+            let pair_below = below.map_or([0.0; S], |b| b.pair);
             let im = rods.inverse_mass[i];
             let mut a = gravity;
             let mut rhs = rods.length[i] * here.rate_squared;
@@ -73,28 +79,45 @@ impl<const S: usize> Linearised<S> {
                 rhs += here.direction[k] * (a[k] - free_above[k]);
             }
             let (diagonal, off) = entries(im, im_above, &u_above, &here.direction);
+            let inverse_pivot = continuants.inverse_pivot(i, diagonal, off);
             let factor = off * inverse_pivot_above;
-            let inverse_pivot = 1.0 / (diagonal - factor * off);
-            eliminated[i] = rhs - factor * eliminated_above;
+            let eliminated = rhs - factor * eliminated_above;
             kept.push(Kept {
                 load: here,
                 free: a,
+                rhs,
                 factor,
                 inverse_pivot,
-                tension: 0.0,
+                tension: eliminated,
                 acceleration: [0.0; S],
             });
             (free_above, im_above, u_above) = (a, im, here.direction);
-            (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated[i]);
+            (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
         }
         let mut out = Self { rods: kept, pivot };
-        out.substitute(rods, &eliminated);
+        if !continuants.in_range() {
+            out.eliminate_by_pivots(rods);
+        }
+        out.substitute(rods);
         out
     }
 
-    /// `ü_i` (1/s²) per rod.
-    pub fn accelerations(&self) -> impl Iterator<Item = &[f64; S]> {
-        self.rods.iter().map(|k| &k.acceleration)
+    /// The elimination again with the pivots `D_i = A_ii − f_i A_{i,i−1}` (a division on
+    /// the serial chain), for the solves whose continuants left their range.
+    #[cold]
+    #[inline(never)]
+    fn eliminate_by_pivots(&mut self, rods: &Rods) {
+        let (mut im_above, mut u_above) = (0.0, [0.0; S]);
+        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+        for (i, kept) in self.rods.iter_mut().enumerate() {
+            let (im, u) = (rods.inverse_mass[i], kept.load.direction);
+            let (diagonal, off) = entries(im, im_above, &u_above, &u);
+            kept.factor = off * inverse_pivot_above;
+            kept.inverse_pivot = 1.0 / (diagonal - kept.factor * off);
+            kept.tension = kept.rhs - kept.factor * eliminated_above;
+            (im_above, u_above) = (im, u);
+            (inverse_pivot_above, eliminated_above) = (kept.inverse_pivot, kept.tension);
+        }
     }
 
     /// Number of rods.
@@ -134,12 +157,12 @@ impl<const S: usize> Linearised<S> {
 
     /// The primal back substitution: `T_i = e_i/D_i − f_{i+1} T_{i+1}`, then
     /// `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i` and `ü_i = (a_i − a_{i−1})/l_i`.
-    fn substitute(&mut self, rods: &Rods, eliminated: &[f64]) {
+    fn substitute(&mut self, rods: &Rods) {
         let n = self.rods.len();
         let mut tension_below = 0.0;
         for i in (0..n).rev() {
             let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
-            let t = eliminated[i] * self.rods[i].inverse_pivot - below_factor * tension_below;
+            let t = self.rods[i].tension * self.rods[i].inverse_pivot - below_factor * tension_below;
             self.rods[i].tension = t;
             tension_below = t;
         }
@@ -165,30 +188,23 @@ impl<const S: usize> Linearised<S> {
         }
     }
 
-    /// `δü_i` (1/s²) along the load tangents `dload(i)` and the pivot tangent `dpivot`,
-    /// written into `out` (`n` entries); `work` holds `n` entries of scratch.
-    pub fn tangent(
-        &self,
-        rods: &Rods,
-        dload: impl Fn(usize) -> LoadTangent<S>,
-        dpivot: [f64; S],
-        work: &mut [TangentRow<S>],
-        out: &mut [[f64; S]],
-    ) {
+    /// `δü_i` (1/s²) along the load tangents in `work` (one [`TangentRow`] per rod) and
+    /// the pivot tangent `dpivot`, written into `out` (`n` entries).
+    pub fn tangent(&self, rods: &Rods, dpivot: [f64; S], work: &mut [TangentRow<S>], out: &mut [[f64; S]]) {
         let n = self.rods.len();
+        let work = &mut work[..n];
         // Down: δF, δa°, r = δb − δA T, eliminated with the kept factors one row behind
         // (row i − 1's r is complete once row i has added its −δA_{i−1,i} T_i).
         let (mut dfree_above, mut free_above) = (dpivot, self.pivot);
         let (mut du_above, mut rhs_above, mut e_above) = ([0.0; S], 0.0, 0.0);
-        let mut dload_here = dload(0);
         for i in 0..n {
-            let dload_below = if i + 1 < n { Some(dload(i + 1)) } else { None };
+            let dload_here = work[i].load;
             let kept = &self.rods[i];
             let im = rods.inverse_mass[i];
             let im_above = if i > 0 { rods.inverse_mass[i - 1] } else { 0.0 };
             let u = kept.load.direction;
             let du = dload_here.direction;
-            let dpair_below = dload_below.map_or([0.0; S], |d| d.pair);
+            let dpair_below = if i + 1 < n { work[i + 1].load.pair } else { [0.0; S] };
             let mut dfree = [0.0; S];
             let mut rhs = rods.length[i] * dload_here.rate_squared;
             for k in 0..S {
@@ -205,11 +221,8 @@ impl<const S: usize> Linearised<S> {
                 e_above = rhs_above - above.factor * e_above;
                 work[i - 1].rhs = e_above;
             }
-            work[i] = TangentRow { direction: du, free: dfree, rhs: 0.0 };
+            work[i].free = dfree;
             (dfree_above, free_above, du_above, rhs_above) = (dfree, kept.free, du, rhs);
-            if let Some(d) = dload_below {
-                dload_here = d;
-            }
         }
         if n > 0 {
             work[n - 1].rhs = rhs_above - self.rods[n - 1].factor * e_above;
@@ -224,12 +237,12 @@ impl<const S: usize> Linearised<S> {
             let row = &work[i];
             let mut da = row.free;
             for k in 0..S {
-                da[k] -= (dt * kept.load.direction[k] + kept.tension * row.direction[k]) * im;
+                da[k] -= (dt * kept.load.direction[k] + kept.tension * row.load.direction[k]) * im;
             }
             if i + 1 < n {
                 let (kb, rb) = (&self.rods[i + 1], &work[i + 1]);
                 for k in 0..S {
-                    da[k] += (dt_below * kb.load.direction[k] + kb.tension * rb.direction[k]) * im;
+                    da[k] += (dt_below * kb.load.direction[k] + kb.tension * rb.load.direction[k]) * im;
                 }
                 let il = rods.inverse_length[i + 1];
                 for k in 0..S {
@@ -247,18 +260,18 @@ impl<const S: usize> Linearised<S> {
     }
 }
 
-/// Scratch of one [`Linearised::tangent`], per rod: `δu_i`, `δa°_i` and the eliminated
-/// right-hand side.
+/// One rod of a [`Linearised::tangent`]: its load's tangent, and the pass's scratch
+/// (`δa°_i` and the eliminated right-hand side).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TangentRow<const S: usize> {
-    direction: [f64; S],
+    load: LoadTangent<S>,
     free: [f64; S],
     rhs: f64,
 }
 
 impl<const S: usize> TangentRow<S> {
-    /// Scratch for `n` rods.
-    pub fn scratch(n: usize) -> Vec<Self> {
-        vec![Self { direction: [0.0; S], free: [0.0; S], rhs: 0.0 }; n]
+    /// The row of a rod whose load moves by `load`.
+    pub fn new(load: LoadTangent<S>) -> Self {
+        Self { load, free: [0.0; S], rhs: 0.0 }
     }
 }

@@ -1,0 +1,261 @@
+//! [`PlanarTangents`]: the planar tension solve in the links' own angles at one state,
+//! kept for its derivatives: Jacobian-vector products in O(n) here, full Jacobians in
+//! O(n²) in `jacobians`. Generic over the chain's dimension, so the generated models
+//! (`Const<N>`, stack arrays) and [`PlanarTension`](super::PlanarTension) (`Dyn`) share it.
+//!
+//! In the links' frames (`C_j = cos(θ_j − θ_{j−1})`, `S_j = sin(θ_j − θ_{j−1})`, the pulls
+//! `f_i = σ_i/l_i − (λ_i/l_i) θ̇_i`, `A` the tension system with `A_ii = 1/m_i + 1/m_{i−1}`
+//! and `A_{j,j−1} = −C_j/m_{j−1}`, 0-based, `1/m_{−1} = 0`) the solve is `A T = b` and
+//! `θ̈ = h(θ, θ̇, σ, p̈, T)`:
+//! ```text
+//! b_i = l_i θ̇_i² + f_{i+1} S_{i+1}/m_i − f_{i−1} S_i/m_{i−1}  [+ u_0·(g⃗ − p̈) for i = 0]
+//! θ̈_i = (f_i A_ii − f_{i+1} C_{i+1}/m_i − f_{i−1} C_i/m_{i−1}
+//!         + T_{i+1} S_{i+1}/m_i − T_{i−1} S_i/m_{i−1}) / l_i   [− n_0·(p̈ − g⃗)/l_0 for i = 0]
+//! ```
+//! with `u_0 = (sin θ_0, −cos θ_0)`, `n_0 = (cos θ_0, sin θ_0)`, `g⃗ = (0, −g)`; `A` is
+//! factored by the classical elimination (`D_i = A_ii − F_i A_{i,i−1}`,
+//! `F_i = A_{i,i−1}/D_{i−1}`).
+//!
+//! With the residual `r = b − A T` at fixed `T` and `H = ∂h/∂T` (tridiagonal, zero
+//! diagonal: `H_{i,i+1} = S_{i+1}/(m_i l_i)`, `H_{i,i−1} = −S_i/(m_{i−1} l_i)`), a change
+//! `δx` of the state or the inputs gives `δθ̈ = δh + H A⁻¹ δr`. An angle, rate or torque
+//! of link `x` moves `r` and `h` in rows `x − 1 … x + 1` only, through the joints `x` and
+//! `x + 1` (`φ_j = θ_j − θ_{j−1}`, [`Joint`]) and the pull `f_x`; so a JVP is one pass that
+//! gathers `δr`, `δh` per row, and one tridiagonal solve with the kept factors.
+
+use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, allocator::Allocator};
+
+use crate::models::rods::Continuants;
+pub use crate::models::rods::RodConstants;
+use crate::models::trig::sin_cos_into;
+
+/// The joint above link `j` (between links `j − 1` and `j`, module docs): `C_j`, `S_j` and
+/// the derivatives of `r_{j−1}`, `r_j`, `h_{j−1}`, `h_j` by `φ_j = θ_j − θ_{j−1}`; zero for
+/// the joints outside the chain (above link 0, below the last).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Joint {
+    pub cos: f64,
+    pub sin: f64,
+    pub r_above: f64,
+    pub r_below: f64,
+    pub h_above: f64,
+    pub h_below: f64,
+}
+
+/// One link of the kept solve.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Link {
+    pub sin: f64,
+    pub cos: f64,
+    /// `θ̇_i` (rad/s).
+    pub rate: f64,
+    /// `f_i` (N).
+    pub pull: f64,
+    /// The joint above this link.
+    pub joint: Joint,
+    /// `F_i = A_{i,i−1}/D_{i−1}` (0 for link 0) and `1/D_i` (kg).
+    pub factor: f64,
+    pub inverse_pivot: f64,
+    /// `T_i` (N).
+    pub tension: f64,
+    /// `θ̈_i` (rad/s²).
+    pub acceleration: f64,
+}
+
+/// [`PlanarTension`](super::PlanarTension)'s solve at one state, kept for its tangents:
+/// the directional derivatives (Jacobian-vector products) of `θ̈` in O(n) each
+/// ([`jvp`](Self::jvp)), and its full Jacobians in O(n²)
+/// ([`jacobians`](Self::jacobians)), in the links' own angles (module docs).
+#[derive(Debug, Clone)]
+pub struct PlanarTangents<'a, L: Dim = Dyn>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    pub(super) rods: RodConstants<'a>,
+    /// `g` (m/s²).
+    pub(super) gravity: f64,
+    /// `p̈` (m/s²).
+    pub(super) pivot: [f64; 2],
+    pub(super) links: OVector<Link, L>,
+    /// The JVP's right-hand side `δr`, then `A⁻¹ δr`.
+    work: OVector<f64, L>,
+}
+
+impl<'a, L: Dim> PlanarTangents<'a, L>
+where
+    DefaultAllocator: Allocator<L>,
+{
+    /// The solve of the chain `rods` under gravity `g` (m/s²) at `θ = q`, `θ̇ = qd` with
+    /// torques `torque` (N·m) and pivot acceleration `p̈ = pivot` (m/s²): `dim` links, every
+    /// slice that long (the caller checks). Non-finite inputs give non-finite results.
+    /// Inlined so that a fixed `n` unrolls it and the result is built in place.
+    #[inline(always)]
+    pub(crate) fn new(
+        rods: RodConstants<'a>,
+        gravity: f64,
+        dim: L,
+        q: &[f64],
+        qd: &[f64],
+        torque: &[f64],
+        pivot: [f64; 2],
+    ) -> Self {
+        let n = dim.value();
+        let RodConstants { inverse_mass: im, inverse_length: il, drag, .. } = rods;
+        let mut trig = OVector::<[f64; 2], L>::from_element_generic(dim, U1, [0.0; 2]);
+        sin_cos_into(q, trig.as_mut_slice());
+        let mut links = OVector::<Link, L>::from_fn_generic(dim, U1, |i, _| {
+            let [sin, cos] = trig[i];
+            let pull = torque[i] * il[i] - drag[i] * qd[i];
+            Link { sin, cos, rate: qd[i], pull, ..Link::default() }
+        });
+        let ls = links.as_mut_slice();
+        for j in 1..n {
+            let (above, here) = (ls[j - 1], ls[j]);
+            ls[j].joint.cos = above.cos * here.cos + above.sin * here.sin;
+            ls[j].joint.sin = here.sin * above.cos - here.cos * above.sin;
+        }
+        // Down: b_i, eliminated as it comes, the pivots by continuants (the classical way
+        // should a continuant leave its range).
+        let mut continuants = Continuants::new();
+        eliminate(ls, rods, gravity, pivot, |i, diagonal, off| continuants.inverse_pivot(i, diagonal, off));
+        if !continuants.in_range() {
+            let mut inverse_pivot_above = 0.0;
+            eliminate(ls, rods, gravity, pivot, |_, diagonal, off| {
+                inverse_pivot_above = 1.0 / (diagonal - off * off * inverse_pivot_above);
+                inverse_pivot_above
+            });
+        }
+        // Up: T_i = e_i/D_i − F_{i+1} T_{i+1}.
+        let mut below = (0.0, 0.0);
+        for i in (0..n).rev() {
+            let t = ls[i].tension * ls[i].inverse_pivot - below.0 * below.1;
+            ls[i].tension = t;
+            below = (ls[i].factor, t);
+        }
+        // θ̈ and the joints' derivative terms.
+        for i in 0..n {
+            let here = ls[i];
+            let im_above = if i >= 1 { im[i - 1] } else { 0.0 };
+            let mut a = here.pull * (im[i] + im_above);
+            if i + 1 < n {
+                let b = ls[i + 1];
+                a += (b.tension * b.joint.sin - b.pull * b.joint.cos) * im[i];
+            }
+            if i >= 1 {
+                let (above, j) = (ls[i - 1], here.joint);
+                a -= (above.pull * j.cos + above.tension * j.sin) * im_above;
+                let w = im_above;
+                ls[i].joint = Joint {
+                    r_above: w * (here.pull * j.cos - j.sin * here.tension),
+                    r_below: w * (-above.pull * j.cos - j.sin * above.tension),
+                    h_above: il[i - 1] * w * (here.pull * j.sin + here.tension * j.cos),
+                    h_below: il[i] * w * (above.pull * j.sin - above.tension * j.cos),
+                    ..j
+                };
+            } else {
+                let [px, py] = pivot;
+                a -= here.cos * px + here.sin * (py + gravity);
+            }
+            ls[i].acceleration = a * il[i];
+        }
+        let work = OVector::from_element_generic(dim, U1, 0.0);
+        Self { rods, gravity, pivot, links, work }
+    }
+
+    /// `θ̈` at the state (rad/s²), per link.
+    pub fn accelerations(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
+        self.links.iter().map(|l| l.acceleration)
+    }
+
+    /// `δθ̈` (rad/s²) along `(δθ, δθ̇, δσ, δp̈)`, written into `out`; every slice has `n`
+    /// entries: one pass gathering `δr` and `δh` with the elimination of `δr` one row
+    /// behind, one back substitution applying `H` (module docs). O(n), allocation-free.
+    pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
+        let n = self.links.len();
+        let RodConstants { inverse_mass: im, length, inverse_length: il, drag } = self.rods;
+        let (links, work) = (self.links.as_slice(), self.work.as_mut_slice());
+        let (dq, dqd, dtorque, out) = (&dq[..n], &dqd[..n], &dtorque[..n], &mut out[..n]);
+        let dpull = |i: usize| dtorque[i] * il[i] - drag[i] * dqd[i];
+        let mut e_above = 0.0;
+        for i in 0..n {
+            let here = &links[i];
+            let df = dpull(i);
+            let im_above = if i >= 1 { im[i - 1] } else { 0.0 };
+            let mut dr = 2.0 * length[i] * here.rate * dqd[i];
+            let mut dh = il[i] * (im[i] + im_above) * df;
+            if i >= 1 {
+                let (j, dphi, df_above) = (here.joint, dq[i] - dq[i - 1], dpull(i - 1));
+                dr += j.r_below * dphi - im_above * j.sin * df_above;
+                dh += j.h_below * dphi - il[i] * im_above * j.cos * df_above;
+            } else {
+                let [px, py] = self.pivot;
+                let (s, c, g) = (here.sin, here.cos, self.gravity);
+                dr -= (s * (g + py) + c * px) * dq[0] + s * dpivot[0] - c * dpivot[1];
+                dh += il[0] * ((s * px - c * (g + py)) * dq[0] - c * dpivot[0] - s * dpivot[1]);
+            }
+            if i + 1 < n {
+                let (j, dphi, df_below) = (links[i + 1].joint, dq[i + 1] - dq[i], dpull(i + 1));
+                dr += j.r_above * dphi + im[i] * j.sin * df_below;
+                dh += j.h_above * dphi - il[i] * im[i] * j.cos * df_below;
+            }
+            e_above = dr - here.factor * e_above;
+            work[i] = e_above;
+            out[i] = dh;
+        }
+        // Up: y_i = e_i/D_i − F_{i+1} y_{i+1}; row i + 1 of H A⁻¹ δr once y_i is known.
+        let mut y_below = 0.0;
+        for i in (0..n).rev() {
+            let factor_below = if i + 1 < n { links[i + 1].factor } else { 0.0 };
+            let y = work[i] * links[i].inverse_pivot - factor_below * y_below;
+            work[i] = y;
+            if i + 1 < n {
+                // H_{i+1,i} y_i + H_{i+1,i+2} y_{i+2}.
+                let below = i + 1;
+                let mut h = -il[below] * im[i] * links[below].joint.sin * y;
+                if below + 1 < n {
+                    h += il[below] * im[below] * links[below + 1].joint.sin * work[below + 1];
+                }
+                out[below] += h;
+            }
+            y_below = y;
+        }
+        if n > 1 {
+            out[0] += il[0] * im[0] * links[1].joint.sin * work[1];
+        }
+    }
+}
+
+/// The down pass of [`PlanarTangents::new`]: `b_i` (module docs) and its elimination,
+/// `F_i = A_{i,i−1}/D_{i−1}` and `e_i = b_i − F_i e_{i−1}` (kept in `tension`), with the
+/// pivots `1/D_i` from `inverse_pivot(i, A_ii, A_{i,i−1})`.
+#[inline(always)]
+fn eliminate(
+    ls: &mut [Link],
+    rods: RodConstants<'_>,
+    gravity: f64,
+    [px, py]: [f64; 2],
+    mut inverse_pivot: impl FnMut(usize, f64, f64) -> f64,
+) {
+    let n = ls.len();
+    let RodConstants { inverse_mass: im, length, .. } = rods;
+    let (mut inverse_pivot_above, mut e_above) = (0.0, 0.0);
+    for i in 0..n {
+        let here = ls[i];
+        let im_above = if i >= 1 { im[i - 1] } else { 0.0 };
+        let mut b = length[i] * here.rate * here.rate;
+        if i == 0 {
+            b += here.cos * (gravity + py) - here.sin * px;
+        } else {
+            b -= ls[i - 1].pull * here.joint.sin * im_above;
+        }
+        if i + 1 < n {
+            b += ls[i + 1].pull * ls[i + 1].joint.sin * im[i];
+        }
+        let off = -here.joint.cos * im_above;
+        let ip = inverse_pivot(i, im[i] + im_above, off);
+        let factor = off * inverse_pivot_above;
+        let e = b - factor * e_above;
+        (ls[i].factor, ls[i].inverse_pivot, ls[i].tension) = (factor, ip, e);
+        (inverse_pivot_above, e_above) = (ip, e);
+    }
+}
