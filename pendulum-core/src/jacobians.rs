@@ -133,10 +133,10 @@ where
     }
 
     /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` into `out.accelerations`, `out.q` and `out.qd`: what
-    /// an implicit integrator's Newton iteration needs. The rest of `out` is unspecified
-    /// (the default computes it too, by
-    /// [`acceleration_jacobians`](Derivatives::acceleration_jacobians); a model with a
-    /// cheaper route for the state alone skips it).
+    /// an implicit integrator's Newton iteration needs. The rest of `out` is unspecified:
+    /// the default computes it too (it is
+    /// [`acceleration_jacobians`](Derivatives::acceleration_jacobians)); the planar
+    /// tension routes skip it.
     ///
     /// Errors: those of [`Model::accelerations`].
     fn state_jacobians(
@@ -148,6 +148,15 @@ where
     ) -> Result<()> {
         self.acceleration_jacobians(q, qd, inputs, out)
     }
+}
+
+/// Which of the Jacobians a route computes (`planar_tension_jacobians`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parts {
+    /// `∂q̈/∂q`, `∂q̈/∂q̇`, `∂q̈/∂σ` and `∂q̈/∂p̈`.
+    All,
+    /// `∂q̈/∂q` and `∂q̈/∂q̇` only ([`Derivatives::state_jacobians`]).
+    State,
 }
 
 #[cfg(test)]

@@ -63,7 +63,7 @@ pub use energy::{
     pivot_momentum_rate, powers,
 };
 pub use error::{Error, Result};
-pub use jacobians::{Derivatives, Jacobians};
+pub use jacobians::{Derivatives, Jacobians, Parts};
 pub use kinematics::{SINGULARITY_TOLERANCE, check_polar_angle, check_polar_sin};
 pub use model::{Inputs, InputsAt, Model, ModelAlloc, check_inputs};
 pub use models::{Directions, Planar, PlanarTangents, PlanarTension, RodMidpoint, Spatial};
@@ -75,6 +75,6 @@ pub mod __private {
     pub use nalgebra;
 
     pub use crate::models::rods::CONTINUANT_RANGE;
-    pub use crate::models::tension::{Parts, RodConstants, planar_tension_jacobians};
+    pub use crate::models::tension::{RodConstants, planar_tension_jacobians};
     pub use crate::models::trig::sin_cos_into;
 }

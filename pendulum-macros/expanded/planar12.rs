@@ -3286,7 +3286,7 @@ const _: () = {
                 qd,
                 inputs,
                 out,
-                ::pendulum_core::__private::Parts::All,
+                ::pendulum_core::Parts::All,
             )
         }
         #[doc = " `q\u{308}`, `∂q\u{308}/∂q` and `∂q\u{308}/∂q\u{307}` alone, by the same solve."]
@@ -3309,7 +3309,7 @@ const _: () = {
                 qd,
                 inputs,
                 out,
-                ::pendulum_core::__private::Parts::State,
+                ::pendulum_core::Parts::State,
             )
         }
     }

@@ -4,7 +4,7 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allo
 
 use crate::chain::Chain;
 use crate::error::Result;
-use crate::jacobians::{Derivatives, Jacobians};
+use crate::jacobians::{Derivatives, Jacobians, Parts};
 use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, ModelAlloc, check_inputs};
@@ -182,15 +182,6 @@ where
 {
     let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
     PlanarTangents::new(rods, gravity, dim, q.as_slice(), qd.as_slice(), inputs.torque.as_slice(), pivot)
-}
-
-/// Which Jacobians [`planar_tension_jacobians`] computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Parts {
-    /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇`, `∂θ̈/∂σ` and `∂θ̈/∂p̈`.
-    All,
-    /// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` only ([`Derivatives::state_jacobians`]).
-    State,
 }
 
 /// `θ̈` and its Jacobians (`parts`) for a planar chain of these rods by the kept tension

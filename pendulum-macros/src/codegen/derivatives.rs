@@ -44,7 +44,7 @@ fn tension_jacobians(plan: &Plan) -> TokenStream {
                 out: &mut ::pendulum_core::Jacobians<Self>,
             ) -> Result<()> {
                 ::pendulum_core::__private::planar_tension_jacobians(
-                    self, #rods, q, qd, inputs, out, ::pendulum_core::__private::Parts::#parts,
+                    self, #rods, q, qd, inputs, out, ::pendulum_core::Parts::#parts,
                 )
             }
         }
