@@ -4,11 +4,14 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use nalgebra::{DVector, Dyn, U2, U3, Vector2};
+use nalgebra::{DVector, Dyn, SVector, U2, U3, Vector2};
 use pendulum_core::integrate::{
     GaussFixedPoint, GaussLegendre, GaussOptions, Integrator, Projected, Rk4, State,
 };
-use pendulum_core::{Canonical, Chain, Directions, FirstOrder, Inputs, Model, Planar, Spatial, trajectory};
+use pendulum_core::{
+    Canonical, Chain, Derivatives, Directions, FirstOrder, Inputs, Jacobians, Model, Planar, PlanarTension,
+    Spatial, trajectory,
+};
 
 /// Asserts the exact message of an error and prints it for the docs.
 fn expect_message<T: std::fmt::Debug>(what: &str, result: pendulum_core::Result<T>, message: &str) {
@@ -114,6 +117,47 @@ fn model_states_and_inputs() {
         "NaN pivot acceleration",
         model.accelerations(&q, &qd, &bad, &mut out),
         "pivot_acceleration[1] must be finite, got NaN",
+    );
+}
+
+pendulum_macros::model! {
+    /// A generated planar chain on the tension route, whose Jacobians come from the kept
+    /// tension solve instead of the trait's default.
+    struct Planar4 { kind: planar, links: 4 }
+}
+
+/// The Jacobians' checks: the generated tension route (fixed sizes: finiteness only) and
+/// `PlanarTension` (sizes and finiteness), each error naming the entry.
+#[test]
+fn derivatives_of_bad_states() {
+    let generated = Planar4::new(Chain::uniform(4, 1.0, 1.0, 9.81).unwrap());
+    let mut jac = Jacobians::zeros(&generated);
+    let (q, qd) = (SVector::<f64, 4>::new(0.1, 0.2, f64::NAN, 0.3), SVector::<f64, 4>::zeros());
+    let inputs = generated.zero_inputs();
+    expect_message(
+        "NaN q, generated Jacobians",
+        generated.acceleration_jacobians(&q, &qd, &inputs, &mut jac),
+        "q[2] must be finite, got NaN",
+    );
+    let qd = SVector::<f64, 4>::new(0.0, f64::INFINITY, 0.0, 0.0);
+    expect_message(
+        "inf qd, generated state Jacobians",
+        generated.state_jacobians(&SVector::zeros(), &qd, &inputs, &mut jac),
+        "qd[1] must be finite, got inf",
+    );
+    let model = PlanarTension::new(chain(3));
+    let mut jac = Jacobians::zeros(&model);
+    let inputs = model.zero_inputs();
+    expect_message(
+        "q length, O(n) Jacobians",
+        model.acceleration_jacobians(&DVector::zeros(2), &DVector::zeros(3), &inputs, &mut jac),
+        "q has 2 entries, expected 3",
+    );
+    let bad = Inputs { torque: DVector::zeros(3), pivot_acceleration: Vector2::new(f64::NAN, 0.0) };
+    expect_message(
+        "NaN pivot acceleration, O(n) Jacobians",
+        model.state_jacobians(&DVector::zeros(3), &DVector::zeros(3), &bad, &mut jac),
+        "pivot_acceleration[0] must be finite, got NaN",
     );
 }
 
