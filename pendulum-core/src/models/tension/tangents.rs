@@ -13,8 +13,9 @@
 //!         + T_{i+1} S_{i+1}/m_i − T_{i−1} S_i/m_{i−1}) / l_i   [− n_0·(p̈ − g⃗)/l_0 for i = 0]
 //! ```
 //! with `u_0 = (sin θ_0, −cos θ_0)`, `n_0 = (cos θ_0, sin θ_0)`, `g⃗ = (0, −g)`; `A` is
-//! factored by the classical elimination (`D_i = A_ii − F_i A_{i,i−1}`,
-//! `F_i = A_{i,i−1}/D_{i−1}`).
+//! factored by Gaussian elimination (`D_i = A_ii − F_i A_{i,i−1}`,
+//! `F_i = A_{i,i−1}/D_{i−1}`), the pivots `1/D_i` as ratios of continuants
+//! (`rods::Continuants`), or the classical way should one leave its range.
 //!
 //! With the residual `r = b − A T` at fixed `T` and `H = ∂h/∂T` (tridiagonal, zero
 //! diagonal: `H_{i,i+1} = S_{i+1}/(m_i l_i)`, `H_{i,i−1} = −S_i/(m_{i−1} l_i)`), a change
@@ -126,11 +127,10 @@ where
             });
         }
         // Up: T_i = e_i/D_i − F_{i+1} T_{i+1}.
-        let mut below = (0.0, 0.0);
-        for i in (0..n).rev() {
-            let t = ls[i].tension * ls[i].inverse_pivot - below.0 * below.1;
-            ls[i].tension = t;
-            below = (ls[i].factor, t);
+        let (mut factor_below, mut tension_below) = (0.0, 0.0);
+        for link in ls.iter_mut().rev() {
+            link.tension = link.tension * link.inverse_pivot - factor_below * tension_below;
+            (factor_below, tension_below) = (link.factor, link.tension);
         }
         // θ̈ and the joints' derivative terms.
         for i in 0..n {
@@ -168,8 +168,8 @@ where
     }
 
     /// `δθ̈` (rad/s²) along `(δθ, δθ̇, δσ, δp̈)`, written into `out`; every slice has `n`
-    /// entries: one pass gathering `δr` and `δh` with the elimination of `δr` one row
-    /// behind, one back substitution applying `H` (module docs). O(n), allocation-free.
+    /// entries: one pass gathering `δr` and `δh` row by row and eliminating `δr` as it
+    /// goes, one back substitution applying `H` (module docs). O(n), allocation-free.
     pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
         let n = self.links.len();
         let RodConstants { inverse_mass: im, length, inverse_length: il, drag } = self.rods;
