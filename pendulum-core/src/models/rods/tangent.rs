@@ -12,9 +12,11 @@
 //! δa_i  = δa°_i + (δT_{i+1} u_{i+1} + T_{i+1} δu_{i+1} − δT_i u_i − T_i δu_i)/m_i
 //! δü_i  = (δa_i − δa_{i−1})/l_i
 //! ```
-//! The primal pass ([`Linearised::new`]) is the classical elimination (`D_i = A_ii − f_i
-//! A_{i,i−1}`, `f_i = A_{i,i−1}/D_{i−1}`), keeping per rod what the tangents need; each
-//! [`Linearised::tangent`] is then one down and one up pass, allocation-free.
+//! The primal pass ([`Linearised::new`]) is Gaussian elimination (`D_i = A_ii − f_i
+//! A_{i,i−1}`, `f_i = A_{i,i−1}/D_{i−1}`, the pivots as ratios of continuants like the
+//! solve's, the classical way should one leave its range), keeping per rod what the
+//! tangents need; each [`Linearised::tangent`] is then one down and one up pass over the
+//! load changes in its rows, allocation-free.
 
 // The per-component loops read and write several `[f64; S]` at one index, like the solve's.
 #![allow(clippy::needless_range_loop)]
