@@ -18,12 +18,14 @@ where
     /// at once: each column changes the solve in three rows, so after `G = H A⁻¹` (n solves
     /// with the kept factors, all at once) each entry is three multiply-adds, O(n²) in all
     /// (module docs).
+    #[inline(always)]
     pub fn jacobians(&self, dq: &mut [f64], dqd: &mut [f64], dtorque: &mut [f64], dpivot: &mut [f64]) {
         self.blocks(dq, dqd, Some((dtorque, dpivot)));
     }
 
     /// [`jacobians`](Self::jacobians) by `θ` and `θ̇` only: the state Jacobians a
     /// linearisation or an implicit integrator needs.
+    #[inline(always)]
     pub fn state_jacobians(&self, dq: &mut [f64], dqd: &mut [f64]) {
         self.blocks(dq, dqd, None);
     }
