@@ -158,30 +158,13 @@ where
     ) -> Result<PlanarTangents<'_, L>> {
         let chain = self.dense.chain();
         check_inputs(chain.links(), q, qd, inputs)?;
-        let tangents = kept(self.rods.constants(), chain.gravity(), self.dof(), q, qd, inputs);
+        let tangents = PlanarTangents::new(self.rods.constants(), chain.gravity(), q, qd, inputs);
         if tangents.accelerations().all(f64::is_finite) {
             Ok(tangents)
         } else {
             Err(crate::error::Error::NotPositiveDefinite)
         }
     }
-}
-
-/// The kept solve of [`PlanarTangents::new`] at `(q, q̇, inputs)`, sizes unchecked.
-#[inline(always)]
-fn kept<'a, L: Dim>(
-    rods: RodConstants<'a>,
-    gravity: f64,
-    dim: L,
-    q: &OVector<f64, L>,
-    qd: &OVector<f64, L>,
-    inputs: &Inputs<L, U2>,
-) -> PlanarTangents<'a, L>
-where
-    DefaultAllocator: Allocator<L> + Allocator<U2>,
-{
-    let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
-    PlanarTangents::new(rods, gravity, dim, q.as_slice(), qd.as_slice(), inputs.torque.as_slice(), pivot)
 }
 
 /// `θ̈` and its Jacobians (`parts`) for a planar chain of these rods by the kept tension
@@ -215,12 +198,12 @@ where
     #[cfg(target_arch = "x86_64")]
     let finite = if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2, checked just above.
-        unsafe { solve_and_differentiate_avx2(rods, gravity, dim, q, qd, inputs, out, parts) }
+        unsafe { solve_and_differentiate_avx2(rods, gravity, q, qd, inputs, out, parts) }
     } else {
-        solve_and_differentiate(rods, gravity, dim, q, qd, inputs, out, parts)
+        solve_and_differentiate(rods, gravity, q, qd, inputs, out, parts)
     };
     #[cfg(not(target_arch = "x86_64"))]
-    let finite = solve_and_differentiate(rods, gravity, dim, q, qd, inputs, out, parts);
+    let finite = solve_and_differentiate(rods, gravity, q, qd, inputs, out, parts);
     if !finite {
         check_inputs(n, q, qd, inputs)?;
         return Err(crate::error::Error::NotPositiveDefinite);
@@ -230,12 +213,10 @@ where
 
 /// The body of [`planar_tension_jacobians`] after its size checks: the kept solve, `θ̈`
 /// into `out`, and, if `θ̈` is finite (the return value), the Jacobians `parts`.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn solve_and_differentiate<M, L>(
     rods: RodConstants<'_>,
     gravity: f64,
-    dim: L,
     q: &OVector<f64, L>,
     qd: &OVector<f64, L>,
     inputs: &Inputs<L, U2>,
@@ -247,7 +228,7 @@ where
     M: Model<Dof = L, Space = U2> + ?Sized,
     DefaultAllocator: ModelAlloc<M::Links, L, U2> + Allocator<L, U2>,
 {
-    let tangents = kept(rods, gravity, dim, q, qd, inputs);
+    let tangents = PlanarTangents::new(rods, gravity, q, qd, inputs);
     for (o, a) in out.accelerations.iter_mut().zip(tangents.accelerations()) {
         *o = a;
     }
@@ -266,11 +247,9 @@ where
 /// part, the same operations (no fused multiply-adds), so the same results.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
 fn solve_and_differentiate_avx2<M, L>(
     rods: RodConstants<'_>,
     gravity: f64,
-    dim: L,
     q: &OVector<f64, L>,
     qd: &OVector<f64, L>,
     inputs: &Inputs<L, U2>,
@@ -282,7 +261,7 @@ where
     M: Model<Dof = L, Space = U2> + ?Sized,
     DefaultAllocator: ModelAlloc<M::Links, L, U2> + Allocator<L, U2>,
 {
-    solve_and_differentiate(rods, gravity, dim, q, qd, inputs, out, parts)
+    solve_and_differentiate(rods, gravity, q, qd, inputs, out, parts)
 }
 
 /// The dense building blocks are [`Planar`]'s; the Jacobians come from the kept O(n) solve
@@ -546,10 +525,10 @@ mod tests {
             pivot_acceleration: Vector2::new(1.5, -2.0),
         };
         let (mut a, mut b) = (Jacobians::zeros(&model), Jacobians::zeros(&model));
-        let (rods, g, dim) = (model.rods.constants(), 9.81, model.dof());
-        assert!(solve_and_differentiate(rods, g, dim, &q, &qd, &inputs, &mut a, Parts::All));
+        let (rods, g) = (model.rods.constants(), 9.81);
+        assert!(solve_and_differentiate(rods, g, &q, &qd, &inputs, &mut a, Parts::All));
         // SAFETY: the CPU has AVX2, checked above.
-        assert!(unsafe { solve_and_differentiate_avx2(rods, g, dim, &q, &qd, &inputs, &mut b, Parts::All) });
+        assert!(unsafe { solve_and_differentiate_avx2(rods, g, &q, &qd, &inputs, &mut b, Parts::All) });
         assert_eq!(a, b);
     }
 

@@ -8,7 +8,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
-use super::tangents::{Joint, PlanarTangents, RodConstants};
+use super::tangents::{Joint, PlanarTangents, RodConstants, coupling};
 
 impl<L: Dim> PlanarTangents<'_, L>
 where
@@ -48,10 +48,10 @@ where
         let green = green.as_mut_slice();
         for j in 0..n {
             if j >= 1 {
-                green[j * n + j - 1] = il[j - 1] * im[j - 1] * links[j].joint.sin;
+                green[j * n + j - 1] = coupling(links, self.rods, j - 1)[1];
             }
             if j + 1 < n {
-                green[j * n + j + 1] = -il[j + 1] * im[j] * links[j + 1].joint.sin;
+                green[j * n + j + 1] = coupling(links, self.rods, j + 1)[0];
             }
         }
         for j in 1..n {

@@ -24,7 +24,9 @@
 //! `x + 1` (`φ_j = θ_j − θ_{j−1}`, [`Joint`]) and the pull `f_x`; so a JVP is one pass that
 //! gathers `δr`, `δh` per row, and one tridiagonal solve with the kept factors.
 
-use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, allocator::Allocator};
+use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, U2, allocator::Allocator};
+
+use crate::model::Inputs;
 
 use crate::models::rods::Continuants;
 pub use crate::models::rods::RodConstants;
@@ -87,20 +89,25 @@ where
     DefaultAllocator: Allocator<L>,
 {
     /// The solve of the chain `rods` under gravity `g` (m/s²) at `θ = q`, `θ̇ = qd` with
-    /// torques `torque` (N·m) and pivot acceleration `p̈ = pivot` (m/s²): `dim` links, every
-    /// slice that long (the caller checks). Non-finite inputs give non-finite results.
-    /// Inlined so that a fixed `n` unrolls it and the result is built in place.
+    /// the torques (N·m) and pivot acceleration (m/s²) of `inputs`: as many links as `q`
+    /// has entries, every vector that long (the caller checks). Non-finite inputs give
+    /// non-finite results. Inlined so that a fixed `n` unrolls it and the result is built
+    /// in place.
     #[inline(always)]
     pub(crate) fn new(
         rods: RodConstants<'a>,
         gravity: f64,
-        dim: L,
-        q: &[f64],
-        qd: &[f64],
-        torque: &[f64],
-        pivot: [f64; 2],
-    ) -> Self {
+        q: &OVector<f64, L>,
+        qd: &OVector<f64, L>,
+        inputs: &Inputs<L, U2>,
+    ) -> Self
+    where
+        DefaultAllocator: Allocator<U2>,
+    {
+        let dim = q.shape_generic().0;
         let n = dim.value();
+        let (q, qd, torque) = (q.as_slice(), qd.as_slice(), inputs.torque.as_slice());
+        let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
         let RodConstants { inverse_mass: im, inverse_length: il, drag, .. } = rods;
         let mut trig = OVector::<[f64; 2], L>::from_element_generic(dim, U1, [0.0; 2]);
         sin_cos_into(q, trig.as_mut_slice());
@@ -210,17 +217,14 @@ where
             work[i] = y;
             if i + 1 < n {
                 // H_{i+1,i} y_i + H_{i+1,i+2} y_{i+2}.
-                let below = i + 1;
-                let mut h = -il[below] * im[i] * links[below].joint.sin * y;
-                if below + 1 < n {
-                    h += il[below] * im[below] * links[below + 1].joint.sin * work[below + 1];
-                }
-                out[below] += h;
+                let [h_above, h_below] = coupling(links, self.rods, i + 1);
+                let y_below2 = if i + 2 < n { work[i + 2] } else { 0.0 };
+                out[i + 1] += h_above * y + h_below * y_below2;
             }
             y_below = y;
         }
         if n > 1 {
-            out[0] += il[0] * im[0] * links[1].joint.sin * work[1];
+            out[0] += coupling(links, self.rods, 0)[1] * work[1];
         }
     }
 }
@@ -258,4 +262,14 @@ fn eliminate(
         (ls[i].factor, ls[i].inverse_pivot, ls[i].tension) = (factor, ip, e);
         (inverse_pivot_above, e_above) = (ip, e);
     }
+}
+
+/// Row `i` of `H = ∂h/∂T` (module docs) for these links: `[H_{i,i−1}, H_{i,i+1}] =
+/// [−S_i/(m_{i−1} l_i), S_{i+1}/(m_i l_i)]` (1/(kg·m)), zero outside the chain.
+#[inline(always)]
+pub(super) fn coupling(links: &[Link], rods: RodConstants<'_>, i: usize) -> [f64; 2] {
+    let (im, il) = (rods.inverse_mass, rods.inverse_length);
+    let above = if i >= 1 { -il[i] * im[i - 1] * links[i].joint.sin } else { 0.0 };
+    let below = if i + 1 < links.len() { il[i] * im[i] * links[i + 1].joint.sin } else { 0.0 };
+    [above, below]
 }
