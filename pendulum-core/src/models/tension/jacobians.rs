@@ -8,7 +8,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
-use super::tangents::{Joint, PlanarTangents, RodConstants, coupling};
+use super::tangents::{PlanarTangents, RodConstants};
 
 impl<L: Dim> PlanarTangents<'_, L>
 where
@@ -38,20 +38,18 @@ where
         if n == 0 {
             return;
         }
-        let RodConstants { inverse_mass: im, length, inverse_length: il, drag } = self.rods;
-        let links = self.links.as_slice();
-        // Joint j between links j − 1 and j; the joints outside the chain (0 and n) are zeros.
-        let joint = |j: usize| if j < n { links[j].joint } else { Joint::default() };
+        let RodConstants { length, inverse_length: il, drag, .. } = self.rods;
+        let (links, columns) = (self.links.as_slice(), self.columns());
         // G = H A⁻¹, column-major: column j is row j of A⁻¹ Hᵀ, the solve of every output
         // at once, each a row operation of the kept elimination.
         let mut green = OMatrix::<f64, L, L>::zeros_generic(dim, dim);
         let green = green.as_mut_slice();
         for j in 0..n {
             if j >= 1 {
-                green[j * n + j - 1] = coupling(links, self.rods, j - 1)[1];
+                green[j * n + j - 1] = columns.coupling(j - 1)[1];
             }
             if j + 1 < n {
-                green[j * n + j + 1] = coupling(links, self.rods, j + 1)[0];
+                green[j * n + j + 1] = columns.coupling(j + 1)[0];
             }
         }
         for j in 1..n {
@@ -74,39 +72,16 @@ where
         }
         let green = &*green;
         let mix = |out: &mut [f64], x: usize, r: [f64; 3], h: [f64; 3]| mix(green, n, out, x, r, h);
-        let [px, py] = self.pivot;
-        let g = self.gravity;
-        let (s0, c0) = (links[0].sin, links[0].cos);
-        // By θ_x: through φ_x (+1) and φ_{x+1} (−1); link 0's u_0·(g⃗ − p̈) and −n_0·(p̈ − g⃗)/l_0.
         for x in 0..n {
-            let (a, b) = (joint(x), joint(x + 1));
-            let (mut r, mut h) = (
-                [a.r_above, a.r_below - b.r_above, -b.r_below],
-                [a.h_above, a.h_below - b.h_above, -b.h_below],
-            );
-            if x == 0 {
-                r[1] -= s0 * (g + py) + c0 * px;
-                h[1] += il[0] * (s0 * px - c0 * (g + py));
-            }
+            let (r, h) = columns.angle(x);
             mix(&mut dq[x * n..(x + 1) * n], x, r, h);
         }
-        // By the pull f_x, then θ̇_x = −(λ_x/l_x) f_x plus 2 l_x θ̇_x in b_x, and σ_x = f_x/l_x.
-        let pull = |x: usize| {
-            // The joints outside the chain are zeros: the entries outside it vanish with them.
-            let (above, below) = (joint(x), joint(x + 1));
-            let (im_above, il_above) = if x >= 1 { (im[x - 1], il[x - 1]) } else { (0.0, 0.0) };
-            let il_below = il.get(x + 1).copied().unwrap_or(0.0);
-            let r = [im_above * above.sin, 0.0, -im[x] * below.sin];
-            let h =
-                [-il_above * im_above * above.cos, il[x] * (im[x] + im_above), -il_below * im[x] * below.cos];
-            (r, h)
-        };
         // By θ̇_x (the pull's column scaled by −λ_x/l_x, and 2 l_x θ̇_x in b_x) and, if asked,
         // by σ_x: the pull's column P_x into dqd's column x first, then ∂θ̈/∂σ_x = P_x/l_x
         // and ∂θ̈/∂θ̇_x = −(λ_x/l_x) P_x + 2 l_x θ̇_x G[:, x].
         let (mut dtorque, dpivot) = inputs.unzip();
         for x in 0..n {
-            let (r, h) = pull(x);
+            let (r, h) = columns.pull(x);
             let column = &mut dqd[x * n..(x + 1) * n];
             let (k, rate) = (-drag[x], 2.0 * length[x] * links[x].rate);
             let Some(dtorque) = dtorque.as_deref_mut() else {
@@ -124,8 +99,9 @@ where
             }
         }
         if let Some(dpivot) = dpivot {
-            mix(&mut dpivot[..n], 0, [0.0, -s0, 0.0], [0.0, -il[0] * c0, 0.0]);
-            mix(&mut dpivot[n..2 * n], 0, [0.0, c0, 0.0], [0.0, -il[0] * s0, 0.0]);
+            for (k, (r, h)) in columns.pivot().into_iter().enumerate() {
+                mix(&mut dpivot[k * n..(k + 1) * n], 0, r, h);
+            }
         }
     }
 }

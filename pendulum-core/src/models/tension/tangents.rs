@@ -177,10 +177,15 @@ where
     /// `δθ̈` (rad/s²) along `(δθ, δθ̇, δσ, δp̈)`, written into `out`; every slice has `n`
     /// entries: one pass gathering `δr` and `δh` row by row and eliminating `δr` as it
     /// goes, one back substitution applying `H` (module docs). O(n), allocation-free.
+    ///
+    /// The rows hold [`Columns`]' derivatives transposed (each row sums what the columns
+    /// `i − 1 … i + 1` put in it), written out per row: gathering through [`Columns`]
+    /// measured twice as slow. The unit tests hold the JVP to the full Jacobians.
     pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
         let n = self.links.len();
         let RodConstants { inverse_mass: im, length, inverse_length: il, drag } = self.rods;
         let (links, work) = (self.links.as_slice(), self.work.as_mut_slice());
+        let columns = Columns { links, rods: self.rods, gravity: self.gravity, pivot: self.pivot };
         let (dq, dqd, dtorque, out) = (&dq[..n], &dqd[..n], &dtorque[..n], &mut out[..n]);
         let dpull = |i: usize| dtorque[i] * il[i] - drag[i] * dqd[i];
         let mut e_above = 0.0;
@@ -217,15 +222,88 @@ where
             work[i] = y;
             if i + 1 < n {
                 // H_{i+1,i} y_i + H_{i+1,i+2} y_{i+2}.
-                let [h_above, h_below] = coupling(links, self.rods, i + 1);
+                let [h_above, h_below] = columns.coupling(i + 1);
                 let y_below2 = if i + 2 < n { work[i + 2] } else { 0.0 };
                 out[i + 1] += h_above * y + h_below * y_below2;
             }
             y_below = y;
         }
         if n > 1 {
-            out[0] += coupling(links, self.rods, 0)[1] * work[1];
+            out[0] += columns.coupling(0)[1] * work[1];
         }
+    }
+
+    /// The columns' view of the kept solve.
+    pub(super) fn columns(&self) -> Columns<'_> {
+        Columns { links: self.links.as_slice(), rods: self.rods, gravity: self.gravity, pivot: self.pivot }
+    }
+}
+
+/// How each input of `θ̈` moves `r` and `h` (module docs): a column changes rows
+/// `x − 1 … x + 1` only, given as `(∂r, ∂h)` in those rows, entries outside the chain zero.
+/// The one place these derivatives are written: the JVP gathers them, the full Jacobians
+/// (`jacobians`) mix `G`'s columns with them.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Columns<'a> {
+    pub links: &'a [Link],
+    pub rods: RodConstants<'a>,
+    /// `g` (m/s²) and `p̈` (m/s²).
+    pub gravity: f64,
+    pub pivot: [f64; 2],
+}
+
+impl Columns<'_> {
+    /// The joint above link `j` (zero outside the chain).
+    #[inline(always)]
+    fn joint(&self, j: usize) -> Joint {
+        if j < self.links.len() { self.links[j].joint } else { Joint::default() }
+    }
+
+    /// By `θ_x`: through `φ_x` (+1) and `φ_{x+1}` (−1); link 0 also through
+    /// `u_0·(g⃗ − p̈)` in `b_0` and `−n_0·(p̈ − g⃗)/l_0` in `h_0`.
+    #[inline(always)]
+    pub fn angle(&self, x: usize) -> ([f64; 3], [f64; 3]) {
+        let (a, b) = (self.joint(x), self.joint(x + 1));
+        let mut r = [a.r_above, a.r_below - b.r_above, -b.r_below];
+        let mut h = [a.h_above, a.h_below - b.h_above, -b.h_below];
+        if x == 0 {
+            let ([px, py], g, il) = (self.pivot, self.gravity, self.rods.inverse_length[0]);
+            let (s0, c0) = (self.links[0].sin, self.links[0].cos);
+            r[1] -= s0 * (g + py) + c0 * px;
+            h[1] += il * (s0 * px - c0 * (g + py));
+        }
+        (r, h)
+    }
+
+    /// By the pull `f_x` (N): `θ̇_x` enters as `−(λ_x/l_x) f_x` (and `2 l_x θ̇_x` in `b_x`),
+    /// `σ_x` as `f_x/l_x`.
+    #[inline(always)]
+    pub fn pull(&self, x: usize) -> ([f64; 3], [f64; 3]) {
+        let (im, il) = (self.rods.inverse_mass, self.rods.inverse_length);
+        let (above, below) = (self.joint(x), self.joint(x + 1));
+        let (im_above, il_above) = if x >= 1 { (im[x - 1], il[x - 1]) } else { (0.0, 0.0) };
+        let il_below = il.get(x + 1).copied().unwrap_or(0.0);
+        let r = [im_above * above.sin, 0.0, -im[x] * below.sin];
+        let h = [-il_above * im_above * above.cos, il[x] * (im[x] + im_above), -il_below * im[x] * below.cos];
+        (r, h)
+    }
+
+    /// By `p̈_x` and `p̈_y`: through `u_0·(g⃗ − p̈)` in `b_0` and `−n_0·(p̈ − g⃗)/l_0` in `h_0`
+    /// (columns of link 0).
+    #[inline(always)]
+    pub fn pivot(&self) -> [([f64; 3], [f64; 3]); 2] {
+        let (s0, c0, il) = (self.links[0].sin, self.links[0].cos, self.rods.inverse_length[0]);
+        [([0.0, -s0, 0.0], [0.0, -il * c0, 0.0]), ([0.0, c0, 0.0], [0.0, -il * s0, 0.0])]
+    }
+
+    /// Row `i` of `H = ∂h/∂T` (module docs): `[H_{i,i−1}, H_{i,i+1}] =
+    /// [−S_i/(m_{i−1} l_i), S_{i+1}/(m_i l_i)]` (1/(kg·m)), zero outside the chain.
+    #[inline(always)]
+    pub fn coupling(&self, i: usize) -> [f64; 2] {
+        let (links, im, il) = (self.links, self.rods.inverse_mass, self.rods.inverse_length);
+        let above = if i >= 1 { -il[i] * im[i - 1] * links[i].joint.sin } else { 0.0 };
+        let below = if i + 1 < links.len() { il[i] * im[i] * links[i + 1].joint.sin } else { 0.0 };
+        [above, below]
     }
 }
 
@@ -262,14 +340,4 @@ fn eliminate(
         (ls[i].factor, ls[i].inverse_pivot, ls[i].tension) = (factor, ip, e);
         (inverse_pivot_above, e_above) = (ip, e);
     }
-}
-
-/// Row `i` of `H = ∂h/∂T` (module docs) for these links: `[H_{i,i−1}, H_{i,i+1}] =
-/// [−S_i/(m_{i−1} l_i), S_{i+1}/(m_i l_i)]` (1/(kg·m)), zero outside the chain.
-#[inline(always)]
-pub(super) fn coupling(links: &[Link], rods: RodConstants<'_>, i: usize) -> [f64; 2] {
-    let (im, il) = (rods.inverse_mass, rods.inverse_length);
-    let above = if i >= 1 { -il[i] * im[i - 1] * links[i].joint.sin } else { 0.0 };
-    let below = if i + 1 < links.len() { il[i] * im[i] * links[i + 1].joint.sin } else { 0.0 };
-    [above, below]
 }
