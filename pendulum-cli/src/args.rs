@@ -3,9 +3,27 @@
 use std::path::PathBuf;
 
 use clap::{Arg, Args, ValueEnum};
-use serde::{Deserialize, Serialize};
+use pendulum_run::{Dimension, InitialSpec, IntegratorKind, StageSolver, View};
 
-use crate::spec::InitialSpec;
+/// `From<$arg> for $lib`: a clap value of the command line as the run description's type,
+/// variant for variant.
+macro_rules! same_variants {
+    ($arg:ident => $lib:ident: $($v:ident),+) => {
+        impl From<$arg> for $lib {
+            fn from(a: $arg) -> Self {
+                match a {
+                    $($arg::$v => Self::$v,)+
+                }
+            }
+        }
+    };
+}
+
+same_variants!(DimensionArg => Dimension: Two, Three);
+same_variants!(IntegratorArg => IntegratorKind: Gl1, Gl2, Gl3, Rk4, Midpoint, Dp54);
+same_variants!(SolverArg => StageSolver: FixedPoint, Newton);
+same_variants!(ViewArg => View: Xz, Yz, Xy);
+use serde::Serialize;
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`
 /// words the help of --masses and --gravity its own way, see [`Physics::run_help`]).
@@ -74,16 +92,14 @@ pub struct SteadyArgs {
 }
 
 /// Space dimension of the chain.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
-pub enum Dimension {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DimensionArg {
     /// Planar chain, angles θ_i.
     #[value(name = "2")]
-    #[serde(rename = "2")]
     Two,
     /// Spatial chain, integrated in unit link directions (initial states in spherical
     /// angles: θ from −z, φ azimuth from +x).
     #[value(name = "3")]
-    #[serde(rename = "3")]
     Three,
 }
 
@@ -99,9 +115,8 @@ pub enum DriveKind {
 }
 
 /// The time integrator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum IntegratorKind {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorArg {
     /// Gauss–Legendre, 1 stage (implicit midpoint), order 2.
     Gl1,
     /// Gauss–Legendre, 2 stages, order 4.
@@ -119,9 +134,8 @@ pub enum IntegratorKind {
 }
 
 /// How an implicit Gauss–Legendre step solves its stage equations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StageSolver {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SolverArg {
     /// Fixed-point iteration: a few right-hand sides per sweep, no Jacobian; needs the
     /// step to be shorter than the chain's fastest period.
     FixedPoint,
@@ -130,9 +144,8 @@ pub enum StageSolver {
 }
 
 /// The plane a 3D chain is drawn in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum View {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ViewArg {
     /// Side view: x to the right, z up.
     Xz,
     /// Side view: y to the right, z up.
@@ -162,7 +175,7 @@ pub struct SimulateArgs {
     pub quiet: bool,
     /// 3D: the plane the animation shows [default: xz].
     #[arg(long, value_enum)]
-    pub view: Option<View>,
+    pub view: Option<ViewArg>,
     /// Most frames in the animation (samples are thinned to fit) [default: 150].
     #[arg(long)]
     pub frames: Option<usize>,
@@ -177,7 +190,7 @@ pub struct SimulateArgs {
 pub struct Physics {
     /// Space dimension.
     #[arg(long, value_enum, default_value = "2")]
-    pub dim: Dimension,
+    pub dim: DimensionArg,
     /// The chain: --n, --masses, --lengths, --gravity.
     #[command(flatten)]
     pub chain: ChainOptions,
@@ -218,10 +231,10 @@ pub struct Physics {
     /// [default: chosen from the chain and drive, see run.json's "chosen": midpoint for
     /// driven or damped 3D runs, gl2 otherwise]
     #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorKind>,
+    pub integrator: Option<IntegratorArg>,
     /// Stage solve of the Gauss–Legendre integrators.
     #[arg(long, value_enum, default_value = "fixed-point")]
-    pub solver: StageSolver,
+    pub solver: SolverArg,
     /// dp54: relative error tolerance per internal step (per state entry, with the same
     /// absolute floor) [default: 1e-8].
     #[arg(long, allow_negative_numbers = true)]

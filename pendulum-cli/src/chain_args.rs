@@ -20,7 +20,7 @@ pub fn per_link_values(options: &ChainOptions) -> CliResult<(Vec<f64>, Vec<f64>)
     let masses = per_link("--masses", &options.masses)?;
     let lengths = per_link("--lengths", &options.lengths)?;
     let n = match options.n {
-        Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
+        Some(0) => return Err(CliError::invalid("--n: a chain needs at least 1 link, got 0")),
         Some(n) => n,
         None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
     };

@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use crate::args::{EvalArgs, ModelKind};
 use crate::error::{CliError, CliResult};
-use crate::models::{planar_model, spatial_model};
 use crate::spec::{expand, parse_list, per_link};
+use pendulum_run::assemble::{planar_model, spatial_model};
 
 /// What `pendulum eval` prints.
 #[derive(Debug, Serialize)]
@@ -83,7 +83,7 @@ pub fn parse_state(args: &EvalArgs) -> CliResult<StateInput> {
         ModelKind::Spatial => q.len() / 2,
     };
     let n = match args.n {
-        Some(0) => return Err(CliError::usage("--n: a chain needs at least 1 link, got 0")),
+        Some(0) => return Err(CliError::invalid("--n: a chain needs at least 1 link, got 0")),
         Some(n) => n,
         None => [masses.len(), lengths.len(), per_link_count].into_iter().find(|&l| l > 1).unwrap_or(1),
     };
@@ -101,13 +101,13 @@ pub fn parse_state(args: &EvalArgs) -> CliResult<StateInput> {
             None => vec![0.0; len],
         };
         if v.len() != len {
-            return Err(CliError::usage(format!("{what}: got {} values, expected {len}", v.len())));
+            return Err(CliError::invalid(format!("{what}: got {} values, expected {len}", v.len())));
         }
         Ok(v)
     };
     if q.len() != dof {
         let layout = if args.model == ModelKind::Planar { "θ_1..θ_n" } else { "θ_1..θ_n, φ_1..φ_n" };
-        return Err(CliError::usage(format!(
+        return Err(CliError::invalid(format!(
             "--q: got {} values, expected {dof} ({layout}) for n = {n}",
             q.len()
         )));

@@ -83,14 +83,14 @@ pub fn run(args: &LinearizeArgs) -> CliResult<()> {
 pub fn linearization(args: &LinearizeArgs) -> CliResult<Linearization> {
     let positive = |x: f64| x > 0.0 && x.is_finite();
     if !positive(args.tolerance) {
-        return Err(CliError::usage(format!(
+        return Err(CliError::invalid(format!(
             "--tolerance must be finite and positive, got {}",
             args.tolerance
         )));
     }
     for (what, w) in [("--lqr-q", args.lqr_q), ("--lqr-r", args.lqr_r)] {
         if !positive(w) {
-            return Err(CliError::usage(format!("{what} must be finite and positive, got {w}")));
+            return Err(CliError::invalid(format!("{what} must be finite and positive, got {w}")));
         }
     }
     let state = parse_state(&args.state)?;
@@ -127,7 +127,7 @@ where
     let (q, qd, inputs) = model_state::<M>(&state.q, &state.qd, &state.torque, &state.pivot);
     linearize(model, &q, &qd, &inputs, tolerance).map_err(|e| match e {
         Error::NotSteady { .. } => {
-            CliError::usage(format!("{e}; pass --force to linearise there anyway (or --tolerance)"))
+            CliError::invalid(format!("{e}; pass --force to linearise there anyway (or --tolerance)"))
         }
         e => e.into(),
     })
@@ -140,7 +140,7 @@ fn design(space: &StateSpace, input: LqrInput, args: &LinearizeArgs) -> CliResul
         LqrInput::PivotX | LqrInput::PivotY | LqrInput::PivotZ => {
             let k = input as usize - LqrInput::PivotX as usize;
             if k >= space.b_pivot.ncols() {
-                return Err(CliError::usage("--lqr pivot-z: a planar pivot moves in x and y only"));
+                return Err(CliError::invalid("--lqr pivot-z: a planar pivot moves in x and y only"));
             }
             space.b_pivot.columns(k, 1).into_owned()
         }
@@ -148,7 +148,7 @@ fn design(space: &StateSpace, input: LqrInput, args: &LinearizeArgs) -> CliResul
     let (n, m) = (space.a.nrows(), b.ncols());
     let q = DMatrix::identity(n, n) * args.lqr_q;
     let r = DMatrix::identity(m, m) * args.lqr_r;
-    let design = lqr(&space.a, &b, &q, &r).map_err(|e| CliError::usage(e.to_string()))?;
+    let design = lqr(&space.a, &b, &q, &r).map_err(|e| CliError::invalid(e.to_string()))?;
     Ok(Gain {
         input: input.name().to_owned(),
         q_weight: args.lqr_q,

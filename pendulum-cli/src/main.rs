@@ -4,19 +4,15 @@
 
 mod args;
 mod chain_args;
-mod choice;
 mod cli;
-mod config;
 mod error;
 mod eval;
-mod final_state;
 mod interrupt;
-mod json_file;
 mod linearize;
-mod models;
 mod modes;
 mod plot;
 mod render;
+mod request;
 mod simulate;
 mod spec;
 mod steady;
@@ -68,7 +64,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            e.exit_code()
+            error::exit_code(&e)
         }
     }
 }

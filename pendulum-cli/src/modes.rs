@@ -1,16 +1,16 @@
 //! `pendulum modes`: the normal modes of the chain hanging at rest (table, modes.csv and
 //! the mode shapes in modes.png).
 
-use std::io::Write;
 use std::path::Path;
 
 use nalgebra::Dyn;
 use pendulum_core::{Chain, bernoulli_frequency, normal_modes, sign_changes};
+use pendulum_run::Csv;
 use plotters::prelude::*;
 
 use crate::args::ModesArgs;
 use crate::chain_args::chain_of;
-use crate::error::{CliError, CliResult, io_failed};
+use crate::error::{CliError, CliResult};
 use crate::plot::{drawing_failed, fonts};
 
 /// Runs `pendulum modes`.
@@ -19,23 +19,19 @@ pub fn modes(args: &ModesArgs) -> CliResult<()> {
     let n = chain.links();
     let count = args.count.unwrap_or(n.min(6));
     if count == 0 || count > n {
-        return Err(CliError::usage(format!("--count must be between 1 and n = {n}, got {count}")));
+        return Err(CliError::invalid(format!("--count must be between 1 and n = {n}, got {count}")));
     }
     let modes = normal_modes(&chain);
     let total: f64 = chain.lengths().iter().sum();
     let uniform = chain.masses().iter().all(|&m| m == chain.masses()[0])
         && chain.lengths().iter().all(|&l| l == chain.lengths()[0]);
     std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
-    let csv_path = args.out.join("modes.csv");
-    let file = std::fs::File::create(&csv_path).map_err(|e| io_failed("create", &csv_path, e))?;
-    let mut csv = std::io::BufWriter::new(file);
     let mut header =
         vec!["k".to_string(), "omega".into(), "frequency_hz".into(), "period".into(), "nodes".into()];
     header.extend((1..=n).map(|i| format!("x{i}")));
-    let write_err = |e| io_failed("write", &csv_path, e);
-    writeln!(csv, "{}", header.join(",")).map_err(write_err)?;
+    let mut csv = Csv::create(&args.out.join("modes.csv"), &header)?;
     let mut out = String::new();
     let continuum = if uniform { "   Bernoulli (continuum)" } else { "" };
     out.push_str(&format!(" k   omega (rad/s)     f (Hz)   period (s)  nodes{continuum}\n"));
@@ -53,15 +49,10 @@ pub fn modes(args: &ModesArgs) -> CliResult<()> {
         }
         out.push_str(&line);
         out.push('\n');
-        let row: Vec<String> = [(k + 1) as f64, omega, f, period, nodes as f64]
-            .iter()
-            .chain(&x)
-            .map(|v| format!("{v:?}"))
-            .collect();
-        writeln!(csv, "{}", row.join(",")).map_err(write_err)?;
+        csv.row([(k + 1) as f64, omega, f, period, nodes as f64].into_iter().chain(x.iter().copied()))?;
         shapes.push((k + 1, omega, x));
     }
-    csv.flush().map_err(write_err)?;
+    csv.finish()?;
     print!("{out}");
     let png = args.out.join("modes.png");
     plot_modes(&png, &chain, &shapes)?;

@@ -1,43 +1,42 @@
 //! `pendulum simulate`: the run loop, streaming the trajectory and energy CSVs, then the
 //! plots, run.json and the summary line.
 
-use std::fs::File;
-use std::io::{BufWriter, IsTerminal, Write};
+use std::io::IsTerminal;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pendulum_core::integrate::State;
-use pendulum_core::trajectory;
+use pendulum_run::{
+    RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View, build, chain, drive_frequency,
+    fastest_mode, other_version, suggested_step,
+};
 
-use crate::args::{Dimension, SimulateArgs, StageSolver, View};
-use crate::choice::{choose, drive_frequency, fastest_mode, suggested_step};
-use crate::config::{Outcome, RunConfig, RunFile};
-use crate::error::{CliError, CliResult, io_failed};
-use crate::final_state::FinalState;
+use crate::args::SimulateArgs;
+use crate::error::{CliError, CliResult};
 use crate::interrupt::INTERRUPTED;
-use crate::json_file::warn_other_version;
-use crate::models::{AnySimulation, Method, Motion, Sample, Simulation, build};
 use crate::plot;
 use crate::render;
-use crate::whirl::Whirl;
+use crate::request;
+use crate::whirl;
 
 /// Runs `pendulum simulate`.
 pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
     let mut config = match &args.from {
         Some(path) => {
             let file = RunFile::read(path)?;
-            if !args.quiet {
-                warn_other_version(path, &file.version);
+            if !args.quiet
+                && let Some(warning) = other_version(path, &file.version)
+            {
+                eprintln!("pendulum: warning: {warning}");
             }
             file.config
         }
-        None => RunConfig::from_args(&args.physics, View::Xz, 150, choose)?,
+        None => request::resolve(&args.physics, View::Xz, 150)?,
     };
     // Presentation only: may differ from the recorded run.
-    config.view = args.view.unwrap_or(config.view);
+    config.view = args.view.map_or(config.view, Into::into);
     config.frames = args.frames.unwrap_or(config.frames);
     config.check()?;
     // A value the chain, drive or state rejects names the file it came from.
@@ -46,7 +45,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
         None => e,
     })?;
     std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
     let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };
     if demo && !args.quiet {
@@ -55,10 +54,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
              see `pendulum simulate --help`"
         );
     }
-    match &simulation {
-        AnySimulation::Planar(s) => execute(s, &config, &options),
-        AnySimulation::Spatial(s) => execute(s, &config, &options),
-    }
+    execute(&simulation, &config, &options)
 }
 
 /// Where and what to write.
@@ -67,56 +63,6 @@ struct Options {
     plots: bool,
     quiet: bool,
 }
-
-/// A CSV file written through a buffer.
-struct Csv {
-    path: PathBuf,
-    writer: BufWriter<File>,
-}
-
-impl Csv {
-    fn create(path: PathBuf, header: &[String]) -> CliResult<Self> {
-        let file = File::create(&path).map_err(|e| io_failed("create", &path, e))?;
-        let mut csv = Self { path, writer: BufWriter::new(file) };
-        let line = header.join(",");
-        csv.line(&line)?;
-        Ok(csv)
-    }
-
-    fn line(&mut self, line: &str) -> CliResult<()> {
-        writeln!(self.writer, "{line}").map_err(|e| io_failed("write", &self.path, e))
-    }
-
-    fn row(&mut self, values: impl IntoIterator<Item = f64>) -> CliResult<()> {
-        let mut first = true;
-        for v in values {
-            let sep = if first { "" } else { "," };
-            first = false;
-            write!(self.writer, "{sep}{v:?}").map_err(|e| io_failed("write", &self.path, e))?;
-        }
-        writeln!(self.writer).map_err(|e| io_failed("write", &self.path, e))
-    }
-
-    fn finish(mut self) -> CliResult<()> {
-        self.writer.flush().map_err(|e| io_failed("flush", &self.path, e))?;
-        self.writer.get_ref().sync_all().map_err(|e| io_failed("sync", &self.path, e))
-    }
-}
-
-/// Columns of the trajectory: t, the simulation's state columns, the pivot and every
-/// mass (x, y in 2D; x, y, z in 3D).
-fn trajectory_header<P: Motion>(simulation: &Simulation<P>, dim: Dimension, n: usize) -> Vec<String> {
-    let axes: &[&str] = if dim == Dimension::Two { &["x", "y"] } else { &["x", "y", "z"] };
-    let mut header = vec!["t".to_string()];
-    header.extend(simulation.state_columns());
-    header.extend(axes.iter().map(|a| format!("pivot_{a}")));
-    for i in 1..=n {
-        header.extend(axes.iter().map(|a| format!("{a}{i}")));
-    }
-    header
-}
-
-const ENERGY_HEADER: [&str; 6] = ["t", "energy", "drive_work", "torque_work", "damped", "balance_residual"];
 
 /// What the plots need from the samples, kept in memory while the CSVs stream out.
 #[derive(Default)]
@@ -127,107 +73,68 @@ struct Kept {
     predicted: Vec<f64>,
 }
 
+impl Sink for Kept {
+    fn sample(&mut self, s: &Sample, h0: f64) -> CliResult<()> {
+        self.times.push(s.t);
+        self.energy.push(s.energy);
+        self.predicted.push(h0 + s.ledger.net());
+        Ok(())
+    }
+}
+
 /// Integrates, writes every output, prints the summary.
-fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &Options) -> CliResult<()> {
+fn execute(simulation: &pendulum_run::AnySimulation, config: &RunConfig, options: &Options) -> CliResult<()> {
     let out = &options.out;
     let n = config.links();
     let mut run_file = RunFile::new(config.clone());
     let run_json = out.join("run.json");
     run_file.write_atomic(&run_json)?;
 
-    let (total_steps, _) = trajectory::plan(0.0, config.end, config.step)?;
-
-    let mut trajectory_csv =
-        Csv::create(out.join("trajectory.csv"), &trajectory_header(simulation, config.dim, n))?;
-    let header: Vec<String> = ENERGY_HEADER.iter().map(|s| s.to_string()).collect();
-    let mut energy_csv = Csv::create(out.join("energy.csv"), &header)?;
-
-    let dims = if config.dim == Dimension::Two { 2 } else { 3 };
-    let mut progress = Progress::new(total_steps, config.end, options.quiet);
-    let system = simulation.system();
-    let mut solver = simulation.integrator(Method::of(config))?;
-    let mut state = State::new(0.0, simulation.initial_state());
+    let (total_steps, _) = pendulum_core::trajectory::plan(0.0, config.end, config.step)?;
+    let mut files = SampleFiles::create(out, &simulation.layout(config))?;
     let mut kept = Kept::default();
-    let whirl = Whirl::of(config)?;
-    let mut tracker = whirl.as_ref().map(Whirl::tracker).transpose()?;
-    let mut write_error = None;
-    let mut initial_energy = None;
-    let mut sample_count: u64 = 0;
-    let result =
-        trajectory::run(&mut *solver, system, &mut state, config.end, config.step, config.every, |t, x| {
-            let sample = simulation.sample(t, x);
-            let h0 = *initial_energy.get_or_insert(sample.energy);
-            if let Err(e) = write_sample(&mut trajectory_csv, &mut energy_csv, &sample, h0, dims) {
-                write_error = Some(e);
-                return ControlFlow::Break(());
-            }
-            keep(&mut kept, &sample, h0);
-            if let Some(tracker) = &mut tracker
-                && let Err(e) = tracker.push(t, &sample.state)
-            {
-                write_error = Some(e);
-                return ControlFlow::Break(());
-            }
-            sample_count += 1;
-            progress.at(t, (t / config.end * total_steps as f64).round() as u64);
-            if INTERRUPTED.load(Ordering::SeqCst) {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        });
+    let mut progress = Progress::new(total_steps, config.end, options.quiet);
+    let report = simulation.run(config, &mut [&mut files, &mut kept], &mut |t| {
+        progress.at(t, (t / config.end * total_steps as f64).round() as u64);
+        if INTERRUPTED.load(Ordering::SeqCst) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    });
     progress.finish();
-    trajectory_csv.finish()?;
-    energy_csv.finish()?;
-    if let Some(e) = write_error {
-        return Err(e);
-    }
+    files.finish()?;
+    let report = report?;
 
-    let (status, error, steps) = match &result {
-        Ok(s) if s.stopped_early => ("interrupted", None, s.steps),
-        Ok(s) => ("completed", None, s.steps),
-        Err(e) => ("failed", Some(e.to_string()), failed_steps(e)),
-    };
     let mut images = Vec::new();
     if options.plots && !kept.times.is_empty() {
         let energy_png = out.join("energy.png");
         plot::energy(&energy_png, &kept.times, &kept.energy, &kept.predicted, energy_scale(config))?;
-        let gif = render::chain_gif(out, config, state.t(), options.quiet)?;
+        let gif = render::chain_gif(out, config, report.t, options.quiet)?;
         images.extend([energy_png, gif]);
     }
-    let motion = &state.x().as_slice()[..system.motion_len()];
-    let phase = whirl.as_ref().map(|w| w.phase(state.t()));
-    FinalState::new(config.dim, n, state.t(), motion, phase).write(out)?;
+    report.final_state.write(out)?;
     // A whirled chain: its shape in the turning frame, in the user's terms (stdout).
-    if let Some(tracker) = &tracker {
-        tracker.finish(out, options.plots)?;
+    if let Some(shape) = &report.shape {
+        whirl::present(shape.as_ref().map_err(Clone::clone)?, out, options.plots)?;
     }
-    run_file.outcome = Some(Outcome {
-        status: status.into(),
-        t: state.t(),
-        steps,
-        samples: sample_count,
-        error: error.clone(),
-        work: Some(solver.stats().into()),
-    });
+    run_file.outcome = Some(report.outcome());
     run_file.write_atomic(&run_json)?;
 
+    let status = report.status.name();
     if !options.quiet {
         let drift =
             kept.energy.iter().zip(&kept.predicted).map(|(h, p)| (h - p).abs()).fold(0.0_f64, f64::max);
         eprintln!(
             "pendulum: {status}: {n} links, {dim}D, t = {t:.4} s in {steps} steps ({integrator:?}, h = {h} s); \
              max |H − H0 − W| = {drift:.3e} J; {samples} samples; files in {dir}{images}",
-            dim = if config.dim == Dimension::Two { 2 } else { 3 },
-            t = state.t(),
+            dim = config.dim.space(),
+            t = report.t,
+            steps = report.steps,
             integrator = config.integrator,
             h = config.step,
-            samples = sample_count,
+            samples = report.samples,
             dir = out.display(),
             images = if images.is_empty() {
                 ""
             } else {
-                if tracker.is_some() {
+                if report.shape.is_some() {
                     " (trajectory.csv, energy.csv, run.json, final.json, shape.json, energy.png, chain.gif, shape.png)"
                 } else {
                     " (trajectory.csv, energy.csv, run.json, final.json, energy.png, chain.gif)"
@@ -235,20 +142,20 @@ fn execute<P: Motion>(simulation: &Simulation<P>, config: &RunConfig, options: &
             },
         );
     }
-    match result {
-        Ok(s) if s.stopped_early => Err(CliError::interrupted(format!(
+    match (report.status, report.error) {
+        (Status::Interrupted, _) => Err(CliError::interrupted(format!(
             "interrupted: the run was cut at t = {} s of {} s; files in {} hold what was computed \
              (run.json says \"interrupted\")",
-            state.t(),
+            report.t,
             config.end,
             out.display()
         ))),
-        Ok(_) => Ok(()),
-        Err(e) => Err(CliError::failed(format!(
+        (Status::Failed, Some(e)) => Err(CliError::failed(format!(
             "the run stopped at t = {} s: {e}{}; files hold what was computed",
-            state.t(),
+            report.t,
             stage_solve_hint(&e, config)
         ))),
+        _ => Ok(()),
     }
 }
 
@@ -262,7 +169,8 @@ fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
     if !stage_failure && !blew_up {
         return String::new();
     }
-    let (fastest, drive) = (fastest_mode(config), drive_frequency(config));
+    let fastest = chain(config).map_or(0.0, |c| fastest_mode(&c, &config.drive));
+    let drive = drive_frequency(&config.drive);
     let suggested = suggested_step(fastest, drive);
     let cause = match drive {
         Some(w) => format!(
@@ -282,14 +190,6 @@ fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
     format!(" ({cause}: try --step {suggested:.1e}{other})")
 }
 
-/// The steps a failed run completed (the failed step's number).
-fn failed_steps(e: &pendulum_core::Error) -> u64 {
-    match e {
-        pendulum_core::Error::StepFailed { step, .. } => *step,
-        _ => 0,
-    }
-}
-
 /// A scale for the energy axis (J): the work gravity could do on the chain,
 /// `Σ_k m_k g (l_1 + … + l_k)`, or the total mass times 1 m²/s² without gravity.
 fn energy_scale(config: &RunConfig) -> f64 {
@@ -300,22 +200,6 @@ fn energy_scale(config: &RunConfig) -> f64 {
         scale += m * config.gravity.max(1.0) * reach;
     }
     scale
-}
-
-/// Writes one sample: a trajectory row (positions with `dims` components) and an
-/// energy row with the balance residual `H − H0 − (W_drive + W_torque − E_damped)`.
-fn write_sample(trajectory: &mut Csv, energy: &mut Csv, s: &Sample, h0: f64, dims: usize) -> CliResult<()> {
-    let positions = std::iter::once(&s.pivot).chain(&s.masses).flat_map(|r| r[..dims].iter().copied());
-    trajectory.row(std::iter::once(s.t).chain(s.state.iter().copied()).chain(positions))?;
-    let l = &s.ledger;
-    let residual = s.energy - h0 - l.net();
-    energy.row([s.t, s.energy, l.drive, l.torque, l.damped, residual])
-}
-
-fn keep(kept: &mut Kept, s: &Sample, h0: f64) {
-    kept.times.push(s.t);
-    kept.energy.push(s.energy);
-    kept.predicted.push(h0 + s.ledger.net());
 }
 
 /// How often a run without a terminal reports how far it is.

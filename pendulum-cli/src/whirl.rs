@@ -1,71 +1,26 @@
 //! What `pendulum simulate` says about a whirled chain (3D, pivot circling the vertical,
-//! steady or ramped): the shape analysis of `pendulum_core::analysis` in the user's terms —
+//! steady or ramped): the shape the run library's analysis found, in the user's terms —
 //! one summary line, `shape.json` and `shape.png`.
 
 use std::path::Path;
 
-use nalgebra::{DVector, U3};
-use pendulum_core::{Directions, ShapeOptions, ShapeReport, ShapeTracker, Turning, WhirlShape};
+use pendulum_core::{ShapeReport, WhirlShape};
+use pendulum_run::write_json_atomic;
 use plotters::prelude::*;
 use serde_json::json;
 
-use crate::args::Dimension;
-use crate::config::RunConfig;
-use crate::error::{CliError, CliResult};
-use crate::json_file::write_json_atomic;
-use crate::models::{chain, turning_drive};
+use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 
-/// The chain of a whirled run with its turning drive, for the shape analysis.
-pub struct Whirl {
-    model: Directions<U3, Box<dyn Turning>>,
-}
-
-impl Whirl {
-    /// The whirl of a configuration: `Some` for a 3D chain whose pivot circles the
-    /// vertical (`--drive circle`, steady or ramped).
-    pub fn of(config: &RunConfig) -> CliResult<Option<Self>> {
-        if config.dim != Dimension::Three {
-            return Ok(None);
-        }
-        let Some(drive) = turning_drive(&config.drive)? else { return Ok(None) };
-        Ok(Some(Self { model: Directions::<U3>::new(chain(config)?).with_drive(drive) }))
+/// The report of a whirled run in the user's terms: its summary line on stdout,
+/// `shape.json` and (with `plots`) `shape.png` in `out`.
+pub fn present(report: &ShapeReport, out: &Path, plots: bool) -> CliResult<()> {
+    println!("{}", summary(report));
+    write_json(&out.join("shape.json"), report)?;
+    if plots {
+        plot(&out.join("shape.png"), report)?;
     }
-
-    /// The circling pivot's azimuth at `t`, rad.
-    pub fn phase(&self, t: f64) -> f64 {
-        self.model.drive().phase(t)
-    }
-
-    /// A tracker of the co-rotating shape with the default options (settled: drift
-    /// ≤ 1e-3 L over the last 5 drive periods).
-    pub fn tracker(&self) -> CliResult<Tracker<'_>> {
-        Ok(Tracker(ShapeTracker::new(&self.model, ShapeOptions::default())?))
-    }
-}
-
-/// Follows the shape along a run, sample by sample (bounded memory).
-pub struct Tracker<'a>(ShapeTracker<'a, Box<dyn Turning>>);
-
-impl Tracker<'_> {
-    /// Takes the sample `(t, x)` of the chain's state `x = (u, w)`.
-    pub fn push(&mut self, t: f64, x: &[f64]) -> CliResult<()> {
-        self.0
-            .push(t, &DVector::from_column_slice(x))
-            .map_err(|e| CliError::failed(format!("shape analysis: {e}")))
-    }
-
-    /// The report at the latest sample, its summary line printed to stdout, `shape.json`
-    /// and (with `plots`) `shape.png` written into `out`.
-    pub fn finish(&self, out: &Path, plots: bool) -> CliResult<ShapeReport> {
-        let report = self.0.report().map_err(|e| CliError::failed(format!("shape analysis: {e}")))?;
-        println!("{}", summary(&report));
-        write_json(&out.join("shape.json"), &report)?;
-        if plots {
-            plot(&out.join("shape.png"), &report)?;
-        }
-        Ok(report)
-    }
+    Ok(())
 }
 
 /// `1 node`, `2 nodes`.

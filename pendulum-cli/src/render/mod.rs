@@ -18,10 +18,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 
-use crate::args::View;
-use crate::config::{DriveConfig, RunConfig};
 use crate::error::{CliError, CliResult};
 use draw::{Layout, Scene, Shot};
+use pendulum_run::View;
+use pendulum_run::{DriveConfig, RunConfig};
 use source::{Run, Trajectory};
 use timing::{Request, Timing, speed_words};
 use view::{AxisMark, Bounds, Circling, Projection};
@@ -106,27 +106,27 @@ pub fn render(args: &RenderArgs) -> CliResult<()> {
         if let Some(v) = value
             && !v.is_finite()
         {
-            return Err(CliError::usage(format!("{name} must be a finite time in s, got {v}")));
+            return Err(CliError::invalid(format!("{name} must be a finite time in s, got {v}")));
         }
     }
     if let (Some(from), Some(to)) = (args.from, args.to)
         && from >= to
     {
-        return Err(CliError::usage(format!("--from {from} s must be before --to {to} s")));
+        return Err(CliError::invalid(format!("--from {from} s must be before --to {to} s")));
     }
     if let Some(s) = args.speed
         && !(s.is_finite() && s > 0.0)
     {
-        return Err(CliError::usage(format!("--speed must be finite and positive, got {s}")));
+        return Err(CliError::invalid(format!("--speed must be finite and positive, got {s}")));
     }
     if !(SIZES.0..=SIZES.1).contains(&args.size) {
         let (lo, hi) = SIZES;
-        return Err(CliError::usage(format!("--size must be {lo} to {hi} px, got {}", args.size)));
+        return Err(CliError::invalid(format!("--size must be {lo} to {hi} px, got {}", args.size)));
     }
     if let Some(n) = args.frames
         && !(2..=MOST_FRAMES as i64).contains(&n)
     {
-        return Err(CliError::usage(format!("--frames must be 2 to {MOST_FRAMES}, got {n}")));
+        return Err(CliError::invalid(format!("--frames must be 2 to {MOST_FRAMES}, got {n}")));
     }
     let run = Run::open(&args.run)?;
     let config = &run.file.config;
@@ -220,7 +220,7 @@ fn animate(job: &Job) -> CliResult<Done> {
     let reach: f64 = config.lengths.iter().sum();
     let slack = 1e-9 * config.end.max(1.0);
     let not_circling = |why: String| {
-        CliError::usage(format!(
+        CliError::invalid(format!(
             "--view co-rotating: the pivot of {} does not circle the vertical axis: {why}",
             job.trajectory.display()
         ))
@@ -249,7 +249,7 @@ fn animate(job: &Job) -> CliResult<Done> {
                     speed: job.speed,
                     period,
                 };
-                let tm = timing::plan(&request).map_err(CliError::usage)?;
+                let tm = timing::plan(&request).map_err(CliError::invalid)?;
                 // Too long a window for the frames: its end, unless --from says where to start.
                 let begin = match job.from {
                     Some(from) => from - slack,
@@ -337,7 +337,7 @@ fn animate(job: &Job) -> CliResult<Done> {
 fn empty_window(job: &Job, trajectory: &Trajectory) -> CliError {
     let shown = job.trajectory.display();
     let (Some(first), Some(last)) = (trajectory.first, trajectory.last) else {
-        return CliError::usage(format!("{shown} holds no samples"));
+        return CliError::invalid(format!("{shown} holds no samples"));
     };
     let message = match (job.from, job.to) {
         (Some(from), _) if from > last => {
@@ -352,7 +352,7 @@ fn empty_window(job: &Job, trajectory: &Trajectory) -> CliError {
             to.unwrap_or(last)
         ),
     };
-    CliError::usage(message)
+    CliError::invalid(message)
 }
 
 impl Done {

@@ -5,9 +5,9 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use crate::args::Dimension;
-use crate::config::{RunConfig, RunFile};
 use crate::error::{CliError, CliResult};
+use pendulum_run::Dimension;
+use pendulum_run::{RunConfig, RunFile};
 
 /// A run directory as `pendulum simulate` leaves it.
 pub struct Run {
@@ -22,22 +22,22 @@ impl Run {
     pub fn open(dir: &Path) -> CliResult<Self> {
         let shown = dir.display();
         if !dir.is_dir() {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{shown} is not a directory (render takes a run directory)"
             )));
         }
         let json = dir.join("run.json");
         if !json.is_file() {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{shown} holds no run: no run.json (`pendulum simulate --out DIR` writes one)"
             )));
         }
         let text = std::fs::read_to_string(&json)
-            .map_err(|e| CliError::usage(format!("cannot read {}: {e}", json.display())))?;
+            .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", json.display())))?;
         let file: RunFile = serde_json::from_str(&text)
-            .map_err(|e| CliError::usage(format!("{} is not a valid run.json: {e}", json.display())))?;
+            .map_err(|e| CliError::invalid(format!("{} is not a valid run.json: {e}", json.display())))?;
         if file.program != "pendulum" {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{} was written by '{}', not pendulum",
                 json.display(),
                 file.program
@@ -46,7 +46,7 @@ impl Run {
         file.config.check().map_err(|e| e.context(json.display()))?;
         let trajectory = dir.join("trajectory.csv");
         if !trajectory.is_file() {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{shown} holds no run: no trajectory.csv beside its run.json"
             )));
         }
@@ -93,13 +93,13 @@ impl Trajectory {
     /// Opens the file and checks its header against the run: `t`, then `pivot_x`,
     /// `pivot_y`[, `pivot_z`] and `x1`, `y1`[, `z1`] … for every mass, last.
     pub fn open(path: &Path, config: &RunConfig) -> CliResult<Self> {
-        let file =
-            File::open(path).map_err(|e| CliError::usage(format!("cannot read {}: {e}", path.display())))?;
+        let file = File::open(path)
+            .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", path.display())))?;
         let mut reader = BufReader::new(file);
         let mut line = String::new();
         reader.read_line(&mut line).map_err(|e| read_failed(path, 1, e))?;
         if line.is_empty() {
-            return Err(CliError::usage(format!("{} is empty (no header line)", path.display())));
+            return Err(CliError::invalid(format!("{} is empty (no header line)", path.display())));
         }
         let header: Vec<String> = line.trim_end().split(',').map(String::from).collect();
         let axes: &[&str] = if config.dim == Dimension::Two { &["x", "y"] } else { &["x", "y", "z"] };
@@ -109,7 +109,7 @@ impl Trajectory {
         }
         let pivot = header.len().saturating_sub(expected.len());
         if header.first().map(String::as_str) != Some("t") || pivot == 0 || header[pivot..] != expected[..] {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{} line 1: the header is not that of a {}D run of {} links (t, …, {}, …, {})",
                 path.display(),
                 axes.len(),
@@ -151,7 +151,7 @@ impl Trajectory {
         }
         let at = || format!("{} line {}", self.path.display(), self.number);
         let Some(text) = self.line.strip_suffix('\n') else {
-            return Err(CliError::usage(format!("{}: the line is cut short (no line end)", at())));
+            return Err(CliError::invalid(format!("{}: the line is cut short (no line end)", at())));
         };
         let mut fields = 0;
         for (j, value) in text.trim_end_matches('\r').split(',').enumerate() {
@@ -162,7 +162,7 @@ impl Trajectory {
             let v: f64 = match value.trim().parse() {
                 Ok(v) if f64::is_finite(v) => v,
                 _ => {
-                    return Err(CliError::usage(format!(
+                    return Err(CliError::invalid(format!(
                         "{}, column {}: '{value}' is not a finite number",
                         at(),
                         self.header[j]
@@ -181,7 +181,7 @@ impl Trajectory {
             }
         }
         if fields != self.header.len() {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{}: {fields} fields, expected {} (is the file cut short?)",
                 at(),
                 self.header.len()
@@ -190,7 +190,7 @@ impl Trajectory {
         if let Some(last) = self.last
             && row.t <= last
         {
-            return Err(CliError::usage(format!("{}: t = {} s does not follow t = {last} s", at(), row.t)));
+            return Err(CliError::invalid(format!("{}: t = {} s does not follow t = {last} s", at(), row.t)));
         }
         self.first.get_or_insert(row.t);
         self.last = Some(row.t);
@@ -200,5 +200,5 @@ impl Trajectory {
 }
 
 fn read_failed(path: &Path, line: usize, e: std::io::Error) -> CliError {
-    CliError::usage(format!("{} line {line}: cannot read: {e}", path.display()))
+    CliError::invalid(format!("{} line {line}: cannot read: {e}", path.display()))
 }

@@ -5,8 +5,8 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::RenderView;
-use crate::args::Dimension;
 use crate::error::{CliError, CliResult};
+use pendulum_run::Dimension;
 
 /// How a position (m) becomes a point of the picture (m).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,7 +39,7 @@ impl Projection {
     pub fn new(view: RenderView, dim: Dimension) -> CliResult<Self> {
         Ok(match (dim, view) {
             (Dimension::Two, RenderView::CoRotating) => {
-                return Err(CliError::usage(
+                return Err(CliError::invalid(
                     "--view co-rotating: this is a 2D run; the co-rotating view needs a 3D run whose \
                      pivot circles the vertical axis",
                 ));

@@ -64,7 +64,7 @@ pub fn follow(
         if let Some(count) = count
             && (count == 0 || count > n)
         {
-            return Err(CliError::usage(format!("--branches must be between 1 and n = {n}, got {count}")));
+            return Err(CliError::invalid(format!("--branches must be between 1 and n = {n}, got {count}")));
         }
         let count = count.unwrap_or(below);
         if count < below {

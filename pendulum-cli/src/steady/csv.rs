@@ -3,14 +3,15 @@
 //! the vertical (on the axis: no crossing to count), `stability` one of `stable`,
 //! `gyroscopic`, `unstable`.
 
-use std::io::Write;
 use std::path::Path;
 
 use pendulum_core::SteadyShape;
+use pendulum_run::Csv;
+use pendulum_run::csv::number as num;
 
 use super::branches::Family;
 use super::shapes::Found;
-use crate::error::{CliResult, io_failed};
+use crate::error::CliResult;
 
 /// branches.csv: `branch` (its number in the table), `omega` (rad/s), `amplitude`
 /// (`max |x_i|`, m), `nodes`, `stability`, `index`, `growth_rate` (largest real part, 1/s),
@@ -65,10 +66,6 @@ pub fn shapes(path: &Path, found: &[Found], n: usize, damped: bool) -> CliResult
     write(path, &header, &rows)
 }
 
-fn num(v: f64) -> String {
-    format!("{v:?}")
-}
-
 fn shape_columns(n: usize) -> Vec<String> {
     (1..=n).map(|i| format!("theta{i}")).chain((1..=n).map(|i| format!("x{i}"))).collect()
 }
@@ -78,12 +75,9 @@ fn angles_and_positions(p: &SteadyShape) -> impl Iterator<Item = String> + '_ {
 }
 
 fn write(path: &Path, header: &[String], rows: &[Vec<String>]) -> CliResult<()> {
-    let file = std::fs::File::create(path).map_err(|e| io_failed("create", path, e))?;
-    let mut csv = std::io::BufWriter::new(file);
-    let write_err = |e| io_failed("write", path, e);
-    writeln!(csv, "{}", header.join(",")).map_err(write_err)?;
+    let mut csv = Csv::create(path, header)?;
     for row in rows {
-        writeln!(csv, "{}", row.join(",")).map_err(write_err)?;
+        csv.fields(row)?;
     }
-    csv.flush().map_err(write_err)
+    csv.finish()
 }

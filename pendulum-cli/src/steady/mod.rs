@@ -31,7 +31,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     let n = chain.links();
     let problem = SteadyRotation::new(&chain, args.radius)?;
     if args.radius != 0.0 && args.branches.is_some() {
-        return Err(CliError::usage("--branches applies to a fixed pivot (--radius 0) only"));
+        return Err(CliError::invalid("--branches applies to a fixed pivot (--radius 0) only"));
     }
     let listed = args.omega.as_deref().map(parse_speeds).transpose()?;
     let damping = match &args.damping {
@@ -48,7 +48,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         Some(w) => {
             check_omega_max(w)?;
             if let Some(&above) = listed.iter().flatten().find(|&&v| v > w) {
-                return Err(CliError::usage(format!(
+                return Err(CliError::invalid(format!(
                     "--omega: {above} rad/s is above --omega-max = {w} rad/s (the branches end there)"
                 )));
             }
@@ -65,7 +65,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     let found = shapes::at(&problem, &chain, &family, &speeds, damping.as_deref())?;
 
     std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
     csv::branches(&args.out.join("branches.csv"), &family, n)?;
     csv::shapes(&args.out.join("shapes.csv"), &found, n, damping.is_some())?;
@@ -92,14 +92,14 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
 fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
     let tokens: Vec<&str> = list.split(',').map(str::trim).collect();
     if tokens.iter().all(|t| t.is_empty()) {
-        return Err(CliError::usage(format!(
+        return Err(CliError::invalid(format!(
             "--omega: '{list}' lists no speed (give one or more in rad/s, e.g. --omega 5,10)"
         )));
     }
     tokens
         .iter()
         .map(|&token| {
-            let bad = |why: &str| CliError::usage(format!("--omega: '{list}' has {why}"));
+            let bad = |why: &str| CliError::invalid(format!("--omega: '{list}' has {why}"));
             if token.is_empty() {
                 return Err(bad("an empty entry"));
             }
@@ -117,7 +117,7 @@ fn check_omega_max(omega_max: f64) -> CliResult<()> {
     if omega_max.is_finite() && omega_max > 0.0 {
         Ok(())
     } else {
-        Err(CliError::usage(format!("--omega-max must be finite and positive, got {omega_max}")))
+        Err(CliError::invalid(format!("--omega-max must be finite and positive, got {omega_max}")))
     }
 }
 

@@ -6,16 +6,17 @@
 use std::path::Path;
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, fastest_frequency_bound, normal_modes};
+use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, normal_modes};
+use pendulum_run::{DriveConfig, drive_frequency, fastest_mode, suggested_step};
 use serde::{Deserialize, Serialize};
 
 use super::point::Point;
 use super::{SweepKind, SweepPhysics};
 use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
-use crate::json_file::write_json_atomic;
 use crate::spec::{expand, per_link};
 use crate::steady::round_up;
+use pendulum_run::write_json_atomic;
 
 /// The shape analysis is fed every this many steps (a point and the same `simulate` run
 /// with `--every 4` report the same).
@@ -102,7 +103,7 @@ impl SweepConfig {
     /// Resolves the command line into a complete configuration.
     pub fn from_args(p: &SweepPhysics) -> CliResult<Self> {
         if let Some(dim) = &p.dim {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "--dim {dim}: not an option of pendulum sweep: sweeps are 3D (the pivot circles the vertical axis)"
             )));
         }
@@ -110,7 +111,7 @@ impl SweepConfig {
         let n = masses.len();
         let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
         if !(p.chain.gravity.is_finite() && p.chain.gravity > 0.0) {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "--gravity must be finite and positive for a sweep (the chain starts hanging at rest), got {}",
                 p.chain.gravity
             )));
@@ -142,7 +143,7 @@ impl SweepConfig {
             (Some(t), true) => Some(t),
             (None, true) => Some(round_up(duration / 3.0)),
             (Some(_), false) => {
-                return Err(CliError::usage(
+                return Err(CliError::invalid(
                     "--ramp-time applies to the kinds ramp-up and ramp-down only (--kind sudden has no ramp)",
                 ));
             }
@@ -178,15 +179,15 @@ impl SweepConfig {
     pub fn check(&self) -> CliResult<()> {
         let n = self.links();
         if n == 0 {
-            return Err(CliError::usage("masses: a chain needs at least 1 link, got 0"));
+            return Err(CliError::invalid("masses: a chain needs at least 1 link, got 0"));
         }
         for (what, got) in [("lengths", self.lengths.len()), ("damping", self.damping.len())] {
             if got != n {
-                return Err(CliError::usage(format!("{what}: got {got} values, expected {n}")));
+                return Err(CliError::invalid(format!("{what}: got {got} values, expected {n}")));
             }
         }
         if !(self.gravity.is_finite() && self.gravity > 0.0) {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "gravity must be finite and positive for a sweep, got {}",
                 self.gravity
             )));
@@ -194,55 +195,55 @@ impl SweepConfig {
         self.damped_chain()?;
         check_radius(self.radius)?;
         if self.omegas.is_empty() {
-            return Err(CliError::usage("--omega: no speed to sweep"));
+            return Err(CliError::invalid("--omega: no speed to sweep"));
         }
         if let Some(w) = self.omegas.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
-            return Err(CliError::usage(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
+            return Err(CliError::invalid(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
         }
         if self.kinds.is_empty() {
-            return Err(CliError::usage("--kind: no kind of experiment given"));
+            return Err(CliError::invalid("--kind: no kind of experiment given"));
         }
         check_duration(self.duration)?;
         let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
         match (self.ramp_time, ramps) {
             (Some(t), true) => {
                 if !(t.is_finite() && t > 0.0) {
-                    return Err(CliError::usage(format!(
+                    return Err(CliError::invalid(format!(
                         "--ramp-time must be finite and positive, got {t} (s)"
                     )));
                 }
                 if t >= self.duration {
-                    return Err(CliError::usage(format!(
+                    return Err(CliError::invalid(format!(
                         "--ramp-time {t} s must be shorter than --duration {} s (the speed is held at ω after the ramp)",
                         self.duration
                     )));
                 }
             }
-            (None, true) => return Err(CliError::usage("ramp_time: the ramp kinds need a ramp time")),
-            (Some(_), false) => return Err(CliError::usage("ramp_time: given without a ramp kind")),
+            (None, true) => return Err(CliError::invalid("ramp_time: the ramp kinds need a ramp time")),
+            (Some(_), false) => return Err(CliError::invalid("ramp_time: given without a ramp kind")),
             (None, false) => {}
         }
         if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(CliError::usage(format!("--step must be finite and positive, got {}", self.step)));
+            return Err(CliError::invalid(format!("--step must be finite and positive, got {}", self.step)));
         }
         let steps = (self.duration / self.step).ceil();
         if steps > MAX_STEPS {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "--duration {} s with --step {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
                 self.duration, self.step
             )));
         }
         if self.feed_every == 0 {
-            return Err(CliError::usage("feed_every must be at least 1 step, got 0"));
+            return Err(CliError::invalid("feed_every must be at least 1 step, got 0"));
         }
         if !(self.settle_periods.is_finite() && self.settle_periods > 0.0) {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "settle_periods must be finite and positive, got {}",
                 self.settle_periods
             )));
         }
         if !(self.settle_tolerance.is_finite() && self.settle_tolerance >= 0.0) {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "settle_tolerance must be finite and non-negative, got {}",
                 self.settle_tolerance
             )));
@@ -292,7 +293,7 @@ fn check_radius(radius: f64) -> CliResult<()> {
     if radius.is_finite() && radius > 0.0 {
         Ok(())
     } else {
-        Err(CliError::usage(format!(
+        Err(CliError::invalid(format!(
             "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
         )))
     }
@@ -302,7 +303,7 @@ fn check_duration(duration: f64) -> CliResult<()> {
     if duration.is_finite() && duration > 0.0 {
         Ok(())
     } else {
-        Err(CliError::usage(format!("--duration must be finite and positive, got {duration} (s)")))
+        Err(CliError::invalid(format!("--duration must be finite and positive, got {duration} (s)")))
     }
 }
 
@@ -310,7 +311,7 @@ fn check_duration(duration: f64) -> CliResult<()> {
 /// rad/s, or in units of √(g/L) when `scaled`). Errors name the value.
 pub fn parse_omegas(spec: &str, scaled: bool) -> CliResult<Vec<f64>> {
     let unit = if scaled { "√(g/L)" } else { "rad/s" };
-    let bad = |why: String| CliError::usage(format!("--omega: '{spec}' {why}"));
+    let bad = |why: String| CliError::invalid(format!("--omega: '{spec}' {why}"));
     let number = |token: &str, what: &str| -> CliResult<f64> {
         let token = token.trim();
         match token.parse::<f64>() {
@@ -371,19 +372,16 @@ fn default_duration(chain: &Chain<Dyn>) -> f64 {
 }
 
 /// The step `pendulum simulate` suggests for this chain on a circle of `radius` turning at
-/// up to `omega` (rad/s), `0.5 / ω_fastest`, at most a fortieth of the drive period, and
-/// here also at most `1 / ν_fastest` (RK4 is stable to `h ν ≈ 2.8` on decaying modes);
-/// rounded down to two digits; `ω_fastest` with `g_eff = g + R ω²`
-/// ([`fastest_frequency_bound`]), `ν_fastest` [`fastest_decay_bound`].
+/// up to `omega` (rad/s) ([`suggested_step`]: `0.5 / ω_fastest`, at most a fortieth of the
+/// drive period, `ω_fastest` with `g_eff = g + R ω²`), here also at most `1 / ν_fastest`
+/// (RK4 is stable to `h ν ≈ 2.8` on decaying modes; [`fastest_decay_bound`]); rounded
+/// down to two digits.
 fn default_step(chain: &Chain<Dyn>, radius: f64, omega: f64) -> f64 {
-    let fastest = fastest_frequency_bound(chain, chain.gravity() + radius * omega * omega);
+    let circle = DriveConfig::Circle { radius, omega };
+    let mut h = suggested_step(fastest_mode(chain, &circle), drive_frequency(&circle));
     let decay = fastest_decay_bound(chain);
-    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
     if decay > 0.0 {
         h = h.min(1.0 / decay);
-    }
-    if omega > 0.0 {
-        h = h.min(std::f64::consts::TAU / omega / 40.0);
     }
     let unit = 10f64.powi(h.log10().floor() as i32 - 1);
     (h / unit).floor() * unit
@@ -437,9 +435,9 @@ impl SweepFile {
     /// Reads and checks a sweep.json; errors name the file and the problem.
     pub fn read(path: &Path) -> CliResult<Self> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::usage(format!("--from: cannot read {}: {e}", path.display())))?;
+            .map_err(|e| CliError::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
         let not_sweep = |why: String| {
-            CliError::usage(format!(
+            CliError::invalid(format!(
                 "--from: {} is not a sweep.json of pendulum sweep: {why}",
                 path.display()
             ))

@@ -4,9 +4,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use pendulum_run::Csv;
+use pendulum_run::csv::number;
+
 use super::config::{SweepConfig, short};
 use super::point::{Point, Status};
-use crate::error::{CliResult, io_failed};
+use crate::error::CliResult;
 
 /// The columns of sweep.csv.
 pub const HEADER: [&str; 16] = [
@@ -30,43 +33,37 @@ pub const HEADER: [&str; 16] = [
 
 /// Writes sweep.csv: [`HEADER`], then one row per point, in the order of the points.
 pub fn write(path: &Path, points: &[Point]) -> CliResult<()> {
-    let mut text = HEADER.join(",");
-    text.push('\n');
+    let mut csv = Csv::create(path, &HEADER)?;
     for p in points {
-        let mut row: Vec<String> = vec![
-            p.kind.name().into(),
-            format!("{:?}", p.omega),
-            format!("{:?}", p.omega_scaled),
-            p.status.name().into(),
-        ];
+        let mut row: Vec<String> =
+            vec![p.kind.name().into(), number(p.omega), number(p.omega_scaled), p.status.name().into()];
         match &p.result {
             Some(r) => {
                 row.extend([
                     r.nodes.to_string(),
                     r.axis_crossings.to_string(),
-                    format!("{:?}", r.tip_radius),
-                    format!("{:?}", r.tip_signed),
+                    number(r.tip_radius),
+                    number(r.tip_signed),
                     r.settled.to_string(),
-                    format!("{:?}", r.drift),
+                    number(r.drift),
                 ]);
                 match &r.nearest {
                     Some(n) => row.extend([
-                        format!("{:?}", n.distance),
+                        number(n.distance),
                         n.nodes.to_string(),
                         n.stable.to_string(),
-                        format!("{:?}", n.growth_rate),
+                        number(n.growth_rate),
                     ]),
                     None => row.extend(std::iter::repeat_n(String::new(), 4)),
                 }
-                row.push(format!("{:?}", r.t));
+                row.push(number(r.t));
                 row.push(format!("{:.3}", r.wall_seconds));
             }
             None => row.extend(std::iter::repeat_n(String::new(), HEADER.len() - 4)),
         }
-        text.push_str(&row.join(","));
-        text.push('\n');
+        csv.fields(&row)?;
     }
-    std::fs::write(path, text).map_err(|e| io_failed("write", path, e))
+    csv.finish()
 }
 
 /// The table on stdout: the sweep's parameters, then one line per point.

@@ -23,7 +23,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::args::ChainOptions;
 use crate::error::{CliError, CliResult};
-use crate::json_file::warn_other_version;
 
 use config::{SweepConfig, SweepFile};
 
@@ -142,20 +141,22 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
     let config = match &args.from {
         Some(path) => {
             let file = SweepFile::read(path)?;
-            if !args.quiet {
-                warn_other_version(path, &file.version);
+            if !args.quiet
+                && let Some(warning) = pendulum_run::other_version(path, &file.version)
+            {
+                eprintln!("pendulum: warning: {warning}");
             }
             file.config
         }
         None => SweepConfig::from_args(&args.physics)?,
     };
     let jobs = match args.jobs {
-        Some(0) => return Err(CliError::usage("--jobs must be at least 1, got 0")),
+        Some(0) => return Err(CliError::invalid("--jobs must be at least 1, got 0")),
         Some(j) => j,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::usage(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
     crate::interrupt::install_handler();
     let sweep = runs::Sweep::new(config, args.out.clone(), jobs, args.quiet)?;

@@ -11,18 +11,18 @@ use std::sync::Mutex;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use nalgebra::{DVector, Dyn, U3};
-use pendulum_core::integrate::{Projected, Rk4, State};
-use pendulum_core::{Chain, Directions, ShapeOptions, ShapeTracker, trajectory};
+use nalgebra::{DVector, Dyn};
+use pendulum_core::integrate::State;
+use pendulum_core::{Chain, ShapeOptions, ShapeTracker, trajectory};
+use pendulum_run::assemble::whirl_model;
+use pendulum_run::final_state::turned_about_vertical;
+use pendulum_run::{DriveConfig, IntegratorKind, Method, directions_integrator, turning_drive};
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
 use super::point::{Outcome, Point, Status};
-use crate::config::DriveConfig;
 use crate::error::{CliError, CliResult};
-use crate::final_state::turned_about_vertical;
 use crate::interrupt::INTERRUPTED;
-use crate::models::turning_drive;
 
 /// Why a run did not finish.
 enum Stop {
@@ -224,7 +224,7 @@ impl Sweep {
         let failed = |e: &dyn std::fmt::Display| Stop::Failed(e.to_string());
         let turning =
             turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
-        let model = Directions::<U3>::new(self.chain.clone()).with_drive(turning);
+        let model = whirl_model(self.chain.clone(), turning);
         let x0 = match start {
             Some(x) => x,
             None => model.hanging(),
@@ -235,11 +235,12 @@ impl Sweep {
             ..ShapeOptions::default()
         };
         let mut tracker = ShapeTracker::new(&model, options).map_err(|e| failed(&e))?;
-        let mut solver = Projected::new(Rk4::new(&model));
+        let mut solver =
+            directions_integrator(Method::of_kind(IntegratorKind::Rk4), &model).map_err(|e| failed(&e))?;
         let mut state = State::new(0.0, x0);
         let mut push_error = None;
         let summary =
-            trajectory::run(&mut solver, &model, &mut state, c.duration, c.step, c.feed_every, |t, x| {
+            trajectory::run(&mut *solver, &model, &mut state, c.duration, c.step, c.feed_every, |t, x| {
                 if let Err(e) = tracker.push(t, x) {
                     push_error = Some(e);
                     return ControlFlow::Break(());

@@ -53,7 +53,7 @@ pub fn view(args: &ViewArgs) -> CliResult<()> {
         return live::live(&args.live, args.port);
     };
     if args.frames < 2 {
-        return Err(CliError::usage(format!("--frames must be at least 2, got {}", args.frames)));
+        return Err(CliError::invalid(format!("--frames must be at least 2, got {}", args.frames)));
     }
     let run = Run::open(dir)?;
     let scene = scene::Scene::read(dir, &run, args.frames)?;

@@ -5,10 +5,10 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::args::Dimension;
-use crate::config::DriveConfig;
 use crate::error::{CliError, CliResult};
 use crate::render::source::{Run, Trajectory};
+use pendulum_run::Dimension;
+use pendulum_run::DriveConfig;
 
 /// Frames a page holds by default: a 300 s run of 100 links at 500 samples stays whole,
 /// and a run of 100 links stays within about 15 MB (about 7.5 bytes per coordinate).
@@ -55,7 +55,7 @@ impl Scene {
         while count.next(&mut row)? {}
         let samples = count.rows;
         if samples == 0 {
-            return Err(CliError::usage(format!("{}: no samples", run.trajectory.display())));
+            return Err(CliError::invalid(format!("{}: no samples", run.trajectory.display())));
         }
         let every = samples.div_ceil(frames as u64).max(1);
         let mut trajectory = Trajectory::open(&run.trajectory, config)?;
@@ -103,12 +103,12 @@ impl Scene {
 fn ledger(dir: &Path, times: &[f32]) -> CliResult<(Vec<f32>, Vec<f32>)> {
     let path = dir.join("energy.csv");
     let text = std::fs::read_to_string(&path)
-        .map_err(|e| CliError::usage(format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", path.display())))?;
     let mut rows = Vec::new();
     for (number, line) in text.lines().enumerate().skip(1) {
         let fields: Vec<f64> = line.split(',').filter_map(|v| v.trim().parse().ok()).collect();
         if fields.len() != 6 {
-            return Err(CliError::usage(format!(
+            return Err(CliError::invalid(format!(
                 "{} line {}: expected 6 numbers",
                 path.display(),
                 number + 1

@@ -17,9 +17,9 @@ pub fn serve(app: Router, port: u16, what: &str) -> CliResult<()> {
         .build()
         .map_err(|e| CliError::failed(format!("cannot start the server: {e}")))?;
     runtime.block_on(async move {
-        let listener = tokio::net::TcpListener::bind(("127.0.0.1", port))
-            .await
-            .map_err(|e| CliError::usage(format!("--port {port}: cannot listen on 127.0.0.1:{port}: {e}")))?;
+        let listener = tokio::net::TcpListener::bind(("127.0.0.1", port)).await.map_err(|e| {
+            CliError::invalid(format!("--port {port}: cannot listen on 127.0.0.1:{port}: {e}"))
+        })?;
         let address =
             listener.local_addr().map_err(|e| CliError::failed(format!("the server's address: {e}")))?;
         eprintln!("pendulum: {what} at http://{address}/ (Ctrl-C stops)");

@@ -106,12 +106,12 @@ fn start(args: &LiveArgs) -> CliResult<Start> {
         gravity: args.gravity,
     };
     if !(0.0..=MAX_START).contains(&args.start) {
-        return Err(CliError::usage(format!("--start {}: must be a time in 0…{MAX_START} s", args.start)));
+        return Err(CliError::invalid(format!("--start {}: must be a time in 0…{MAX_START} s", args.start)));
     }
     let chain = chain_of(&options)?;
     let (damping, radius, omega, time) = (args.damping, args.radius, args.omega, 0.0);
     let start = Start { chain, damping, radius, omega, time };
-    start.session().map_err(|e| CliError::usage(format!("--live: {e}")))?;
+    start.session().map_err(|e| CliError::invalid(format!("--live: {e}")))?;
     Ok(Start { time: args.start, ..start })
 }
 

@@ -3,7 +3,8 @@
 
 use nalgebra::{Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, State};
-use pendulum_core::{Chain, Directions, Drive, RodMidpoint, Steered};
+use pendulum_core::{Chain, Directions, Drive, Steered};
+use pendulum_run::{IntegratorKind, Method, directions_integrator};
 use serde::{Deserialize, Serialize};
 
 /// The step, s: four per frame of a 60 Hz display. The midpoint rule is exact on the rods
@@ -77,7 +78,8 @@ pub struct Frame {
 /// A live chain and its steered pivot.
 pub struct Session {
     model: Directions<U3, Steered>,
-    integrator: RodMidpoint,
+    /// The implicit midpoint rule on the rods (the run library's `midpoint`).
+    integrator: Box<dyn Integrator<Directions<U3, Steered>> + Send>,
     state: State<Dyn>,
 }
 
@@ -93,7 +95,9 @@ impl Session {
         let drive = Steered::new(HAND_RATE, CIRCLE_RATE).map_err(|e| e.to_string())?;
         let model = Directions::new(chain).with_drive(drive);
         let state = State::new(0.0, model.hanging());
-        let mut session = Self { model, integrator: RodMidpoint::new(), state };
+        let integrator = directions_integrator(Method::of_kind(IntegratorKind::Midpoint), &model)
+            .map_err(|e| e.to_string())?;
+        let mut session = Self { model, integrator, state };
         for control in [Control::Damping(damping), Control::Radius(radius), Control::Omega(omega)] {
             session.apply(control)?;
         }

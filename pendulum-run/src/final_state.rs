@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::args::Dimension;
-use crate::error::{CliError, CliResult};
-use crate::json_file::write_json_atomic;
+use crate::description::Dimension;
+use crate::error::{Error, Result};
+use crate::json::write_json_atomic;
 
 /// The file name a run writes its final state to.
 pub const FILE_NAME: &str = "final.json";
@@ -22,7 +22,7 @@ pub const FILE_NAME: &str = "final.json";
 pub struct FinalState {
     /// Always `"pendulum"`.
     pub program: String,
-    /// The `pendulum-cli` version that wrote the file.
+    /// The version of the program that wrote the file.
     pub version: String,
     /// Space dimension.
     pub dim: Dimension,
@@ -51,7 +51,7 @@ impl FinalState {
         let half = motion.len() / 2;
         Self {
             program: "pendulum".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
+            version: crate::VERSION.into(),
             dim,
             links,
             t,
@@ -79,22 +79,21 @@ impl FinalState {
 
     /// Reads the final state at `path` (a `final.json`, or a run directory holding one)
     /// for a run of `links` links in `dim`; errors name the file and what does not fit.
-    pub fn read_for(path: &Path, dim: Dimension, links: usize) -> CliResult<Self> {
+    pub fn read_for(path: &Path, dim: Dimension, links: usize) -> Result<Self> {
         let file: PathBuf = if path.is_dir() { path.join(FILE_NAME) } else { path.to_path_buf() };
-        let fail = |m: String| CliError::usage(format!("--initial {}: {m}", file.display()));
+        let fail = |m: String| Error::invalid(format!("--initial {}: {m}", file.display()));
         let text = std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read it: {e}")))?;
         let state: Self =
             serde_json::from_str(&text).map_err(|e| fail(format!("not a pendulum final state: {e}")))?;
         if state.program != "pendulum" {
             return Err(fail(format!("written by '{}', not pendulum", state.program)));
         }
-        let name = |d: Dimension| if d == Dimension::Two { "2D" } else { "3D" };
         if state.dim != dim || state.links != links {
             return Err(fail(format!(
                 "a state of {} links in {}, this run has {links} links in {}",
                 state.links,
-                name(state.dim),
-                name(dim)
+                state.dim.name(),
+                dim.name()
             )));
         }
         let per_link = if dim == Dimension::Two { 1 } else { 3 };
@@ -118,7 +117,7 @@ impl FinalState {
     }
 
     /// Writes the file into `dir`.
-    pub fn write(&self, dir: &Path) -> CliResult<()> {
+    pub fn write(&self, dir: &Path) -> Result<()> {
         write_json_atomic(&dir.join(FILE_NAME), self)
     }
 }

@@ -1,6 +1,8 @@
-//! Which core model simulates which chain (one place to switch models), and the
-//! [`Simulation`] the run loop sees: a motion with its energy ledger, its initial state,
-//! and what one sample of it means ([`Motion`]: trajectory columns, positions).
+//! The one place a description becomes core values: which model simulates which chain,
+//! the drive of a [`DriveConfig`], the integrator of a [`Method`], and the [`Simulation`]
+//! the run loop sees (a motion with its energy ledger, its initial state, and what one
+//! sample of it means: [`Motion`], trajectory columns and positions). The CLI's commands,
+//! the live page and the sweep build their chains here.
 
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, U2, U3};
 use pendulum_core::energy::Powered;
@@ -14,9 +16,8 @@ use pendulum_core::{
     Model, ModelAlloc, PlanarTension, RampedCircle, RodMidpoint, Spatial, Turning,
 };
 
-use crate::args::{Dimension, IntegratorKind, StageSolver};
-use crate::config::{DEFAULT_TOLERANCE, DriveConfig, RunConfig};
-use crate::error::{CliError, CliResult};
+use crate::description::{DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver};
+use crate::error::{Error, Result};
 
 /// One sample of a run, in plain numbers.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,6 +51,11 @@ pub struct Method {
 }
 
 impl Method {
+    /// The method `kind` with the default stage solve (fixed point) and tolerance.
+    pub fn of_kind(kind: IntegratorKind) -> Self {
+        Self { kind, solver: StageSolver::FixedPoint, tolerance: DEFAULT_TOLERANCE }
+    }
+
     /// The method of a configuration.
     pub fn of(config: &RunConfig) -> Self {
         Self {
@@ -65,7 +71,7 @@ impl Method {
 fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
     method: Method,
     system: &S,
-) -> CliResult<Box<dyn Integrator<S> + 'a>> {
+) -> Result<Box<dyn Integrator<S> + Send + 'a>> {
     let options = GaussOptions::default();
     Ok(match (method.kind, method.solver) {
         (IntegratorKind::Gl1, StageSolver::Newton) => {
@@ -89,7 +95,7 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
         (IntegratorKind::Rk4, _) => Box::new(Rk4::new(system)),
         (IntegratorKind::Dp54, _) => Box::new(DormandPrince::new(system, method.tolerance, Unprojected)?),
         (IntegratorKind::Midpoint, _) => {
-            return Err(CliError::usage(
+            return Err(Error::invalid(
                 "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
             ));
         }
@@ -100,7 +106,7 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
 fn projected_integrator<'a, S: Constrained<Dim = Dyn> + 'a>(
     method: Method,
     system: &S,
-) -> CliResult<Box<dyn Integrator<S> + 'a>> {
+) -> Result<Box<dyn Integrator<S> + Send + 'a>> {
     Ok(match method.kind {
         // Projected after every internal step, not only at the end of each step.
         IntegratorKind::Dp54 => Box::new(DormandPrince::new(system, method.tolerance, OntoConstraints)?),
@@ -122,7 +128,7 @@ pub trait Motion: Powered + Sized {
     fn integrator<'a>(
         system: &'a Accounted<Self>,
         method: Method,
-    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>>;
+    ) -> Result<Box<dyn Integrator<Accounted<Self>> + 'a>>;
 }
 
 /// A model in angles with a boxed pivot drive and constant torques.
@@ -158,8 +164,8 @@ where
     fn integrator<'a>(
         system: &'a Accounted<Self>,
         method: Method,
-    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
-        plain_integrator(method, system)
+    ) -> Result<Box<dyn Integrator<Accounted<Self>> + 'a>> {
+        Ok(plain_integrator(method, system)?)
     }
 }
 
@@ -189,14 +195,30 @@ where
     fn integrator<'a>(
         system: &'a Accounted<Self>,
         method: Method,
-    ) -> CliResult<Box<dyn Integrator<Accounted<Self>> + 'a>> {
-        match method.kind {
-            // Exact on the rods by construction; a projection of the rates would change the
-            // energy outside the ledger.
-            IntegratorKind::Midpoint => Ok(Box::new(RodMidpoint::new())),
-            _ => projected_integrator(method, system),
-        }
+    ) -> Result<Box<dyn Integrator<Accounted<Self>> + 'a>> {
+        Ok(directions_integrator(method, system)?)
     }
+}
+
+/// The integrator of a method for a chain in unit link directions, with its ledger or
+/// without: `midpoint` the implicit midpoint rule on the rods ([`RodMidpoint`], exact on
+/// them by construction: a projection of the rates would change the energy outside the
+/// ledger), any other kind followed by the projection onto the rods.
+pub fn directions_integrator<'a, S>(method: Method, system: &S) -> Result<Box<dyn Integrator<S> + Send + 'a>>
+where
+    S: Constrained<Dim = Dyn> + 'a,
+    RodMidpoint: Integrator<S>,
+{
+    match method.kind {
+        IntegratorKind::Midpoint => Ok(Box::new(RodMidpoint::new())),
+        _ => projected_integrator(method, system),
+    }
+}
+
+/// A 3D chain in unit link directions whose pivot circles the vertical ([`Turning`]): the
+/// model of a whirl's shape analysis and of a sweep's points.
+pub fn whirl_model(chain: Chain<Dyn>, drive: Box<dyn Turning>) -> Directions<U3, Box<dyn Turning>> {
+    Directions::<U3>::new(chain).with_drive(drive)
 }
 
 /// A chain set up to run: its motion with the energy ledger ([`Accounted`]) and the state
@@ -208,7 +230,7 @@ pub struct Simulation<P> {
 
 impl<P: Motion> Simulation<P> {
     /// The motion from its state `motion` at t = 0, with an empty ledger.
-    fn new(motion: P, start: &[f64]) -> CliResult<Self> {
+    fn new(motion: P, start: &[f64]) -> Result<Self> {
         let system = Accounted::of(motion);
         let x0 = system.start(start)?;
         Ok(Self { system, x0 })
@@ -244,7 +266,7 @@ impl<P: Motion> Simulation<P> {
     }
 
     /// The integrator of this method for the system.
-    pub fn integrator(&self, method: Method) -> CliResult<Box<dyn Integrator<Accounted<P>> + '_>> {
+    pub fn integrator(&self, method: Method) -> Result<Box<dyn Integrator<Accounted<P>> + '_>> {
         P::integrator(&self.system, method)
     }
 }
@@ -258,7 +280,7 @@ where
 }
 
 /// The chain of a configuration, validated by the core.
-pub fn chain(config: &RunConfig) -> CliResult<Chain<Dyn>> {
+pub fn chain(config: &RunConfig) -> Result<Chain<Dyn>> {
     Ok(Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?)
 }
 
@@ -280,28 +302,28 @@ where
     DefaultAllocator: nalgebra::allocator::Allocator<Self>,
 {
     /// The circle drive, steady or ramped, in this space (3D only).
-    fn circle(config: &DriveConfig) -> CliResult<Box<dyn Drive<Self>>>;
+    fn circle(config: &DriveConfig) -> Result<Box<dyn Drive<Self>>>;
 }
 
 impl RunSpace for U2 {
-    fn circle(_: &DriveConfig) -> CliResult<Box<dyn Drive<U2>>> {
-        Err(CliError::usage("--drive circle moves the pivot on a horizontal circle: 3D only"))
+    fn circle(_: &DriveConfig) -> Result<Box<dyn Drive<U2>>> {
+        Err(Error::invalid("--drive circle moves the pivot on a horizontal circle: 3D only"))
     }
 }
 
 impl RunSpace for U3 {
-    fn circle(config: &DriveConfig) -> CliResult<Box<dyn Drive<U3>>> {
+    fn circle(config: &DriveConfig) -> Result<Box<dyn Drive<U3>>> {
         match turning_drive(config)? {
             // Upcast: the same box, not a box of a box (the drive is called at every step).
             Some(turning) => Ok(turning),
-            None => Err(CliError::usage("not a circle drive")),
+            None => Err(Error::invalid("not a circle drive")),
         }
     }
 }
 
 /// The drive of a configuration as a [`Turning`] one (the pivot circling the vertical
 /// axis: circle, steady or ramped), or `None` for other drives.
-pub fn turning_drive(config: &DriveConfig) -> CliResult<Option<Box<dyn Turning>>> {
+pub fn turning_drive(config: &DriveConfig) -> Result<Option<Box<dyn Turning>>> {
     Ok(match *config {
         DriveConfig::Circle { radius, omega } => Some(Box::new(Circle::new(radius, omega)?)),
         DriveConfig::RampedCircle { radius, initial_omega, omega, duration } => {
@@ -312,7 +334,7 @@ pub fn turning_drive(config: &DriveConfig) -> CliResult<Option<Box<dyn Turning>>
 }
 
 /// The pivot drive of a configuration.
-fn drive<S: RunSpace>(config: &DriveConfig) -> CliResult<Box<dyn Drive<S>>>
+fn drive<S: RunSpace>(config: &DriveConfig) -> Result<Box<dyn Drive<S>>>
 where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
@@ -339,7 +361,7 @@ pub enum AnySimulation {
 /// 2D chains run in angles (the one place to change it: [`planar_model`]); 3D chains in
 /// unit link directions, free of the spherical angles' singularity, started from
 /// spherical angles `q = (θ, φ)` and rates `q̇` (any angles, a hanging chain included).
-pub fn build(config: &RunConfig) -> CliResult<AnySimulation> {
+pub fn build(config: &RunConfig) -> Result<AnySimulation> {
     let chain = chain(config)?;
     let (q, qd) = (&config.initial.coordinates, &config.initial.rates);
     Ok(match config.dim {
