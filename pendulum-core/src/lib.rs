@@ -64,7 +64,7 @@ pub use energy::{
 };
 pub use error::{Error, Result};
 pub use jacobians::{Derivatives, Jacobians, Parts};
-pub use kinematics::{SINGULARITY_TOLERANCE, check_polar_angle, check_polar_sin};
+pub use kinematics::{SINGULARITY_TOLERANCE, TurningFrame, check_polar_angle, check_polar_sin};
 pub use model::{Inputs, InputsAt, Model, ModelAlloc, check_inputs};
 pub use models::{Directions, Planar, PlanarTangents, PlanarTension, RodMidpoint, Spatial};
 pub use systems::{Canonical, FirstOrder};

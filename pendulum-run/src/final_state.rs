@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use pendulum_core::TurningFrame;
 use serde::{Deserialize, Serialize};
 
 use crate::description::Dimension;
@@ -62,12 +63,12 @@ impl FinalState {
         }
     }
 
-    /// The state a continuing run starts from: coordinates then rates, in 3D turned by
-    /// `−pivot_phase` about the vertical when the pivot circled ([`turned_about_vertical`]).
+    /// The state a continuing run starts from: coordinates then rates, in 3D seen in the
+    /// frame turning with the pivot ([`TurningFrame`]) when the pivot circled.
     pub fn start(&self) -> Vec<f64> {
         let state: Vec<f64> = self.coordinates.iter().chain(&self.rates).copied().collect();
         match (self.dim, self.pivot_phase) {
-            (Dimension::Three, Some(phase)) => turned_about_vertical(&state, -phase),
+            (Dimension::Three, Some(phase)) => TurningFrame::at(phase).turn_vectors(&state),
             _ => state,
         }
     }
@@ -122,34 +123,6 @@ impl FinalState {
     }
 }
 
-/// A 3D state `(u_1..u_n, w_1..w_n)` (3 components each) turned by `angle` (rad) about
-/// the vertical z axis.
-pub fn turned_about_vertical(x: &[f64], angle: f64) -> Vec<f64> {
-    let (s, c) = angle.sin_cos();
-    let mut y = x.to_vec();
-    for k in 0..x.len() / 3 {
-        let (a, b) = (x[3 * k], x[3 * k + 1]);
-        y[3 * k] = c * a - s * b;
-        y[3 * k + 1] = s * a + c * b;
-    }
-    y
-}
-
 fn representation(dim: Dimension) -> &'static str {
     if dim == Dimension::Two { "angles" } else { "directions" }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn turning_a_state_turns_every_vector_about_z() {
-        let x = [1.0, 0.0, -1.0, 0.0, 2.0, 0.5];
-        let y = turned_about_vertical(&x, std::f64::consts::FRAC_PI_2);
-        let expected = [0.0, 1.0, -1.0, -2.0, 0.0, 0.5];
-        for (a, b) in y.iter().zip(expected) {
-            assert!((a - b).abs() < 1e-15, "{y:?}");
-        }
-    }
 }

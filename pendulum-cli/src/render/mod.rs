@@ -267,7 +267,7 @@ fn animate(job: &Job) -> CliResult<Done> {
         if co_rotating && let Some(why) = circling.broken() {
             return Err(not_circling(why.to_string()));
         }
-        let turn = view::turn_of(&row.pivot);
+        let turn = pendulum_core::TurningFrame::of_pivot(&row.pivot);
         let tip = projection.point(row.masses.last().expect("a chain has a mass"), turn);
         let span = TRAIL_FRAMES * tm.interval;
         let trail_stride = ((span / sample / TRAIL_POINTS).ceil() as u64).max(1);

@@ -6,6 +6,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::RenderView;
 use crate::error::{CliError, CliResult};
+use pendulum_core::TurningFrame;
 use pendulum_run::Dimension;
 
 /// How a position (m) becomes a point of the picture (m).
@@ -52,14 +53,14 @@ impl Projection {
         })
     }
 
-    /// The drawn point of the position `r` (m); `turn` is (cos φ, sin φ) of the pivot's
-    /// azimuth at the same instant (only the co-rotating view uses it).
-    pub fn point(self, r: &[f64; 3], turn: (f64, f64)) -> (f64, f64) {
+    /// The drawn point of the position `r` (m); `turn` is the frame turning with the
+    /// pivot at the same instant (only the co-rotating view uses it).
+    pub fn point(self, r: &[f64; 3], turn: TurningFrame) -> (f64, f64) {
         match self {
             Self::Plane | Self::Top => (r[0], r[1]),
             Self::Side => (r[0], r[2]),
             Self::SideY => (r[1], r[2]),
-            Self::CoRotating => (r[0] * turn.0 + r[1] * turn.1, r[2]),
+            Self::CoRotating => (turn.turn(r[0], r[1]).0, r[2]),
         }
     }
 
@@ -103,12 +104,6 @@ impl Projection {
     }
 }
 
-/// (cos φ, sin φ) of the pivot's azimuth φ = atan2(p_y, p_x) ((1, 0) on the axis).
-pub fn turn_of(pivot: &[f64; 3]) -> (f64, f64) {
-    let r = pivot[0].hypot(pivot[1]);
-    if r > 0.0 { (pivot[0] / r, pivot[1] / r) } else { (1.0, 0.0) }
-}
-
 /// Follows the pivot's azimuth φ(t) = atan2(p_y, p_x) sample by sample: the pivot circles
 /// the vertical axis if it stays off the axis, turns one way only (by less than a quarter
 /// turn between samples, so the turning is resolved) and turns at all. Any drive that
@@ -141,7 +136,7 @@ impl Circling {
             self.broken = Some(format!("it is on the axis at t = {t} s"));
             return;
         }
-        let phi = p[1].atan2(p[0]);
+        let phi = TurningFrame::of_pivot(p).phase();
         if let Some(previous) = self.previous {
             let step = (phi - previous + PI).rem_euclid(TAU) - PI;
             if step.abs() > FRAC_PI_2 {
@@ -246,7 +241,7 @@ mod tests {
     #[test]
     fn the_co_rotating_view_turns_the_pivot_onto_the_positive_x_axis() {
         let pivot = [0.0, -0.2, 0.0];
-        let p = Projection::CoRotating.point(&pivot, turn_of(&pivot));
+        let p = Projection::CoRotating.point(&pivot, TurningFrame::of_pivot(&pivot));
         assert!((p.0 - 0.2).abs() < 1e-15 && p.1 == 0.0, "{p:?}");
     }
 

@@ -13,9 +13,8 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Dyn};
 use pendulum_core::integrate::State;
-use pendulum_core::{Chain, ShapeOptions, ShapeTracker, trajectory};
+use pendulum_core::{Chain, ShapeOptions, ShapeTracker, TurningFrame, trajectory};
 use pendulum_run::assemble::whirl_model;
-use pendulum_run::final_state::turned_about_vertical;
 use pendulum_run::{DriveConfig, IntegratorKind, Method, directions_integrator, turning_drive};
 
 use super::SweepKind;
@@ -261,7 +260,7 @@ impl Sweep {
         let report = tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
         let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64());
         let phase = model.drive().phase(state.t());
-        Ok((outcome, DVector::from_vec(turned_about_vertical(state.x().as_slice(), -phase))))
+        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(state.x().as_slice()))))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use pendulum_core::TurningFrame;
 use serde::Serialize;
 
 use crate::error::{CliError, CliResult};
@@ -36,6 +37,9 @@ pub struct Scene {
     pub predicted: Vec<f32>,
     /// Whether the pivot circles the vertical (the page then offers the co-rotating frame).
     pub turning: bool,
+    /// A circling pivot's azimuth φ at the kept samples, rad (the co-rotating frame turns
+    /// every point by −φ: [`TurningFrame`]); empty for other runs.
+    pub phases: Vec<f32>,
     /// Samples in the trajectory.
     pub samples: u64,
     /// One sample in `every` is kept.
@@ -61,11 +65,15 @@ impl Scene {
         let mut trajectory = Trajectory::open(&run.trajectory, config)?;
         let reach: f64 = config.lengths.iter().sum();
         let unit = reach * 1e-6;
-        let (mut times, mut positions) = (Vec::new(), Vec::new());
+        let turning = matches!(config.drive, DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. });
+        let (mut times, mut positions, mut phases) = (Vec::new(), Vec::new(), Vec::new());
         let mut index = 0;
         while trajectory.next(&mut row)? {
             if index % every == 0 {
                 times.push(row.t as f32);
+                if turning {
+                    phases.push(TurningFrame::of_pivot(&row.pivot).phase() as f32);
+                }
                 for p in std::iter::once(&row.pivot).chain(&row.masses) {
                     positions.extend(p.iter().map(|v| (v / unit).round() as i64));
                 }
@@ -84,7 +92,8 @@ impl Scene {
             unit,
             energy,
             predicted,
-            turning: matches!(config.drive, DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. }),
+            turning,
+            phases,
             samples,
             every,
             parameters: parameters(run),

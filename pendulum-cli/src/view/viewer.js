@@ -11,14 +11,15 @@
   const view = { frame: 0, playing: false, clock: 0, corotating: false, trail: true };
 
   // Point k (0: the pivot) of sample f, x, y, z with z up (a 2D run's plane x–y is shown
-  // as x–z); co-rotating: turned back by the pivot's azimuth.
+  // as x–z); co-rotating: turned back by the pivot's azimuth φ, which the server sends
+  // (S.phases, the core's TurningFrame).
   function point(f, k) {
     const o = f * per + 3 * k;
     let x = S.unit * S.positions[o], y = S.unit * S.positions[o + 1], z = S.unit * S.positions[o + 2];
     if (S.dim === 2) return [x, 0, y];
     if (view.corotating && S.turning) {
-      const a = -Math.atan2(S.positions[f * per + 1], S.positions[f * per]);
-      [x, y] = [Math.cos(a) * x - Math.sin(a) * y, Math.sin(a) * x + Math.cos(a) * y];
+      const c = Math.cos(S.phases[f]), s = Math.sin(S.phases[f]);
+      [x, y] = [c * x + s * y, -s * x + c * y];
     }
     return [x, y, z];
   }

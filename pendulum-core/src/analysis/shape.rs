@@ -47,6 +47,7 @@ use crate::analysis::modes::sign_changes;
 use crate::analysis::relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
 use crate::drive::{Circle, Turning};
 use crate::error::{Error, Result};
+use crate::kinematics::TurningFrame;
 use crate::models::directions::Directions;
 
 /// A chain's shape in the co-rotating frame (module docs: frame, plane, profile, nodes).
@@ -150,12 +151,15 @@ pub fn co_rotating_positions<Dr: Turning>(
 /// [`co_rotating_positions`] of a checked state.
 fn turned<Dr: Turning>(model: &Directions<U3, Dr>, t: f64, x: &DVector<f64>) -> Vec<Vector3<f64>> {
     let drive = model.drive();
-    let (s, c) = drive.phase(t).sin_cos();
+    let frame = TurningFrame::at(drive.phase(t));
     let radius = drive.radius();
     model
         .relative_positions(x)
         .into_iter()
-        .map(|r| Vector3::new(radius + c * r.x + s * r.y, -s * r.x + c * r.y, r.z))
+        .map(|r| {
+            let (x, y) = frame.place(radius, r.x, r.y);
+            Vector3::new(x, y, r.z)
+        })
         .collect()
 }
 

@@ -7,11 +7,13 @@
 //! and accelerations, the mass positions, and the gradient `∂T/∂q` of the kinetic energy.
 //! Every model in angles names its chart (`Model::Chart`); the models in unit directions
 //! ([`Directions`](crate::models::directions::Directions)) convert to and from the charts
-//! here. Nothing else in the crate writes `sin θ cos φ`.
+//! here. Nothing else in the crate writes `sin θ cos φ`. [`TurningFrame`] is the frame
+//! turning with a pivot that circles the vertical.
 
 mod planar;
 mod spherical;
 pub(crate) mod tilt;
+mod turning;
 
 use nalgebra::{DefaultAllocator, Dim, DimName, OVector, allocator::Allocator};
 
@@ -21,6 +23,7 @@ pub use planar::PlanarAngles;
 pub use spherical::{
     SINGULARITY_TOLERANCE, SphericalAngles, SphericalLink, check_polar_angle, check_polar_sin,
 };
+pub use turning::TurningFrame;
 
 /// Angle coordinates of a chain's links, as the models order them: `q` holds one block of
 /// `n` entries per name in [`COORDINATES`](Chart::COORDINATES) (planar `(θ_1…θ_n)`,
