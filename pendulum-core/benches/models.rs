@@ -41,10 +41,8 @@ use pendulum_core::{
     Chain, Directions, FirstOrder, Inputs, Model, ModelAlloc, Planar, PlanarTension, Spatial,
 };
 
-// The closed form is written once, in xtask, where its unit tests check it against
-// `Planar<Dyn>` (`cargo test -p xtask`; a benchmark target runs no unit tests). It uses
-// nothing of xtask, so it compiles here as it is.
-
+// The closed form is written once, in `pendulum-core/src/models/closed_form.rs`, where its
+// unit tests check it against `Planar<Dyn>`.
 use pendulum_core::models::DoublePendulum;
 
 pendulum_macros::model! {

@@ -8,9 +8,8 @@ use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, alloca
 use crate::drive::{Drive, Driven, TorqueAt};
 use crate::energy::power::{Powers, inertial_energy, powers};
 use crate::error::{Error, Result};
-use crate::integrate::{Constrained, Integrator, State, Stats, System};
+use crate::integrate::{Constrained, System};
 use crate::model::{InputsAt, Model, ModelAlloc};
-use crate::models::RodMidpoint;
 use crate::models::directions::Directions;
 use crate::systems::first_order::FirstOrder;
 
@@ -130,7 +129,7 @@ pub struct Accounted<P> {
 pub type AccountedDirections<S, Dr> = Accounted<Directions<S, Dr>>;
 
 /// Length of the ledger at the end of an [`Accounted`] state.
-const LEDGER_LEN: usize = 3;
+pub(crate) const LEDGER_LEN: usize = 3;
 
 impl<P: Powered> Accounted<P> {
     /// The motion with its ledger.
@@ -385,43 +384,6 @@ where
     }
 }
 
-/// [`RodMidpoint`] with the ledger: the pivot's work and the damping loss of each step are added to
-/// `W_drive` and `E_damped` exactly as the step changes the energy.
-impl<S: DimName, Dr: Drive<S>> Integrator<Accounted<Directions<S, Dr>>> for RodMidpoint
-where
-    DefaultAllocator: Allocator<S>,
-{
-    fn step(
-        &mut self,
-        system: &Accounted<Directions<S, Dr>>,
-        state: &mut State<nalgebra::Dyn>,
-        h: f64,
-    ) -> Result<()> {
-        let len = system.motion_len();
-        let x = state.x();
-        if x.len() != len + LEDGER_LEN {
-            return Err(Error::LengthMismatch { what: "x", expected: len + LEDGER_LEN, got: x.len() });
-        }
-        let mut next = x.clone();
-        let work = self.advance(
-            system.chain(),
-            state.t(),
-            &x.as_slice()[..len],
-            h,
-            &mut next.as_mut_slice()[..len],
-        )?;
-        let mut increment = next - x;
-        increment[len] = work.drive;
-        increment[len + 2] = work.damped;
-        state.advance(h, &increment);
-        Ok(())
-    }
-
-    fn stats(&self) -> &Stats {
-        RodMidpoint::stats(self)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use nalgebra::{U2, U3, Vector2};
@@ -431,8 +393,10 @@ mod tests {
 
     use crate::chain::Chain;
     use crate::drive::{Circle, ConstantTorque, Harmonic};
+    use crate::integrate::Integrator;
     use crate::models::planar::Planar;
     use crate::models::spatial::Spatial;
+    use crate::rod_midpoint::RodMidpoint;
 
     use crate::integrate::{Projected, Rk4, State};
     use crate::trajectory;

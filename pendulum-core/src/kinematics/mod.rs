@@ -13,6 +13,7 @@
 mod planar;
 mod spherical;
 pub(crate) mod tilt;
+pub(crate) mod trig;
 mod turning;
 
 use nalgebra::{DefaultAllocator, Dim, DimName, OVector, allocator::Allocator};

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::integrate::{Constrained, System};
 use crate::kinematics::{Chart, PlanarAngles, SphericalAngles, SphericalLink, check_polar_sin};
 use crate::model::check_vector;
-use crate::models::rods::{Load, Rods, with_scratch};
+use crate::rods::{Load, Rods, with_scratch};
 
 mod tangents;
 

@@ -5,17 +5,12 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OMatrix, OVector, U2, allocator::Allo
 use crate::chain::Chain;
 use crate::error::Result;
 use crate::jacobians::{Derivatives, Jacobians, Parts};
+use crate::kinematics::trig::sin_cos_into;
 use crate::kinematics::{Chart, PlanarAngles};
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, ModelAlloc, check_inputs};
 use crate::models::planar::Planar;
-use crate::models::rods::{Load, Rods, with_scratch};
-use crate::models::trig::sin_cos_into;
-
-mod jacobians;
-mod tangents;
-
-pub use tangents::{PlanarTangents, RodConstants};
+use crate::rods::{Load, PlanarTangents, RodConstants, Rods, with_scratch};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
 /// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric

@@ -1,16 +1,7 @@
-//! `Model::accelerations` by the rod tensions ([`Algorithm::Tension`]): the O(n) solve of
-//! `pendulum_core::PlanarTension` and `Directions` (the `rods` module docs there), unrolled
-//! in the model's own angles, with its per-link constants stored by `new`.
-//!
-//! Mass `i` (0-based, the pivot `p` above mass 0) sits at `r_i = r_{i−1} + l_i u_i`. With the
-//! free accelerations `a°_i = g⃗ + (F_i − F_{i+1}) / m_i` (`a°_{−1} = p̈`, `F_i` the force
-//! pair of the generalized forces on rod `i`), the tensions solve the symmetric
-//! tridiagonal system
-//! ```text
-//! (1/m_i + 1/m_{i−1}) T_i − (u_{i−1}·u_i / m_{i−1}) T_{i−1} − (u_i·u_{i+1} / m_i) T_{i+1}
-//!     = l_i |u̇_i|² + u_i · (a°_i − a°_{i−1})
-//! ```
-//! by a twisted factorisation ([`twisted_solve`]: continuants from both ends meeting at the
+//! `Model::accelerations` by the rod tensions ([`Algorithm::Tension`]): the system
+//! `A T = b` of `pendulum_core::rods` (stated and derived once, in that module's docs;
+//! 0-based here, the pivot above mass 0), unrolled in the model's own angles, with its
+//! per-link constants stored by `new`. It is solved by a twisted factorisation ([`twisted_solve`]: continuants from both ends meeting at the
 //! middle row, no division on a serial chain; classical pivots if a continuant leaves
 //! `CONTINUANT_RANGE`), then the mass accelerations `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i`
 //! and `ü_i = (a_i − a_{i−1}) / l_i`, mapped to the angles:

@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, allocator::Allocator
 use super::Directions;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
-use crate::models::rods::{Column, Linearised, Load, LoadTangent, TangentRow};
+use crate::rods::{Column, Linearised, Load, LoadTangent, TangentRow};
 
 impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
 where

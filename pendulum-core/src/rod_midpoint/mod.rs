@@ -12,10 +12,14 @@ use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 
 use crate::chain::Chain;
 use crate::drive::Drive;
+use crate::energy::Accounted;
+use crate::energy::ledger::LEDGER_LEN;
 use crate::error::{Error, Result};
 use crate::integrate::{Integrator, State, Stats};
 use crate::models::directions::Directions;
-use crate::models::rod_newton::{self, LinkRow, Pivot};
+use newton::{LinkRow, Pivot};
+
+mod newton;
 
 /// The energy-conserving midpoint step of a chain of point masses on rigid rods
 /// (Gonzalez, *Mechanical systems subject to holonomic constraints*, 1999), on the mass
@@ -39,7 +43,7 @@ use crate::models::rod_newton::{self, LinkRow, Pivot};
 /// tolerance and round-off at any step size.
 ///
 /// Each Newton iteration assembles the Newton matrix link by link (link `i`'s position and
-/// multiplier) and eliminates it in `O(n)` (`rod_newton`). Start: the rods turned by `h w_i` and the
+/// multiplier) and eliminates it in `O(n)` ([`newton`]). Start: the rods turned by `h w_i` and the
 /// multipliers `T_i/l_i` of the tensions at `t`. A step in which a link would turn by more
 /// than 1 rad, or whose Newton iteration does not converge in 12 iterations, is taken as
 /// two halves (up to 10 times nested). The state is the [`Directions`] state `(u, w)`
@@ -311,7 +315,7 @@ fn newton<const C: usize>(
             return Err(iterations);
         }
         iterations += 1;
-        // Residuals and the Newton matrix, link by link (`rod_newton` module docs).
+        // Residuals and the Newton matrix, link by link (`newton` module docs).
         let Work { rows, pivots } = &mut *work;
         rows.clear();
         let mut next = rod(&x1, 0);
@@ -344,7 +348,7 @@ fn newton<const C: usize>(
                 constraint: -0.5 * (dot(e, e) - l[i] * l[i]),
             });
         }
-        if !rod_newton::solve(rows, pivots) {
+        if !newton::solve(rows, pivots) {
             return Err(iterations);
         }
         let mut largest: f64 = 0.0;
@@ -406,6 +410,43 @@ where
 
     fn stats(&self) -> &Stats {
         &self.stats
+    }
+}
+
+/// [`RodMidpoint`] with the ledger: the pivot's work and the damping loss of each step are added to
+/// `W_drive` and `E_damped` exactly as the step changes the energy.
+impl<S: DimName, Dr: Drive<S>> Integrator<Accounted<Directions<S, Dr>>> for RodMidpoint
+where
+    DefaultAllocator: Allocator<S>,
+{
+    fn step(
+        &mut self,
+        system: &Accounted<Directions<S, Dr>>,
+        state: &mut State<nalgebra::Dyn>,
+        h: f64,
+    ) -> Result<()> {
+        let len = system.motion_len();
+        let x = state.x();
+        if x.len() != len + LEDGER_LEN {
+            return Err(Error::LengthMismatch { what: "x", expected: len + LEDGER_LEN, got: x.len() });
+        }
+        let mut next = x.clone();
+        let work = self.advance(
+            system.chain(),
+            state.t(),
+            &x.as_slice()[..len],
+            h,
+            &mut next.as_mut_slice()[..len],
+        )?;
+        let mut increment = next - x;
+        increment[len] = work.drive;
+        increment[len + 2] = work.damped;
+        state.advance(h, &increment);
+        Ok(())
+    }
+
+    fn stats(&self) -> &Stats {
+        RodMidpoint::stats(self)
     }
 }
 

@@ -1,9 +1,12 @@
-//! [`PlanarTangents`]: the planar tension solve in the links' own angles at one state,
-//! kept for its derivatives: Jacobian-vector products in O(n) here, full Jacobians in
-//! O(n²) in `jacobians`. Generic over the chain's dimension, so the generated models
-//! (`Const<N>`, stack arrays) and [`PlanarTension`](super::PlanarTension) (`Dyn`) share it.
+//! [`PlanarTangents`]: the tension system of the [module docs](super) solved in the links'
+//! own angles at one state and kept for its derivatives: `θ̈`, Jacobian-vector products in
+//! O(n) here, full Jacobians in O(n²) in `angle_jacobians`. Generic over the chain's
+//! dimension, so the generated models (`Const<N>`, stack arrays) and
+//! [`PlanarTension`](crate::PlanarTension) (`Dyn`) share it.
 //!
-//! In the links' frames (`C_j = cos(θ_j − θ_{j−1})`, `S_j = sin(θ_j − θ_{j−1})`, the pulls
+//! The system `A T = b` written in the links' frames (the planar substitution of
+//! [`PlanarTension`](crate::PlanarTension): `u_i = (sin θ_i, −cos θ_i)`, so
+//! `u_{j−1}·u_j = C_j`), with `C_j = cos(θ_j − θ_{j−1})`, `S_j = sin(θ_j − θ_{j−1})`, the pulls
 //! `f_i = σ_i/l_i − (λ_i/l_i) θ̇_i`, `A` the tension system with `A_ii = 1/m_i + 1/m_{i−1}`
 //! and `A_{j,j−1} = −C_j/m_{j−1}`, 0-based, `1/m_{−1} = 0`) the solve is `A T = b` and
 //! `θ̈ = h(θ, θ̇, σ, p̈, T)`:
@@ -28,9 +31,8 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, U2, allocator::Allocator
 
 use crate::model::Inputs;
 
-use crate::models::rods::Continuants;
-pub use crate::models::rods::RodConstants;
-use crate::models::trig::sin_cos_into;
+use super::{Continuants, RodConstants};
+use crate::kinematics::trig::sin_cos_into;
 
 /// The joint above link `j` (between links `j − 1` and `j`, module docs): `C_j`, `S_j` and
 /// the derivatives of `r_{j−1}`, `r_j`, `h_{j−1}`, `h_j` by `φ_j = θ_j − θ_{j−1}`; zero for

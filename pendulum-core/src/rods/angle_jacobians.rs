@@ -1,6 +1,6 @@
 //! [`PlanarTangents`]' full Jacobians in the links' own angles, O(n²) with a small constant.
 //!
-//! With the residual `r = b − A T` at fixed `T` and `H = ∂h/∂T` (`tangents` module docs),
+//! With the residual `r = b − A T` at fixed `T` and `H = ∂h/∂T` (`angles` module docs),
 //! `∂θ̈/∂x = ∂h/∂x + G ∂r/∂x` with `G = H A⁻¹`. Every column `x` (an angle, rate or torque
 //! of link `x`, or the pivot) changes `r` and `h` in rows `x − 1 … x + 1` only, so after
 //! `G` (n solves with the kept factors of `A`, all outputs at once) each entry costs three
@@ -8,7 +8,8 @@
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
-use super::tangents::{PlanarTangents, RodConstants};
+use super::RodConstants;
+use super::angles::PlanarTangents;
 
 impl<L: Dim> PlanarTangents<'_, L>
 where
