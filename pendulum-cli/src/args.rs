@@ -5,24 +5,6 @@ use std::path::PathBuf;
 use clap::{Arg, Args, ValueEnum};
 use pendulum_run::{Dimension, InitialSpec, IntegratorKind, StageSolver, View};
 
-/// `From<$arg> for $lib`: a clap value of the command line as the run description's type,
-/// variant for variant.
-macro_rules! same_variants {
-    ($arg:ident => $lib:ident: $($v:ident),+) => {
-        impl From<$arg> for $lib {
-            fn from(a: $arg) -> Self {
-                match a {
-                    $($arg::$v => Self::$v,)+
-                }
-            }
-        }
-    };
-}
-
-same_variants!(DimensionArg => Dimension: Two, Three);
-same_variants!(IntegratorArg => IntegratorKind: Gl1, Gl2, Gl3, Rk4, Midpoint, Dp54);
-same_variants!(SolverArg => StageSolver: FixedPoint, Newton);
-same_variants!(ViewArg => View: Xz, Yz, Xy);
 use serde::Serialize;
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`
@@ -91,18 +73,6 @@ pub struct SteadyArgs {
     pub out: PathBuf,
 }
 
-/// Space dimension of the chain.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum DimensionArg {
-    /// Planar chain, angles θ_i.
-    #[value(name = "2")]
-    Two,
-    /// Spatial chain, integrated in unit link directions (initial states in spherical
-    /// angles: θ from −z, φ azimuth from +x).
-    #[value(name = "3")]
-    Three,
-}
-
 /// The pivot's motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum DriveKind {
@@ -112,46 +82,6 @@ pub enum DriveKind {
     Harmonic,
     /// p(t) = R (cos ωt, sin ωt, 0), a horizontal circle (3D only).
     Circle,
-}
-
-/// The time integrator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum IntegratorArg {
-    /// Gauss–Legendre, 1 stage (implicit midpoint), order 2.
-    Gl1,
-    /// Gauss–Legendre, 2 stages, order 4.
-    Gl2,
-    /// Gauss–Legendre, 3 stages, order 6.
-    Gl3,
-    /// Classical explicit Runge–Kutta, order 4.
-    Rk4,
-    /// 3D only: the implicit midpoint rule on the rod constraints, O(n) per Newton
-    /// iteration, stable at any step; energy and ledger exact; order 2.
-    Midpoint,
-    /// Dormand–Prince 5(4), explicit, its own step chosen inside each --step to meet
-    /// --tolerance (3D: projected onto the rods after every internal step).
-    Dp54,
-}
-
-/// How an implicit Gauss–Legendre step solves its stage equations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SolverArg {
-    /// Fixed-point iteration: a few right-hand sides per sweep, no Jacobian; needs the
-    /// step to be shorter than the chain's fastest period.
-    FixedPoint,
-    /// Newton's method with a finite-difference Jacobian (cost grows as dim³).
-    Newton,
-}
-
-/// The plane a 3D chain is drawn in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ViewArg {
-    /// Side view: x to the right, z up.
-    Xz,
-    /// Side view: y to the right, z up.
-    Yz,
-    /// Top view: x to the right, y up.
-    Xy,
 }
 
 /// Options of `pendulum simulate`.
@@ -175,7 +105,7 @@ pub struct SimulateArgs {
     pub quiet: bool,
     /// 3D: the plane the animation shows [default: xz].
     #[arg(long, value_enum)]
-    pub view: Option<ViewArg>,
+    pub view: Option<View>,
     /// Most frames in the animation (samples are thinned to fit) [default: 150].
     #[arg(long)]
     pub frames: Option<usize>,
@@ -190,7 +120,7 @@ pub struct SimulateArgs {
 pub struct Physics {
     /// Space dimension.
     #[arg(long, value_enum, default_value = "2")]
-    pub dim: DimensionArg,
+    pub dim: Dimension,
     /// The chain: --n, --masses, --lengths, --gravity.
     #[command(flatten)]
     pub chain: ChainOptions,
@@ -231,10 +161,10 @@ pub struct Physics {
     /// [default: chosen from the chain and drive, see run.json's "chosen": midpoint for
     /// driven or damped 3D runs, gl2 otherwise]
     #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorArg>,
+    pub integrator: Option<IntegratorKind>,
     /// Stage solve of the Gauss–Legendre integrators.
     #[arg(long, value_enum, default_value = "fixed-point")]
-    pub solver: SolverArg,
+    pub solver: StageSolver,
     /// dp54: relative error tolerance per internal step (per state entry, with the same
     /// absolute floor) [default: 1e-8].
     #[arg(long, allow_negative_numbers = true)]

@@ -17,7 +17,7 @@ pub fn resolve(p: &Physics, view: View, frames: usize) -> CliResult<RunConfig> {
 
 /// The request a run's options make; errors name the flag.
 pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
-    let dim = Dimension::from(p.dim);
+    let dim = p.dim;
     let (masses, lengths) = per_link_values(&p.chain)?;
     let n = masses.len();
     let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
@@ -70,8 +70,8 @@ pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
         drive,
         initial: p.initial.clone(),
         spin: p.spin,
-        integrator: p.integrator.map(Into::into),
-        solver: p.solver.into(),
+        integrator: p.integrator,
+        solver: p.solver,
         tolerance: p.tolerance,
         step: p.step,
         end: p.end,

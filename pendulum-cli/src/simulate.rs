@@ -36,7 +36,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
         None => request::resolve(&args.physics, View::Xz, 150)?,
     };
     // Presentation only: may differ from the recorded run.
-    config.view = args.view.map_or(config.view, Into::into);
+    config.view = args.view.unwrap_or(config.view);
     config.frames = args.frames.unwrap_or(config.frames);
     config.check()?;
     // A value the chain, drive or state rejects names the file it came from.

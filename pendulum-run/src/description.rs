@@ -7,13 +7,16 @@ use crate::error::{Error, Result};
 
 /// Space dimension of the chain.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Dimension {
     /// Planar chain, angles θ_i.
     #[serde(rename = "2")]
+    #[cfg_attr(feature = "clap", value(name = "2"))]
     Two,
     /// Spatial chain, integrated in unit link directions (initial states in spherical
     /// angles: θ from −z, φ azimuth from +x).
     #[serde(rename = "3")]
+    #[cfg_attr(feature = "clap", value(name = "3"))]
     Three,
 }
 
@@ -37,6 +40,7 @@ impl Dimension {
 
 /// The time integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum IntegratorKind {
     /// Gauss–Legendre, 1 stage (implicit midpoint), order 2.
@@ -50,13 +54,14 @@ pub enum IntegratorKind {
     /// 3D only: the implicit midpoint rule on the rod constraints, O(n) per Newton
     /// iteration, stable at any step; energy and ledger exact; order 2.
     Midpoint,
-    /// Dormand–Prince 5(4), explicit, its own step chosen inside each step to meet the
-    /// tolerance (3D: projected onto the rods after every internal step).
+    /// Dormand–Prince 5(4), explicit, its own step chosen inside each --step to meet
+    /// --tolerance (3D: projected onto the rods after every internal step).
     Dp54,
 }
 
 /// How an implicit Gauss–Legendre step solves its stage equations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum StageSolver {
     /// Fixed-point iteration: a few right-hand sides per sweep, no Jacobian; needs the
@@ -66,8 +71,9 @@ pub enum StageSolver {
     Newton,
 }
 
-/// The plane a 3D chain's animation is drawn in.
+/// The plane a 3D chain is drawn in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum View {
     /// Side view: x to the right, z up.
