@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Arg, Args, ValueEnum};
-use pendulum_run::{Dimension, InitialSpec, IntegratorKind, StageSolver, View};
+use pendulum_experiment::{Dimension, InitialSpec, IntegratorKind, StageSolver, View};
 
 use serde::Serialize;
 

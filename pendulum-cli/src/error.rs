@@ -1,15 +1,15 @@
-//! The command's error: the run library's [`Error`](pendulum_run::Error), one line, and
+//! The command's error: the run library's [`Error`](pendulum_experiment::Error), one line, and
 //! the exit status each kind maps to.
 
 use std::process::ExitCode;
 
-pub use pendulum_run::error::io_failed;
+pub use pendulum_experiment::error::io_failed;
 
 /// What went wrong, and whose fault it was: `Invalid` (exit status 2) a bad argument,
 /// value or input file, nothing computed; `Failed` (exit status 1) the inputs were valid
 /// but the computation stopped, files written so far are valid; `Interrupted` (exit
 /// status 130) Ctrl-C cut the run, the files written are valid and say so.
-pub type CliError = pendulum_run::Error;
+pub type CliError = pendulum_experiment::Error;
 
 /// The command's result type.
 pub type CliResult<T> = Result<T, CliError>;

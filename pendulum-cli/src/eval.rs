@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::args::{EvalArgs, ModelKind};
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, parse_list, per_link};
-use pendulum_run::assemble::{planar_model, spatial_model};
+use pendulum_experiment::assemble::{planar_model, spatial_model};
 
 /// What `pendulum eval` prints.
 #[derive(Debug, Serialize)]

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use nalgebra::Dyn;
 use pendulum_core::{Chain, bernoulli_frequency, normal_modes, sign_changes};
-use pendulum_run::Csv;
+use pendulum_experiment::Csv;
 use plotters::prelude::*;
 
 use crate::args::ModesArgs;

@@ -2,7 +2,7 @@
 //! drive assembled from its flags, and the combinations the description cannot express
 //! refused by flag name.
 
-use pendulum_run::{Dimension, DriveConfig, Request, RunConfig, View};
+use pendulum_experiment::{Dimension, DriveConfig, Request, RunConfig, View};
 
 use crate::args::{DriveKind, Physics};
 use crate::chain_args::per_link_values;

@@ -8,7 +8,7 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pendulum_run::{
+use pendulum_experiment::{
     RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View, build, chain, drive_frequency,
     fastest_mode, other_version, suggested_step,
 };
@@ -83,7 +83,11 @@ impl Sink for Kept {
 }
 
 /// Integrates, writes every output, prints the summary.
-fn execute(simulation: &pendulum_run::AnySimulation, config: &RunConfig, options: &Options) -> CliResult<()> {
+fn execute(
+    simulation: &pendulum_experiment::AnySimulation,
+    config: &RunConfig,
+    options: &Options,
+) -> CliResult<()> {
     let out = &options.out;
     let n = config.links();
     let mut run_file = RunFile::new(config.clone());

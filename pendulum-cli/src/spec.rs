@@ -1,10 +1,10 @@
 //! Parsing of the values a user types: numbers, comma lists, per-link values (a number
 //! file is read by the run library's [`read_numbers`]; initial-state specs are its
-//! [`InitialSpec`](pendulum_run::InitialSpec)).
+//! [`InitialSpec`](pendulum_experiment::InitialSpec)).
 
 use std::path::Path;
 
-use pendulum_run::read_numbers;
+use pendulum_experiment::read_numbers;
 
 use crate::error::{CliError, CliResult};
 

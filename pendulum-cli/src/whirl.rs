@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use pendulum_core::{ShapeReport, WhirlShape};
-use pendulum_run::write_json_atomic;
+use pendulum_experiment::write_json_atomic;
 use plotters::prelude::*;
 use serde_json::json;
 

@@ -8,6 +8,7 @@ pub mod claims;
 pub mod expr;
 pub mod regen;
 pub mod sample;
+pub mod test;
 pub mod verify;
 
 use std::path::PathBuf;

@@ -11,6 +11,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Task {
+    /// Every test, Rust and Python: `cargo test --workspace`, then the Python package
+    /// built into a virtual environment (target/python) and its pytest suite and stub
+    /// check. The README's test command.
+    Test(xtask::test::Options),
     /// Compare the generated and generic models (and the document's printed
     /// equations) against the sympy reference at many random states.
     Verify(xtask::verify::Options),
@@ -50,5 +54,6 @@ fn main() -> anyhow::Result<()> {
         }
         Task::Reference { check, .. } => xtask::regen::run(check),
         Task::Bench(options) => xtask::bench::run(&options),
+        Task::Test(options) => xtask::test::run(&options),
     }
 }

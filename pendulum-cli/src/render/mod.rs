@@ -20,8 +20,8 @@ use clap::{Args, ValueEnum};
 
 use crate::error::{CliError, CliResult};
 use draw::{Layout, Scene, Shot};
-use pendulum_run::View;
-use pendulum_run::{DriveConfig, RunConfig};
+use pendulum_experiment::View;
+use pendulum_experiment::{DriveConfig, RunConfig};
 use source::{Run, Trajectory};
 use timing::{Request, Timing, speed_words};
 use view::{AxisMark, Bounds, Circling, Projection};

@@ -6,8 +6,8 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use crate::error::{CliError, CliResult};
-use pendulum_run::Dimension;
-use pendulum_run::{RunConfig, RunFile};
+use pendulum_experiment::Dimension;
+use pendulum_experiment::{RunConfig, RunFile};
 
 /// A run directory as `pendulum simulate` leaves it.
 pub struct Run {

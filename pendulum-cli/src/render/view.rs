@@ -7,7 +7,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use super::RenderView;
 use crate::error::{CliError, CliResult};
 use pendulum_core::TurningFrame;
-use pendulum_run::Dimension;
+use pendulum_experiment::Dimension;
 
 /// How a position (m) becomes a point of the picture (m).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use pendulum_core::SteadyShape;
-use pendulum_run::Csv;
-use pendulum_run::csv::number as num;
+use pendulum_experiment::Csv;
+use pendulum_experiment::csv::number as num;
 
 use super::branches::Family;
 use super::shapes::Found;

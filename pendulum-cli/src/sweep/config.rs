@@ -7,7 +7,7 @@ use std::path::Path;
 
 use nalgebra::Dyn;
 use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, normal_modes};
-use pendulum_run::{DriveConfig, drive_frequency, fastest_mode, suggested_step};
+use pendulum_experiment::{DriveConfig, drive_frequency, fastest_mode, suggested_step};
 use serde::{Deserialize, Serialize};
 
 use super::point::Point;
@@ -16,7 +16,7 @@ use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
 use crate::steady::round_up;
-use pendulum_run::write_json_atomic;
+use pendulum_experiment::write_json_atomic;
 
 /// The shape analysis is fed every this many steps (a point and the same `simulate` run
 /// with `--every 4` report the same).

@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use pendulum_run::Csv;
-use pendulum_run::csv::number;
+use pendulum_experiment::Csv;
+use pendulum_experiment::csv::number;
 
 use super::config::{SweepConfig, short};
 use super::point::{Point, Status};

@@ -142,7 +142,7 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
         Some(path) => {
             let file = SweepFile::read(path)?;
             if !args.quiet
-                && let Some(warning) = pendulum_run::other_version(path, &file.version)
+                && let Some(warning) = pendulum_experiment::other_version(path, &file.version)
             {
                 eprintln!("pendulum: warning: {warning}");
             }

@@ -14,8 +14,8 @@ use std::time::Instant;
 use nalgebra::{DVector, Dyn};
 use pendulum_core::integrate::State;
 use pendulum_core::{Chain, ShapeOptions, ShapeTracker, TurningFrame, trajectory};
-use pendulum_run::assemble::whirl_model;
-use pendulum_run::{DriveConfig, IntegratorKind, Method, directions_integrator, turning_drive};
+use pendulum_experiment::assemble::whirl_model;
+use pendulum_experiment::{DriveConfig, IntegratorKind, Method, directions_integrator, turning_drive};
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};

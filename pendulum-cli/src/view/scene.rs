@@ -8,8 +8,8 @@ use serde::Serialize;
 
 use crate::error::{CliError, CliResult};
 use crate::render::source::{Run, Trajectory};
-use pendulum_run::Dimension;
-use pendulum_run::DriveConfig;
+use pendulum_experiment::Dimension;
+use pendulum_experiment::DriveConfig;
 
 /// Frames a page holds by default: a 300 s run of 100 links at 500 samples stays whole,
 /// and a run of 100 links stays within about 15 MB (about 7.5 bytes per coordinate).

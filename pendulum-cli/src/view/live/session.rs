@@ -4,7 +4,7 @@
 use nalgebra::{Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, State};
 use pendulum_core::{Chain, Directions, Drive, Steered};
-use pendulum_run::{IntegratorKind, Method, directions_integrator};
+use pendulum_experiment::{IntegratorKind, Method, directions_integrator};
 use serde::{Deserialize, Serialize};
 
 /// The step, s: four per frame of a 60 Hz display. The midpoint rule is exact on the rods

@@ -1,0 +1,18 @@
+"""Dynamics of N-link pendulums: chains of point masses on massless rigid rods, hung from a
+pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
+
+- ``Chain``: a chain's parameters and its models evaluated on arrays (accelerations,
+  the terms of ``M q̈ + c + k + d = Q``, energies, analytic Jacobians), many states per
+  call along leading axes; its normal modes and linearisation.
+- ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
+  run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
+  took (``RunResult.shape``).
+- ``plot_ledger``, ``plot_shape``: quick matplotlib pictures (matplotlib optional).
+
+SI units throughout, angles in radians. See ``docs/python.md`` in the repository.
+"""
+
+from ._pendulum import Chain, Run, RunResult, __version__
+from ._plots import plot_ledger, plot_shape
+
+__all__ = ["Chain", "Run", "RunResult", "__version__", "plot_ledger", "plot_shape"]

@@ -1,0 +1,145 @@
+"""Type stubs of the native module (checked against it by mypy.stubtest)."""
+
+from os import PathLike
+from typing import Any, Optional, Sequence, Union, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Chain", "Run", "RunResult", "__version__"]
+__version__: str
+
+_Array = npt.NDArray[np.float64]
+_PerLink = Union[float, Sequence[float], npt.ArrayLike]
+
+@final
+class Chain:
+    def __new__(
+        cls,
+        masses: _PerLink,
+        lengths: _PerLink,
+        gravity: float = 9.81,
+        damping: Optional[_PerLink] = None,
+    ) -> Chain: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def masses(self) -> _Array: ...
+    @property
+    def lengths(self) -> _Array: ...
+    @property
+    def gravity(self) -> float: ...
+    @property
+    def damping(self) -> _Array: ...
+    def __eq__(self, other: object, /) -> bool: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    def accelerations(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
+        *,
+        model: str = "planar",
+    ) -> _Array: ...
+    def jacobians(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
+        *,
+        model: str = "planar",
+    ) -> tuple[_Array, _Array, _Array]: ...
+    def terms(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
+        *,
+        model: str = "planar",
+    ) -> dict[str, Any]: ...
+    def energy(
+        self, q: npt.ArrayLike, qd: Optional[npt.ArrayLike] = None, *, model: str = "planar"
+    ) -> tuple[_Array, _Array]: ...
+    def modes(self) -> tuple[_Array, _Array]: ...
+    def linearize(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
+        *,
+        model: str = "planar",
+        force: bool = False,
+        tolerance: float = ...,
+    ) -> dict[str, Any]: ...
+
+@final
+class Run:
+    def __new__(
+        cls,
+        *,
+        dim: int = 2,
+        n: Optional[int] = None,
+        masses: Optional[_PerLink] = None,
+        lengths: Optional[_PerLink] = None,
+        gravity: float = 9.81,
+        damping: Optional[_PerLink] = None,
+        torque: Optional[_PerLink] = None,
+        drive: str = "fixed",
+        amplitude: float = 0.05,
+        omega: float = 10.0,
+        phase: float = 0.0,
+        direction: Optional[Sequence[float]] = None,
+        radius: float = 0.1,
+        ramp_time: Optional[float] = None,
+        ramp_from: Optional[float] = None,
+        initial: str = "tilted:1.0",
+        spin: Optional[float] = None,
+        integrator: Optional[str] = None,
+        solver: str = "fixed-point",
+        tolerance: Optional[float] = None,
+        step: Optional[float] = None,
+        end: float = 10.0,
+        every: Optional[int] = None,
+    ) -> Run: ...
+    @staticmethod
+    def load(path: Union[str, PathLike[str]]) -> Run: ...
+    @staticmethod
+    def from_json(text: str) -> Run: ...
+    def to_json(self) -> str: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def step(self) -> float: ...
+    @property
+    def end(self) -> float: ...
+    @property
+    def chosen(self) -> Optional[str]: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    def run(self, out: Optional[Union[str, PathLike[str]]] = None) -> RunResult: ...
+
+@final
+class RunResult:
+    @property
+    def status(self) -> str: ...
+    @property
+    def error(self) -> Optional[str]: ...
+    @property
+    def t_end(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def t(self) -> _Array: ...
+    @property
+    def states(self) -> _Array: ...
+    @property
+    def positions(self) -> _Array: ...
+    @property
+    def ledger(self) -> dict[str, _Array]: ...
+    @property
+    def final_state(self) -> _Array: ...
+    @property
+    def shape(self) -> Optional[dict[str, Any]]: ...

@@ -1,0 +1,108 @@
+//! numpy arrays with a leading batch axis: `(..., k)` in, the states as rows, and rows of
+//! results back out in the same leading shape.
+
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use crate::errors::invalid;
+
+/// A batch of rows of `width` numbers: the leading shape and the rows, row-major.
+pub struct Rows {
+    /// The shape before the last axis (empty for one row).
+    pub lead: Vec<usize>,
+    /// Row after row.
+    pub data: Vec<f64>,
+    /// Numbers per row.
+    pub width: usize,
+}
+
+impl Rows {
+    /// Number of rows.
+    pub fn count(&self) -> usize {
+        self.lead.iter().product()
+    }
+
+    /// Row `i`.
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+
+    /// `what` as rows of `width`: an array (or anything numpy takes) whose last axis has
+    /// `width` entries. Errors name `what` and say what was expected.
+    pub fn read(what: &str, value: &Bound<'_, PyAny>, width: usize) -> PyResult<Self> {
+        let array: PyReadonlyArrayDyn<'_, f64> = value
+            .extract()
+            .or_else(|_| {
+                let np = value.py().import("numpy")?;
+                np.call_method1("asarray", (value, "float64"))?.extract()
+            })
+            .map_err(|_| invalid(format!("{what}: not an array of numbers")))?;
+        let shape = array.shape().to_vec();
+        let Some((&last, lead)) = shape.split_last() else {
+            return Err(invalid(format!(
+                "{what}: a scalar, expected an array whose last axis has {width} entries"
+            )));
+        };
+        if last != width {
+            return Err(invalid(format!("{what}: the last axis has {last} entries, expected {width}")));
+        }
+        let data: Vec<f64> = array.as_array().iter().copied().collect();
+        if let Some(v) = data.iter().find(|v| !v.is_finite()) {
+            return Err(invalid(format!("{what}: {v} is not finite")));
+        }
+        Ok(Self { lead: lead.to_vec(), data, width })
+    }
+
+    /// `what` as rows matching `like`'s leading shape: `None` gives zeros, one row
+    /// (shape `(width,)`) is used for every row of `like`.
+    pub fn read_like(
+        what: &str,
+        value: Option<&Bound<'_, PyAny>>,
+        width: usize,
+        like: &Rows,
+    ) -> PyResult<Self> {
+        let Some(value) = value.filter(|v| !v.is_none()) else {
+            return Ok(Self { lead: like.lead.clone(), data: vec![0.0; like.count() * width], width });
+        };
+        let rows = Self::read(what, value, width)?;
+        if rows.lead == like.lead {
+            return Ok(rows);
+        }
+        if rows.lead.is_empty() {
+            let data = rows.data.iter().copied().cycle().take(like.count() * width).collect();
+            return Ok(Self { lead: like.lead.clone(), data, width });
+        }
+        Err(invalid(format!(
+            "{what}: the leading shape {:?} is not that of q, {:?} (give one row for all, or one per state)",
+            rows.lead, like.lead
+        )))
+    }
+}
+
+/// `data` as an array of shape `lead + tail`.
+pub fn array<'py>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    lead: &[usize],
+    tail: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let shape: Vec<usize> = lead.iter().chain(tail).copied().collect();
+    PyArray1::from_vec(py, data).reshape(shape)
+}
+
+/// A per-link value: one number for every link or a sequence of `n` (`n = None`: the
+/// sequence's length, or `default_n` for one number).
+pub fn per_link(what: &str, value: &Bound<'_, PyAny>, n: Option<usize>) -> PyResult<Vec<f64>> {
+    if let Ok(v) = value.extract::<f64>() {
+        return Ok(vec![v; n.unwrap_or(1)]);
+    }
+    let v: Vec<f64> =
+        value.extract().map_err(|_| invalid(format!("{what}: not a number or a sequence of numbers")))?;
+    match n {
+        Some(n) if v.len() == 1 => Ok(vec![v[0]; n]),
+        Some(n) if v.len() != n => {
+            Err(invalid(format!("{what}: got {} values for {n} links (give 1 or {n})", v.len())))
+        }
+        _ => Ok(v),
+    }
+}

@@ -1,0 +1,429 @@
+//! `pendulum.Chain`: a chain's parameters, and its models evaluated on numpy arrays —
+//! accelerations, the terms of `M q̈ + c + k + d = Q`, energies and the analytic Jacobians —
+//! for one state or a leading batch of them; its normal modes and linearisation.
+
+use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, Dyn, OVector};
+use numpy::PyArray1;
+use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::arrays::{Rows, array, per_link};
+use crate::errors::{core_error, invalid};
+
+/// A chain of point masses on massless rigid rods, hung from a pivot.
+///
+/// `Chain(masses, lengths, gravity=9.81, damping=0.0)`: masses in kg and rod lengths in m,
+/// one number for every link or one per link (`n` from the longer list); gravity g in
+/// m/s²; damping λ_i in N·m·s. Models: `"planar"` (angles θ_i from the downward vertical,
+/// accelerations by the O(n) rod-tension solve) and `"spatial"` (spherical angles θ_i from
+/// −z and azimuths φ_i, q = (θ_1..θ_n, φ_1..φ_n); singular where a link is vertical).
+#[pyclass(module = "pendulum._pendulum", name = "Chain", frozen)]
+#[derive(Clone)]
+pub struct Chain {
+    pub inner: pendulum_core::Chain<Dyn>,
+}
+
+/// Which model a call evaluates.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Planar,
+    Spatial,
+}
+
+impl Kind {
+    fn of(name: &str) -> PyResult<Self> {
+        match name {
+            "planar" => Ok(Self::Planar),
+            "spatial" => Ok(Self::Spatial),
+            _ => Err(invalid(format!("model: '{name}' is neither 'planar' nor 'spatial'"))),
+        }
+    }
+
+    /// Coordinates of a chain of `n` links, and the pivot's components.
+    fn sizes(self, n: usize) -> (usize, usize) {
+        match self {
+            Self::Planar => (n, 2),
+            Self::Spatial => (2 * n, 3),
+        }
+    }
+}
+
+/// The inputs of one call: the states and inputs as rows, checked.
+struct Batch {
+    q: Rows,
+    qd: Rows,
+    torque: Rows,
+    pivot: Rows,
+}
+
+impl Chain {
+    fn batch(
+        &self,
+        kind: Kind,
+        q: &Bound<'_, PyAny>,
+        qd: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+        pivot: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Batch> {
+        let (dof, space) = kind.sizes(self.inner.links());
+        let q = Rows::read("q", q, dof)?;
+        let qd = Rows::read_like("qd", qd, dof, &q)?;
+        let torque = Rows::read_like("torque", torque, dof, &q)?;
+        let pivot = Rows::read_like("pivot_acceleration", pivot, space, &q)?;
+        Ok(Batch { q, qd, torque, pivot })
+    }
+}
+
+/// One state's vectors and inputs for model `M`.
+fn state<M: Model<Dof = Dyn>>(b: &Batch, i: usize) -> (DVector<f64>, DVector<f64>, Inputs<Dyn, M::Space>)
+where
+    DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
+{
+    let inputs = Inputs {
+        torque: DVector::from_column_slice(b.torque.row(i)),
+        pivot_acceleration: OVector::<f64, M::Space>::from_iterator_generic(
+            M::Space::name(),
+            nalgebra::U1,
+            b.pivot.row(i).iter().copied(),
+        ),
+    };
+    (DVector::from_column_slice(b.q.row(i)), DVector::from_column_slice(b.qd.row(i)), inputs)
+}
+
+/// `q̈` of every state, row after row.
+fn accelerations<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, b: &Batch) -> pendulum_core::Result<Vec<f64>>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    let dof = b.q.width;
+    let mut out = vec![0.0; b.q.count() * dof];
+    let mut qdd = DVector::zeros(dof);
+    for i in 0..b.q.count() {
+        let (q, qd, inputs) = state::<M>(b, i);
+        model.accelerations(&q, &qd, &inputs, &mut qdd)?;
+        out[i * dof..(i + 1) * dof].copy_from_slice(qdd.as_slice());
+    }
+    Ok(out)
+}
+
+/// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
+fn jacobians<M: Derivatives<Links = Dyn, Dof = Dyn>>(
+    model: &M,
+    b: &Batch,
+) -> pendulum_core::Result<[Vec<f64>; 3]>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
+{
+    let (count, dof) = (b.q.count(), b.q.width);
+    let mut out = [vec![0.0; count * dof], vec![0.0; count * dof * dof], vec![0.0; count * dof * dof]];
+    let mut jac = Jacobians::zeros(model);
+    for i in 0..count {
+        let (q, qd, inputs) = state::<M>(b, i);
+        model.state_jacobians(&q, &qd, &inputs, &mut jac)?;
+        out[0][i * dof..(i + 1) * dof].copy_from_slice(jac.accelerations.as_slice());
+        for (k, m) in [(1, &jac.q), (2, &jac.qd)] {
+            // nalgebra is column-major; numpy rows.
+            let t = m.transpose();
+            out[k][i * dof * dof..(i + 1) * dof * dof].copy_from_slice(t.as_slice());
+        }
+    }
+    Ok(out)
+}
+
+/// Every term of one state: M, c, k, d, Q, q̈, T, U.
+fn terms<M: Model<Links = Dyn, Dof = Dyn>>(py: Python<'_>, model: &M, b: &Batch) -> PyResult<Py<PyDict>>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    let dof = b.q.width;
+    let (q, qd, inputs) = state::<M>(b, 0);
+    let mut qdd = DVector::zeros(dof);
+    model.accelerations(&q, &qd, &inputs, &mut qdd).map_err(core_error)?;
+    let mut mass = DMatrix::zeros(dof, dof);
+    model.mass_matrix(&q, &mut mass);
+    let vector = |f: &dyn Fn(&mut DVector<f64>)| {
+        let mut out = DVector::zeros(dof);
+        f(&mut out);
+        out.as_slice().to_vec()
+    };
+    let d = PyDict::new(py);
+    d.set_item("mass_matrix", array(py, mass.transpose().as_slice().to_vec(), &[dof, dof], &[])?)?;
+    d.set_item("velocity_terms", PyArray1::from_vec(py, vector(&|o| model.velocity_terms(&q, &qd, o))))?;
+    d.set_item("gravity_terms", PyArray1::from_vec(py, vector(&|o| model.gravity_terms(&q, o))))?;
+    d.set_item(
+        "pivot_terms",
+        PyArray1::from_vec(py, vector(&|o| model.pivot_terms(&q, &inputs.pivot_acceleration, o))),
+    )?;
+    d.set_item(
+        "generalized_forces",
+        PyArray1::from_vec(py, vector(&|o| model.generalized_forces(&q, &qd, &inputs.torque, o))),
+    )?;
+    d.set_item("accelerations", PyArray1::from_vec(py, qdd.as_slice().to_vec()))?;
+    d.set_item("kinetic_energy", model.kinetic_energy(&q, &qd))?;
+    d.set_item("potential_energy", model.potential_energy(&q))?;
+    Ok(d.unbind())
+}
+
+/// Kinetic and potential energy of every state.
+fn energies<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, b: &Batch) -> (Vec<f64>, Vec<f64>)
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
+{
+    (0..b.q.count())
+        .map(|i| {
+            let (q, qd, _) = state::<M>(b, i);
+            (model.kinetic_energy(&q, &qd), model.potential_energy(&q))
+        })
+        .unzip()
+}
+
+/// Calls `f` with the model of `kind` (generic over it).
+macro_rules! with_model {
+    ($chain:expr, $kind:expr, |$m:ident| $body:expr) => {
+        match $kind {
+            Kind::Planar => {
+                let $m = PlanarTension::new($chain.clone());
+                $body
+            }
+            Kind::Spatial => {
+                let $m = Spatial::new($chain.clone());
+                $body
+            }
+        }
+    };
+}
+
+#[pymethods]
+impl Chain {
+    #[new]
+    #[pyo3(signature = (masses, lengths, gravity = 9.81, damping = None))]
+    fn new(
+        masses: &Bound<'_, PyAny>,
+        lengths: &Bound<'_, PyAny>,
+        gravity: f64,
+        damping: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let m = per_link("masses", masses, None)?;
+        let l = per_link("lengths", lengths, None)?;
+        let n = m.len().max(l.len());
+        let m = per_link("masses", masses, Some(n))?;
+        let l = per_link("lengths", lengths, Some(n))?;
+        let chain = pendulum_core::Chain::<Dyn>::new(&m, &l, gravity).map_err(core_error)?;
+        let chain = match damping.filter(|d| !d.is_none()) {
+            Some(d) => chain.with_damping(&per_link("damping", d, Some(n))?).map_err(core_error)?,
+            None => chain,
+        };
+        Ok(Self { inner: chain })
+    }
+
+    /// Number of links.
+    #[getter]
+    fn n(&self) -> usize {
+        self.inner.links()
+    }
+
+    /// Masses m_i, kg.
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.masses().as_slice())
+    }
+
+    /// Rod lengths l_i, m.
+    #[getter]
+    fn lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.lengths().as_slice())
+    }
+
+    /// Gravity g, m/s².
+    #[getter]
+    fn gravity(&self) -> f64 {
+        self.inner.gravity()
+    }
+
+    /// Damping λ_i, N·m·s.
+    #[getter]
+    fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.damping().as_slice())
+    }
+
+    fn __repr__(&self) -> String {
+        let c = &self.inner;
+        format!(
+            "Chain(n={}, length={} m, mass={} kg, gravity={} m/s²)",
+            c.links(),
+            c.lengths().sum(),
+            c.masses().sum(),
+            c.gravity()
+        )
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner == other.inner
+    }
+
+    /// Pickles as its parameters.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let py = slf.py();
+        let c = &slf.get().inner;
+        let args = (
+            c.masses().as_slice().to_vec(),
+            c.lengths().as_slice().to_vec(),
+            c.gravity(),
+            c.damping().as_slice().to_vec(),
+        );
+        Ok((slf.get_type().into_any(), args.into_pyobject(py)?))
+    }
+
+    /// The accelerations q̈ (rad/s²) of the states `q` (rad) with rates `qd` (rad/s),
+    /// torques σ (N·m) and pivot acceleration p̈ (m/s²; 2 components planar, 3 spatial),
+    /// by `model` ("planar" or "spatial"). `q` may hold many states along leading axes,
+    /// shape `(..., dof)`; `qd`, `torque` (default zeros) are one row for all or one per
+    /// state, likewise `pivot_acceleration`. Returns an array shaped like `q`.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
+    fn accelerations<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
+        model: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let kind = Kind::of(model)?;
+        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
+        let chain = &self.inner;
+        let out = py.detach(|| with_model!(chain, kind, |m| accelerations(&m, &b))).map_err(core_error)?;
+        Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
+    }
+
+    /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
+    /// by the coordinates (1/s²) and the rates (1/s), entry `[..., a, b]` = ∂q̈_a/∂x_b; the
+    /// states as for `accelerations`.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
+    fn jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
+        model: &str,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let kind = Kind::of(model)?;
+        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
+        let chain = &self.inner;
+        let [qdd, dq, dqd] =
+            py.detach(|| with_model!(chain, kind, |m| jacobians(&m, &b))).map_err(core_error)?;
+        let w = b.q.width;
+        let items = [
+            array(py, qdd, &b.q.lead, &[w])?,
+            array(py, dq, &b.q.lead, &[w, w])?,
+            array(py, dqd, &b.q.lead, &[w, w])?,
+        ];
+        PyTuple::new(py, items)
+    }
+
+    /// Every term of `M q̈ + c + k + d = Q` at one state (the sympy reference's form), as
+    /// a dict: mass_matrix (kg·m²), velocity_terms, gravity_terms, pivot_terms,
+    /// generalized_forces (N·m), accelerations (rad/s²), kinetic_energy and
+    /// potential_energy (J).
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
+    fn terms(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        qd: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+        pivot_acceleration: Option<&Bound<'_, PyAny>>,
+        model: &str,
+    ) -> PyResult<Py<PyDict>> {
+        let kind = Kind::of(model)?;
+        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
+        if !b.q.lead.is_empty() {
+            return Err(invalid("terms: one state at a time (q of shape (dof,))"));
+        }
+        with_model!(&self.inner, kind, |m| terms(py, &m, &b))
+    }
+
+    /// `(T, U)`: kinetic and potential energy (J) of the states, shaped like `q` without its
+    /// last axis.
+    #[pyo3(signature = (q, qd = None, *, model = "planar"))]
+    fn energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        model: &str,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let kind = Kind::of(model)?;
+        let b = self.batch(kind, q, qd, None, None)?;
+        let chain = &self.inner;
+        let (t, u) = py.detach(|| with_model!(chain, kind, |m| energies(&m, &b)));
+        Ok((array(py, t, &b.q.lead, &[])?.into_any(), array(py, u, &b.q.lead, &[])?.into_any()))
+    }
+
+    /// `(frequencies, shapes)`: the normal modes of the chain hanging at rest, angular
+    /// frequencies ω_k (rad/s, ascending) and the mode shapes in link angles as columns
+    /// (mass-normalised).
+    fn modes<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let modes = pendulum_core::normal_modes(&self.inner);
+        let n = self.inner.links();
+        Ok((
+            PyArray1::from_slice(py, modes.frequencies.as_slice()).into_any(),
+            array(py, modes.shapes.transpose().as_slice().to_vec(), &[n, n], &[])?.into_any(),
+        ))
+    }
+
+    /// The linearisation about a steady state (q̈ = 0: an equilibrium or a steady
+    /// rotation), from the analytic derivatives: a dict with `A` (state x = (q, q̇)),
+    /// `B_torque`, `B_pivot` and the `eigenvalues` of A (complex, 1/s, by decreasing real
+    /// part). A state that is not steady (|q̈_i| > tolerance, rad/s²) raises ValueError
+    /// unless `force=True`.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", force = false, tolerance = pendulum_core::STEADY_TOLERANCE))]
+    #[allow(clippy::too_many_arguments)]
+    fn linearize(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        qd: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+        pivot_acceleration: Option<&Bound<'_, PyAny>>,
+        model: &str,
+        force: bool,
+        tolerance: f64,
+    ) -> PyResult<Py<PyDict>> {
+        let kind = Kind::of(model)?;
+        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
+        if !b.q.lead.is_empty() {
+            return Err(invalid("linearize: one state at a time (q of shape (dof,))"));
+        }
+        let tolerance = if force { f64::INFINITY } else { tolerance };
+        let s = with_model!(&self.inner, kind, |m| linearize_with(&m, &b, tolerance)).map_err(core_error)?;
+        let d = PyDict::new(py);
+        let matrix =
+            |m: &DMatrix<f64>| array(py, m.transpose().as_slice().to_vec(), &[m.nrows(), m.ncols()], &[]);
+        d.set_item("A", matrix(&s.a)?)?;
+        d.set_item("B_torque", matrix(&s.b_torque)?)?;
+        d.set_item("B_pivot", matrix(&s.b_pivot)?)?;
+        let eig: Vec<pyo3::Bound<'_, pyo3::types::PyComplex>> =
+            s.eigenvalues.iter().map(|e| pyo3::types::PyComplex::from_doubles(py, e.re, e.im)).collect();
+        let np = py.import("numpy")?;
+        d.set_item("eigenvalues", np.call_method1("array", (eig, "complex128"))?)?;
+        d.set_item("residual", s.residual)?;
+        Ok(d.unbind())
+    }
+}
+
+/// [`pendulum_core::linearize`] of one model at the batch's first state.
+fn linearize_with<M: Derivatives<Links = Dyn, Dof = Dyn>>(
+    model: &M,
+    b: &Batch,
+    tolerance: f64,
+) -> pendulum_core::Result<pendulum_core::StateSpace>
+where
+    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
+{
+    let (q, qd, inputs) = state::<M>(b, 0);
+    pendulum_core::linearize(model, &q, &qd, &inputs, tolerance)
+}

@@ -1,0 +1,21 @@
+//! `import pendulum`: the library from Python. Thin glue: chains and models evaluated on
+//! numpy arrays (a leading batch axis: many states in one call), the run description of
+//! `pendulum-experiment` with its run loop, the normal modes and linearisation. No physics here;
+//! every long call releases the GIL and answers Ctrl-C with `KeyboardInterrupt`.
+
+mod arrays;
+mod chain;
+mod errors;
+mod run;
+
+use pyo3::prelude::*;
+
+/// The native part of the `pendulum` package (`pendulum._pendulum`); import `pendulum`.
+#[pymodule]
+fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", pendulum_experiment::VERSION)?;
+    m.add_class::<chain::Chain>()?;
+    m.add_class::<run::Run>()?;
+    m.add_class::<run::RunResult>()?;
+    Ok(())
+}

@@ -1,0 +1,133 @@
+"""Chain and its models on numpy arrays: against an independent numpy computation of the
+double pendulum, against the models' own identities, batched and one state at a time, and
+with bad input."""
+
+import math
+import pickle
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import pendulum
+
+G = 9.81
+
+
+def double_pendulum(m1, m2, l1, l2, g, th1, th2, w1, w2):
+    """θ̈ of the textbook double pendulum (angles from the downward vertical), solved from
+    its 2×2 mass matrix with numpy: an independent derivation of the planar equations."""
+    d = th1 - th2
+    mass = np.array([[(m1 + m2) * l1**2, m2 * l1 * l2 * math.cos(d)], [m2 * l1 * l2 * math.cos(d), m2 * l2**2]])
+    force = np.array(
+        [
+            -m2 * l1 * l2 * w2**2 * math.sin(d) - (m1 + m2) * g * l1 * math.sin(th1),
+            m2 * l1 * l2 * w1**2 * math.sin(d) - m2 * g * l2 * math.sin(th2),
+        ]
+    )
+    return np.linalg.solve(mass, force)
+
+
+positive = st.floats(0.1, 3.0)
+angle = st.floats(-3.0, 3.0)
+rate = st.floats(-5.0, 5.0)
+
+
+@settings(max_examples=200, deadline=None)
+@given(positive, positive, positive, positive, angle, angle, rate, rate)
+def test_the_double_pendulum_agrees_with_an_independent_numpy_derivation(m1, m2, l1, l2, a, b, wa, wb):
+    chain = pendulum.Chain([m1, m2], [l1, l2], gravity=G)
+    qdd = chain.accelerations([a, b], [wa, wb])
+    expected = double_pendulum(m1, m2, l1, l2, G, a, b, wa, wb)
+    assert np.allclose(qdd, expected, rtol=1e-9, atol=1e-9), (qdd, expected)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(1, 12), st.integers(0, 2**32 - 1))
+def test_the_equation_of_motion_holds_with_the_terms_it_returns(n, seed):
+    rng = np.random.default_rng(seed)
+    chain = pendulum.Chain(rng.uniform(0.1, 2.0, n), rng.uniform(0.1, 1.0, n), damping=rng.uniform(0, 0.1, n))
+    for model, dof, space in [("planar", n, 2), ("spatial", 2 * n, 3)]:
+        q = rng.uniform(0.3, 2.8, dof) if model == "spatial" else rng.uniform(-3, 3, dof)
+        qd, torque, pivot = rng.normal(size=dof), rng.normal(size=dof), rng.normal(size=space)
+        t = chain.terms(q, qd, torque, pivot, model=model)
+        m = t["mass_matrix"]
+        assert np.allclose(m, m.T, atol=1e-12)
+        lhs = m @ t["accelerations"] + t["velocity_terms"] + t["gravity_terms"] + t["pivot_terms"]
+        assert np.allclose(lhs, t["generalized_forces"], atol=1e-9 * (1 + np.abs(lhs).max()))
+        kinetic, potential = chain.energy(q, qd, model=model)
+        assert math.isclose(float(kinetic), t["kinetic_energy"], rel_tol=1e-12)
+        assert math.isclose(float(potential), t["potential_energy"], rel_tol=1e-12, abs_tol=1e-12)
+        assert math.isclose(t["kinetic_energy"], 0.5 * qd @ m @ qd, rel_tol=1e-9)
+
+
+def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
+    rng = np.random.default_rng(1)
+    chain = pendulum.Chain(0.1, 0.1, damping=0.01)
+    chain = pendulum.Chain([0.1] * 8, [0.1] * 8, damping=0.01)
+    q, qd = rng.uniform(-2, 2, (3, 5, 8)), rng.normal(size=(3, 5, 8))
+    torque = rng.normal(size=8)
+    batch = chain.accelerations(q, qd, torque)
+    assert batch.shape == (3, 5, 8)
+    for i in range(3):
+        for j in range(5):
+            assert np.array_equal(batch[i, j], chain.accelerations(q[i, j], qd[i, j], torque))
+    qdd, dq, dqd = chain.jacobians(q, qd)
+    assert (qdd.shape, dq.shape, dqd.shape) == ((3, 5, 8), (3, 5, 8, 8), (3, 5, 8, 8))
+
+
+def test_the_analytic_jacobians_are_the_slopes_of_the_accelerations():
+    rng = np.random.default_rng(2)
+    chain = pendulum.Chain(rng.uniform(0.2, 1, 5), rng.uniform(0.2, 1, 5), damping=0.05)
+    q, qd = rng.uniform(-2, 2, 5), rng.normal(size=5)
+    _, dq, dqd = chain.jacobians(q, qd)
+    eps = 1e-6
+    for k in range(5):
+        e = np.zeros(5)
+        e[k] = eps
+        fd_q = (chain.accelerations(q + e, qd) - chain.accelerations(q - e, qd)) / (2 * eps)
+        fd_qd = (chain.accelerations(q, qd + e) - chain.accelerations(q, qd - e)) / (2 * eps)
+        assert np.allclose(dq[:, k], fd_q, rtol=1e-6, atol=1e-6)
+        assert np.allclose(dqd[:, k], fd_qd, rtol=1e-6, atol=1e-6)
+
+
+def test_one_link_is_the_simple_pendulum():
+    chain = pendulum.Chain(2.0, 0.5)
+    assert math.isclose(float(chain.accelerations([0.3])[0]), -G / 0.5 * math.sin(0.3), rel_tol=1e-14)
+    frequencies, shapes = chain.modes()
+    assert math.isclose(frequencies[0], math.sqrt(G / 0.5), rel_tol=1e-12)
+    assert shapes.shape == (1, 1)
+    lin = chain.linearize([0.0])
+    assert np.allclose(sorted(lin["eigenvalues"].imag), [-math.sqrt(G / 0.5), math.sqrt(G / 0.5)])
+    upright = chain.linearize([math.pi])
+    assert math.isclose(upright["eigenvalues"][0].real, math.sqrt(G / 0.5), rel_tol=1e-9)
+
+
+def test_chains_pickle_and_compare():
+    chain = pendulum.Chain([1.0, 2.0], [0.5, 0.25], gravity=3.7, damping=[0.1, 0.0])
+    again = pickle.loads(pickle.dumps(chain))
+    assert again == chain and again.n == 2 and again.gravity == 3.7
+    assert np.array_equal(again.damping, [0.1, 0.0])
+    assert "n=2" in repr(chain)
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: pendulum.Chain([1.0, -1.0], 0.5), "mass of link 2 must be finite and positive, got -1"),
+        (lambda: pendulum.Chain(1.0, [0.5, 0.5, 0.5], damping=[0.1, 0.2]), "damping: got 2 values for 3 links"),
+        (lambda: pendulum.Chain(1.0, [0.5, 0.5]).accelerations([0.1, 0.2, 0.3]), "q: the last axis has 3 entries, expected 2"),
+        (lambda: pendulum.Chain(1.0, [0.5, 0.5]).accelerations([0.1, float("nan")]), "q: NaN is not finite"),
+        (lambda: pendulum.Chain(1.0, 0.5).accelerations(0.3), "q: a scalar"),
+        (lambda: pendulum.Chain(1.0, 0.5).accelerations([0.3], model="cartesian"), "model: 'cartesian'"),
+        (lambda: pendulum.Chain(1.0, 0.5).accelerations(np.zeros((4, 1)), np.zeros((3, 1))), "qd: the leading shape"),
+        (lambda: pendulum.Chain(1.0, 0.5).accelerations([0.0, 0.0], model="spatial"), "spherical-angle singularity"),
+        (lambda: pendulum.Chain(1.0, 0.5).linearize([0.3]), "not an equilibrium"),
+        (lambda: pendulum.Chain(1.0, 0.5).accelerations(["a"]), "q: not an array of numbers"),
+    ],
+)
+def test_bad_input_is_a_value_error_naming_the_value(call, message):
+    with pytest.raises(ValueError, match=message) as e:
+        call()
+    assert "\n" not in str(e.value)

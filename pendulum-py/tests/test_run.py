@@ -1,0 +1,134 @@
+"""Run: the experiment `pendulum simulate` runs, from Python — the same description, the
+same final state bit for bit, the ledger, the shape answer, files when asked, pickling,
+bad input and Ctrl-C."""
+
+import json
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import pendulum
+from conftest import RUNS
+
+
+def test_the_demo_runs_to_arrays_and_its_ledger_closes():
+    run = pendulum.Run()
+    assert run.n == 3 and run.end == 10.0 and "gl2" in run.chosen
+    result = run.run()
+    assert result.status == "completed" and result.t_end == pytest.approx(10.0)
+    samples = len(result.t)
+    assert result.states.shape == (samples, 6)
+    assert result.positions.shape == (samples, 4, 3)
+    assert np.abs(result.ledger["balance_residual"]).max() < 1e-6
+    # The positions are those of the angles: mass 1 at l_1 (sin θ_1, −cos θ_1).
+    theta = result.states[:, 0]
+    assert np.allclose(result.positions[:, 1, 0], 0.5 * np.sin(theta), atol=1e-12)
+    assert np.allclose(result.positions[:, 1, 1], -0.5 * np.cos(theta), atol=1e-12)
+    assert result.shape is None
+
+
+@pytest.mark.parametrize("name", ["triple", "whirl", "dp"])
+def test_a_cli_run_json_repeats_to_the_cli_final_state_bit_for_bit(name):
+    run = pendulum.Run.load(RUNS / f"{name}.run.json")
+    result = run.run()
+    final = json.loads((RUNS / f"{name}.final.json").read_text())
+    expected = np.array(final["coordinates"] + final["rates"])
+    assert np.array_equal(result.final_state, expected)
+
+
+def test_a_whirled_chain_says_which_shape_it_took():
+    result = pendulum.Run(
+        dim=3, n=12, lengths=0.1, initial="hanging", drive="circle", radius=0.08, omega=5.0,
+        integrator="rk4", step=0.001, end=10.0, every=10,
+    ).run()
+    shape = result.shape
+    assert shape is not None and shape["nodes"] >= 1 and shape["tip_radius"] > 0
+    assert shape["nearest"] is None or shape["nearest"]["nodes"] >= 1
+    # 3D states are unit link directions and their rates.
+    u = result.final_state[:36].reshape(12, 3)
+    assert np.allclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-9)
+
+
+def test_files_are_written_only_when_asked(tmp_path):
+    run = pendulum.Run(n=2, end=1.0)
+    run.run()
+    assert not any(tmp_path.iterdir())
+    result = run.run(out=tmp_path / "out")
+    names = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert names == ["energy.csv", "final.json", "run.json", "trajectory.csv"]
+    written = json.loads((tmp_path / "out" / "run.json").read_text())
+    assert written["outcome"]["status"] == "completed"
+    assert written["outcome"]["samples"] == len(result.t)
+    again = pendulum.Run.load(tmp_path / "out" / "run.json").run()
+    assert np.array_equal(again.final_state, result.final_state)
+
+
+def test_runs_pickle_as_their_description():
+    run = pendulum.Run(dim=3, n=4, drive="circle", radius=0.05, omega=4.0, end=2.0, damping=1e-3)
+    again = pickle.loads(pickle.dumps(run))
+    assert again.to_json() == run.to_json()
+    assert json.loads(run.to_json())["integrator"] == "midpoint"
+    assert np.array_equal(again.run().final_state, run.run().final_state)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"end": -1.0}, "--end must be finite and positive, got -1"),
+        ({"step": 0.0}, "--step must be finite and positive, got 0"),
+        ({"dim": 4}, "dim: 4 is neither 2 nor 3"),
+        ({"drive": "square"}, "drive: 'square' is not one of fixed, harmonic, circle"),
+        ({"drive": "circle"}, "--drive circle moves the pivot on a horizontal circle: 3D only"),
+        ({"masses": [1.0, 2.0], "n": 3}, "masses: got 2 values for 3 links"),
+        ({"integrator": "euler"}, "integrator: 'euler' is not one of"),
+        ({"initial": "sideways"}, "initial: 'sideways' is not hanging"),
+        ({"tolerance": 1e-6}, "--tolerance applies to --integrator dp54 only"),
+        ({"masses": -1.0}, "mass of link 1 must be finite and positive"),
+    ],
+)
+def test_bad_runs_are_value_errors_with_the_cli_message(kwargs, message):
+    with pytest.raises(ValueError, match=message) as e:
+        pendulum.Run(**kwargs).run()
+    assert "\n" not in str(e.value)
+
+
+def test_a_run_that_blows_up_reports_failed_with_its_samples():
+    result = pendulum.Run(n=3, integrator="rk4", step=0.3, end=2.0).run()
+    assert result.status == "failed" and "failed" in result.error
+    assert len(result.t) >= 1 and result.t_end < 2.0
+
+
+def test_ctrl_c_interrupts_a_long_run_within_a_second():
+    code = (
+        "import pendulum, sys\n"
+        "run = pendulum.Run(dim=3, n=200, initial='hanging', drive='circle', radius=0.02, omega=6.0,"
+        " integrator='rk4', step=1e-4, end=1e4, every=1000)\n"
+        "print('started', flush=True)\n"
+        "try:\n    run.run()\nexcept KeyboardInterrupt:\n    print('interrupted', flush=True)\n    sys.exit(3)\n"
+    )
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(1.0)
+    sent = time.monotonic()
+    os.kill(child.pid, signal.SIGINT)
+    out, _ = child.communicate(timeout=30)
+    elapsed = time.monotonic() - sent
+    assert child.returncode == 3 and "interrupted" in out, (child.returncode, out)
+    assert elapsed < 1.0, f"KeyboardInterrupt {elapsed:.2f} s after SIGINT"
+
+
+def test_the_docs_whirl_takes_two_nodes_at_six_rad_per_second():
+    """docs/python.md's example: the README's 100-link chain at ω = 6 rad/s."""
+    run = pendulum.Run(dim=3, n=100, masses=0.01, lengths=0.01, damping=3e-4, initial="hanging",
+                       drive="circle", radius=0.02, omega=6.0, integrator="rk4", step=0.001,
+                       every=100, end=150.0)
+    shape = run.run().shape
+    assert shape["nodes"] == 2 and shape["settled"]
+    assert shape["tip_radius"] == pytest.approx(4.4351e-2, rel=1e-4)
+    assert shape["nearest"]["nodes"] == 2 and shape["nearest"]["stable"]
