@@ -1,9 +1,10 @@
-//! The CLI's number readers (`pendulum-cli/src/spec.rs`, included by path: the CLI is a
-//! binary crate): a comma list typed on the command line and a number file. Either the
-//! numbers, all finite, or a usage error naming the option; never a panic.
+//! The number readers: a comma list typed on the command line (`pendulum-cli/src/spec.rs`,
+//! included by path: the CLI is a binary crate) and a number file (the run library's
+//! `read_numbers`). Either the numbers, all finite, or a usage error naming the option;
+//! never a panic.
 #![no_main]
 
-#[allow(dead_code)]
+#[allow(dead_code, unused_imports)]
 #[path = "../../pendulum-cli/src/error.rs"]
 mod error;
 #[allow(dead_code)]
@@ -28,7 +29,7 @@ fuzz_target!(|data: &[u8]| {
     std::fs::create_dir_all(&dir).expect("scratch directory");
     let path = dir.join("numbers.txt");
     std::fs::write(&path, data).expect("scratch file");
-    match spec::read_numbers("--lengths", &path) {
+    match pendulum_experiment::read_numbers("--lengths", &path) {
         Ok(values) => assert!(!values.is_empty() && values.iter().all(|v| v.is_finite())),
         Err(e) => assert!(e.to_string().starts_with("--lengths: "), "{e}"),
     }

@@ -1,29 +1,7 @@
-//! The CLI's run.json reader (`RunFile::read` in `pendulum-cli/src/config.rs`, included by
-//! path with the modules it uses: the CLI is a binary crate) on arbitrary file contents:
-//! a checked configuration or a usage error naming the file, never a panic.
+//! The run.json reader (`pendulum_experiment::RunFile::read`, which `pendulum simulate
+//! --from` and `pendulum.Run.load` use) on arbitrary file contents: a checked
+//! configuration or a usage error naming the file, never a panic.
 #![no_main]
-
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/args.rs"]
-mod args;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/chain_args.rs"]
-mod chain_args;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/config.rs"]
-mod config;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/error.rs"]
-mod error;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/final_state.rs"]
-mod final_state;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/json_file.rs"]
-mod json_file;
-#[allow(dead_code)]
-#[path = "../../pendulum-cli/src/spec.rs"]
-mod spec;
 
 use libfuzzer_sys::fuzz_target;
 
@@ -32,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
     std::fs::create_dir_all(&dir).expect("scratch directory");
     let path = dir.join("run.json");
     std::fs::write(&path, data).expect("scratch file");
-    match config::RunFile::read(&path) {
+    match pendulum_experiment::RunFile::read(&path) {
         Ok(file) => {
             // `check` leaves the values to the chain's own validation (as the CLI does
             // next): building the chain gives the chain or an error, never a panic.

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Arg, Args, ValueEnum};
-use pendulum_experiment::{Dimension, InitialSpec, IntegratorKind, StageSolver, View};
+use pendulum_experiment::{Dimension, DriveKind, InitialSpec, IntegratorKind, StageSolver, View};
 
 use serde::Serialize;
 
@@ -71,17 +71,6 @@ pub struct SteadyArgs {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR", default_value = "pendulum-steady")]
     pub out: PathBuf,
-}
-
-/// The pivot's motion.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum DriveKind {
-    /// Pivot at rest at the origin.
-    Fixed,
-    /// p(t) = A sin(ωt + φ) d̂ along --direction (default vertical).
-    Harmonic,
-    /// p(t) = R (cos ωt, sin ωt, 0), a horizontal circle (3D only).
-    Circle,
 }
 
 /// Options of `pendulum simulate`.

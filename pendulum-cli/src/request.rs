@@ -1,10 +1,10 @@
 //! A run's options as the run library's [`Request`]: the per-link values parsed, the
-//! drive assembled from its flags, and the combinations the description cannot express
-//! refused by flag name.
+//! drive's flags handed to the library's [`DriveOptions`] (which refuses the
+//! combinations the description cannot express, by flag name).
 
-use pendulum_experiment::{Dimension, DriveConfig, Request, RunConfig, View};
+use pendulum_experiment::{Dimension, DriveOptions, Request, RunConfig, View};
 
-use crate::args::{DriveKind, Physics};
+use crate::args::Physics;
 use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, parse_list, per_link};
@@ -28,38 +28,18 @@ pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
             return Err(CliError::invalid("--torque: constant torques are available in 2D only (--dim 2)"));
         }
     };
-    let drive = match p.drive {
-        DriveKind::Fixed => DriveConfig::Fixed,
-        DriveKind::Harmonic => {
-            let direction = match &p.direction {
-                Some(s) => parse_list("--direction", s)?,
-                None => {
-                    let mut up = vec![0.0; dim.space()];
-                    up[dim.space() - 1] = 1.0;
-                    up
-                }
-            };
-            DriveConfig::Harmonic { direction, amplitude: p.amplitude, omega: p.omega, phase: p.phase }
-        }
-        DriveKind::Circle => match p.ramp_time {
-            None => DriveConfig::Circle { radius: p.radius, omega: p.omega },
-            Some(duration) => DriveConfig::RampedCircle {
-                radius: p.radius,
-                initial_omega: p.ramp_from.unwrap_or(0.0),
-                omega: p.omega,
-                duration,
-            },
-        },
-    };
-    if (p.ramp_time.is_some() || p.ramp_from.is_some()) && p.drive != DriveKind::Circle {
-        return Err(CliError::invalid("--ramp-time and --ramp-from apply to --drive circle only"));
+    let direction = p.direction.as_deref().map(|s| parse_list("--direction", s)).transpose()?;
+    let drive = DriveOptions {
+        kind: p.drive,
+        amplitude: p.amplitude,
+        omega: p.omega,
+        phase: p.phase,
+        direction,
+        radius: p.radius,
+        ramp_time: p.ramp_time,
+        ramp_from: p.ramp_from,
     }
-    if p.ramp_from.is_some() && p.ramp_time.is_none() {
-        return Err(CliError::invalid("--ramp-from needs --ramp-time (the ramp's duration, s)"));
-    }
-    if p.direction.is_some() && p.drive != DriveKind::Harmonic {
-        return Err(CliError::invalid("--direction applies to --drive harmonic only"));
-    }
+    .config(dim)?;
     Ok(Request {
         dim,
         masses,

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+pub use pendulum_experiment::options::expand;
 use pendulum_experiment::read_numbers;
 
 use crate::error::{CliError, CliResult};
@@ -48,16 +49,6 @@ pub fn per_link(what: &str, spec: &str) -> CliResult<Vec<f64>> {
         return parse_list(what, spec);
     }
     Err(CliError::invalid(format!("{what}: '{spec}' is neither a number, a comma list nor an existing file")))
-}
-
-/// Expands a per-link list to `n` entries: a single value is repeated, otherwise the
-/// list must have exactly `n` entries.
-pub fn expand(what: &str, values: Vec<f64>, n: usize) -> CliResult<Vec<f64>> {
-    match values.len() {
-        1 => Ok(vec![values[0]; n]),
-        len if len == n => Ok(values),
-        len => Err(CliError::invalid(format!("{what}: got {len} values for {n} links (give 1 or {n})"))),
-    }
 }
 
 #[cfg(test)]

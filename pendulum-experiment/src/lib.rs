@@ -50,7 +50,6 @@
 //! ```
 
 pub mod assemble;
-pub mod choice;
 pub mod csv;
 pub mod description;
 pub mod error;
@@ -59,13 +58,13 @@ pub mod files;
 pub mod final_state;
 pub mod initial;
 pub mod json;
+pub mod options;
 pub mod record;
 pub mod request;
 pub mod run;
 pub mod whirl;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};
-pub use choice::{Choice, choose, drive_frequency, fastest_mode, suggested_step};
 pub use csv::Csv;
 pub use description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, InitialConfig, IntegratorKind, RunConfig, StageSolver, View,
@@ -76,8 +75,9 @@ pub use files::SampleFiles;
 pub use final_state::FinalState;
 pub use initial::{InitialSpec, initial_state, read_numbers};
 pub use json::write_json_atomic;
+pub use options::{DriveKind, DriveOptions};
 pub use record::Recorder;
-pub use request::Request;
+pub use request::{Choice, Request, choose, drive_frequency, fastest_mode, suggested_step};
 pub use run::{Layout, Report, Sink, Status};
 pub use whirl::Whirl;
 

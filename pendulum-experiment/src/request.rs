@@ -1,9 +1,12 @@
 //! A run as asked for ([`Request`]): the chain, drive and start given, the integrator,
 //! step and sampling optional ("choose for me"); [`Request::resolve`] checks it, makes
-//! the choices ([`choose`](crate::choice::choose)) and returns the complete
-//! [`RunConfig`].
+//! the choices ([`choose`]: from the chain's fastest mode, its slowest and the drive) and
+//! returns the complete [`RunConfig`]. Also the step a failed run is advised to try
+//! ([`suggested_step`]).
 
-use crate::choice::choose;
+use nalgebra::Dyn;
+use pendulum_core::{Chain, fastest_frequency_bound};
+
 use crate::description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, View, check_step,
 };
@@ -101,5 +104,237 @@ impl Request {
         };
         config.check()?;
         Ok(config)
+    }
+}
+
+/// What a run was given or chose: the integrator, step and sampling, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice {
+    /// The integrator.
+    pub integrator: IntegratorKind,
+    /// The step, s.
+    pub step: f64,
+    /// A sample every `every` steps.
+    pub every: usize,
+    /// Why, in words, for what was chosen (`None` when everything was given).
+    pub reason: Option<String>,
+}
+
+/// Samples a run writes when `--every` is not given (about; at least one per step).
+const TARGET_SAMPLES: f64 = 500.0;
+
+/// Steps of the implicit midpoint rule per period of the faster of the drive and the
+/// chain's slowest swing.
+const MIDPOINT_STEPS_PER_PERIOD: f64 = 20.0;
+
+/// The default step of the Gauss–Legendre and RK4 integrators where the chain allows it, s.
+const EXPLICIT_DEFAULT_STEP: f64 = 0.005;
+
+/// Fills in what the request leaves open:
+/// - integrator: `midpoint` for a 3D chain that is driven or damped (implicit, stable
+///   past the chain's fastest mode, which such a run need not resolve; the ledger closes
+///   exactly), `gl2` otherwise (conservative runs, where its energy behaviour matters, and
+///   2D runs, in angles);
+/// - step: for `midpoint` a twentieth of the period of the faster of the drive and the
+///   chain's slowest swing `√(g/L)`; for `dp54` the sample interval of about 500 samples
+///   (it adapts its own steps inside); for the others `min(0.005 s, 0.5/ω_fastest, T_drive/40)`
+///   ([`suggested_step`]);
+/// - every: about 500 samples over the run.
+pub fn choose(config: &Request) -> Choice {
+    let mut reasons = Vec::new();
+    let driven = !matches!(config.drive, DriveConfig::Fixed);
+    let damped = config.damping.iter().any(|l| *l != 0.0);
+    let fastest = Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)
+        .and_then(|c| c.with_damping(&config.damping))
+        .map_or(0.0, |c| fastest_mode(&c, &config.drive));
+    let chosen_integrator = config.integrator.unwrap_or_else(|| {
+        let kind = if config.dim == Dimension::Three && (driven || damped) {
+            IntegratorKind::Midpoint
+        } else {
+            IntegratorKind::Gl2
+        };
+        reasons.push(match kind {
+            IntegratorKind::Midpoint => format!(
+                "integrator midpoint: a {} 3D chain, stepped implicitly over its fastest mode \
+                 (about {fastest:.3e} rad/s; an explicit step would need h < {:.1e} s), the ledger exact",
+                if driven { "driven" } else { "damped" },
+                2.8 / fastest.max(f64::MIN_POSITIVE)
+            ),
+            _ => "integrator gl2: Gauss–Legendre, order 4, for its energy behaviour (not driven, \
+                  not damped, or 2D)"
+                .into(),
+        });
+        kind
+    });
+    let drive = drive_frequency(&config.drive);
+    let chosen_step = config.step.unwrap_or_else(|| {
+        let (h, why) = match chosen_integrator {
+            IntegratorKind::Midpoint => {
+                let slowest = slowest_swing(&config.lengths, config.gravity);
+                let (omega, what) = match drive {
+                    Some(w) if w > slowest => (w, format!("the drive's period ({w} rad/s)")),
+                    _ => (slowest, format!("the chain's slowest swing (√(g/L) = {slowest:.3} rad/s)")),
+                };
+                if omega > 0.0 {
+                    (std::f64::consts::TAU / omega / MIDPOINT_STEPS_PER_PERIOD, format!("1/20 of {what}"))
+                } else {
+                    (config.end / 1000.0, "a thousandth of the run (no gravity, no drive)".into())
+                }
+            }
+            IntegratorKind::Dp54 => (
+                config.end / TARGET_SAMPLES,
+                "the sample interval, about 500 samples (dp54 sizes its own steps within it)".into(),
+            ),
+            _ => {
+                let h = suggested_step(fastest, drive).min(EXPLICIT_DEFAULT_STEP);
+                (h, format!("min(0.005 s, 0.5/ω_fastest, T_drive/40), ω_fastest ≈ {fastest:.3e} rad/s"))
+            }
+        };
+        let h = h.min(config.end);
+        reasons.push(format!("step {h:.4e} s: {why}"));
+        h
+    });
+    let chosen_every = config.every.unwrap_or_else(|| {
+        let k = (config.end / (chosen_step * TARGET_SAMPLES)).floor().max(1.0) as usize;
+        reasons.push(format!("every {k} steps: about {TARGET_SAMPLES} samples"));
+        k
+    });
+    Choice {
+        integrator: chosen_integrator,
+        step: chosen_step,
+        every: chosen_every,
+        reason: (!reasons.is_empty()).then(|| reasons.join("; ")),
+    }
+}
+
+/// The slowest swing of the chain as one pendulum of its whole length, `√(g/L)` (rad/s),
+/// with `L = Σ l_i`: the first mode of a uniform chain is 1.2 times that.
+fn slowest_swing(lengths: &[f64], gravity: f64) -> f64 {
+    let length: f64 = lengths.iter().sum();
+    (gravity.max(0.0) / length).sqrt()
+}
+
+/// The chain's fastest angular frequency (rad/s), [`fastest_frequency_bound`] with the
+/// drive's largest acceleration added to gravity.
+pub fn fastest_mode(chain: &Chain<Dyn>, drive: &DriveConfig) -> f64 {
+    let accel = match drive {
+        DriveConfig::Fixed => 0.0,
+        DriveConfig::Harmonic { amplitude, omega, .. } => amplitude.abs() * omega * omega,
+        DriveConfig::Circle { radius, omega } => radius * omega * omega,
+        DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
+            radius * initial_omega.abs().max(omega.abs()).powi(2)
+        }
+    };
+    fastest_frequency_bound(chain, chain.gravity() + accel)
+}
+
+/// The drive's angular frequency (rad/s), if it has one.
+pub fn drive_frequency(drive: &DriveConfig) -> Option<f64> {
+    match drive {
+        DriveConfig::Fixed => None,
+        DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
+        DriveConfig::RampedCircle { initial_omega, omega, .. } => Some(initial_omega.abs().max(omega.abs())),
+    }
+}
+
+/// A step that resolves both: `h = 0.5 / ω_fastest`, at most a fortieth of the drive period.
+pub fn suggested_step(fastest: f64, drive: Option<f64>) -> f64 {
+    let mut h = 0.5 / fastest.max(f64::MIN_POSITIVE);
+    if let Some(w) = drive.filter(|w| *w > 0.0) {
+        h = h.min(std::f64::consts::TAU / w / 40.0);
+    }
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n` links of 1/n m and 1/n kg (a 1 m chain), hanging, 300 s, nothing chosen yet.
+    fn config(dim: Dimension, n: usize, drive: DriveConfig, damping: f64) -> Request {
+        let link = 1.0 / n as f64;
+        Request {
+            dim,
+            masses: vec![link; n],
+            lengths: vec![link; n],
+            gravity: 9.81,
+            damping: vec![damping; n],
+            torque: None,
+            drive,
+            initial: InitialSpec::Hanging,
+            spin: None,
+            integrator: None,
+            solver: StageSolver::FixedPoint,
+            tolerance: None,
+            step: None,
+            end: 300.0,
+            every: None,
+            view: View::Xz,
+            frames: 150,
+        }
+    }
+
+    /// [`config`] with the integrator, step and sampling given.
+    fn given(
+        mut r: Request,
+        integrator: Option<IntegratorKind>,
+        step: Option<f64>,
+        every: Option<usize>,
+    ) -> Request {
+        (r.integrator, r.step, r.every) = (integrator, step, every);
+        r
+    }
+
+    const WHIRL: DriveConfig = DriveConfig::Circle { radius: 0.02, omega: 6.0 };
+
+    #[test]
+    fn a_driven_3d_chain_gets_the_midpoint_step_at_a_twentieth_of_the_drive_period() {
+        let c = choose(&config(Dimension::Three, 100, WHIRL, 3e-4));
+        assert_eq!(c.integrator, IntegratorKind::Midpoint);
+        assert!((c.step - std::f64::consts::TAU / 6.0 / 20.0).abs() < 1e-15, "{}", c.step);
+        assert_eq!(c.every, 11, "300 s / (0.0524 s × 500)");
+        let reason = c.reason.unwrap();
+        assert!(reason.starts_with("integrator midpoint: a driven 3D chain"), "{reason}");
+        assert!(reason.contains("about 6.474e2 rad/s"), "{reason}");
+    }
+
+    #[test]
+    fn a_damped_undriven_3d_chain_steps_by_its_slowest_swing() {
+        let c = choose(&config(Dimension::Three, 10, DriveConfig::Fixed, 1e-3));
+        assert_eq!(c.integrator, IntegratorKind::Midpoint);
+        let period = std::f64::consts::TAU / 9.81_f64.sqrt();
+        assert!((c.step - period / 20.0).abs() < 1e-15, "{}", c.step);
+        assert!(c.reason.unwrap().contains("a damped 3D chain"));
+    }
+
+    #[test]
+    fn conservative_and_planar_runs_keep_gauss_legendre_below_the_fastest_mode() {
+        // A free 3D chain of 100 links: gl2 at 0.5/ω_fastest, far below 0.005 s.
+        let free = config(Dimension::Three, 100, DriveConfig::Fixed, 0.0);
+        let c = choose(&free);
+        assert_eq!(c.integrator, IntegratorKind::Gl2);
+        let chain = Chain::<Dyn>::new(&free.masses, &free.lengths, free.gravity).unwrap();
+        assert!((c.step - 0.5 / fastest_mode(&chain, &free.drive)).abs() < 1e-15);
+        // A driven damped planar triple pendulum: gl2 at 0.005 s (its modes are slow).
+        let drive =
+            DriveConfig::Harmonic { direction: vec![0.0, 1.0], amplitude: 0.01, omega: 2.0, phase: 0.0 };
+        let c = choose(&config(Dimension::Two, 3, drive, 0.01));
+        assert_eq!((c.integrator, c.step), (IntegratorKind::Gl2, EXPLICIT_DEFAULT_STEP));
+    }
+
+    #[test]
+    fn dp54_samples_its_adaptive_steps_about_500_times() {
+        let c =
+            choose(&given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None));
+        assert_eq!((c.step, c.every), (300.0 / 500.0, 1));
+        assert!(c.reason.unwrap().starts_with("step 6.0000e-1 s: the sample interval"));
+    }
+
+    #[test]
+    fn what_is_given_is_kept_and_not_explained() {
+        let request =
+            given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), Some(7));
+        let c = choose(&request);
+        assert_eq!(c, Choice { integrator: IntegratorKind::Rk4, step: 1e-3, every: 7, reason: None });
     }
 }

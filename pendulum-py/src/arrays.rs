@@ -90,19 +90,11 @@ pub fn array<'py>(
     PyArray1::from_vec(py, data).reshape(shape)
 }
 
-/// A per-link value: one number for every link or a sequence of `n` (`n = None`: the
-/// sequence's length, or `default_n` for one number).
-pub fn per_link(what: &str, value: &Bound<'_, PyAny>, n: Option<usize>) -> PyResult<Vec<f64>> {
+/// A per-link value as given: one number (a list of one) or a sequence of numbers;
+/// [`pendulum_experiment::options::expand`] makes it one per link.
+pub fn per_link(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     if let Ok(v) = value.extract::<f64>() {
-        return Ok(vec![v; n.unwrap_or(1)]);
+        return Ok(vec![v]);
     }
-    let v: Vec<f64> =
-        value.extract().map_err(|_| invalid(format!("{what}: not a number or a sequence of numbers")))?;
-    match n {
-        Some(n) if v.len() == 1 => Ok(vec![v[0]; n]),
-        Some(n) if v.len() != n => {
-            Err(invalid(format!("{what}: got {} values for {n} links (give 1 or {n})", v.len())))
-        }
-        _ => Ok(v),
-    }
+    value.extract().map_err(|_| invalid(format!("{what}: not a number or a sequence of numbers")))
 }

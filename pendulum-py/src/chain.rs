@@ -7,9 +7,11 @@ use numpy::PyArray1;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use rayon::prelude::*;
 
 use crate::arrays::{Rows, array, per_link};
-use crate::errors::{core_error, invalid};
+use crate::errors::{core_error, invalid, run_error};
+use pendulum_experiment::options::{expand, links};
 
 /// A chain of point masses on massless rigid rods, hung from a pivot.
 ///
@@ -91,24 +93,49 @@ where
     (DVector::from_column_slice(b.q.row(i)), DVector::from_column_slice(b.qd.row(i)), inputs)
 }
 
+/// Rows at least this many numbers in all are computed on every core.
+const PARALLEL_FROM: usize = 4096;
+
+/// `count` rows of `width` numbers, row `i` written by `f(i, row)`: on every core for a
+/// large batch (each row the same computation whatever the thread, so the same bits), and
+/// the first failing row's error, by index.
+fn rows<F>(count: usize, width: usize, f: F) -> pendulum_core::Result<Vec<f64>>
+where
+    F: Fn(usize, &mut [f64]) -> pendulum_core::Result<()> + Sync,
+{
+    let mut out = vec![0.0; count * width];
+    if width == 0 {
+        return Ok(out);
+    }
+    let results: Vec<pendulum_core::Result<()>> = if count * width < PARALLEL_FROM {
+        out.chunks_mut(width).enumerate().map(|(i, row)| f(i, row)).collect()
+    } else {
+        out.par_chunks_mut(width).enumerate().map(|(i, row)| f(i, row)).collect()
+    };
+    results.into_iter().collect::<pendulum_core::Result<()>>()?;
+    Ok(out)
+}
+
 /// `q̈` of every state, row after row.
-fn accelerations<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, b: &Batch) -> pendulum_core::Result<Vec<f64>>
+fn accelerations<M: Model<Links = Dyn, Dof = Dyn> + Sync>(
+    model: &M,
+    b: &Batch,
+) -> pendulum_core::Result<Vec<f64>>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
     let dof = b.q.width;
-    let mut out = vec![0.0; b.q.count() * dof];
-    let mut qdd = DVector::zeros(dof);
-    for i in 0..b.q.count() {
+    rows(b.q.count(), dof, |i, row| {
         let (q, qd, inputs) = state::<M>(b, i);
+        let mut qdd = DVector::zeros(dof);
         model.accelerations(&q, &qd, &inputs, &mut qdd)?;
-        out[i * dof..(i + 1) * dof].copy_from_slice(qdd.as_slice());
-    }
-    Ok(out)
+        row.copy_from_slice(qdd.as_slice());
+        Ok(())
+    })
 }
 
 /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
-fn jacobians<M: Derivatives<Links = Dyn, Dof = Dyn>>(
+fn jacobians<M: Derivatives<Links = Dyn, Dof = Dyn> + Sync>(
     model: &M,
     b: &Batch,
 ) -> pendulum_core::Result<[Vec<f64>; 3]>
@@ -116,17 +143,28 @@ where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
 {
     let (count, dof) = (b.q.count(), b.q.width);
-    let mut out = [vec![0.0; count * dof], vec![0.0; count * dof * dof], vec![0.0; count * dof * dof]];
-    let mut jac = Jacobians::zeros(model);
-    for i in 0..count {
+    let width = dof + 2 * dof * dof;
+    let all = rows(count, width, |i, row| {
         let (q, qd, inputs) = state::<M>(b, i);
+        let mut jac = Jacobians::zeros(model);
         model.state_jacobians(&q, &qd, &inputs, &mut jac)?;
-        out[0][i * dof..(i + 1) * dof].copy_from_slice(jac.accelerations.as_slice());
-        for (k, m) in [(1, &jac.q), (2, &jac.qd)] {
-            // nalgebra is column-major; numpy rows.
-            let t = m.transpose();
-            out[k][i * dof * dof..(i + 1) * dof * dof].copy_from_slice(t.as_slice());
-        }
+        let (qdd, matrices) = row.split_at_mut(dof);
+        qdd.copy_from_slice(jac.accelerations.as_slice());
+        let (dq, dqd) = matrices.split_at_mut(dof * dof);
+        // nalgebra is column-major; numpy rows.
+        dq.copy_from_slice(jac.q.transpose().as_slice());
+        dqd.copy_from_slice(jac.qd.transpose().as_slice());
+        Ok(())
+    })?;
+    let mut out = [
+        Vec::with_capacity(count * dof),
+        Vec::with_capacity(count * dof * dof),
+        Vec::with_capacity(count * dof * dof),
+    ];
+    for row in all.chunks(width.max(1)).take(count) {
+        out[0].extend_from_slice(&row[..dof]);
+        out[1].extend_from_slice(&row[dof..dof + dof * dof]);
+        out[2].extend_from_slice(&row[dof + dof * dof..]);
     }
     Ok(out)
 }
@@ -204,14 +242,16 @@ impl Chain {
         gravity: f64,
         damping: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let m = per_link("masses", masses, None)?;
-        let l = per_link("lengths", lengths, None)?;
+        // One number each: one link (a pendulum), unlike a run's default of 3.
+        let (m, l) = (per_link("masses", masses)?, per_link("lengths", lengths)?);
         let n = m.len().max(l.len());
-        let m = per_link("masses", masses, Some(n))?;
-        let l = per_link("lengths", lengths, Some(n))?;
+        let (n, m, l) = links(Some(n), ("masses", m), ("lengths", l)).map_err(run_error)?;
         let chain = pendulum_core::Chain::<Dyn>::new(&m, &l, gravity).map_err(core_error)?;
         let chain = match damping.filter(|d| !d.is_none()) {
-            Some(d) => chain.with_damping(&per_link("damping", d, Some(n))?).map_err(core_error)?,
+            Some(d) => {
+                let damping = expand("damping", per_link("damping", d)?, n).map_err(run_error)?;
+                chain.with_damping(&damping).map_err(core_error)?
+            }
             None => chain,
         };
         Ok(Self { inner: chain })

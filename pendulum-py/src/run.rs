@@ -9,8 +9,8 @@ use std::time::{Duration, Instant};
 use numpy::PyArray1;
 use pendulum_core::ShapeReport;
 use pendulum_experiment::{
-    Dimension, DriveConfig, InitialSpec, IntegratorKind, Recorder, Report, Request, RunConfig, RunFile,
-    SampleFiles, StageSolver, View, build,
+    Dimension, DriveConfig, DriveOptions, InitialSpec, Recorder, Report, Request, RunConfig, RunFile,
+    SampleFiles, View, build, options,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -57,10 +57,6 @@ pub struct RunResult {
     shape: Option<Result<ShapeReport, String>>,
 }
 
-fn parse<T>(what: &str, value: &str, choices: &str, from: impl Fn(&str) -> Option<T>) -> PyResult<T> {
-    from(value).ok_or_else(|| invalid(format!("{what}: '{value}' is not one of {choices}")))
-}
-
 #[pymethods]
 impl Run {
     #[new]
@@ -101,70 +97,30 @@ impl Run {
         };
         let listed = |what: &str, v: Option<&Bound<'_, PyAny>>, default: f64| -> PyResult<Vec<f64>> {
             match v.filter(|v| !v.is_none()) {
-                Some(v) => per_link(what, v, None),
+                Some(v) => per_link(what, v),
                 None => Ok(vec![default]),
             }
         };
-        let (m, l) = (listed("masses", masses, 1.0)?, listed("lengths", lengths, 0.5)?);
-        let n = match n {
-            Some(0) => return Err(invalid("n: a chain needs at least 1 link, got 0")),
-            Some(n) => n,
-            None => [m.len(), l.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
-        };
-        let expand = |what: &str, v: Vec<f64>| -> PyResult<Vec<f64>> {
-            match v.len() {
-                1 => Ok(vec![v[0]; n]),
-                len if len == n => Ok(v),
-                len => Err(invalid(format!("{what}: got {len} values for {n} links (give 1 or {n})"))),
-            }
-        };
-        let masses = expand("masses", m)?;
-        let lengths = expand("lengths", l)?;
-        let damping = expand("damping", listed("damping", damping, 0.0)?)?;
+        let (n, masses, lengths) = options::links(
+            n,
+            ("masses", listed("masses", masses, 1.0)?),
+            ("lengths", listed("lengths", lengths, 0.5)?),
+        )
+        .map_err(run_error)?;
+        let damping = options::expand("damping", listed("damping", damping, 0.0)?, n).map_err(run_error)?;
         let torque = match torque.filter(|t| !t.is_none()) {
-            Some(t) => Some(expand("torque", per_link("torque", t, None)?)?),
+            Some(t) => Some(options::expand("torque", per_link("torque", t)?, n).map_err(run_error)?),
             None => None,
         };
-        let drive = match drive {
-            "fixed" => DriveConfig::Fixed,
-            "harmonic" => {
-                let space = dim.space();
-                let direction = direction.unwrap_or_else(|| {
-                    let mut up = vec![0.0; space];
-                    up[space - 1] = 1.0;
-                    up
-                });
-                DriveConfig::Harmonic { direction, amplitude, omega, phase }
-            }
-            "circle" => match ramp_time {
-                None => DriveConfig::Circle { radius, omega },
-                Some(duration) => DriveConfig::RampedCircle {
-                    radius,
-                    initial_omega: ramp_from.unwrap_or(0.0),
-                    omega,
-                    duration,
-                },
-            },
-            other => return Err(invalid(format!("drive: '{other}' is not one of fixed, harmonic, circle"))),
-        };
+        let kind = options::by_name("drive", drive, "fixed, harmonic, circle").map_err(run_error)?;
+        let drive = DriveOptions { kind, amplitude, omega, phase, direction, radius, ramp_time, ramp_from }
+            .config(dim)
+            .map_err(run_error)?;
         let integrator = integrator
-            .map(|s| {
-                parse("integrator", s, "gl1, gl2, gl3, rk4, midpoint, dp54", |s| match s {
-                    "gl1" => Some(IntegratorKind::Gl1),
-                    "gl2" => Some(IntegratorKind::Gl2),
-                    "gl3" => Some(IntegratorKind::Gl3),
-                    "rk4" => Some(IntegratorKind::Rk4),
-                    "midpoint" => Some(IntegratorKind::Midpoint),
-                    "dp54" => Some(IntegratorKind::Dp54),
-                    _ => None,
-                })
-            })
-            .transpose()?;
-        let solver = parse("solver", solver, "fixed-point, newton", |s| match s {
-            "fixed-point" => Some(StageSolver::FixedPoint),
-            "newton" => Some(StageSolver::Newton),
-            _ => None,
-        })?;
+            .map(|s| options::by_name("integrator", s, "gl1, gl2, gl3, rk4, midpoint, dp54"))
+            .transpose()
+            .map_err(run_error)?;
+        let solver = options::by_name("solver", solver, "fixed-point, newton").map_err(run_error)?;
         let initial: InitialSpec = initial.parse().map_err(|e: String| invalid(format!("initial: {e}")))?;
         let request = Request {
             dim,

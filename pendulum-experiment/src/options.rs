@@ -1,0 +1,179 @@
+//! A run's options as a front end collects them (the flags of `pendulum simulate`, the
+//! keyword arguments of `pendulum.Run`), made into the description's values with the
+//! checks and one-line messages every front end shares: per-link lists, the drive, and
+//! the names of the integrators and stage solves.
+
+use serde::de::DeserializeOwned;
+
+use crate::description::{Dimension, DriveConfig};
+use crate::error::{Error, Result};
+
+/// The links of a chain from its per-link lists: `n` if given, else the length of a list of
+/// more than one value, else 3 links; a single value is repeated for every link.
+/// Returns `(n, masses, lengths)`; errors name `what` of each (`"--masses"`, `"masses"`).
+pub fn links(
+    n: Option<usize>,
+    masses: (&str, Vec<f64>),
+    lengths: (&str, Vec<f64>),
+) -> Result<(usize, Vec<f64>, Vec<f64>)> {
+    let n = match n {
+        Some(0) => {
+            return Err(Error::invalid(format!(
+                "{}: a chain needs at least 1 link, got 0",
+                n_flag(masses.0)
+            )));
+        }
+        Some(n) => n,
+        None => [masses.1.len(), lengths.1.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
+    };
+    Ok((n, expand(masses.0, masses.1, n)?, expand(lengths.0, lengths.1, n)?))
+}
+
+/// `--n` beside `--masses`, `n` beside `masses`.
+fn n_flag(masses: &str) -> &'static str {
+    if masses.starts_with("--") { "--n" } else { "n" }
+}
+
+/// A per-link list of `n` entries: one value is repeated, otherwise the list must have
+/// exactly `n` entries.
+pub fn expand(what: &str, values: Vec<f64>, n: usize) -> Result<Vec<f64>> {
+    match values.len() {
+        1 => Ok(vec![values[0]; n]),
+        len if len == n => Ok(values),
+        len => Err(Error::invalid(format!("{what}: got {len} values for {n} links (give 1 or {n})"))),
+    }
+}
+
+/// The pivot's motion, as options name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum DriveKind {
+    /// Pivot at rest at the origin.
+    Fixed,
+    /// p(t) = A sin(ωt + φ) d̂ along --direction (default vertical).
+    Harmonic,
+    /// p(t) = R (cos ωt, sin ωt, 0), a horizontal circle (3D only).
+    Circle,
+}
+
+/// The drive's options: its kind and every parameter any kind takes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriveOptions {
+    /// Which motion.
+    pub kind: DriveKind,
+    /// Harmonic: amplitude `A`, m.
+    pub amplitude: f64,
+    /// Harmonic or circle: angular frequency `ω`, rad/s.
+    pub omega: f64,
+    /// Harmonic: phase `φ`, rad.
+    pub phase: f64,
+    /// Harmonic: direction (2 or 3 components; `None`: vertical).
+    pub direction: Option<Vec<f64>>,
+    /// Circle: radius `R`, m.
+    pub radius: f64,
+    /// Circle: ramp the speed from `ramp_from` to `omega` over this many seconds.
+    pub ramp_time: Option<f64>,
+    /// Circle with a ramp: the speed at t = 0, rad/s (`None`: 0).
+    pub ramp_from: Option<f64>,
+}
+
+impl DriveOptions {
+    /// The drive these options describe for a chain in `dim`; the parameters a kind does
+    /// not take are refused by name when given.
+    pub fn config(&self, dim: Dimension) -> Result<DriveConfig> {
+        let drive = match self.kind {
+            DriveKind::Fixed => DriveConfig::Fixed,
+            DriveKind::Harmonic => {
+                let direction = self.direction.clone().unwrap_or_else(|| {
+                    let mut up = vec![0.0; dim.space()];
+                    up[dim.space() - 1] = 1.0;
+                    up
+                });
+                DriveConfig::Harmonic {
+                    direction,
+                    amplitude: self.amplitude,
+                    omega: self.omega,
+                    phase: self.phase,
+                }
+            }
+            DriveKind::Circle => match self.ramp_time {
+                None => DriveConfig::Circle { radius: self.radius, omega: self.omega },
+                Some(duration) => DriveConfig::RampedCircle {
+                    radius: self.radius,
+                    initial_omega: self.ramp_from.unwrap_or(0.0),
+                    omega: self.omega,
+                    duration,
+                },
+            },
+        };
+        if (self.ramp_time.is_some() || self.ramp_from.is_some()) && self.kind != DriveKind::Circle {
+            return Err(Error::invalid("--ramp-time and --ramp-from apply to --drive circle only"));
+        }
+        if self.ramp_from.is_some() && self.ramp_time.is_none() {
+            return Err(Error::invalid("--ramp-from needs --ramp-time (the ramp's duration, s)"));
+        }
+        if self.direction.is_some() && self.kind != DriveKind::Harmonic {
+            return Err(Error::invalid("--direction applies to --drive harmonic only"));
+        }
+        Ok(drive)
+    }
+}
+
+/// A value of the description by its name in run.json (`"rk4"`, `"fixed-point"`,
+/// `"circle"`); errors name `what` and list the `choices`.
+pub fn by_name<T: DeserializeOwned>(what: &str, name: &str, choices: &str) -> Result<T> {
+    serde_json::from_value(serde_json::Value::String(name.into()))
+        .map_err(|_| Error::invalid(format!("{what}: '{name}' is not one of {choices}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::description::IntegratorKind;
+
+    #[test]
+    fn lists_expand_to_the_links_and_errors_name_the_option() {
+        assert_eq!(links(None, ("m", vec![1.0]), ("l", vec![0.5])).unwrap(), (3, vec![1.0; 3], vec![0.5; 3]));
+        assert_eq!(links(None, ("m", vec![1.0, 2.0]), ("l", vec![0.5])).unwrap().2, vec![0.5; 2]);
+        let e = links(Some(3), ("--masses", vec![1.0, 2.0]), ("--lengths", vec![0.5])).unwrap_err();
+        assert_eq!(e.to_string(), "--masses: got 2 values for 3 links (give 1 or 3)");
+        assert_eq!(
+            links(Some(0), ("masses", vec![1.0]), ("lengths", vec![1.0])).unwrap_err().to_string(),
+            "n: a chain needs at least 1 link, got 0"
+        );
+    }
+
+    #[test]
+    fn a_drive_takes_only_its_own_parameters() {
+        let circle = DriveOptions {
+            kind: DriveKind::Circle,
+            amplitude: 0.05,
+            omega: 5.0,
+            phase: 0.0,
+            direction: None,
+            radius: 0.02,
+            ramp_time: Some(100.0),
+            ramp_from: None,
+        };
+        assert_eq!(
+            circle.config(Dimension::Three).unwrap(),
+            DriveConfig::RampedCircle { radius: 0.02, initial_omega: 0.0, omega: 5.0, duration: 100.0 }
+        );
+        let shaken = DriveOptions { kind: DriveKind::Harmonic, ..circle.clone() };
+        assert!(shaken.config(Dimension::Two).unwrap_err().to_string().contains("--drive circle only"));
+        let up = DriveOptions { ramp_time: None, ..shaken };
+        assert_eq!(
+            up.config(Dimension::Two).unwrap(),
+            DriveConfig::Harmonic { direction: vec![0.0, 1.0], amplitude: 0.05, omega: 5.0, phase: 0.0 }
+        );
+    }
+
+    #[test]
+    fn names_are_run_json_names() {
+        assert_eq!(by_name::<IntegratorKind>("integrator", "dp54", "…").unwrap(), IntegratorKind::Dp54);
+        assert_eq!(by_name::<DriveKind>("drive", "circle", "…").unwrap(), DriveKind::Circle);
+        let e = by_name::<IntegratorKind>("integrator", "euler", "gl1, rk4").unwrap_err();
+        assert_eq!(e.to_string(), "integrator: 'euler' is not one of gl1, rk4");
+    }
+}
