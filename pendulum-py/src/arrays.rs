@@ -46,7 +46,10 @@ impl Rows {
         if last != width {
             return Err(invalid(format!("{what}: the last axis has {last} entries, expected {width}")));
         }
-        let data: Vec<f64> = array.as_array().iter().copied().collect();
+        let data: Vec<f64> = match array.as_slice() {
+            Ok(contiguous) => contiguous.to_vec(),
+            Err(_) => array.as_array().iter().copied().collect(),
+        };
         if let Some(v) = data.iter().find(|v| !v.is_finite()) {
             return Err(invalid(format!("{what}: {v} is not finite")));
         }
@@ -87,7 +90,11 @@ pub fn array<'py>(
     tail: &[usize],
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let shape: Vec<usize> = lead.iter().chain(tail).copied().collect();
-    PyArray1::from_vec(py, data).reshape(shape)
+    let flat = PyArray1::from_vec(py, data);
+    if shape.len() == 1 {
+        return Ok(flat.to_dyn().clone());
+    }
+    flat.reshape(shape)
 }
 
 /// A per-link value as given: one number (a list of one) or a sequence of numbers;

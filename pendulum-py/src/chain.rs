@@ -2,7 +2,7 @@
 //! accelerations, the terms of `M q̈ + c + k + d = Q`, energies and the analytic Jacobians —
 //! for one state or a leading batch of them; its normal modes and linearisation.
 
-use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, Dyn, OVector};
+use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
 use numpy::PyArray1;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
@@ -24,6 +24,9 @@ use pendulum_experiment::options::{expand, links};
 #[derive(Clone)]
 pub struct Chain {
     pub inner: pendulum_core::Chain<Dyn>,
+    /// The models, built once.
+    planar: PlanarTension<Dyn>,
+    spatial: Spatial<Dyn>,
 }
 
 /// Which model a call evaluates.
@@ -77,43 +80,72 @@ impl Chain {
     }
 }
 
-/// One state's vectors and inputs for model `M`.
-fn state<M: Model<Dof = Dyn>>(b: &Batch, i: usize) -> (DVector<f64>, DVector<f64>, Inputs<Dyn, M::Space>)
+/// One state's vectors and inputs for model `M`, filled row by row (allocated once per
+/// thread, not per state).
+struct State<M: Model<Dof = Dyn>>
 where
     DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
 {
-    let inputs = Inputs {
-        torque: DVector::from_column_slice(b.torque.row(i)),
-        pivot_acceleration: OVector::<f64, M::Space>::from_iterator_generic(
-            M::Space::name(),
-            nalgebra::U1,
-            b.pivot.row(i).iter().copied(),
-        ),
-    };
-    (DVector::from_column_slice(b.q.row(i)), DVector::from_column_slice(b.qd.row(i)), inputs)
+    q: DVector<f64>,
+    qd: DVector<f64>,
+    inputs: Inputs<Dyn, M::Space>,
 }
 
-/// Rows at least this many numbers in all are computed on every core.
+impl<M: Model<Dof = Dyn>> State<M>
+where
+    DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
+{
+    fn new(dof: usize) -> Self {
+        Self { q: DVector::zeros(dof), qd: DVector::zeros(dof), inputs: Inputs::zeros(Dyn(dof)) }
+    }
+
+    /// Row `i` of the batch.
+    fn load(&mut self, b: &Batch, i: usize) -> &mut Self {
+        self.q.copy_from_slice(b.q.row(i));
+        self.qd.copy_from_slice(b.qd.row(i));
+        self.inputs.torque.copy_from_slice(b.torque.row(i));
+        self.inputs.pivot_acceleration.copy_from_slice(b.pivot.row(i));
+        self
+    }
+}
+
+/// Rows at least this many numbers in all are computed on every core, with the GIL
+/// released; smaller batches in the calling thread.
 const PARALLEL_FROM: usize = 4096;
 
-/// `count` rows of `width` numbers, row `i` written by `f(i, row)`: on every core for a
-/// large batch (each row the same computation whatever the thread, so the same bits), and
-/// the first failing row's error, by index.
-fn rows<F>(count: usize, width: usize, f: F) -> pendulum_core::Result<Vec<f64>>
+/// `count` rows of `width` numbers, row `i` written by `f(scratch, i, row)` with a
+/// scratch from `init` per thread: on every core for a large batch (each row the same
+/// computation whatever the thread, so the same bits), and the first failing row's error,
+/// by index.
+fn rows<S, F>(
+    count: usize,
+    width: usize,
+    init: impl Fn() -> S + Sync,
+    f: F,
+) -> pendulum_core::Result<Vec<f64>>
 where
-    F: Fn(usize, &mut [f64]) -> pendulum_core::Result<()> + Sync,
+    F: Fn(&mut S, usize, &mut [f64]) -> pendulum_core::Result<()> + Sync,
 {
     let mut out = vec![0.0; count * width];
     if width == 0 {
         return Ok(out);
     }
     let results: Vec<pendulum_core::Result<()>> = if count * width < PARALLEL_FROM {
-        out.chunks_mut(width).enumerate().map(|(i, row)| f(i, row)).collect()
+        let mut scratch = init();
+        out.chunks_mut(width).enumerate().map(|(i, row)| f(&mut scratch, i, row)).collect()
     } else {
-        out.par_chunks_mut(width).enumerate().map(|(i, row)| f(i, row)).collect()
+        out.par_chunks_mut(width)
+            .enumerate()
+            .map_init(&init, |scratch, (i, row)| f(scratch, i, row))
+            .collect()
     };
     results.into_iter().collect::<pendulum_core::Result<()>>()?;
     Ok(out)
+}
+
+/// Runs `f` without the GIL when the batch is large enough to be worth it.
+fn maybe_detached<T: Send>(py: Python<'_>, numbers: usize, f: impl FnOnce() -> T + Send) -> T {
+    if numbers < PARALLEL_FROM { f() } else { py.detach(f) }
 }
 
 /// `q̈` of every state, row after row.
@@ -125,13 +157,17 @@ where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
     let dof = b.q.width;
-    rows(b.q.count(), dof, |i, row| {
-        let (q, qd, inputs) = state::<M>(b, i);
-        let mut qdd = DVector::zeros(dof);
-        model.accelerations(&q, &qd, &inputs, &mut qdd)?;
-        row.copy_from_slice(qdd.as_slice());
-        Ok(())
-    })
+    rows(
+        b.q.count(),
+        dof,
+        || (State::<M>::new(dof), DVector::zeros(dof)),
+        |(state, qdd), i, row| {
+            let s = state.load(b, i);
+            model.accelerations(&s.q, &s.qd, &s.inputs, qdd)?;
+            row.copy_from_slice(qdd.as_slice());
+            Ok(())
+        },
+    )
 }
 
 /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
@@ -144,18 +180,22 @@ where
 {
     let (count, dof) = (b.q.count(), b.q.width);
     let width = dof + 2 * dof * dof;
-    let all = rows(count, width, |i, row| {
-        let (q, qd, inputs) = state::<M>(b, i);
-        let mut jac = Jacobians::zeros(model);
-        model.state_jacobians(&q, &qd, &inputs, &mut jac)?;
-        let (qdd, matrices) = row.split_at_mut(dof);
-        qdd.copy_from_slice(jac.accelerations.as_slice());
-        let (dq, dqd) = matrices.split_at_mut(dof * dof);
-        // nalgebra is column-major; numpy rows.
-        dq.copy_from_slice(jac.q.transpose().as_slice());
-        dqd.copy_from_slice(jac.qd.transpose().as_slice());
-        Ok(())
-    })?;
+    let all = rows(
+        count,
+        width,
+        || (State::<M>::new(dof), Jacobians::zeros(model)),
+        |(state, jac), i, row| {
+            let s = state.load(b, i);
+            model.state_jacobians(&s.q, &s.qd, &s.inputs, jac)?;
+            let (qdd, matrices) = row.split_at_mut(dof);
+            qdd.copy_from_slice(jac.accelerations.as_slice());
+            let (dq, dqd) = matrices.split_at_mut(dof * dof);
+            // nalgebra is column-major; numpy rows.
+            dq.copy_from_slice(jac.q.transpose().as_slice());
+            dqd.copy_from_slice(jac.qd.transpose().as_slice());
+            Ok(())
+        },
+    )?;
     let mut out = [
         Vec::with_capacity(count * dof),
         Vec::with_capacity(count * dof * dof),
@@ -175,7 +215,8 @@ where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
     let dof = b.q.width;
-    let (q, qd, inputs) = state::<M>(b, 0);
+    let mut state = State::<M>::new(dof);
+    let State { q, qd, inputs } = state.load(b, 0);
     let mut qdd = DVector::zeros(dof);
     model.accelerations(&q, &qd, &inputs, &mut qdd).map_err(core_error)?;
     let mut mass = DMatrix::zeros(dof, dof);
@@ -208,24 +249,25 @@ fn energies<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, b: &Batch) -> (Vec<f64>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
+    let mut state = State::<M>::new(b.q.width);
     (0..b.q.count())
         .map(|i| {
-            let (q, qd, _) = state::<M>(b, i);
-            (model.kinetic_energy(&q, &qd), model.potential_energy(&q))
+            let s = state.load(b, i);
+            (model.kinetic_energy(&s.q, &s.qd), model.potential_energy(&s.q))
         })
         .unzip()
 }
 
-/// Calls `f` with the model of `kind` (generic over it).
+/// Evaluates `$body` with `$m` the chain's model of `$kind` (generic over it).
 macro_rules! with_model {
     ($chain:expr, $kind:expr, |$m:ident| $body:expr) => {
         match $kind {
             Kind::Planar => {
-                let $m = PlanarTension::new($chain.clone());
+                let $m = &$chain.planar;
                 $body
             }
             Kind::Spatial => {
-                let $m = Spatial::new($chain.clone());
+                let $m = &$chain.spatial;
                 $body
             }
         }
@@ -254,7 +296,11 @@ impl Chain {
             }
             None => chain,
         };
-        Ok(Self { inner: chain })
+        Ok(Self {
+            planar: PlanarTension::new(chain.clone()),
+            spatial: Spatial::new(chain.clone()),
+            inner: chain,
+        })
     }
 
     /// Number of links.
@@ -332,8 +378,9 @@ impl Chain {
     ) -> PyResult<Bound<'py, PyAny>> {
         let kind = Kind::of(model)?;
         let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
-        let chain = &self.inner;
-        let out = py.detach(|| with_model!(chain, kind, |m| accelerations(&m, &b))).map_err(core_error)?;
+        let numbers = b.q.data.len();
+        let out = maybe_detached(py, numbers, || with_model!(self, kind, |m| accelerations(m, &b)))
+            .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 
@@ -352,9 +399,9 @@ impl Chain {
     ) -> PyResult<Bound<'py, PyTuple>> {
         let kind = Kind::of(model)?;
         let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
-        let chain = &self.inner;
         let [qdd, dq, dqd] =
-            py.detach(|| with_model!(chain, kind, |m| jacobians(&m, &b))).map_err(core_error)?;
+            maybe_detached(py, b.q.data.len() * b.q.width, || with_model!(self, kind, |m| jacobians(m, &b)))
+                .map_err(core_error)?;
         let w = b.q.width;
         let items = [
             array(py, qdd, &b.q.lead, &[w])?,
@@ -383,7 +430,7 @@ impl Chain {
         if !b.q.lead.is_empty() {
             return Err(invalid("terms: one state at a time (q of shape (dof,))"));
         }
-        with_model!(&self.inner, kind, |m| terms(py, &m, &b))
+        with_model!(self, kind, |m| terms(py, m, &b))
     }
 
     /// `(T, U)`: kinetic and potential energy (J) of the states, shaped like `q` without its
@@ -398,8 +445,7 @@ impl Chain {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let kind = Kind::of(model)?;
         let b = self.batch(kind, q, qd, None, None)?;
-        let chain = &self.inner;
-        let (t, u) = py.detach(|| with_model!(chain, kind, |m| energies(&m, &b)));
+        let (t, u) = maybe_detached(py, b.q.data.len(), || with_model!(self, kind, |m| energies(m, &b)));
         Ok((array(py, t, &b.q.lead, &[])?.into_any(), array(py, u, &b.q.lead, &[])?.into_any()))
     }
 
@@ -439,7 +485,7 @@ impl Chain {
             return Err(invalid("linearize: one state at a time (q of shape (dof,))"));
         }
         let tolerance = if force { f64::INFINITY } else { tolerance };
-        let s = with_model!(&self.inner, kind, |m| linearize_with(&m, &b, tolerance)).map_err(core_error)?;
+        let s = with_model!(self, kind, |m| linearize_with(m, &b, tolerance)).map_err(core_error)?;
         let d = PyDict::new(py);
         let matrix =
             |m: &DMatrix<f64>| array(py, m.transpose().as_slice().to_vec(), &[m.nrows(), m.ncols()], &[]);
@@ -464,6 +510,7 @@ fn linearize_with<M: Derivatives<Links = Dyn, Dof = Dyn>>(
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
 {
-    let (q, qd, inputs) = state::<M>(b, 0);
-    pendulum_core::linearize(model, &q, &qd, &inputs, tolerance)
+    let mut state = State::<M>::new(b.q.width);
+    let s = state.load(b, 0);
+    pendulum_core::linearize(model, &s.q, &s.qd, &s.inputs, tolerance)
 }
