@@ -216,11 +216,12 @@ where
 {
     let dof = b.q.width;
     let mut state = State::<M>::new(dof);
-    let State { q, qd, inputs } = state.load(b, 0);
+    let s = state.load(b, 0);
+    let (q, qd, inputs) = (&s.q, &s.qd, &s.inputs);
     let mut qdd = DVector::zeros(dof);
-    model.accelerations(&q, &qd, &inputs, &mut qdd).map_err(core_error)?;
+    model.accelerations(q, qd, inputs, &mut qdd).map_err(core_error)?;
     let mut mass = DMatrix::zeros(dof, dof);
-    model.mass_matrix(&q, &mut mass);
+    model.mass_matrix(q, &mut mass);
     let vector = |f: &dyn Fn(&mut DVector<f64>)| {
         let mut out = DVector::zeros(dof);
         f(&mut out);
@@ -228,19 +229,19 @@ where
     };
     let d = PyDict::new(py);
     d.set_item("mass_matrix", array(py, mass.transpose().as_slice().to_vec(), &[dof, dof], &[])?)?;
-    d.set_item("velocity_terms", PyArray1::from_vec(py, vector(&|o| model.velocity_terms(&q, &qd, o))))?;
-    d.set_item("gravity_terms", PyArray1::from_vec(py, vector(&|o| model.gravity_terms(&q, o))))?;
+    d.set_item("velocity_terms", PyArray1::from_vec(py, vector(&|o| model.velocity_terms(q, qd, o))))?;
+    d.set_item("gravity_terms", PyArray1::from_vec(py, vector(&|o| model.gravity_terms(q, o))))?;
     d.set_item(
         "pivot_terms",
-        PyArray1::from_vec(py, vector(&|o| model.pivot_terms(&q, &inputs.pivot_acceleration, o))),
+        PyArray1::from_vec(py, vector(&|o| model.pivot_terms(q, &inputs.pivot_acceleration, o))),
     )?;
     d.set_item(
         "generalized_forces",
-        PyArray1::from_vec(py, vector(&|o| model.generalized_forces(&q, &qd, &inputs.torque, o))),
+        PyArray1::from_vec(py, vector(&|o| model.generalized_forces(q, qd, &inputs.torque, o))),
     )?;
     d.set_item("accelerations", PyArray1::from_vec(py, qdd.as_slice().to_vec()))?;
-    d.set_item("kinetic_energy", model.kinetic_energy(&q, &qd))?;
-    d.set_item("potential_energy", model.potential_energy(&q))?;
+    d.set_item("kinetic_energy", model.kinetic_energy(q, qd))?;
+    d.set_item("potential_energy", model.potential_energy(q))?;
     Ok(d.unbind())
 }
 
