@@ -5,9 +5,7 @@
 use std::path::Path;
 
 use pendulum_core::{ShapeReport, WhirlShape};
-use pendulum_experiment::write_json_atomic;
 use plotters::prelude::*;
-use serde_json::json;
 
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
@@ -16,7 +14,7 @@ use crate::plot::{drawing_failed, fonts};
 /// `shape.json` and (with `plots`) `shape.png` in `out`.
 pub fn present(report: &ShapeReport, out: &Path, plots: bool) -> CliResult<()> {
     println!("{}", summary(report));
-    write_json(&out.join("shape.json"), report)?;
+    pendulum_experiment::whirl::write_shape_json(&out.join("shape.json"), report)?;
     if plots {
         plot(&out.join("shape.png"), report)?;
     }
@@ -72,53 +70,6 @@ pub fn summary(r: &ShapeReport) -> String {
         plural(s.axis_crossings, "axis crossing"),
         s.tip_radius
     )
-}
-
-fn shape_json(s: &WhirlShape) -> serde_json::Value {
-    json!({
-        "nodes": s.nodes,
-        "axis_crossings": s.axis_crossings,
-        "tip_radius": s.tip_radius,
-        "plane_azimuth": s.plane_azimuth,
-        "out_of_plane": s.out_of_plane,
-        "radial": s.radial,
-        "depth": s.depth,
-        "positions": s.positions.iter().map(|r| [r.x, r.y, r.z]).collect::<Vec<_>>(),
-    })
-}
-
-fn write_json(path: &Path, r: &ShapeReport) -> CliResult<()> {
-    let nearest = match &r.nearest {
-        Ok(n) => json!({
-            "found": true,
-            "omega": n.omega,
-            "distance": n.distance,
-            "nodes": n.shape.nodes,
-            "stable": n.stable,
-            "growth_rate": n.growth_rate,
-            "shape": shape_json(&n.shape),
-        }),
-        Err(e) => json!({ "found": false, "reason": e.to_string() }),
-    };
-    let value = json!({
-        "conventions": "co-rotating frame: the pivot at (R, 0, 0), the rotation axis along z (m); \
-                        nodes = axis_crossings + 1 (the pivot counts as a node); radial = signed distance \
-                        from the axis in the fitted plane, depth below the pivot (m); growth_rate in 1/s",
-        "t": r.t,
-        "omega": r.omega,
-        "radius": r.radius,
-        "nodes": r.shape.nodes,
-        "axis_crossings": r.shape.axis_crossings,
-        "tip_radius": r.shape.tip_radius,
-        "settled": r.settling.settled,
-        "drift": r.settling.drift,
-        "drift_threshold": r.settling.threshold,
-        "window": r.settling.window,
-        "window_covered": r.settling.covered,
-        "shape": shape_json(&r.shape),
-        "nearest": nearest,
-    });
-    write_json_atomic(path, &value)
 }
 
 /// Where the signed radial coordinate changes sign between masses `i` and `i + 1`: the

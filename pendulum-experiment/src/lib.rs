@@ -59,9 +59,11 @@ pub mod final_state;
 pub mod initial;
 pub mod json;
 pub mod options;
+pub mod page;
 pub mod record;
 pub mod request;
 pub mod run;
+pub mod run_dir;
 pub mod whirl;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};

@@ -55,6 +55,8 @@ pub struct RunResult {
     recorder: Recorder,
     final_state: Vec<f64>,
     shape: Option<Result<ShapeReport, String>>,
+    /// Where its files were written (`run(out=…)`), if anywhere.
+    directory: Option<PathBuf>,
 }
 
 #[pymethods]
@@ -217,8 +219,9 @@ impl Run {
 
     /// Runs it: the samples as arrays in a `RunResult`, with the shape a whirled chain
     /// took. With `out` (a directory, created if missing), also writes run.json,
-    /// trajectory.csv, energy.csv and final.json there, as `pendulum simulate --no-plots`
-    /// does. The GIL is released while it runs; Ctrl-C raises KeyboardInterrupt.
+    /// trajectory.csv, energy.csv, final.json and (a whirl) shape.json there, as
+    /// `pendulum simulate --no-plots` does; a notebook then shows the result as the
+    /// interactive page of `pendulum view`. The GIL is released while it runs; Ctrl-C raises KeyboardInterrupt.
     #[pyo3(signature = (out = None))]
     fn run(&self, py: Python<'_>, out: Option<PathBuf>) -> PyResult<RunResult> {
         let config = &self.config;
@@ -263,6 +266,9 @@ impl Run {
             let report = report?;
             if let Some(dir) = &out {
                 report.final_state.write(dir)?;
+                if let Some(Ok(shape)) = &report.shape {
+                    pendulum_experiment::whirl::write_shape_json(&dir.join("shape.json"), shape)?;
+                }
                 let mut file = RunFile::new(config.clone());
                 file.outcome = Some(report.outcome());
                 file.write_atomic(&dir.join("run.json"))?;
@@ -283,6 +289,7 @@ impl Run {
             recorder,
             final_state,
             shape: report.shape.map(|s| s.map_err(|e| e.to_string())),
+            directory: out,
         })
     }
 }
@@ -370,6 +377,20 @@ impl RunResult {
         };
         d.set_item("nearest", nearest)?;
         Ok(Some(d.unbind()))
+    }
+
+    /// The directory its files were written to (`run(out=…)`), or None.
+    #[getter]
+    fn directory(&self) -> Option<PathBuf> {
+        self.directory.clone()
+    }
+
+    /// In a notebook: the page of `pendulum view` (the chain under an orbit camera,
+    /// playback, the co-rotating frame, the ledger) in an iframe, for a run written with
+    /// `run(out=…)`; None otherwise (the notebook shows the repr).
+    fn _repr_html_(&self) -> PyResult<Option<String>> {
+        let Some(dir) = &self.directory else { return Ok(None) };
+        Ok(Some(crate::iframe(&crate::page_of(dir, pendulum_experiment::page::DEFAULT_FRAMES)?)))
     }
 
     fn __repr__(&self) -> String {

@@ -132,3 +132,20 @@ def test_the_docs_whirl_takes_two_nodes_at_six_rad_per_second():
     assert shape["nodes"] == 2 and shape["settled"]
     assert shape["tip_radius"] == pytest.approx(4.4351e-2, rel=1e-4)
     assert shape["nearest"]["nodes"] == 2 and shape["nearest"]["stable"]
+
+
+def test_a_written_run_shows_as_the_viewer_page_in_a_notebook(tmp_path):
+    run = pendulum.Run(dim=3, n=6, lengths=0.1, initial="hanging", drive="circle", radius=0.05, omega=5.0,
+                       integrator="rk4", step=0.002, end=6.0, every=5)
+    assert run.run()._repr_html_() is None
+    result = run.run(out=tmp_path)
+    assert str(result.directory) == str(tmp_path)
+    assert (tmp_path / "shape.json").exists()
+    html = pendulum.page(tmp_path)
+    assert html.startswith("<!doctype html>")
+    assert '"links":6' in html and '"phases":[' in html
+    cell = result._repr_html_()
+    assert cell.startswith("<iframe srcdoc=") and "&quot;links&quot;:6" in cell
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="holds no run: no run.json"):
+        pendulum.page(tmp_path / "empty")

@@ -8,7 +8,6 @@
 
 mod draw;
 mod encode;
-pub mod source;
 mod timing;
 mod view;
 
@@ -21,8 +20,8 @@ use clap::{Args, ValueEnum};
 use crate::error::{CliError, CliResult};
 use draw::{Layout, Scene, Shot};
 use pendulum_experiment::View;
+use pendulum_experiment::run_dir::{Run, Trajectory};
 use pendulum_experiment::{DriveConfig, RunConfig};
-use source::{Run, Trajectory};
 use timing::{Request, Timing, speed_words};
 use view::{AxisMark, Bounds, Circling, Projection};
 

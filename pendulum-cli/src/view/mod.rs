@@ -1,9 +1,8 @@
 //! `pendulum view RUN_DIR`: a run as one self-contained web page (data and scripts inline,
-//! nothing fetched) with an orbit camera, playback, a time slider and the energy ledger
-//! (`viewer.js`), served on localhost or written to a file (`--export`).
+//! nothing fetched: `pendulum_experiment::page`) with an orbit camera, playback, a time
+//! slider and the energy ledger, served on localhost or written to a file (`--export`).
 
 mod live;
-mod scene;
 mod serve;
 
 use std::path::PathBuf;
@@ -12,18 +11,9 @@ use axum::Router;
 use axum::response::Html;
 use axum::routing::get;
 use clap::Args;
+use pendulum_experiment::page;
 
-use crate::error::{CliError, CliResult, io_failed};
-use crate::render::source::Run;
-
-/// The page's HTML and style, with `/*SCENE*/` where the data goes and `/*VIEWER*/`
-/// where the script goes.
-const PAGE: &str = include_str!("page.html");
-/// Drawing the chain, shared with the live page: plain JavaScript, no library, no build
-/// step.
-const DRAW: &str = include_str!("draw.js");
-/// The viewer of a recorded run.
-const VIEWER: &str = include_str!("viewer.js");
+use crate::error::{CliResult, io_failed};
 
 /// Options of `pendulum view`.
 #[derive(Debug, Args)]
@@ -40,7 +30,7 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 8765, conflicts_with = "export")]
     pub port: u16,
     /// Most frames in the page; longer runs are thinned to every k-th sample.
-    #[arg(long, value_name = "N", default_value_t = scene::DEFAULT_FRAMES, conflicts_with = "live")]
+    #[arg(long, value_name = "N", default_value_t = page::DEFAULT_FRAMES, conflicts_with = "live")]
     pub frames: usize,
     /// A live chain instead of a run.
     #[command(flatten)]
@@ -52,18 +42,7 @@ pub fn view(args: &ViewArgs) -> CliResult<()> {
     let Some(dir) = args.run.as_ref().filter(|_| !args.live.live) else {
         return live::live(&args.live, args.port);
     };
-    if args.frames < 2 {
-        return Err(CliError::invalid(format!("--frames must be at least 2, got {}", args.frames)));
-    }
-    let run = Run::open(dir)?;
-    let scene = scene::Scene::read(dir, &run, args.frames)?;
-    let json = serde_json::to_string(&scene)
-        .map_err(|e| CliError::failed(format!("cannot encode the scene: {e}")))?;
-    // Inside a <script> element nothing may close it.
-    let json = json.replace("</", "<\\/");
-    // The scene last: nothing in the run's text is read as a placeholder.
-    let page =
-        PAGE.replacen("/*DRAW*/", DRAW, 1).replacen("/*VIEWER*/", VIEWER, 1).replacen("/*SCENE*/", &json, 1);
+    let (page, scene) = page::page(dir, args.frames)?;
     let what = format!(
         "{}: {} frames of {} samples (every {}), {:.1} MB",
         dir.display(),

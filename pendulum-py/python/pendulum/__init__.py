@@ -7,12 +7,14 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).
+- ``page(directory)``: the self-contained page of ``pendulum view`` for a run written with
+  ``Run.run(out=...)``; in a notebook such a result displays as that page.
 - ``plot_ledger``, ``plot_shape``: quick matplotlib pictures (matplotlib optional).
 
 SI units throughout, angles in radians. See ``docs/python.md`` in the repository.
 """
 
-from ._pendulum import Chain, Run, RunResult, __version__
+from ._pendulum import Chain, Run, RunResult, __version__, page
 from ._plots import plot_ledger, plot_shape
 
-__all__ = ["Chain", "Run", "RunResult", "__version__", "plot_ledger", "plot_shape"]
+__all__ = ["Chain", "Run", "RunResult", "__version__", "page", "plot_ledger", "plot_shape"]

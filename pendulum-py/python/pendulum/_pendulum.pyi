@@ -1,15 +1,18 @@
 """Type stubs of the native module (checked against it by mypy.stubtest)."""
 
 from os import PathLike
+from pathlib import Path
 from typing import Any, Optional, Sequence, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Chain", "Run", "RunResult", "__version__"]
+__all__ = ["Chain", "Run", "RunResult", "__version__", "page"]
 __version__: str
 
 _Array = npt.NDArray[np.float64]
+
+def page(directory: Union[str, PathLike[str]], frames: int = ...) -> str: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
 
 @final
@@ -143,3 +146,6 @@ class RunResult:
     def final_state(self) -> _Array: ...
     @property
     def shape(self) -> Optional[dict[str, Any]]: ...
+    @property
+    def directory(self) -> Optional[Path]: ...
+    def _repr_html_(self) -> Optional[str]: ...

@@ -119,7 +119,7 @@ fn start(args: &LiveArgs) -> CliResult<Start> {
 pub fn live(args: &LiveArgs, port: u16) -> CliResult<()> {
     let start = start(args)?;
     let what = format!("live: {} links, a new chain for every page", start.chain.links());
-    let page = PAGE.replacen("/*DRAW*/", super::DRAW, 1).replacen("/*LIVE*/", LIVE, 1);
+    let page = PAGE.replacen("/*DRAW*/", pendulum_experiment::page::DRAW, 1).replacen("/*LIVE*/", LIVE, 1);
     let app = Router::new()
         .route("/", get(move || async move { Html(page) }))
         .route("/hold/{seconds}", get(hold))

@@ -6,10 +6,9 @@ use std::path::Path;
 use pendulum_core::TurningFrame;
 use serde::Serialize;
 
-use crate::error::{CliError, CliResult};
-use crate::render::source::{Run, Trajectory};
-use pendulum_experiment::Dimension;
-use pendulum_experiment::DriveConfig;
+use crate::description::{Dimension, DriveConfig};
+use crate::error::{Error, Result};
+use crate::run_dir::{Run, Trajectory};
 
 /// Frames a page holds by default: a 300 s run of 100 links at 500 samples stays whole,
 /// and a run of 100 links stays within about 15 MB (about 7.5 bytes per coordinate).
@@ -52,14 +51,14 @@ pub struct Scene {
 
 impl Scene {
     /// Reads the run in `dir`, keeping at most `frames` samples (every k-th).
-    pub fn read(dir: &Path, run: &Run, frames: usize) -> CliResult<Self> {
+    pub fn read(dir: &Path, run: &Run, frames: usize) -> Result<Self> {
         let config = &run.file.config;
         let mut count = Trajectory::open(&run.trajectory, config)?;
         let mut row = count.row();
         while count.next(&mut row)? {}
         let samples = count.rows;
         if samples == 0 {
-            return Err(CliError::invalid(format!("{}: no samples", run.trajectory.display())));
+            return Err(Error::invalid(format!("{}: no samples", run.trajectory.display())));
         }
         let every = samples.div_ceil(frames as u64).max(1);
         let mut trajectory = Trajectory::open(&run.trajectory, config)?;
@@ -109,15 +108,15 @@ impl Scene {
 
 /// H and H0 + W at the kept times, from energy.csv (the rows with those times; missing
 /// rows as NaN, which the plot skips).
-fn ledger(dir: &Path, times: &[f32]) -> CliResult<(Vec<f32>, Vec<f32>)> {
+fn ledger(dir: &Path, times: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
     let path = dir.join("energy.csv");
     let text = std::fs::read_to_string(&path)
-        .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
     let mut rows = Vec::new();
     for (number, line) in text.lines().enumerate().skip(1) {
         let fields: Vec<f64> = line.split(',').filter_map(|v| v.trim().parse().ok()).collect();
         if fields.len() != 6 {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{} line {}: expected 6 numbers",
                 path.display(),
                 number + 1

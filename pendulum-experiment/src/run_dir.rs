@@ -1,13 +1,14 @@
-//! The run a render draws: its run.json, and its trajectory.csv read one row at a time
-//! (only the time, pivot and mass columns are parsed).
+//! A run directory as `pendulum simulate` (or `pendulum.Run.run(out=…)`) leaves it, read
+//! back: its run.json, and its trajectory.csv one row at a time (only the time, pivot and
+//! mass columns are parsed). What `pendulum render` draws and the page shows.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use crate::error::{CliError, CliResult};
-use pendulum_experiment::Dimension;
-use pendulum_experiment::{RunConfig, RunFile};
+use crate::description::{Dimension, RunConfig};
+use crate::error::{Error, Result};
+use crate::file::RunFile;
 
 /// A run directory as `pendulum simulate` leaves it.
 pub struct Run {
@@ -19,25 +20,23 @@ pub struct Run {
 
 impl Run {
     /// Opens `dir`: it must hold a valid run.json and a trajectory.csv.
-    pub fn open(dir: &Path) -> CliResult<Self> {
+    pub fn open(dir: &Path) -> Result<Self> {
         let shown = dir.display();
         if !dir.is_dir() {
-            return Err(CliError::invalid(format!(
-                "{shown} is not a directory (render takes a run directory)"
-            )));
+            return Err(Error::invalid(format!("{shown} is not a directory (render takes a run directory)")));
         }
         let json = dir.join("run.json");
         if !json.is_file() {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{shown} holds no run: no run.json (`pendulum simulate --out DIR` writes one)"
             )));
         }
         let text = std::fs::read_to_string(&json)
-            .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", json.display())))?;
+            .map_err(|e| Error::invalid(format!("cannot read {}: {e}", json.display())))?;
         let file: RunFile = serde_json::from_str(&text)
-            .map_err(|e| CliError::invalid(format!("{} is not a valid run.json: {e}", json.display())))?;
+            .map_err(|e| Error::invalid(format!("{} is not a valid run.json: {e}", json.display())))?;
         if file.program != "pendulum" {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{} was written by '{}', not pendulum",
                 json.display(),
                 file.program
@@ -46,7 +45,7 @@ impl Run {
         file.config.check().map_err(|e| e.context(json.display()))?;
         let trajectory = dir.join("trajectory.csv");
         if !trajectory.is_file() {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{shown} holds no run: no trajectory.csv beside its run.json"
             )));
         }
@@ -92,14 +91,14 @@ pub struct Trajectory {
 impl Trajectory {
     /// Opens the file and checks its header against the run: `t`, then `pivot_x`,
     /// `pivot_y`[, `pivot_z`] and `x1`, `y1`[, `z1`] … for every mass, last.
-    pub fn open(path: &Path, config: &RunConfig) -> CliResult<Self> {
-        let file = File::open(path)
-            .map_err(|e| CliError::invalid(format!("cannot read {}: {e}", path.display())))?;
+    pub fn open(path: &Path, config: &RunConfig) -> Result<Self> {
+        let file =
+            File::open(path).map_err(|e| Error::invalid(format!("cannot read {}: {e}", path.display())))?;
         let mut reader = BufReader::new(file);
         let mut line = String::new();
         reader.read_line(&mut line).map_err(|e| read_failed(path, 1, e))?;
         if line.is_empty() {
-            return Err(CliError::invalid(format!("{} is empty (no header line)", path.display())));
+            return Err(Error::invalid(format!("{} is empty (no header line)", path.display())));
         }
         let header: Vec<String> = line.trim_end().split(',').map(String::from).collect();
         let axes: &[&str] = if config.dim == Dimension::Two { &["x", "y"] } else { &["x", "y", "z"] };
@@ -109,7 +108,7 @@ impl Trajectory {
         }
         let pivot = header.len().saturating_sub(expected.len());
         if header.first().map(String::as_str) != Some("t") || pivot == 0 || header[pivot..] != expected[..] {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{} line 1: the header is not that of a {}D run of {} links (t, …, {}, …, {})",
                 path.display(),
                 axes.len(),
@@ -141,7 +140,7 @@ impl Trajectory {
     /// Reads the next row into `row`; `false` at the end of the file. Errors: a line cut
     /// short, a wrong number of fields, a value that is not a finite number, a time that
     /// does not increase.
-    pub fn next(&mut self, row: &mut Row) -> CliResult<bool> {
+    pub fn next(&mut self, row: &mut Row) -> Result<bool> {
         self.line.clear();
         self.number += 1;
         let read =
@@ -151,7 +150,7 @@ impl Trajectory {
         }
         let at = || format!("{} line {}", self.path.display(), self.number);
         let Some(text) = self.line.strip_suffix('\n') else {
-            return Err(CliError::invalid(format!("{}: the line is cut short (no line end)", at())));
+            return Err(Error::invalid(format!("{}: the line is cut short (no line end)", at())));
         };
         let mut fields = 0;
         for (j, value) in text.trim_end_matches('\r').split(',').enumerate() {
@@ -162,7 +161,7 @@ impl Trajectory {
             let v: f64 = match value.trim().parse() {
                 Ok(v) if f64::is_finite(v) => v,
                 _ => {
-                    return Err(CliError::invalid(format!(
+                    return Err(Error::invalid(format!(
                         "{}, column {}: '{value}' is not a finite number",
                         at(),
                         self.header[j]
@@ -181,7 +180,7 @@ impl Trajectory {
             }
         }
         if fields != self.header.len() {
-            return Err(CliError::invalid(format!(
+            return Err(Error::invalid(format!(
                 "{}: {fields} fields, expected {} (is the file cut short?)",
                 at(),
                 self.header.len()
@@ -190,7 +189,7 @@ impl Trajectory {
         if let Some(last) = self.last
             && row.t <= last
         {
-            return Err(CliError::invalid(format!("{}: t = {} s does not follow t = {last} s", at(), row.t)));
+            return Err(Error::invalid(format!("{}: t = {} s does not follow t = {last} s", at(), row.t)));
         }
         self.first.get_or_insert(row.t);
         self.last = Some(row.t);
@@ -199,6 +198,6 @@ impl Trajectory {
     }
 }
 
-fn read_failed(path: &Path, line: usize, e: std::io::Error) -> CliError {
-    CliError::invalid(format!("{} line {line}: cannot read: {e}", path.display()))
+fn read_failed(path: &Path, line: usize, e: std::io::Error) -> Error {
+    Error::invalid(format!("{} line {line}: cannot read: {e}", path.display()))
 }
