@@ -1,6 +1,6 @@
 // The run viewer: the chain under an orbit camera (draw.js), playback on the sample
 // times, the energy ledger under a cursor. Plain JavaScript on two canvases; SCENE is the
-// run (pendulum-cli/src/view/scene.rs). `#t=K` opens at sample K; `#selftest` checks the
+// run (pendulum-experiment/src/page/scene.rs). `#t=K` opens at sample K; `#selftest` checks the
 // page in a headless browser and writes the result into <pre id="selftest">.
 "use strict";
 (function () {
