@@ -1,6 +1,6 @@
 //! A run as data: [`RunConfig`], every parameter of an experiment (chain, drive, damping
 //! and torques, initial state, end, integrator, step and sampling, how to draw it), the
-//! schema of `run.json` (inside [`RunFile`](crate::RunFile)), and its checks.
+//! schema of `run.json` (inside [`RunFile`](crate::file::RunFile)), and its checks.
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};

@@ -10,6 +10,10 @@ use crate::description::RunConfig;
 use crate::error::{Error, Result};
 use crate::json::write_json_atomic;
 
+/// The version of the program that writes run.json and final.json (the workspace's crates
+/// share it).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
 /// What `run.json` holds: the program and version that made it, the configuration and
 /// (once known) how the run ended.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -78,7 +82,7 @@ impl From<&pendulum_core::integrate::Stats> for IntegratorWork {
 impl RunFile {
     /// A run file of this program's version for `config`.
     pub fn new(config: RunConfig) -> Self {
-        Self { program: "pendulum".into(), version: crate::VERSION.into(), config, outcome: None }
+        Self { program: "pendulum".into(), version: VERSION.into(), config, outcome: None }
     }
 
     /// Reads and checks a run.json; errors name the file and the problem.
@@ -108,11 +112,11 @@ impl RunFile {
 /// A warning for a file written by another version of the program (`version`), to repeat
 /// a run from: the results may differ. `None` for this version.
 pub fn other_version(path: &Path, version: &str) -> Option<String> {
-    (version != crate::VERSION).then(|| {
+    (version != VERSION).then(|| {
         format!(
             "{} was written by pendulum {version}, this is {}; results may differ",
             path.display(),
-            crate::VERSION
+            VERSION
         )
     })
 }

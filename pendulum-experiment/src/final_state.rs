@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::description::Dimension;
 use crate::error::{Error, Result};
+use crate::file::VERSION;
 use crate::json::write_json_atomic;
 
 /// The file name a run writes its final state to.
@@ -52,7 +53,7 @@ impl FinalState {
         let half = motion.len() / 2;
         Self {
             program: "pendulum".into(),
-            version: crate::VERSION.into(),
+            version: VERSION.into(),
             dim,
             links,
             t,

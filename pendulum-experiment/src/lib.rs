@@ -72,7 +72,7 @@ pub use description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, InitialConfig, IntegratorKind, RunConfig, StageSolver, View,
 };
 pub use error::{Error, Result};
-pub use file::{IntegratorWork, Outcome, RunFile, other_version};
+pub use file::{IntegratorWork, Outcome, RunFile, VERSION, other_version};
 pub use files::SampleFiles;
 pub use final_state::FinalState;
 pub use initial::{InitialSpec, initial_state, read_numbers};
@@ -82,7 +82,3 @@ pub use record::Recorder;
 pub use request::{Choice, Request, choose, drive_frequency, fastest_mode, suggested_step};
 pub use run::{Layout, Report, Sink, Status};
 pub use whirl::Whirl;
-
-/// The version of the program that writes run.json and final.json (the workspace's crates
-/// share it).
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,6 +1,6 @@
 //! The run loop every front end shares: integrate a built [`AnySimulation`] over its
 //! configuration's time span, hand every sample to the [`Sink`]s (files, an in-memory
-//! [`Recorder`](crate::Recorder), a socket), follow a whirled chain's shape, and return
+//! [`Recorder`](crate::record::Recorder), a socket), follow a whirled chain's shape, and return
 //! a [`Report`]: how the run ended, what the integrator did, the final state and the
 //! shape answer.
 

@@ -390,7 +390,7 @@ impl RunResult {
     /// `run(out=…)`; None otherwise (the notebook shows the repr).
     fn _repr_html_(&self) -> PyResult<Option<String>> {
         let Some(dir) = &self.directory else { return Ok(None) };
-        Ok(Some(crate::iframe(&crate::page_of(dir, pendulum_experiment::page::DEFAULT_FRAMES)?)))
+        Ok(Some(crate::page::iframe(&crate::page::page_of(dir, pendulum_experiment::page::DEFAULT_FRAMES)?)))
     }
 
     fn __repr__(&self) -> String {

@@ -110,7 +110,7 @@ impl Table {
     }
 }
 
-/// The colour the pages draw masses in (`MASS` in pendulum-cli/src/view/draw.js).
+/// The colour the pages draw masses in (`MASS` in pendulum-experiment/src/page/draw.js).
 pub const MASS_COLOUR: [u8; 3] = [20, 50, 150];
 
 /// The headless browser, if there is one: `$PENDULUM_CHROMIUM`, else `chromium`,
@@ -184,7 +184,7 @@ impl Screenshot {
 }
 
 /// Checks a page's self-test `picture` (its camera and the canvas as a PNG data URL,
-/// `picture()` in pendulum-cli/src/view/draw.js): every point of `masses` (m, z up),
+/// `picture()` in pendulum-experiment/src/page/draw.js): every point of `masses` (m, z up),
 /// projected here as the page's orthographic camera does (turned by yaw about the
 /// vertical, tilted by pitch, about its centre), lands within a pixel of the mass colour.
 pub fn assert_drawn_at(picture: &serde_json::Value, masses: &[[f64; 3]]) {
