@@ -309,7 +309,11 @@ fn bad_inputs_get_one_line_and_exit_status_2() {
         &["render", "empty"],
         "error: empty holds no run: no run.json (`pendulum simulate --out DIR` writes one)",
     );
-    usage(&dir, &["render", "nowhere"], "error: nowhere is not a directory (render takes a run directory)");
+    usage(
+        &dir,
+        &["render", "nowhere"],
+        "error: nowhere is not a run directory (what `pendulum simulate --out DIR` writes)",
+    );
     copy("half", None);
     usage(&dir, &["render", "half"], "error: half holds no run: no trajectory.csv beside its run.json");
     // Cut in the middle of line 6, and line 4 missing its last two fields.

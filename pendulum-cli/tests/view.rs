@@ -68,6 +68,13 @@ fn bad_inputs_are_one_line_errors() {
     assert!(stderr(&out).contains("holds no run: no run.json"), "{}", stderr(&out));
     let out = run_in(&dir, &["view", "empty", "--port", "0"]);
     assert_eq!(out.status.code(), Some(2), "no server for a directory without a run");
+    // A missing directory: the message is view's, not render's (a regression).
+    let out = run_in(&dir, &["view", "nowhere", "--export", "p.html"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).trim(),
+        "error: nowhere is not a run directory (what `pendulum simulate --out DIR` writes)"
+    );
     // A trajectory cut in the middle of a line.
     let (run_dir, _) = exported("view-truncated");
     let csv = run_dir.join("run/trajectory.csv");

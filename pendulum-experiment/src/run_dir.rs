@@ -23,7 +23,9 @@ impl Run {
     pub fn open(dir: &Path) -> Result<Self> {
         let shown = dir.display();
         if !dir.is_dir() {
-            return Err(Error::invalid(format!("{shown} is not a directory (render takes a run directory)")));
+            return Err(Error::invalid(format!(
+                "{shown} is not a run directory (what `pendulum simulate --out DIR` writes)"
+            )));
         }
         let json = dir.join("run.json");
         if !json.is_file() {
