@@ -14,6 +14,9 @@
 //!   ([`SampleFiles`] writes trajectory.csv and energy.csv, [`Recorder`] keeps arrays),
 //!   and the [`Report`] says how the run ended, its final state and, for a whirled chain,
 //!   the shape it took.
+//! - [`options`] turns a front end's separate options (flags, keyword arguments) into the
+//!   description's values with the shared one-line messages; [`run_dir`] reads a written
+//!   run back; [`page`] makes the self-contained page of `pendulum view` and notebooks.
 //!
 //! The core (`pendulum-core`) stays free of serde and files: this crate sits between it
 //! and the front ends, so an embedder of a fixed-N model builds neither.
