@@ -2,11 +2,11 @@
 //! drive's flags handed to the library's [`DriveOptions`] (which refuses the
 //! combinations the description cannot express, by flag name).
 
-use pendulum_experiment::{Dimension, DriveOptions, Request, RunConfig, View};
+use pendulum_experiment::{DriveOptions, Request, RunConfig, View};
 
 use crate::args::Physics;
 use crate::chain_args::per_link_values;
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
 use crate::spec::{expand, parse_list, per_link};
 
 /// The configuration a run's options describe: [`request`], resolved (the integrator,
@@ -21,13 +21,8 @@ pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
     let (masses, lengths) = per_link_values(&p.chain)?;
     let n = masses.len();
     let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
-    let torque = match (&p.torque, dim) {
-        (None, _) => None,
-        (Some(s), Dimension::Two) => Some(expand("--torque", per_link("--torque", s)?, n)?),
-        (Some(_), Dimension::Three) => {
-            return Err(CliError::invalid("--torque: constant torques are available in 2D only (--dim 2)"));
-        }
-    };
+    // A torque in 3D is refused by the library's `resolve`, by the same message.
+    let torque = p.torque.as_deref().map(|s| expand("--torque", per_link("--torque", s)?, n)).transpose()?;
     let direction = p.direction.as_deref().map(|s| parse_list("--direction", s)).transpose()?;
     let drive = DriveOptions {
         kind: p.drive,

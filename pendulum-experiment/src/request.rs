@@ -58,12 +58,12 @@ impl Request {
     /// The complete configuration: the initial state resolved (a spec, a file, a previous
     /// run's final state), the integrator, step and sampling chosen where not given, every
     /// value checked. Errors name the bad value.
-    pub fn resolve(self) -> Result<RunConfig> {
+    pub fn resolve(mut self) -> Result<RunConfig> {
         let n = self.masses.len();
         if self.spin.is_some() && self.dim == Dimension::Two {
             return Err(Error::invalid("--spin (initial azimuthal rate) applies to --dim 3 only"));
         }
-        let torque = match (self.torque.clone(), self.dim) {
+        let torque = match (self.torque.take(), self.dim) {
             (None, Dimension::Two) => vec![0.0; n],
             (None, Dimension::Three) => Vec::new(),
             (Some(t), Dimension::Two) => t,
