@@ -1,20 +1,82 @@
-//! Ctrl-C: a flag the long runs (`simulate`, `sweep`) look at between samples, so that
-//! they stop, write valid files and exit 130; and that stops `pendulum view`'s server.
+//! Ctrl-C in every command.
+//!
+//! A phase that can stop itself and leave valid files (`simulate`'s run loop, `sweep`'s
+//! runs, `view`'s server) holds a [`StopsItself`] guard: a Ctrl-C then sets
+//! [`INTERRUPTED`] and the phase ends at its next check. Anywhere else (plotting, GIF
+//! encoding, `steady`, `render`) a Ctrl-C exits at once with status 130, after removing the
+//! partial files registered as [`Partial`]: what was finished before stays, nothing
+//! half-written does. A second Ctrl-C always exits at once.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-/// Set by the Ctrl-C handler; a run stops at its next sample and writes its files.
+/// Set by the first Ctrl-C; a phase holding [`StopsItself`] stops at its next check.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-/// Ctrl-C once: the run stops at its next sample and writes valid files. Twice: exit at
-/// once (status 130).
+/// How many [`StopsItself`] guards are alive.
+static STOPPING_ITSELF: AtomicUsize = AtomicUsize::new(0);
+
+/// Files being written that are not yet valid.
+static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The process exits with status 130 (the shell's convention after Ctrl-C).
+pub const EXIT_STATUS: i32 = 130;
+
+/// Installs the Ctrl-C handler (once, at the start of every command).
 pub fn install_handler() {
     let installed = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
+        let first = !INTERRUPTED.swap(true, Ordering::SeqCst);
+        if first && STOPPING_ITSELF.load(Ordering::SeqCst) > 0 {
+            return;
         }
+        let partial = PARTIAL.lock().unwrap_or_else(|e| e.into_inner());
+        for path in partial.iter() {
+            let _ = std::fs::remove_file(path);
+        }
+        eprintln!("error: interrupted; the files written before Ctrl-C are complete");
+        std::process::exit(EXIT_STATUS);
     });
     if let Err(e) = installed {
-        eprintln!("pendulum: warning: Ctrl-C will end the run without writing files ({e})");
+        eprintln!("pendulum: warning: Ctrl-C will end the program without cleaning up ({e})");
+    }
+}
+
+/// While alive, a Ctrl-C asks the current phase to stop at its next check of
+/// [`INTERRUPTED`] instead of ending the process.
+#[must_use = "the phase stops itself only while the guard lives"]
+pub struct StopsItself(());
+
+impl StopsItself {
+    /// Enters a phase that checks [`INTERRUPTED`] at least once a second.
+    pub fn enter() -> Self {
+        STOPPING_ITSELF.fetch_add(1, Ordering::SeqCst);
+        Self(())
+    }
+}
+
+impl Drop for StopsItself {
+    fn drop(&mut self) {
+        STOPPING_ITSELF.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// A file being written: removed if Ctrl-C ends the process before the guard drops.
+pub struct Partial(PathBuf);
+
+impl Partial {
+    /// Registers `path` until the guard drops.
+    pub fn register(path: &Path) -> Self {
+        PARTIAL.lock().unwrap_or_else(|e| e.into_inner()).push(path.to_path_buf());
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        let mut partial = PARTIAL.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = partial.iter().position(|p| *p == self.0) {
+            partial.swap_remove(i);
+        }
     }
 }

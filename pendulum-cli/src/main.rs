@@ -42,9 +42,9 @@ fn main() -> ExitCode {
             }
         },
     };
+    interrupt::install_handler();
     let result = match &cli.command {
         Command::Simulate(args) => {
-            interrupt::install_handler();
             // `pendulum simulate` alone: the demo.
             let demo = std::env::args_os().len() == 2;
             simulate::simulate(args, demo)
@@ -54,10 +54,7 @@ fn main() -> ExitCode {
         Command::Modes(args) => modes::modes(args),
         Command::Steady(args) => steady::steady(args),
         Command::Render(args) => render::render(args),
-        Command::View(args) => {
-            interrupt::install_handler();
-            view::view(args)
-        }
+        Command::View(args) => view::view(args),
         Command::Sweep(args) => sweep::sweep(args),
     };
     match result {

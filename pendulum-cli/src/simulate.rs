@@ -9,13 +9,13 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_experiment::{
-    RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View, build, chain, drive_frequency,
-    fastest_mode, other_version, suggested_step,
+    IntegratorKind, RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View, build, chain,
+    drive_frequency, fastest_mode, other_version, suggested_step,
 };
 
 use crate::args::SimulateArgs;
 use crate::error::{CliError, CliResult};
-use crate::interrupt::INTERRUPTED;
+use crate::interrupt::{INTERRUPTED, StopsItself};
 use crate::plot;
 use crate::render;
 use crate::request;
@@ -98,14 +98,26 @@ fn execute(
     let mut files = SampleFiles::create(out, &simulation.layout(config))?;
     let mut kept = Kept::default();
     let mut progress = Progress::new(total_steps, config.end, options.quiet);
+    let stops = StopsItself::enter();
     let report = simulation.run(config, &mut [&mut files, &mut kept], &mut |t| {
         progress.at(t, (t / config.end * total_steps as f64).round() as u64);
         if INTERRUPTED.load(Ordering::SeqCst) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
     });
+    drop(stops);
     progress.finish();
     files.finish()?;
     let report = report?;
 
+    // The data first, so that a Ctrl-C while drawing (which ends the program at once)
+    // leaves them complete.
+    report.final_state.write(out)?;
+    run_file.outcome = Some(report.outcome());
+    run_file.write_atomic(&run_json)?;
+    // A whirled chain: its shape in the turning frame, in the user's terms (stdout).
+    let shape = report.shape.as_ref().map(|shape| shape.as_ref().map_err(Clone::clone)).transpose()?;
+    if let Some(shape) = shape {
+        whirl::write(shape, out)?;
+    }
     let mut images = Vec::new();
     if options.plots && !kept.times.is_empty() {
         let energy_png = out.join("energy.png");
@@ -113,13 +125,9 @@ fn execute(
         let gif = render::chain_gif(out, config, report.t, options.quiet)?;
         images.extend([energy_png, gif]);
     }
-    report.final_state.write(out)?;
-    // A whirled chain: its shape in the turning frame, in the user's terms (stdout).
-    if let Some(shape) = &report.shape {
-        whirl::present(shape.as_ref().map_err(Clone::clone)?, out, options.plots)?;
+    if let Some(shape) = shape {
+        whirl::present(shape, out, options.plots)?;
     }
-    run_file.outcome = Some(report.outcome());
-    run_file.write_atomic(&run_json)?;
 
     let status = report.status.name();
     if !options.quiet {
@@ -154,44 +162,67 @@ fn execute(
             config.end,
             out.display()
         ))),
-        (Status::Failed, Some(e)) => Err(CliError::failed(format!(
-            "the run stopped at t = {} s: {e}{}; files hold what was computed",
-            report.t,
-            stage_solve_hint(&e, config)
-        ))),
+        (Status::Failed, Some(e)) => {
+            let hint = stage_solve_hint(&e, config);
+            Err(CliError::failed(match e {
+                // Names its time itself.
+                pendulum_core::Error::BlewUp { .. } => format!("{e}{hint}; files hold what was computed"),
+                _ => {
+                    format!("the run stopped at t = {} s: {e}{hint}; files hold what was computed", report.t)
+                }
+            }))
+        }
         _ => Ok(()),
     }
 }
 
-/// Advice for a failed step: a stage solve that did not converge (or a step that blew
-/// up) usually means the step is too long for the chain's fastest mode or the drive;
-/// names both and suggests a step. Empty for other errors.
+/// Advice for a run that failed: a stage solve that did not converge or a run that blew
+/// up usually means the step is too long for the chain's fastest mode or the drive; names
+/// both and suggests what the user has not already chosen (a shorter step, Newton's stage
+/// solve, RK4). Empty for other errors.
 fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
-    let pendulum_core::Error::StepFailed { source, .. } = e else { return String::new() };
-    let stage_failure = matches!(**source, pendulum_core::Error::StageSolveFailed { .. });
-    let blew_up = matches!(**source, pendulum_core::Error::NonFinite { .. });
+    use pendulum_core::Error;
+    let source = match e {
+        Error::StepFailed { source, .. } => &**source,
+        other => other,
+    };
+    let stage_failure = matches!(source, Error::StageSolveFailed { .. });
+    let blew_up =
+        matches!(source, Error::NonFinite { .. } | Error::NonFiniteState { .. } | Error::BlewUp { .. });
     if !stage_failure && !blew_up {
         return String::new();
     }
     let fastest = chain(config).map_or(0.0, |c| fastest_mode(&c, &config.drive));
     let drive = drive_frequency(&config.drive);
     let suggested = suggested_step(fastest, drive);
-    let cause = match drive {
-        Some(w) => format!(
-            "the step --step {} is likely too long for the chain's fastest mode (about {fastest:.3e} rad/s) \
-             or the drive ({w} rad/s)",
-            config.step
-        ),
-        None => format!(
-            "the step --step {} is likely too long for the chain's fastest mode (about {fastest:.3e} rad/s)",
-            config.step
-        ),
+    let mut tries = Vec::new();
+    // A suggestion must be a real change: shorter than the step already taken.
+    if suggested < 0.9 * config.step.abs() {
+        tries.push(format!("--step {suggested:.1e}"));
+    }
+    if stage_failure && config.solver == StageSolver::FixedPoint {
+        tries.push("--solver newton".into());
+    }
+    if config.integrator != IntegratorKind::Rk4 && config.integrator != IntegratorKind::Dp54 {
+        tries.push("--integrator rk4".into());
+    }
+    let modes = match drive {
+        Some(w) => format!("the chain's fastest mode (about {fastest:.3e} rad/s) or the drive ({w} rad/s)"),
+        None => format!("the chain's fastest mode (about {fastest:.3e} rad/s)"),
     };
-    let other = match (stage_failure, config.solver) {
-        (true, StageSolver::FixedPoint) => ", --solver newton or --integrator rk4",
-        (true, StageSolver::Newton) | (false, _) => " or --integrator rk4",
+    let cause = if tries.iter().any(|t| t.starts_with("--step")) {
+        format!("the step --step {} is likely too long for {modes}", config.step)
+    } else {
+        format!("the step --step {} is already short for {modes}", config.step)
     };
-    format!(" ({cause}: try --step {suggested:.1e}{other})")
+    match tries.len() {
+        0 => format!(" ({cause})"),
+        1 => format!(" ({cause}: try {})", tries[0]),
+        _ => {
+            let (last, rest) = tries.split_last().expect("two or more");
+            format!(" ({cause}: try {} or {last})", rest.join(", "))
+        }
+    }
 }
 
 /// A scale for the energy axis (J): the work gravity could do on the chain,

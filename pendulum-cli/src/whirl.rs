@@ -10,15 +10,19 @@ use plotters::prelude::*;
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 
-/// The report of a whirled run in the user's terms: its summary line on stdout,
-/// `shape.json` and (with `plots`) `shape.png` in `out`.
+/// The report of a whirled run in the user's terms: its summary line on stdout and (with
+/// `plots`) `shape.png` in `out`.
 pub fn present(report: &ShapeReport, out: &Path, plots: bool) -> CliResult<()> {
     println!("{}", summary(report));
-    pendulum_experiment::whirl::write_shape_json(&out.join("shape.json"), report)?;
     if plots {
         plot(&out.join("shape.png"), report)?;
     }
     Ok(())
+}
+
+/// Writes `shape.json` (before the pictures, with the run's other data).
+pub fn write(report: &ShapeReport, out: &Path) -> CliResult<()> {
+    pendulum_experiment::whirl::write_shape_json(&out.join("shape.json"), report)
 }
 
 /// `1 node`, `2 nodes`.

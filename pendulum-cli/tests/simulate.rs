@@ -502,3 +502,32 @@ fn a_run_that_fails_exits_1_with_valid_files_and_says_why() {
     assert_eq!(trajectory.rows.len(), 1, "the initial state only");
     assert!(std::fs::read(dir.join("run/chain.gif")).unwrap().starts_with(b"GIF89a"));
 }
+
+#[test]
+fn a_run_that_blows_up_stops_there_with_valid_files_and_new_advice() {
+    // Issue 34: RK4 at 80 ms on the README's 100-link whirl reaches infinite energy at
+    // t = 0.24 s; the energy plot's axis search then looped for ever, deaf to Ctrl-C, and
+    // the advice named the integrator already in use.
+    let dir = scratch("blow-up");
+    let whirl = ["--dim", "3", "--n", "100", "--masses", "0.01", "--lengths", "0.01", "--damping", "3e-4"];
+    let drive = ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6"];
+    let run = ["--integrator", "rk4", "--step", "0.08", "--every", "1", "--end", "5", "--out", "run"];
+    let out = common::run_within(&dir, &[&["simulate"][..], &whirl, &drive, &run].concat(), 10);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let message = stderr(&out);
+    let last = message.lines().last().unwrap();
+    assert!(last.starts_with("error: the energy reached inf J at t = 0.238"), "{last}");
+    assert!(last.contains("try --step 7.7e-4)"), "{last}");
+    assert!(!last.contains("--integrator"), "{last}");
+    let json = run_json(&dir.join("run"));
+    assert_eq!(json["outcome"]["status"], "failed");
+    assert!(json["outcome"]["error"].as_str().unwrap().contains("the run blew up"));
+    // The samples up to the blow-up, the last one infinite; the pictures drawn.
+    let energy = Csv::read(&dir.join("run/energy.csv")).column("energy");
+    assert_eq!(energy.len(), 4);
+    assert!(energy[..3].iter().all(|e| e.is_finite()) && energy[3] == f64::INFINITY);
+    assert!(std::fs::read(dir.join("run/energy.png")).unwrap().starts_with(b"\x89PNG"));
+    assert!(std::fs::read(dir.join("run/chain.gif")).unwrap().starts_with(b"GIF89a"));
+    // A failed run has no shape to report.
+    assert!(!dir.join("run/shape.json").exists());
+}

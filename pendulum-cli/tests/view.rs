@@ -195,6 +195,9 @@ fn the_server_serves_the_page_until_ctrl_c_and_refuses_a_port_in_use() {
     assert_eq!(message.lines().count(), 1, "{message}");
     let killed = Command::new("sh").args(["-c", &format!("kill -INT {}", child.id())]).status().unwrap();
     assert!(killed.success());
+    let sent = std::time::Instant::now();
     assert!(child.wait().unwrap().success());
+    // Within a second of Ctrl-C (issue 34).
+    assert!(sent.elapsed() < std::time::Duration::from_secs(1), "{:?}", sent.elapsed());
     assert_eq!(lines.next().unwrap().unwrap(), "pendulum: stopped");
 }

@@ -160,6 +160,15 @@ pub enum Error {
         /// What went wrong.
         source: Box<Error>,
     },
+    /// A run's state is still finite but its energy is not: the run has blown up (a step
+    /// too long for the chain, as a rule). The run stops at the sample that shows it.
+    #[error("the energy reached {} J at t = {} s: the run blew up", num(.energy), num(.t))]
+    BlewUp {
+        /// Time of the sample, s.
+        t: f64,
+        /// The sample's energy, J.
+        energy: f64,
+    },
     /// A steady-rotation or normal-mode request has a parameter out of range.
     #[error("steady rotation: {what} must be {requirement}, got {}", num(.value))]
     InvalidSteady {

@@ -90,7 +90,7 @@ pub struct Report {
     pub work: IntegratorWork,
     /// The state the run ended in, exactly.
     pub final_state: FinalState,
-    /// A whirled chain (3D, pivot circling the vertical) that was not interrupted: the
+    /// A whirled chain (3D, pivot circling the vertical) that completed its run: the
     /// shape it took, or why the analysis failed. `None` for other runs.
     pub shape: Option<Result<ShapeReport>>,
 }
@@ -122,7 +122,8 @@ impl AnySimulation {
     /// Runs `config` (the configuration this simulation was built from) from t = 0 to
     /// its end: every `every`-th step a sample to each sink in turn, then
     /// `observe(t)`, which may stop the run (`ControlFlow::Break`: the report says
-    /// [`Status::Interrupted`]). A failed step ends the run with [`Status::Failed`] and the
+    /// [`Status::Interrupted`]). A failed step, or a sample whose energy is not finite
+    /// ([`pendulum_core::Error::BlewUp`]), ends the run with [`Status::Failed`] and the
     /// samples so far; a sink's error or a failure of the shape analysis ends it with
     /// that error.
     pub fn run(
@@ -152,6 +153,7 @@ fn run<P: Motion>(
     let whirl = Whirl::of(config)?;
     let mut tracker = whirl.as_ref().map(Whirl::tracker).transpose()?;
     let mut stop_error = None;
+    let mut blew_up = None;
     let mut initial_energy = None;
     let mut samples: u64 = 0;
     let result =
@@ -171,12 +173,17 @@ fn run<P: Motion>(
                 return ControlFlow::Break(());
             }
             samples += 1;
+            if !sample.energy.is_finite() {
+                blew_up = Some(pendulum_core::Error::BlewUp { t, energy: sample.energy });
+                return ControlFlow::Break(());
+            }
             observe(t)
         });
     if let Some(e) = stop_error {
         return Err(e);
     }
     let (status, error, steps) = match result {
+        Ok(s) if blew_up.is_some() => (Status::Failed, blew_up, s.steps),
         Ok(s) if s.stopped_early => (Status::Interrupted, None, s.steps),
         Ok(s) => (Status::Completed, None, s.steps),
         Err(e) => {
@@ -198,8 +205,8 @@ fn run<P: Motion>(
         samples,
         work: solver.stats().into(),
         final_state,
-        // A run cut on request ends at once: the nearest steady shape costs a dense
-        // spectrum (about a second at 200 links).
-        shape: tracker.as_ref().filter(|_| status != Status::Interrupted).map(|t| t.report()),
+        // A run cut on request ends at once (the nearest steady shape costs a dense
+        // spectrum, about a second at 200 links); a failed run has no shape to report.
+        shape: tracker.as_ref().filter(|_| status == Status::Completed).map(|t| t.report()),
     })
 }

@@ -11,6 +11,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{CliError, CliResult, io_failed};
+use crate::interrupt::Partial;
 
 /// The palette index left transparent (pixels unchanged since the previous frame).
 const CLEAR: u8 = 255;
@@ -61,6 +62,8 @@ pub struct GifFile {
     encoder: Option<gif::Encoder<BufWriter<File>>>,
     /// Where the frames go until [`GifFile::finish`] renames it to `path`.
     partial: PathBuf,
+    /// Removes `partial` if Ctrl-C ends the process.
+    _registered: Partial,
     path: PathBuf,
     size: usize,
     palette: Palette,
@@ -77,6 +80,7 @@ impl GifFile {
         let mut name = path.file_name().unwrap_or_default().to_os_string();
         name.push(".partial");
         let partial = path.with_file_name(name);
+        let registered = Partial::register(&partial);
         let file = File::create(&partial).map_err(|e| io_failed("create", &partial, e))?;
         let palette = Palette::new(colours);
         let side = size as u16;
@@ -88,6 +92,7 @@ impl GifFile {
         Ok(Self {
             encoder: Some(encoder),
             partial,
+            _registered: registered,
             path: path.to_path_buf(),
             size: size as usize,
             palette,

@@ -158,9 +158,11 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
-    crate::interrupt::install_handler();
     let sweep = runs::Sweep::new(config, args.out.clone(), jobs, args.quiet)?;
-    let points = sweep.run()?;
+    let points = {
+        let _stops = crate::interrupt::StopsItself::enter();
+        sweep.run()?
+    };
     let config = sweep.config();
     csv::write(&args.out.join("sweep.csv"), &points)?;
     csv::table(config, &points);

@@ -6,7 +6,7 @@ use std::time::Duration;
 use axum::Router;
 
 use crate::error::{CliError, CliResult};
-use crate::interrupt::INTERRUPTED;
+use crate::interrupt::{INTERRUPTED, StopsItself};
 
 /// Serves `app` at `http://127.0.0.1:PORT/` (any free port for 0) on one thread until
 /// Ctrl-C. A port that cannot be listened on is a usage error naming it.
@@ -16,6 +16,7 @@ pub fn serve(app: Router, port: u16, what: &str) -> CliResult<()> {
         .enable_time()
         .build()
         .map_err(|e| CliError::failed(format!("cannot start the server: {e}")))?;
+    let _stops = StopsItself::enter();
     runtime.block_on(async move {
         let listener = tokio::net::TcpListener::bind(("127.0.0.1", port)).await.map_err(|e| {
             CliError::invalid(format!("--port {port}: cannot listen on 127.0.0.1:{port}: {e}"))

@@ -16,6 +16,52 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
     pendulum().args(args).current_dir(dir).output().expect("the pendulum binary runs")
 }
 
+/// Runs `pendulum args...` in `dir`, failing the test if it has not ended within
+/// `seconds` (the process is killed, so a hang fails instead of stalling the suite).
+pub fn run_within(dir: &Path, args: &[&str], seconds: u64) -> Output {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let mut child = pendulum()
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the pendulum binary runs");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(seconds) {
+            let _ = child.kill();
+            let out = child.wait_with_output().unwrap();
+            panic!("pendulum {} did not end within {seconds} s; stderr: {}", args.join(" "), stderr(&out));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Sends SIGINT (Ctrl-C) to `child` once `ready()` holds, and returns its output and the
+/// time it took to end after the signal. Fails the test if `ready` does not hold within
+/// 60 s.
+#[cfg(unix)]
+pub fn interrupt_when(
+    child: std::process::Child,
+    mut ready: impl FnMut() -> bool,
+) -> (Output, std::time::Duration) {
+    use std::time::{Duration, Instant};
+    let start = Instant::now();
+    while !ready() {
+        assert!(start.elapsed() < Duration::from_secs(60), "the phase to interrupt never came");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // The shell's kill builtin: present wherever `sh` is.
+    let killed = Command::new("sh").args(["-c", &format!("kill -INT {}", child.id())]).status().unwrap();
+    assert!(killed.success());
+    let sent = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    (out, sent.elapsed())
+}
+
 /// A fresh, empty scratch directory named for the test.
 pub fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pendulum-cli").join(name);
