@@ -54,7 +54,7 @@ pub fn energy(path: &Path, times: &[f64], energy: &[f64], predicted: &[f64], sca
     let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
     // Halved before subtracting: the span of values near ±f64::MAX stays finite.
     let mid = 0.5 * lo + 0.5 * hi;
-    let half = (0.55 * hi - 0.55 * lo).max(0.02 * scale).max(1e-12).min(f64::MAX / 4.0);
+    let half = (0.55 * hi - 0.55 * lo).max(0.02 * scale).clamp(1e-12, f64::MAX / 4.0);
     let worst = energy.iter().zip(predicted).map(|(h, p)| (h - p).abs()).fold(0.0_f64, f64::max);
     let left_out = 2 * times.len().min(energy.len()) - energy_line.len() - predicted_line.len();
     let caption = if left_out == 0 {
