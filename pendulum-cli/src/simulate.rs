@@ -240,36 +240,46 @@ fn energy_scale(config: &RunConfig) -> f64 {
 /// How often a run without a terminal reports how far it is.
 const PLAIN_PROGRESS_EVERY: Duration = Duration::from_secs(5);
 
-/// Progress of a run of 2000 steps or more: a bar on a terminal; without one (a pipe, a
-/// log file, CI), a plain line every [`PLAIN_PROGRESS_EVERY`] instead.
+/// Progress of a run that lasts: nothing for its first [`QUIET_START`]; then a bar on a
+/// terminal, or without one (a pipe, a log file, CI) a plain line every
+/// [`PLAIN_PROGRESS_EVERY`].
 struct Progress {
     bar: ProgressBar,
     /// Plain lines: `(run end t1, when the last line was printed)`.
     plain: Option<(f64, Instant)>,
+    /// The bar is drawn (after [`QUIET_START`]).
+    shown: bool,
+    quiet: bool,
     started: Instant,
 }
+
+/// How long a run goes before it reports progress.
+const QUIET_START: Duration = Duration::from_secs(2);
 
 impl Progress {
     fn new(steps: u64, end: f64, quiet: bool) -> Self {
         let started = Instant::now();
-        if quiet || steps < 2000 {
-            return Self { bar: ProgressBar::hidden(), plain: None, started };
-        }
-        if !std::io::stderr().is_terminal() {
-            return Self { bar: ProgressBar::hidden(), plain: Some((end, started)), started };
-        }
-        let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
+        // The first plain line QUIET_START after the start.
+        let plain = (!std::io::stderr().is_terminal()).then(|| (end, started.checked_sub(PLAIN_PROGRESS_EVERY - QUIET_START).unwrap_or(started)));
+        let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::hidden());
         if let Ok(style) =
             ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}")
         {
             bar.set_style(style);
         }
-        Self { bar, plain: None, started }
+        Self { bar, plain, shown: false, quiet, started }
     }
 
     /// The run reached time `t` (s), step `step`.
     fn at(&mut self, t: f64, step: u64) {
+        if self.quiet || self.started.elapsed() < QUIET_START {
+            return;
+        }
         self.bar.set_position(step);
+        if self.plain.is_none() && !self.shown {
+            self.shown = true;
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
         if let Some((end, last)) = &mut self.plain
             && last.elapsed() >= PLAIN_PROGRESS_EVERY
         {

@@ -531,3 +531,38 @@ fn a_run_that_blows_up_stops_there_with_valid_files_and_new_advice() {
     // A failed run has no shape to report.
     assert!(!dir.join("run/shape.json").exists());
 }
+
+#[test]
+fn a_million_links_with_the_defaults_is_refused_at_once_with_what_to_give() {
+    // Issue 34: the default sampling took every step, and trajectory.csv reached 1.76 GB
+    // after 26 of 178 steps with nothing on the terminal.
+    let dir = scratch("million-links");
+    let out = common::run_within(&dir, &["simulate", "--n", "1000000", "--end", "0.01", "--out", "run"], 60);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(message.contains("one sample of trajectory.csv takes about 80 MB"), "{message}");
+    assert!(message.contains("give --every 178 to write those two (about 160 MB)"), "{message}");
+    assert!(!dir.join("run").exists(), "nothing written");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_long_run_reports_progress_within_seconds_however_sparse_its_samples() {
+    use std::io::{BufRead, BufReader};
+    use std::time::{Duration, Instant};
+    // 100,000 links: about 0.15 s a step, and one sample at each end of 0.05 s.
+    let dir = scratch("early-progress");
+    let mut child = common::pendulum()
+        .args(["simulate", "--n", "100000", "--end", "0.05", "--every", "1000", "--no-plots", "--out", "run"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let first = BufReader::new(child.stderr.take().unwrap()).lines().next().unwrap().unwrap();
+    let took = start.elapsed();
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(first.starts_with("pendulum: t = ") && first.contains("s to go"), "{first}");
+    assert!(took < Duration::from_secs(5), "the first progress line came after {took:?}");
+}

@@ -78,7 +78,7 @@ impl Request {
         if !(self.end.is_finite() && self.end > 0.0) {
             return Err(Error::invalid(format!("--end must be finite and positive, got {}", self.end)));
         }
-        let choice = choose(&self);
+        let choice = choose(&self)?;
         let config = RunConfig {
             dim: self.dim,
             masses: self.masses,
@@ -139,8 +139,9 @@ const EXPLICIT_DEFAULT_STEP: f64 = 0.005;
 ///   chain's slowest swing `√(g/L)`; for `dp54` the sample interval of about 500 samples
 ///   (it adapts its own steps inside); for the others `min(0.005 s, 0.5/ω_fastest, T_drive/40)`
 ///   ([`suggested_step`]);
-/// - every: about 500 samples over the run.
-pub fn choose(config: &Request) -> Choice {
+/// - every: about 500 samples over the run, fewer where trajectory.csv would pass
+///   [`TRAJECTORY_BUDGET`] (an error where even two samples would).
+pub fn choose(config: &Request) -> Result<Choice> {
     let mut reasons = Vec::new();
     let driven = !matches!(config.drive, DriveConfig::Fixed);
     let damped = config.damping.iter().any(|l| *l != 0.0);
@@ -194,17 +195,75 @@ pub fn choose(config: &Request) -> Choice {
         reasons.push(format!("step {h:.4e} s: {why}"));
         h
     });
-    let chosen_every = config.every.unwrap_or_else(|| {
-        let k = (config.end / (chosen_step * TARGET_SAMPLES)).floor().max(1.0) as usize;
-        reasons.push(format!("every {k} steps: about {TARGET_SAMPLES} samples"));
-        k
-    });
-    Choice {
+    let chosen_every = match config.every {
+        Some(k) => k,
+        None => {
+            let (k, why) = default_every(config, chosen_step)?;
+            reasons.push(why);
+            k
+        }
+    };
+    Ok(Choice {
         integrator: chosen_integrator,
         step: chosen_step,
         every: chosen_every,
         reason: (!reasons.is_empty()).then(|| reasons.join("; ")),
+    })
+}
+
+/// The size trajectory.csv may take with the default sampling, bytes.
+pub const TRAJECTORY_BUDGET: f64 = 100e6;
+
+/// Bytes of one number in the CSV files, about: the shortest form that reads back exactly
+/// (up to 17 digits, a sign, a point, an exponent) and its comma.
+const BYTES_PER_NUMBER: f64 = 20.0;
+
+/// About the bytes of one row of trajectory.csv for `links` links: the time, the state
+/// (2D: angles and rates; 3D: directions and angular velocities), the pivot and every mass.
+pub fn sample_bytes(dim: Dimension, links: usize) -> f64 {
+    let n = links as f64;
+    let space = dim.space() as f64;
+    let state = match dim {
+        Dimension::Two => 2.0 * n,
+        Dimension::Three => 6.0 * n,
+    };
+    (1.0 + state + space * (n + 1.0)) * BYTES_PER_NUMBER
+}
+
+/// The default sampling: about 500 samples, fewer where they would take more than
+/// [`TRAJECTORY_BUDGET`]; returns `every` and why. A chain so large that the first and the
+/// last state alone pass the budget is an error that says what to give instead.
+fn default_every(config: &Request, step: f64) -> Result<(usize, String)> {
+    let steps = pendulum_core::trajectory::plan(0.0, config.end, step)?.0.max(1) as f64;
+    let k = (config.end / (step * TARGET_SAMPLES)).floor().max(1.0);
+    let row = sample_bytes(config.dim, config.masses.len());
+    // Samples at t = 0, every k steps, and at the end.
+    let samples = (steps / k).floor() + 1.0 + if steps % k == 0.0 { 0.0 } else { 1.0 };
+    if samples * row <= TRAJECTORY_BUDGET {
+        return Ok((k as usize, format!("every {k} steps: about {TARGET_SAMPLES} samples")));
     }
+    let fit = (TRAJECTORY_BUDGET / row).floor();
+    let mb = |bytes: f64| bytes / 1e6;
+    if fit < 2.0 {
+        return Err(Error::invalid(format!(
+            "a chain of {} links: one sample of trajectory.csv takes about {:.0} MB, and the default \
+             sampling keeps the file under {:.0} MB, too little for the first and the last state: give \
+             --every {steps} to write those two (about {:.0} MB)",
+            config.masses.len(),
+            mb(row),
+            mb(TRAJECTORY_BUDGET),
+            mb(2.0 * row),
+        )));
+    }
+    let k = (steps / (fit - 1.0)).ceil();
+    let kept = (steps / k).floor() + 1.0 + if steps % k == 0.0 { 0.0 } else { 1.0 };
+    let why = format!(
+        "every {k} steps: {kept} samples, fewer than the usual {TARGET_SAMPLES} to keep trajectory.csv \
+         under {:.0} MB (about {:.1} MB a sample)",
+        mb(TRAJECTORY_BUDGET),
+        mb(row)
+    );
+    Ok((k as usize, why))
 }
 
 /// The slowest swing of the chain as one pendulum of its whole length, `√(g/L)` (rad/s),
@@ -289,7 +348,7 @@ mod tests {
 
     #[test]
     fn a_driven_3d_chain_gets_the_midpoint_step_at_a_twentieth_of_the_drive_period() {
-        let c = choose(&config(Dimension::Three, 100, WHIRL, 3e-4));
+        let c = choose(&config(Dimension::Three, 100, WHIRL, 3e-4)).unwrap();
         assert_eq!(c.integrator, IntegratorKind::Midpoint);
         assert!((c.step - std::f64::consts::TAU / 6.0 / 20.0).abs() < 1e-15, "{}", c.step);
         assert_eq!(c.every, 11, "300 s / (0.0524 s × 500)");
@@ -300,7 +359,7 @@ mod tests {
 
     #[test]
     fn a_damped_undriven_3d_chain_steps_by_its_slowest_swing() {
-        let c = choose(&config(Dimension::Three, 10, DriveConfig::Fixed, 1e-3));
+        let c = choose(&config(Dimension::Three, 10, DriveConfig::Fixed, 1e-3)).unwrap();
         assert_eq!(c.integrator, IntegratorKind::Midpoint);
         let period = std::f64::consts::TAU / 9.81_f64.sqrt();
         assert!((c.step - period / 20.0).abs() < 1e-15, "{}", c.step);
@@ -311,30 +370,52 @@ mod tests {
     fn conservative_and_planar_runs_keep_gauss_legendre_below_the_fastest_mode() {
         // A free 3D chain of 100 links: gl2 at 0.5/ω_fastest, far below 0.005 s.
         let free = config(Dimension::Three, 100, DriveConfig::Fixed, 0.0);
-        let c = choose(&free);
+        let c = choose(&free).unwrap();
         assert_eq!(c.integrator, IntegratorKind::Gl2);
         let chain = Chain::<Dyn>::new(&free.masses, &free.lengths, free.gravity).unwrap();
         assert!((c.step - 0.5 / fastest_mode(&chain, &free.drive)).abs() < 1e-15);
         // A driven damped planar triple pendulum: gl2 at 0.005 s (its modes are slow).
         let drive =
             DriveConfig::Harmonic { direction: vec![0.0, 1.0], amplitude: 0.01, omega: 2.0, phase: 0.0 };
-        let c = choose(&config(Dimension::Two, 3, drive, 0.01));
+        let c = choose(&config(Dimension::Two, 3, drive, 0.01)).unwrap();
         assert_eq!((c.integrator, c.step), (IntegratorKind::Gl2, EXPLICIT_DEFAULT_STEP));
     }
 
     #[test]
     fn dp54_samples_its_adaptive_steps_about_500_times() {
         let c =
-            choose(&given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None));
+            choose(&given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None)).unwrap();
         assert_eq!((c.step, c.every), (300.0 / 500.0, 1));
         assert!(c.reason.unwrap().starts_with("step 6.0000e-1 s: the sample interval"));
+    }
+
+    #[test]
+    fn the_default_sampling_keeps_the_trajectory_within_its_budget() {
+        // 20,000 links in 3D, 1 s at 1 ms: 1001 samples of 3.6 MB would be 3.6 GB.
+        let mut big = given(config(Dimension::Three, 20_000, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), None);
+        big.end = 1.0;
+        let row = sample_bytes(Dimension::Three, 20_000);
+        assert!((row - (1.0 + 9.0 * 20_000.0 + 3.0) * 20.0).abs() < 1e-6);
+        let c = choose(&big).unwrap();
+        let samples = 1000 / c.every + 1 + usize::from(1000 % c.every != 0);
+        assert!(samples as f64 * row <= TRAJECTORY_BUDGET, "{samples} samples of {row} bytes");
+        assert!((samples + 1) as f64 * row > TRAJECTORY_BUDGET / 2.0, "thinned no more than needed: {samples}");
+        let reason = c.reason.unwrap();
+        assert!(reason.contains(&format!("{samples} samples, fewer than the usual 500")), "{reason}");
+        // A million links in 2D: two samples alone pass the budget (issue 34: the run wrote
+        // 1.76 GB in a minute). An error that says what to give.
+        let mut huge = given(config(Dimension::Two, 1_000_000, DriveConfig::Fixed, 0.0), None, Some(5e-5), None);
+        huge.end = 0.01;
+        let e = choose(&huge).unwrap_err().to_string();
+        assert!(e.starts_with("a chain of 1000000 links: one sample of trajectory.csv takes about 80 MB"), "{e}");
+        assert!(e.ends_with("give --every 200 to write those two (about 160 MB)"), "{e}");
     }
 
     #[test]
     fn what_is_given_is_kept_and_not_explained() {
         let request =
             given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), Some(7));
-        let c = choose(&request);
+        let c = choose(&request).unwrap();
         assert_eq!(c, Choice { integrator: IntegratorKind::Rk4, step: 1e-3, every: 7, reason: None });
     }
 }

@@ -120,8 +120,8 @@ impl AnySimulation {
     }
 
     /// Runs `config` (the configuration this simulation was built from) from t = 0 to
-    /// its end: every `every`-th step a sample to each sink in turn, then
-    /// `observe(t)`, which may stop the run (`ControlFlow::Break`: the report says
+    /// its end: every `every`-th step (and the last) a sample to each sink in turn; after
+    /// every step `observe(t)`, which may stop the run (`ControlFlow::Break`: the report says
     /// [`Status::Interrupted`]). A failed step, or a sample whose energy is not finite
     /// ([`pendulum_core::Error::BlewUp`]), ends the run with [`Status::Failed`] and the
     /// samples so far; a sink's error or a failure of the shape analysis ends it with
@@ -146,7 +146,6 @@ fn run<P: Motion>(
     sinks: &mut [&mut dyn Sink],
     observe: &mut dyn FnMut(f64) -> ControlFlow<()>,
 ) -> Result<Report> {
-    trajectory::plan(0.0, config.end, config.step)?;
     let system = simulation.system();
     let mut solver = simulation.integrator(Method::of(config))?;
     let mut state = State::new(0.0, simulation.initial_state());
@@ -156,8 +155,20 @@ fn run<P: Motion>(
     let mut blew_up = None;
     let mut initial_energy = None;
     let mut samples: u64 = 0;
+    // Every step comes back here, so that `observe` (progress, Ctrl-C) hears of each one
+    // however sparse the samples; every `every`-th and the last are sampled.
+    config.check()?;
+    let (last_step, _) = trajectory::plan(0.0, config.end, config.step)?;
+    let mut step: u64 = 0;
     let result =
-        trajectory::run(&mut *solver, system, &mut state, config.end, config.step, config.every, |t, x| {
+        trajectory::run(&mut *solver, system, &mut state, config.end, config.step, 1, |t, x| {
+            let sampled = step % config.every as u64 == 0 || step == last_step;
+            step += 1;
+            // A run stopped between samples ends with a sample of where it stopped.
+            let stopped = !sampled && observe(t).is_break();
+            if !sampled && !stopped {
+                return ControlFlow::Continue(());
+            }
             let sample = simulation.sample(t, x);
             let h0 = *initial_energy.get_or_insert(sample.energy);
             for sink in sinks.iter_mut() {
@@ -177,7 +188,7 @@ fn run<P: Motion>(
                 blew_up = Some(pendulum_core::Error::BlewUp { t, energy: sample.energy });
                 return ControlFlow::Break(());
             }
-            observe(t)
+            if stopped { ControlFlow::Break(()) } else { observe(t) }
         });
     if let Some(e) = stop_error {
         return Err(e);

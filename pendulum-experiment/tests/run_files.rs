@@ -99,14 +99,19 @@ fn an_observer_stops_the_run_and_the_report_says_so() {
     let file = RunFile::read(&runs().join("triple.run.json")).unwrap();
     let mut seen = 0;
     let mut observe = |t: f64| {
-        if t >= 1.0 {
+        if t >= 1.011 {
             return ControlFlow::Break(());
         }
         seen += 1;
         ControlFlow::Continue(())
     };
-    let report = build(&file.config).unwrap().run(&file.config, &mut [], &mut observe).unwrap();
+    let config = &file.config;
+    let report = build(config).unwrap().run(config, &mut [], &mut observe).unwrap();
     assert_eq!(report.status, Status::Interrupted);
-    assert!((1.0..1.1).contains(&report.t), "{}", report.t);
-    assert_eq!(report.samples, seen + 1);
+    // Stopped at the first step past t = 1.011 s (step 203), between samples, and sampled there.
+    assert!(report.t >= 1.011 && report.t < 1.011 + 1.001 * config.step, "{}", report.t);
+    assert_eq!(seen, report.steps, "the observer hears of t = 0 and of every step before the stop");
+    let every = config.every as u64;
+    assert_ne!(report.steps % every, 0, "the test stops between samples");
+    assert_eq!(report.samples, report.steps / every + 2, "t = 0, every {every} steps, the stop");
 }
