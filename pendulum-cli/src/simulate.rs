@@ -9,8 +9,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_experiment::{
-    IntegratorKind, RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View, build, chain,
-    drive_frequency, fastest_mode, other_version, suggested_step,
+    IntegratorKind, RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View,
+    balance::potential_scale, build, chain, drive_frequency, fastest_mode, other_version, suggested_step,
 };
 
 use crate::args::SimulateArgs;
@@ -121,7 +121,7 @@ fn execute(
     let mut images = Vec::new();
     if options.plots && !kept.times.is_empty() {
         let energy_png = out.join("energy.png");
-        plot::energy(&energy_png, &kept.times, &kept.energy, &kept.predicted, energy_scale(config))?;
+        plot::energy(&energy_png, &kept.times, &kept.energy, &kept.predicted, potential_scale(config))?;
         let gif = render::chain_gif(out, config, report.t, options.quiet)?;
         images.extend([energy_png, gif]);
     }
@@ -129,13 +129,22 @@ fn execute(
         whirl::present(shape, out, options.plots)?;
     }
 
+    // Said even with --quiet: the run's answer is not to be trusted as it stands.
+    for warning in report.warnings() {
+        eprintln!("pendulum: warning: {warning}");
+    }
     let status = report.status.name();
     if !options.quiet {
-        let drift =
-            kept.energy.iter().zip(&kept.predicted).map(|(h, p)| (h - p).abs()).fold(0.0_f64, f64::max);
+        let balance = &report.balance;
+        let off = if balance.is_off() {
+            format!(" ({:.1} % of the energy scale: off)", 100.0 * balance.fraction())
+        } else {
+            String::new()
+        };
         eprintln!(
             "pendulum: {status}: {n} links, {dim}D, t = {t:.4} s in {steps} steps ({integrator:?}, h = {h} s); \
-             max |H − H0 − W| = {drift:.3e} J; {samples} samples; files in {dir}{images}",
+             max |H − H0 − W| = {drift:.3e} J{off}; {samples} samples; files in {dir}{images}",
+            drift = balance.residual,
             dim = config.dim.space(),
             t = report.t,
             steps = report.steps,
@@ -225,18 +234,6 @@ fn stage_solve_hint(e: &pendulum_core::Error, config: &RunConfig) -> String {
     }
 }
 
-/// A scale for the energy axis (J): the work gravity could do on the chain,
-/// `Σ_k m_k g (l_1 + … + l_k)`, or the total mass times 1 m²/s² without gravity.
-fn energy_scale(config: &RunConfig) -> f64 {
-    let mut reach = 0.0;
-    let mut scale = 0.0;
-    for (m, l) in config.masses.iter().zip(&config.lengths) {
-        reach += l;
-        scale += m * config.gravity.max(1.0) * reach;
-    }
-    scale
-}
-
 /// How often a run without a terminal reports how far it is.
 const PLAIN_PROGRESS_EVERY: Duration = Duration::from_secs(5);
 
@@ -260,7 +257,8 @@ impl Progress {
     fn new(steps: u64, end: f64, quiet: bool) -> Self {
         let started = Instant::now();
         // The first plain line QUIET_START after the start.
-        let plain = (!std::io::stderr().is_terminal()).then(|| (end, started.checked_sub(PLAIN_PROGRESS_EVERY - QUIET_START).unwrap_or(started)));
+        let plain = (!std::io::stderr().is_terminal())
+            .then(|| (end, started.checked_sub(PLAIN_PROGRESS_EVERY - QUIET_START).unwrap_or(started)));
         let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::hidden());
         if let Ok(style) =
             ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, ETA {eta}")

@@ -566,3 +566,34 @@ fn a_long_run_reports_progress_within_seconds_however_sparse_its_samples() {
     assert!(first.starts_with("pendulum: t = ") && first.contains("s to go"), "{first}");
     assert!(took < Duration::from_secs(5), "the first progress line came after {took:?}");
 }
+
+#[test]
+fn a_run_whose_energy_balance_is_off_says_so_and_a_good_one_does_not() {
+    // Issue 34: RK4 at 0.2 s "completed" with exit 0 and an energy-balance error of 3.8 J
+    // (13 % of the triple pendulum's energy scale), said nowhere.
+    let dir = scratch("balance-off");
+    let out =
+        run_in(&dir, &["simulate", "--integrator", "rk4", "--step", "0.2", "--end", "20", "--out", "off"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(
+        message.contains(
+            "pendulum: warning: the energy balance is off by 3.806e0 J, 12.9 % of the run's energy scale"
+        ),
+        "{message}"
+    );
+    assert!(message.contains("max |H − H0 − W| = 3.806e0 J (12.9 % of the energy scale: off)"), "{message}");
+    let outcome = &run_json(&dir.join("off"))["outcome"];
+    assert!((outcome["balance"]["residual"].as_f64().unwrap() - 3.806).abs() < 1e-3);
+    assert!(outcome["warnings"][0].as_str().unwrap().starts_with("the energy balance is off"));
+    // The default step keeps the balance at round-off: nothing to say.
+    let out = run_in(&dir, &["simulate", "--end", "20", "--out", "good"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+    let outcome = &run_json(&dir.join("good"))["outcome"];
+    assert!(
+        outcome["balance"]["residual"].as_f64().unwrap()
+            < 1e-6 * outcome["balance"]["scale"].as_f64().unwrap()
+    );
+    assert!(outcome.get("warnings").is_none());
+}

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use crate::balance::Balance;
 use serde::{Deserialize, Serialize};
 
 use crate::description::RunConfig;
@@ -48,6 +49,14 @@ pub struct Outcome {
     /// What the integrator did (absent in files of earlier versions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub work: Option<IntegratorWork>,
+    /// The energy balance: `max |H − H0 − W|` and the scale it is judged against (absent
+    /// in files of earlier versions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub balance: Option<Balance>,
+    /// What the reader of the run should know: an energy balance that is off (absent when
+    /// there is nothing to say).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// What the integrator did over a run: the counts that say what a step cost.

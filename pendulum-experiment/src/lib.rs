@@ -53,6 +53,7 @@
 //! ```
 
 pub mod assemble;
+pub mod balance;
 pub mod csv;
 pub mod description;
 pub mod error;
@@ -70,6 +71,7 @@ pub mod run_dir;
 pub mod whirl;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};
+pub use balance::{BALANCE_TOLERANCE, Balance};
 pub use csv::Csv;
 pub use description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, InitialConfig, IntegratorKind, RunConfig, StageSolver, View,

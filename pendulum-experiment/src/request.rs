@@ -384,7 +384,8 @@ mod tests {
     #[test]
     fn dp54_samples_its_adaptive_steps_about_500_times() {
         let c =
-            choose(&given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None)).unwrap();
+            choose(&given(config(Dimension::Three, 10, WHIRL, 0.0), Some(IntegratorKind::Dp54), None, None))
+                .unwrap();
         assert_eq!((c.step, c.every), (300.0 / 500.0, 1));
         assert!(c.reason.unwrap().starts_with("step 6.0000e-1 s: the sample interval"));
     }
@@ -392,22 +393,30 @@ mod tests {
     #[test]
     fn the_default_sampling_keeps_the_trajectory_within_its_budget() {
         // 20,000 links in 3D, 1 s at 1 ms: 1001 samples of 3.6 MB would be 3.6 GB.
-        let mut big = given(config(Dimension::Three, 20_000, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), None);
+        let mut big =
+            given(config(Dimension::Three, 20_000, WHIRL, 0.0), Some(IntegratorKind::Rk4), Some(1e-3), None);
         big.end = 1.0;
         let row = sample_bytes(Dimension::Three, 20_000);
         assert!((row - (1.0 + 9.0 * 20_000.0 + 3.0) * 20.0).abs() < 1e-6);
         let c = choose(&big).unwrap();
         let samples = 1000 / c.every + 1 + usize::from(1000 % c.every != 0);
         assert!(samples as f64 * row <= TRAJECTORY_BUDGET, "{samples} samples of {row} bytes");
-        assert!((samples + 1) as f64 * row > TRAJECTORY_BUDGET / 2.0, "thinned no more than needed: {samples}");
+        assert!(
+            (samples + 1) as f64 * row > TRAJECTORY_BUDGET / 2.0,
+            "thinned no more than needed: {samples}"
+        );
         let reason = c.reason.unwrap();
         assert!(reason.contains(&format!("{samples} samples, fewer than the usual 500")), "{reason}");
         // A million links in 2D: two samples alone pass the budget (issue 34: the run wrote
         // 1.76 GB in a minute). An error that says what to give.
-        let mut huge = given(config(Dimension::Two, 1_000_000, DriveConfig::Fixed, 0.0), None, Some(5e-5), None);
+        let mut huge =
+            given(config(Dimension::Two, 1_000_000, DriveConfig::Fixed, 0.0), None, Some(5e-5), None);
         huge.end = 0.01;
         let e = choose(&huge).unwrap_err().to_string();
-        assert!(e.starts_with("a chain of 1000000 links: one sample of trajectory.csv takes about 80 MB"), "{e}");
+        assert!(
+            e.starts_with("a chain of 1000000 links: one sample of trajectory.csv takes about 80 MB"),
+            "{e}"
+        );
         assert!(e.ends_with("give --every 200 to write those two (about 160 MB)"), "{e}");
     }
 

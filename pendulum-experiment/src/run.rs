@@ -11,6 +11,7 @@ use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
 use crate::assemble::{AnySimulation, Method, Motion, Sample, Simulation};
+use crate::balance::Balance;
 use crate::description::{Dimension, RunConfig};
 use crate::error::Result;
 use crate::file::{IntegratorWork, Outcome};
@@ -90,12 +91,23 @@ pub struct Report {
     pub work: IntegratorWork,
     /// The state the run ended in, exactly.
     pub final_state: FinalState,
+    /// The energy balance over the samples.
+    pub balance: Balance,
     /// A whirled chain (3D, pivot circling the vertical) that completed its run: the
     /// shape it took, or why the analysis failed. `None` for other runs.
     pub shape: Option<Result<ShapeReport>>,
 }
 
 impl Report {
+    /// What the reader should know about a run that ended: an energy balance that is off.
+    /// (A failed run says why it failed instead.)
+    pub fn warnings(&self) -> Vec<String> {
+        match self.status {
+            Status::Failed => Vec::new(),
+            _ => self.balance.warning().into_iter().collect(),
+        }
+    }
+
     /// run.json's `outcome`.
     pub fn outcome(&self) -> Outcome {
         Outcome {
@@ -105,6 +117,8 @@ impl Report {
             samples: self.samples,
             error: self.error.as_ref().map(ToString::to_string),
             work: Some(self.work.clone()),
+            balance: Some(self.balance),
+            warnings: self.warnings(),
         }
     }
 }
@@ -154,42 +168,43 @@ fn run<P: Motion>(
     let mut stop_error = None;
     let mut blew_up = None;
     let mut initial_energy = None;
+    let mut balance = Balance::new(config);
     let mut samples: u64 = 0;
     // Every step comes back here, so that `observe` (progress, Ctrl-C) hears of each one
     // however sparse the samples; every `every`-th and the last are sampled.
     config.check()?;
     let (last_step, _) = trajectory::plan(0.0, config.end, config.step)?;
     let mut step: u64 = 0;
-    let result =
-        trajectory::run(&mut *solver, system, &mut state, config.end, config.step, 1, |t, x| {
-            let sampled = step % config.every as u64 == 0 || step == last_step;
-            step += 1;
-            // A run stopped between samples ends with a sample of where it stopped.
-            let stopped = !sampled && observe(t).is_break();
-            if !sampled && !stopped {
-                return ControlFlow::Continue(());
-            }
-            let sample = simulation.sample(t, x);
-            let h0 = *initial_energy.get_or_insert(sample.energy);
-            for sink in sinks.iter_mut() {
-                if let Err(e) = sink.sample(&sample, h0) {
-                    stop_error = Some(e);
-                    return ControlFlow::Break(());
-                }
-            }
-            if let Some(tracker) = &mut tracker
-                && let Err(e) = tracker.push(t, &sample.state)
-            {
+    let result = trajectory::run(&mut *solver, system, &mut state, config.end, config.step, 1, |t, x| {
+        let sampled = step % config.every as u64 == 0 || step == last_step;
+        step += 1;
+        // A run stopped between samples ends with a sample of where it stopped.
+        let stopped = !sampled && observe(t).is_break();
+        if !sampled && !stopped {
+            return ControlFlow::Continue(());
+        }
+        let sample = simulation.sample(t, x);
+        let h0 = *initial_energy.get_or_insert(sample.energy);
+        balance.push(&sample, h0);
+        for sink in sinks.iter_mut() {
+            if let Err(e) = sink.sample(&sample, h0) {
                 stop_error = Some(e);
                 return ControlFlow::Break(());
             }
-            samples += 1;
-            if !sample.energy.is_finite() {
-                blew_up = Some(pendulum_core::Error::BlewUp { t, energy: sample.energy });
-                return ControlFlow::Break(());
-            }
-            if stopped { ControlFlow::Break(()) } else { observe(t) }
-        });
+        }
+        if let Some(tracker) = &mut tracker
+            && let Err(e) = tracker.push(t, &sample.state)
+        {
+            stop_error = Some(e);
+            return ControlFlow::Break(());
+        }
+        samples += 1;
+        if !sample.energy.is_finite() {
+            blew_up = Some(pendulum_core::Error::BlewUp { t, energy: sample.energy });
+            return ControlFlow::Break(());
+        }
+        if stopped { ControlFlow::Break(()) } else { observe(t) }
+    });
     if let Some(e) = stop_error {
         return Err(e);
     }
@@ -216,6 +231,7 @@ fn run<P: Motion>(
         samples,
         work: solver.stats().into(),
         final_state,
+        balance,
         // A run cut on request ends at once (the nearest steady shape costs a dense
         // spectrum, about a second at 200 links); a failed run has no shape to report.
         shape: tracker.as_ref().filter(|_| status == Status::Completed).map(|t| t.report()),

@@ -57,6 +57,16 @@ pub struct RunResult {
     shape: Option<Result<ShapeReport, String>>,
     /// Where its files were written (`run(out=…)`), if anywhere.
     directory: Option<PathBuf>,
+    /// The energy balance's worst error `max |H − H0 − W|` over the samples, J.
+    #[pyo3(get)]
+    balance_residual: f64,
+    /// The energy scale the balance is judged against, J.
+    #[pyo3(get)]
+    energy_scale: f64,
+    /// What the run should tell you (an energy balance that is off); each is also issued
+    /// as a `RuntimeWarning`.
+    #[pyo3(get)]
+    warnings: Vec<String>,
 }
 
 #[pymethods]
@@ -281,7 +291,15 @@ impl Run {
         }
         let final_state =
             report.final_state.coordinates.iter().chain(&report.final_state.rates).copied().collect();
+        let warnings = report.warnings();
+        for warning in &warnings {
+            let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+            PyErr::warn(py, &category, &std::ffi::CString::new(warning.as_str())?, 1)?;
+        }
         Ok(RunResult {
+            balance_residual: report.balance.residual,
+            energy_scale: report.balance.scale,
+            warnings,
             status: report.status.name().into(),
             error: report.error.as_ref().map(ToString::to_string),
             t_end: report.t,

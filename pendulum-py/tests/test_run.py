@@ -104,6 +104,16 @@ def test_a_run_that_blows_up_reports_failed_with_its_samples():
     assert len(result.t) >= 1 and result.t_end < 2.0
 
 
+def test_an_energy_balance_that_is_off_is_a_runtime_warning():
+    with pytest.warns(RuntimeWarning, match=r"the energy balance is off by 3\.806e0 J, 12\.9 %"):
+        result = pendulum.Run(integrator="rk4", step=0.2, end=20.0).run()
+    assert result.status == "completed"
+    assert result.balance_residual == pytest.approx(3.806, abs=1e-3)
+    assert result.warnings and result.warnings[0].startswith("the energy balance is off")
+    good = pendulum.Run(end=20.0).run()
+    assert good.warnings == [] and good.balance_residual < 1e-6 * good.energy_scale
+
+
 def test_ctrl_c_interrupts_a_long_run_within_a_second():
     code = (
         "import pendulum, sys\n"

@@ -1,0 +1,80 @@
+//! The energy balance of a run: how far the inertial-frame energy strayed from what the
+//! ledger says it should be, `max |H − H0 − W|` with `W = W_drive + W_torque − E_damped`,
+//! against the energy scale of the run. An exact integration keeps it at round-off; a step
+//! too long for the chain shows here first, so a balance that is off is said, not left to
+//! be found in energy.csv.
+
+use serde::{Deserialize, Serialize};
+
+use crate::assemble::Sample;
+use crate::description::RunConfig;
+
+/// The fraction of the energy scale beyond which the balance is reported as off.
+pub const BALANCE_TOLERANCE: f64 = 1e-2;
+
+/// The worst energy-balance error of a run and the scale it is judged against.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Balance {
+    /// `max |H − H0 − W|` over the samples, J.
+    pub residual: f64,
+    /// The energy scale, J: the larger of [`potential_scale`] and the largest energy that
+    /// changed hands (`|H − H0|`, `|W_drive|`, `|W_torque|`, `E_damped`) at any sample.
+    pub scale: f64,
+}
+
+/// The work gravity could do on the chain, `Σ_k m_k g (l_1 + … + l_k)` (J), with
+/// `g ≥ 1 m/s²` so that a chain without gravity still has a scale.
+pub fn potential_scale(config: &RunConfig) -> f64 {
+    let mut reach = 0.0;
+    let mut scale = 0.0;
+    for (m, l) in config.masses.iter().zip(&config.lengths) {
+        reach += l;
+        scale += m * config.gravity.max(1.0) * reach;
+    }
+    scale
+}
+
+impl Balance {
+    /// Nothing seen yet: no residual, the chain's [`potential_scale`].
+    pub fn new(config: &RunConfig) -> Self {
+        Self { residual: 0.0, scale: potential_scale(config) }
+    }
+
+    /// Takes one sample; `h0` is the first sample's energy, J.
+    pub fn push(&mut self, sample: &Sample, h0: f64) {
+        let ledger = &sample.ledger;
+        let change = sample.energy - h0;
+        // NaN compares false: `max` keeps the finite value, so a non-finite residual is
+        // kept explicitly.
+        let residual = (change - ledger.net()).abs();
+        self.residual = if residual.is_nan() { f64::NAN } else { self.residual.max(residual) };
+        for exchanged in [change.abs(), ledger.drive.abs(), ledger.torque.abs(), ledger.damped.abs()] {
+            self.scale = self.scale.max(exchanged);
+        }
+    }
+
+    /// The residual as a fraction of the scale.
+    pub fn fraction(&self) -> f64 {
+        self.residual / self.scale
+    }
+
+    /// Whether the residual passes [`BALANCE_TOLERANCE`] of the scale (or is not finite).
+    pub fn is_off(&self) -> bool {
+        let fraction = self.fraction();
+        fraction.is_nan() || fraction > BALANCE_TOLERANCE
+    }
+
+    /// A one-line warning when the balance [`is_off`](Self::is_off).
+    pub fn warning(&self) -> Option<String> {
+        self.is_off().then(|| {
+            format!(
+                "the energy balance is off by {:.3e} J, {:.1} % of the run's energy scale {:.3e} J \
+                 (more than {} %): the step is likely too long for an accurate run",
+                self.residual,
+                100.0 * self.fraction(),
+                self.scale,
+                100.0 * BALANCE_TOLERANCE
+            )
+        })
+    }
+}
