@@ -31,7 +31,7 @@ cp "$runs/kapitza/energy.png" "$gallery/kapitza-energy.png"
 # A hanging 12-link chain whirled by its pivot on a horizontal circle (3D): the side view
 # simulate draws, then the same run drawn again from above and turning with the pivot.
 pendulum simulate --dim 3 --n 12 --lengths 0.1 --initial hanging --drive circle --radius 0.08 \
-    --omega 5 --step 0.001 --end 10 --every 10 --frames 100 --out "$runs/whirl" --quiet
+    --omega 5 --step 0.001 --end 10 --every 10 --frames 100 --view xz --out "$runs/whirl" --quiet
 cp "$runs/whirl/chain.gif" "$gallery/whirl-side.gif"
 pendulum render "$runs/whirl" --view top --out "$gallery/whirl-top.gif" --quiet
 pendulum render "$runs/whirl" --view co-rotating --out "$gallery/whirl-co-rotating.gif" --quiet

@@ -92,7 +92,7 @@ pub struct SimulateArgs {
     /// No progress bar and no summary line.
     #[arg(long)]
     pub quiet: bool,
-    /// 3D: the plane the animation shows [default: xz].
+    /// 3D: the plane the animation shows [default: co-rotating for a pivot on a circle, else xz].
     #[arg(long, value_enum)]
     pub view: Option<View>,
     /// Most frames in the animation (samples are thinned to fit) [default: 150].

@@ -11,12 +11,13 @@ use crate::spec::{expand, parse_list, per_link};
 
 /// The configuration a run's options describe: [`request`], resolved (the integrator,
 /// step and sampling chosen where not given).
-pub fn resolve(p: &Physics, view: View, frames: usize) -> CliResult<RunConfig> {
-    request(p, view, frames)?.resolve()
+pub fn resolve(p: &Physics, frames: usize) -> CliResult<RunConfig> {
+    request(p, frames)?.resolve()
 }
 
-/// The request a run's options make; errors name the flag.
-pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
+/// The request a run's options make, in the view [`View::default_for`] the run; errors
+/// name the flag.
+pub fn request(p: &Physics, frames: usize) -> CliResult<Request> {
     let dim = p.dim;
     let (masses, lengths) = per_link_values(&p.chain)?;
     let n = masses.len();
@@ -35,6 +36,7 @@ pub fn request(p: &Physics, view: View, frames: usize) -> CliResult<Request> {
         ramp_from: p.ramp_from,
     }
     .config(dim)?;
+    let view = View::default_for(dim, &drive);
     Ok(Request {
         dim,
         masses,

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pendulum_experiment::{
-    IntegratorKind, RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status, View,
+    IntegratorKind, RunConfig, RunFile, Sample, SampleFiles, Sink, StageSolver, Status,
     balance::potential_scale, build, chain, drive_frequency, fastest_mode, other_version, suggested_step,
 };
 
@@ -33,7 +33,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
             }
             file.config
         }
-        None => request::resolve(&args.physics, View::Xz, 150)?,
+        None => request::resolve(&args.physics, 150)?,
     };
     // Presentation only: may differ from the recorded run.
     config.view = args.view.unwrap_or(config.view);

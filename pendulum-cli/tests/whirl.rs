@@ -211,3 +211,28 @@ fn a_written_2d_sample_costs_time_linear_in_n() {
         large / small
     );
 }
+
+#[test]
+fn the_default_whirl_is_drawn_co_rotating_and_warns_about_nothing() {
+    // Issue 34: with the defaults, 300 s of whirl at 6 rad/s got about 500 samples, 1.8
+    // per drive period, and the side-view GIF warned the user to change --step.
+    let dir = scratch("default-whirl-view");
+    let chain = ["--dim", "3", "--n", "20", "--lengths", "0.05", "--masses", "0.05", "--damping", "3e-4"];
+    let drive = ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "300"];
+    let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--out", "run"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(!message.contains("warning"), "{message}");
+    assert!(message.contains("run/chain.gif: ") && message.contains(", co-rotating side view x'–z"), "{message}");
+    assert_eq!(common::run_json(&dir.join("run"))["config"]["view"], "co-rotating");
+    // A side view asked for still warns: the samples are too far apart for it.
+    let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--view", "xz", "--out", "side"]].concat());
+    assert!(stderr(&out).contains("the drive may look aliased"), "{}", stderr(&out));
+    // The co-rotating view needs a pivot on a circle.
+    let out = run_in(&dir, &["simulate", "--dim", "3", "--view", "co-rotating", "--out", "bad"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).trim(),
+        "error: --view co-rotating needs a 3D chain whose pivot circles (--dim 3 --drive circle)"
+    );
+}

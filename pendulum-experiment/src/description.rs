@@ -82,6 +82,24 @@ pub enum View {
     Yz,
     /// Top view: x to the right, y up.
     Xy,
+    /// The side view in the frame turning with a pivot that circles the vertical axis (3D
+    /// runs driven on a circle): a steady shape stands still, and nothing can alias. The
+    /// default for such runs.
+    #[serde(rename = "co-rotating")]
+    CoRotating,
+}
+
+impl View {
+    /// The view a run is drawn in unless one is asked for: [`View::CoRotating`] for a 3D
+    /// chain whose pivot circles, the side view `xz` otherwise.
+    pub fn default_for(dim: Dimension, drive: &DriveConfig) -> Self {
+        if Self::turns_with(dim, drive) { Self::CoRotating } else { Self::Xz }
+    }
+
+    /// Whether the pivot circles the vertical axis of a 3D chain (the turning frame exists).
+    fn turns_with(dim: Dimension, drive: &DriveConfig) -> bool {
+        dim == Dimension::Three && drive.circles()
+    }
 }
 
 /// The pivot's motion, with every parameter.
@@ -120,6 +138,14 @@ pub enum DriveConfig {
         /// Duration of the ramp, s.
         duration: f64,
     },
+}
+
+impl DriveConfig {
+    /// Whether the pivot moves on a horizontal circle about the vertical axis (at a steady
+    /// or a ramped speed).
+    pub fn circles(&self) -> bool {
+        matches!(self, Self::Circle { .. } | Self::RampedCircle { .. })
+    }
 }
 
 /// The initial state: what was asked for and the resolved numbers.
@@ -256,6 +282,11 @@ impl RunConfig {
         }
         if self.every == 0 {
             return Err(Error::invalid("--every must be at least 1 step, got 0"));
+        }
+        if self.view == View::CoRotating && !View::turns_with(self.dim, &self.drive) {
+            return Err(Error::invalid(
+                "--view co-rotating needs a 3D chain whose pivot circles (--dim 3 --drive circle)",
+            ));
         }
         if self.frames < 2 {
             return Err(Error::invalid(format!("--frames must be at least 2, got {}", self.frames)));

@@ -21,7 +21,7 @@ use crate::error::{CliError, CliResult};
 use draw::{Layout, Scene, Shot};
 use pendulum_experiment::View;
 use pendulum_experiment::run_dir::{Run, Trajectory};
-use pendulum_experiment::{DriveConfig, RunConfig};
+use pendulum_experiment::{Dimension, DriveConfig, RunConfig};
 use timing::{Request, Timing, speed_words};
 use view::{AxisMark, Bounds, Circling, Projection};
 
@@ -86,6 +86,7 @@ impl From<View> for RenderView {
             View::Xz => Self::Side,
             View::Yz => Self::Yz,
             View::Xy => Self::Top,
+            View::CoRotating => Self::CoRotating,
         }
     }
 }
@@ -224,6 +225,9 @@ fn animate(job: &Job) -> CliResult<Done> {
             job.trajectory.display()
         ))
     };
+    // A pivot driven on a circle circles however sparse the samples; any other is
+    // checked sample by sample (and refused).
+    let check_circling = co_rotating && !config.drive.circles();
     let mut circling = Circling::new(reach);
     // Planned at the first row: the timing, and the window's first time (s), less a tolerance.
     let mut planned: Option<(Timing, f64)> = None;
@@ -263,7 +267,7 @@ fn animate(job: &Job) -> CliResult<Done> {
         }
         let t0 = *start.get_or_insert(row.t);
         circling.push(row.t, &row.pivot);
-        if co_rotating && let Some(why) = circling.broken() {
+        if check_circling && let Some(why) = circling.broken() {
             return Err(not_circling(why.to_string()));
         }
         let turn = pendulum_core::TurningFrame::of_pivot(&row.pivot);
@@ -296,7 +300,7 @@ fn animate(job: &Job) -> CliResult<Done> {
         return Err(empty_window(job, &trajectory));
     };
     let (first, last) = (first.t, last.t);
-    let circles = circling.verdict();
+    let circles = if config.dim == Dimension::Three && config.drive.circles() { Ok(()) } else { circling.verdict() };
     if co_rotating && let Err(why) = circles.clone() {
         return Err(not_circling(why));
     }
