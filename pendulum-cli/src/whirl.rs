@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use pendulum_core::{ShapeReport, WhirlShape};
+use pendulum_core::{NearestSteady, ShapeReport, WhirlShape};
+use pendulum_experiment::whirl::growth_words;
 use plotters::prelude::*;
 
 use crate::error::CliResult;
@@ -30,12 +31,13 @@ fn plural(count: usize, noun: &str) -> String {
     if count == 1 { format!("1 {noun}") } else { format!("{count} {noun}s") }
 }
 
-/// `stable`, or `unstable` with the growth rate, of the nearest steady shape.
-fn stability(growth_rate: f64, stable: bool) -> String {
-    if stable {
-        format!("stable (largest growth rate {growth_rate:.2e} 1/s)")
+/// `stable`, or `unstable`, with the growth rate of the nearest steady shape.
+fn stability(n: &NearestSteady) -> String {
+    let rate = growth_words(n.growth_rate, n.rate_bound);
+    if n.stable {
+        format!("stable (largest growth rate {rate})")
     } else {
-        format!("unstable (growth rate {growth_rate:.3e} 1/s)")
+        format!("unstable (growth rate {rate})")
     }
 }
 
@@ -61,7 +63,7 @@ pub fn summary(r: &ShapeReport) -> String {
             "nearest steady shape {:.1e} m away: {}, {}",
             n.distance,
             plural(n.shape.nodes, "node"),
-            stability(n.growth_rate, n.stable)
+            stability(n)
         ),
         Err(e) => format!("no steady shape found nearby ({e})"),
     };

@@ -218,12 +218,16 @@ fn the_default_whirl_is_drawn_co_rotating_and_warns_about_nothing() {
     // per drive period, and the side-view GIF warned the user to change --step.
     let dir = scratch("default-whirl-view");
     let chain = ["--dim", "3", "--n", "20", "--lengths", "0.05", "--masses", "0.05", "--damping", "3e-4"];
-    let drive = ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "300"];
+    let drive =
+        ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "300"];
     let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--out", "run"]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let message = stderr(&out);
     assert!(!message.contains("warning"), "{message}");
-    assert!(message.contains("run/chain.gif: ") && message.contains(", co-rotating side view x'–z"), "{message}");
+    assert!(
+        message.contains("run/chain.gif: ") && message.contains(", co-rotating side view x'–z"),
+        "{message}"
+    );
     assert_eq!(common::run_json(&dir.join("run"))["config"]["view"], "co-rotating");
     // A side view asked for still warns: the samples are too far apart for it.
     let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--view", "xz", "--out", "side"]].concat());
@@ -235,4 +239,22 @@ fn the_default_whirl_is_drawn_co_rotating_and_warns_about_nothing() {
         stderr(&out).trim(),
         "error: --view co-rotating needs a 3D chain whose pivot circles (--dim 3 --drive circle)"
     );
+}
+
+#[test]
+fn a_growth_rate_within_round_off_is_reported_as_zero_with_its_bound() {
+    // Issue 34: an undamped whirl's nearest steady shape was "stable (+9.97e-16 1/s)".
+    let dir = scratch("round-off-rate");
+    let args = ["simulate", "--dim", "3", "--n", "3", "--initial", "hanging", "--drive", "circle"];
+    let out = run_in(
+        &dir,
+        &[&args[..], &["--radius", "0.02", "--omega", "2", "--end", "20", "--out", "run"]].concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = stdout(&out);
+    assert!(line.contains("stable (largest growth rate 0 within round-off, |rate| ≤ 2.0e-6 1/s)"), "{line}");
+    let shape: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/shape.json")).unwrap()).unwrap();
+    let nearest = &shape["nearest"];
+    assert!(nearest["growth_rate"].as_f64().unwrap().abs() <= nearest["growth_rate_bound"].as_f64().unwrap());
 }

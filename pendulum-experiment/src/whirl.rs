@@ -72,6 +72,17 @@ fn shape_json(s: &WhirlShape) -> serde_json::Value {
     })
 }
 
+/// A growth rate `rate` (1/s) in words: `0 within round-off, |rate| ≤ 6.0e-6 1/s` when
+/// its magnitude is at most `bound` (the spectrum's round-off, 1/s), else `-5.57e-2 1/s`.
+pub fn growth_words(rate: f64, bound: f64) -> String {
+    // NaN falls through to the number: said, never hidden.
+    if rate.abs() <= bound {
+        format!("0 within round-off, |rate| ≤ {bound:.1e} 1/s")
+    } else {
+        format!("{rate:.2e} 1/s")
+    }
+}
+
 /// `shape.json`: the report in the user's terms (conventions stated in the file).
 pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
     let nearest = match &r.nearest {
@@ -82,6 +93,7 @@ pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
             "nodes": n.shape.nodes,
             "stable": n.stable,
             "growth_rate": n.growth_rate,
+            "growth_rate_bound": n.rate_bound,
             "shape": shape_json(&n.shape),
         }),
         Err(e) => json!({ "found": false, "reason": e.to_string() }),
@@ -89,7 +101,8 @@ pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
     let value = json!({
         "conventions": "co-rotating frame: the pivot at (R, 0, 0), the rotation axis along z (m); \
                         nodes = axis_crossings + 1 (the pivot counts as a node); radial = signed distance \
-                        from the axis in the fitted plane, depth below the pivot (m); growth_rate in 1/s",
+                        from the axis in the fitted plane, depth below the pivot (m); growth_rate in 1/s, zero within round-off \
+                        when its magnitude is at most growth_rate_bound",
         "t": r.t,
         "omega": r.omega,
         "radius": r.radius,
@@ -105,4 +118,19 @@ pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
         "nearest": nearest,
     });
     write_json_atomic(path, &value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::growth_words;
+
+    #[test]
+    fn rates_within_round_off_are_zero_and_say_the_bound() {
+        // Issue 34: +9.97e-16 1/s was printed as a rate.
+        assert_eq!(growth_words(9.97e-16, 6e-6), "0 within round-off, |rate| ≤ 6.0e-6 1/s");
+        assert_eq!(growth_words(-6e-6, 6e-6), "0 within round-off, |rate| ≤ 6.0e-6 1/s");
+        assert_eq!(growth_words(-5.57e-2, 6e-6), "-5.57e-2 1/s");
+        assert_eq!(growth_words(3.1e-3, 6e-6), "3.10e-3 1/s");
+        assert_eq!(growth_words(f64::NAN, 6e-6), "NaN 1/s");
+    }
 }

@@ -367,7 +367,8 @@ impl RunResult {
     /// frame turning with the pivot, as a dict — nodes (axis crossings + 1, the pivot
     /// counted), axis_crossings, tip_radius (m), settled, drift (m), omega (rad/s), and
     /// nearest: the nearest damped steady shape (nodes, distance in m, stable,
-    /// growth_rate in 1/s) or None when none was found. None for other runs.
+    /// growth_rate in 1/s, zero within round-off when its magnitude is at most
+    /// growth_rate_bound) or None when none was found. None for other runs.
     #[getter]
     fn shape(&self, py: Python<'_>) -> PyResult<Option<Py<PyDict>>> {
         let Some(shape) = &self.shape else { return Ok(None) };
@@ -388,6 +389,7 @@ impl RunResult {
                 e.set_item("distance", n.distance)?;
                 e.set_item("stable", n.stable)?;
                 e.set_item("growth_rate", n.growth_rate)?;
+                e.set_item("growth_rate_bound", n.rate_bound)?;
                 e.set_item("tip_radius", n.shape.tip_radius)?;
                 Some(e)
             }

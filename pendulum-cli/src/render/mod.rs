@@ -300,7 +300,8 @@ fn animate(job: &Job) -> CliResult<Done> {
         return Err(empty_window(job, &trajectory));
     };
     let (first, last) = (first.t, last.t);
-    let circles = if config.dim == Dimension::Three && config.drive.circles() { Ok(()) } else { circling.verdict() };
+    let circles =
+        if config.dim == Dimension::Three && config.drive.circles() { Ok(()) } else { circling.verdict() };
     if co_rotating && let Err(why) = circles.clone() {
         return Err(not_circling(why));
     }

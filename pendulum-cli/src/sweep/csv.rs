@@ -6,6 +6,7 @@ use std::path::Path;
 
 use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number;
+use pendulum_experiment::whirl::growth_words;
 
 use super::config::{SweepConfig, short};
 use super::point::{Point, Status};
@@ -117,7 +118,11 @@ pub fn table(config: &SweepConfig, points: &[Point]) {
             Some(n) => (
                 format!("{:.2e}", n.distance),
                 n.nodes.to_string(),
-                format!("{} ({:+.2e} 1/s)", if n.stable { "stable" } else { "unstable" }, n.growth_rate),
+                format!(
+                    "{} ({})",
+                    if n.stable { "stable" } else { "unstable" },
+                    growth_words(n.growth_rate, n.growth_rate_bound)
+                ),
             ),
             None => ("-".into(), "-".into(), "none found".into()),
         };

@@ -111,6 +111,10 @@ pub struct Nearest {
     pub stable: bool,
     /// Largest real part of its damped spectrum, 1/s.
     pub growth_rate: f64,
+    /// Growth rates of smaller magnitude are zero within round-off, 1/s (absent in files
+    /// of earlier versions).
+    #[serde(default)]
+    pub growth_rate_bound: f64,
 }
 
 impl Outcome {
@@ -124,6 +128,7 @@ impl Outcome {
                     tip_radius: n.shape.tip_radius,
                     stable: n.stable,
                     growth_rate: n.growth_rate,
+                    growth_rate_bound: n.rate_bound,
                 }),
                 None,
             ),

@@ -250,7 +250,10 @@ pub struct NearestSteady {
     pub distance: f64,
     /// Largest real part of its damped spectrum, 1/s (negative: every mode decays).
     pub growth_rate: f64,
-    /// `growth_rate < growth_tolerance · |ω|`.
+    /// `growth_tolerance · |ω|`, 1/s: growth rates of smaller magnitude are zero within
+    /// the spectrum's round-off.
+    pub rate_bound: f64,
+    /// `growth_rate < rate_bound`.
     pub stable: bool,
 }
 
@@ -297,6 +300,7 @@ pub fn nearest_steady<Dr: Turning>(
         shape: eq_shape,
         equilibrium,
         growth_rate,
+        rate_bound: options.growth_tolerance * omega.abs(),
         stable: growth_rate < options.growth_tolerance * omega.abs(),
     })
 }
