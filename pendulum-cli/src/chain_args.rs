@@ -23,3 +23,15 @@ pub fn per_link_values(options: &ChainOptions) -> CliResult<(Vec<f64>, Vec<f64>)
         pendulum_experiment::options::links(options.n, ("--masses", masses), ("--lengths", lengths))?;
     Ok((masses, lengths))
 }
+
+/// The chain in one line for a command's header, with `damping` (N·m·s per link) when
+/// given.
+pub fn header(chain: &Chain<Dyn>, damping: Option<&[f64]>) -> String {
+    let undamped = vec![0.0; chain.links()];
+    pendulum_experiment::words::chain_words(
+        chain.masses().as_slice(),
+        chain.lengths().as_slice(),
+        chain.gravity(),
+        damping.unwrap_or(&undamped),
+    )
+}

@@ -23,7 +23,7 @@ mod whirl;
 use std::process::ExitCode;
 
 use clap::Parser;
-use clap::error::ErrorKind;
+use clap::error::{ContextKind, ContextValue, ErrorKind};
 
 use cli::{Cli, Command};
 
@@ -34,6 +34,11 @@ fn main() -> ExitCode {
             ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => e.exit(),
             ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
                 let _ = e.print();
+                return ExitCode::from(2);
+            }
+            ErrorKind::ArgumentConflict => {
+                let given: Vec<String> = std::env::args().skip(1).collect();
+                eprintln!("{}", conflict(&e, &given).unwrap_or_else(|| one_line(&e.to_string())));
                 return ExitCode::from(2);
             }
             _ => {
@@ -75,4 +80,19 @@ fn one_line(text: &str) -> String {
         .filter(|l| !l.is_empty())
         .collect();
     if lines.is_empty() { "error: invalid arguments".into() } else { lines.join(" ") }
+}
+
+/// A conflict between options named by the ones given, not by every option of the group
+/// clap lists (`--from X --n 5` named some 25): `None` when clap's error does not say.
+fn conflict(e: &clap::Error, given: &[String]) -> Option<String> {
+    let Some(ContextValue::String(arg)) = e.get(ContextKind::InvalidArg) else { return None };
+    let others = match e.get(ContextKind::PriorArg)? {
+        ContextValue::Strings(list) => list.clone(),
+        ContextValue::String(one) => vec![one.clone()],
+        _ => return None,
+    };
+    let flag = |usage: &str| usage.split([' ', '=']).next().unwrap_or_default().to_string();
+    let given: Vec<String> = given.iter().map(|a| flag(a)).collect();
+    let named: Vec<String> = others.into_iter().filter(|o| given.contains(&flag(o))).collect();
+    (!named.is_empty()).then(|| format!("error: the argument '{arg}' cannot be used with {}", named.join(", ")))
 }

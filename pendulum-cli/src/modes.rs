@@ -32,7 +32,7 @@ pub fn modes(args: &ModesArgs) -> CliResult<()> {
         vec!["k".to_string(), "omega".into(), "frequency_hz".into(), "period".into(), "nodes".into()];
     header.extend((1..=n).map(|i| format!("x{i}")));
     let mut csv = Csv::create(&args.out.join("modes.csv"), &header)?;
-    let mut out = String::new();
+    let mut out = format!("normal modes of {}; pivot fixed\n", crate::chain_args::header(&chain, None));
     let continuum = if uniform { "   Bernoulli (continuum)" } else { "" };
     out.push_str(&format!(" k   omega (rad/s)     f (Hz)   period (s)  nodes{continuum}\n"));
     let mut shapes = Vec::new();

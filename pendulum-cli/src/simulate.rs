@@ -48,6 +48,15 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
         CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
     let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };
+    if !args.quiet {
+        let chain = pendulum_experiment::words::chain_words(
+            &config.masses,
+            &config.lengths,
+            config.gravity,
+            &config.damping,
+        );
+        eprintln!("pendulum: {}D, {chain}", config.dim.space());
+    }
     if demo && !args.quiet {
         eprintln!(
             "pendulum: no options given, running the demo (a triple pendulum released from 1 rad, 10 s); \

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use pendulum_core::{NearestSteady, ShapeReport, WhirlShape};
-use pendulum_experiment::whirl::growth_words;
+use pendulum_experiment::words::growth_words;
 use plotters::prelude::*;
 
 use crate::error::CliResult;

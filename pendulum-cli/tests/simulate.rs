@@ -597,3 +597,12 @@ fn a_run_whose_energy_balance_is_off_says_so_and_a_good_one_does_not() {
     );
     assert!(outcome.get("warnings").is_none());
 }
+
+#[test]
+fn from_with_a_chain_option_names_only_the_option_given() {
+    // Issue 34: `--from X --n 5` listed some 25 options that conflict with --from.
+    let dir = scratch("from-conflict");
+    let out = run_in(&dir, &["simulate", "--from", "run.json", "--n", "5", "--omega=3"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(stderr(&out).trim(), "error: the argument '--from <RUN_JSON>' cannot be used with --n <N>, --omega <OMEGA>");
+}

@@ -69,6 +69,7 @@ pub mod request;
 pub mod run;
 pub mod run_dir;
 pub mod whirl;
+pub mod words;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};
 pub use balance::{BALANCE_TOLERANCE, Balance};

@@ -72,17 +72,6 @@ fn shape_json(s: &WhirlShape) -> serde_json::Value {
     })
 }
 
-/// A growth rate `rate` (1/s) in words: `0 within round-off, |rate| ≤ 6.0e-6 1/s` when
-/// its magnitude is at most `bound` (the spectrum's round-off, 1/s), else `-5.57e-2 1/s`.
-pub fn growth_words(rate: f64, bound: f64) -> String {
-    // NaN falls through to the number: said, never hidden.
-    if rate.abs() <= bound {
-        format!("0 within round-off, |rate| ≤ {bound:.1e} 1/s")
-    } else {
-        format!("{rate:.2e} 1/s")
-    }
-}
-
 /// `shape.json`: the report in the user's terms (conventions stated in the file).
 pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
     let nearest = match &r.nearest {
@@ -120,17 +109,3 @@ pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
     write_json_atomic(path, &value)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::growth_words;
-
-    #[test]
-    fn rates_within_round_off_are_zero_and_say_the_bound() {
-        // Issue 34: +9.97e-16 1/s was printed as a rate.
-        assert_eq!(growth_words(9.97e-16, 6e-6), "0 within round-off, |rate| ≤ 6.0e-6 1/s");
-        assert_eq!(growth_words(-6e-6, 6e-6), "0 within round-off, |rate| ≤ 6.0e-6 1/s");
-        assert_eq!(growth_words(-5.57e-2, 6e-6), "-5.57e-2 1/s");
-        assert_eq!(growth_words(3.1e-3, 6e-6), "3.10e-3 1/s");
-        assert_eq!(growth_words(f64::NAN, 6e-6), "NaN 1/s");
-    }
-}

@@ -17,7 +17,7 @@ mod table;
 use pendulum_core::{SteadyRotation, SteadyShape, Verdict, stability};
 
 use crate::args::SteadyArgs;
-use crate::chain_args::chain_of;
+use crate::chain_args::{self, chain_of};
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
 
@@ -67,6 +67,12 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
+    let pivot = if args.radius == 0.0 {
+        "pivot fixed".to_string()
+    } else {
+        format!("pivot on a circle of radius {} m", args.radius)
+    };
+    println!("steady rotation of {}; {pivot}", chain_args::header(&chain, damping.as_deref()));
     csv::branches(&args.out.join("branches.csv"), &family, n)?;
     csv::shapes(&args.out.join("shapes.csv"), &found, n, damping.is_some())?;
     table::branches(&family, &problem, omega_max);

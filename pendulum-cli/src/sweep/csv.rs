@@ -6,7 +6,7 @@ use std::path::Path;
 
 use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number;
-use pendulum_experiment::whirl::growth_words;
+use pendulum_experiment::words::growth_words;
 
 use super::config::{SweepConfig, short};
 use super::point::{Point, Status};

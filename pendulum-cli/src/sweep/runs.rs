@@ -114,7 +114,8 @@ impl Sweep {
             let (speeds, kinds) = (c.omegas.len(), c.kinds.len());
             eprintln!(
                 "pendulum: sweep of {speeds} speed{} × {kinds} kind{} = {} runs of {} s each \
-                 (RK4 + projection, h = {} s, {} steps) on {} thread{}{}",
+                 (RK4 + projection, h = {} s, {} steps) on {} thread{}{}; {}, pivot on a circle of \
+                 radius {} m",
                 if speeds == 1 { "" } else { "s" },
                 if kinds == 1 { "" } else { "s" },
                 self.points.len(),
@@ -124,6 +125,8 @@ impl Sweep {
                 self.jobs,
                 if self.jobs == 1 { "" } else { "s" },
                 if self.down.is_empty() { "" } else { "; the ramp-down points run one after the other" },
+                pendulum_experiment::words::chain_words(&c.masses, &c.lengths, c.gravity, &c.damping),
+                c.radius,
             );
         }
         let shared = Mutex::new(Shared { points: self.points.clone(), finished: 0, error: None });
