@@ -94,5 +94,6 @@ fn conflict(e: &clap::Error, given: &[String]) -> Option<String> {
     let flag = |usage: &str| usage.split([' ', '=']).next().unwrap_or_default().to_string();
     let given: Vec<String> = given.iter().map(|a| flag(a)).collect();
     let named: Vec<String> = others.into_iter().filter(|o| given.contains(&flag(o))).collect();
-    (!named.is_empty()).then(|| format!("error: the argument '{arg}' cannot be used with {}", named.join(", ")))
+    (!named.is_empty())
+        .then(|| format!("error: the argument '{arg}' cannot be used with {}", named.join(", ")))
 }

@@ -95,6 +95,56 @@ fn crossings(s: &WhirlShape) -> Vec<(f64, f64)> {
 /// distance from the rotation axis (horizontal, stretched to show the shape) against the
 /// depth below the pivot; the axis, the nodes (the pivot and the axis crossings), and the
 /// nearest damped steady shape overlaid.
+/// What the shape plot shows: the half-width `x` and the vertical range `y` (m), and the
+/// stretch across when it is not to scale.
+#[derive(Debug, PartialEq)]
+struct Frame {
+    x: f64,
+    y: (f64, f64),
+    stretch: Option<f64>,
+}
+
+/// The frame of a shape `width` m either side of the axis and `depth` m deep on a plot of
+/// `px` pixels (w, h): to scale where the shape allows it (the emptier direction widened),
+/// else stretched across by more than [`MOST_UNSTRETCHED`].
+fn frame(width: f64, depth: f64, px: (f64, f64)) -> Frame {
+    let (top, bottom) = (0.04 * depth, -1.04 * depth);
+    let stretch = (px.0 / (2.0 * width)) / (px.1 / (top - bottom));
+    if stretch < 1.0 {
+        Frame { x: width, y: (top - px.1 * 2.0 * width / px.0, top), stretch: None }
+    } else if stretch < MOST_UNSTRETCHED {
+        Frame { x: px.0 * (top - bottom) / px.1 / 2.0, y: (bottom, top), stretch: None }
+    } else {
+        Frame { x: width, y: (bottom, top), stretch: Some(stretch) }
+    }
+}
+
+/// The shape plot's layout on `root`, over `x` × `y` (m).
+fn layout<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<
+    ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    DrawingAreaErrorKind<DB::ErrorType>,
+> {
+    ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+}
+
+/// A shape at most this much wider in pixels per metre across than down is drawn to scale
+/// instead.
+const MOST_UNSTRETCHED: f64 = 1.5;
+
 fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
     fonts();
     let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
@@ -118,22 +168,25 @@ fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
         Err(_) => "no steady shape found",
     };
     let caption = format!("ω = {:.3} rad/s: {}, {settled}; {stable}", r.omega, plural(s.nodes, "node"));
-    let mut chart = ChartBuilder::on(&root)
-        .caption(caption, ("sans-serif", 20))
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d(-width..width, (-1.04 * depth)..(0.04 * depth))
-        .map_err(|e| fail(&e))?;
-    let stretch = (depth / (2.0 * width)) * (720.0 - 78.0) / (900.0 - 100.0);
+    // The plot's size in pixels, from the same layout drawn into a scratch buffer.
+    let (w_px, h_px) = {
+        let mut scratch = vec![0u8; 720 * 900 * 3];
+        let area = BitMapBackend::with_buffer(&mut scratch, (720, 900)).into_drawing_area();
+        let chart = layout(&area, &caption, (-1.0, 1.0), (-1.0, 1.0)).map_err(|e| fail(&e))?;
+        let (w, h) = chart.plotting_area().dim_in_pixel();
+        (f64::from(w), f64::from(h))
+    };
+    let Frame { x, y, stretch } = frame(width, depth, (w_px, h_px));
+    let mut chart = layout(&root, &caption, (-x, x), y).map_err(|e| fail(&e))?;
     chart
         .configure_mesh()
-        .x_desc(if stretch >= 1.5 {
+        .x_desc(if let Some(stretch) = stretch {
             format!(
-                "signed distance from the rotation axis in the shape's plane (m), stretched ×{stretch:.0}"
+                "signed distance from the rotation axis in the shape's plane (m), stretched ×{}",
+                if stretch < 10.0 { format!("{stretch:.1}") } else { format!("{stretch:.0}") }
             )
         } else {
-            "signed distance from the rotation axis in the shape's plane (m)".to_string()
+            "signed distance from the rotation axis in the shape's plane (m), to scale".to_string()
         })
         .y_desc("height relative to the pivot (m)")
         .light_line_style(BLACK.mix(0.03))
@@ -142,7 +195,7 @@ fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
         .map_err(|e| fail(&e))?;
     let axis = ShapeStyle::from(&BLACK.mix(0.6)).stroke_width(1);
     chart
-        .draw_series(DashedLineSeries::new(vec![(0.0, 0.04 * depth), (0.0, -1.04 * depth)], 8, 6, axis))
+        .draw_series(DashedLineSeries::new(vec![(0.0, y.1), (0.0, y.0)], 8, 6, axis))
         .map_err(|e| fail(&e))?
         .label("rotation axis")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], axis));
@@ -180,4 +233,32 @@ fn plot(path: &Path, r: &ShapeReport) -> CliResult<()> {
         .draw()
         .map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Frame, frame};
+
+    /// Pixels per metre across and down.
+    fn scales(f: &Frame, px: (f64, f64)) -> (f64, f64) {
+        (px.0 / (2.0 * f.x), px.1 / (f.y.1 - f.y.0))
+    }
+
+    #[test]
+    fn shapes_are_drawn_to_scale_unless_too_narrow_and_then_say_so() {
+        let px = (620.0, 780.0);
+        // Issue 34: the ramped 1-node shape (0.86 m out, 0.53 m down) was drawn at
+        // 319 px/m across against 1390 px/m down, unlabelled.
+        for (width, depth) in [(0.99, 0.53), (0.5, 1.0), (0.3, 1.0)] {
+            let f = frame(width, depth, px);
+            let (across, down) = scales(&f, px);
+            assert!((across / down - 1.0).abs() < 1e-12, "{width} × {depth}: {across} against {down} px/m");
+            assert!(f.x >= width && f.y.0 <= -1.04 * depth && f.y.1 >= 0.04 * depth, "{f:?}");
+            assert_eq!(f.stretch, None);
+        }
+        // A 2-node shape 6 cm out of 1 m: stretched across, by the ratio it names.
+        let f = frame(0.069, 1.0, px);
+        let (across, down) = scales(&f, px);
+        assert!((f.stretch.unwrap() - across / down).abs() < 1e-12 && f.stretch.unwrap() > 1.5);
+    }
 }

@@ -604,5 +604,8 @@ fn from_with_a_chain_option_names_only_the_option_given() {
     let dir = scratch("from-conflict");
     let out = run_in(&dir, &["simulate", "--from", "run.json", "--n", "5", "--omega=3"]);
     assert_eq!(out.status.code(), Some(2));
-    assert_eq!(stderr(&out).trim(), "error: the argument '--from <RUN_JSON>' cannot be used with --n <N>, --omega <OMEGA>");
+    assert_eq!(
+        stderr(&out).trim(),
+        "error: the argument '--from <RUN_JSON>' cannot be used with --n <N>, --omega <OMEGA>"
+    );
 }

@@ -108,4 +108,3 @@ pub fn write_shape_json(path: &Path, r: &ShapeReport) -> Result<()> {
     });
     write_json_atomic(path, &value)
 }
-

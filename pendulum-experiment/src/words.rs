@@ -62,7 +62,10 @@ mod tests {
             chain_words(&[1.0, 2.0, 3.0], &[0.5; 3], 9.81, &[0.0; 3]),
             "3 links, lengths 0.5 m, masses 1–3 kg (L = 1.5 m, M = 6 kg), g = 9.81 m/s²"
         );
-        assert_eq!(chain_words(&[1.0], &[0.2], 0.0, &[0.0]), "1 link of 0.2 m, 1 kg (L = 0.2 m, M = 1 kg), g = 0 m/s²");
+        assert_eq!(
+            chain_words(&[1.0], &[0.2], 0.0, &[0.0]),
+            "1 link of 0.2 m, 1 kg (L = 0.2 m, M = 1 kg), g = 0 m/s²"
+        );
     }
 
     #[test]
