@@ -73,23 +73,55 @@ fn hanging_depths(chain: &Chain<Dyn>) -> Vec<f64> {
         .collect()
 }
 
+/// Where the chain crosses the vertical through the pivot: the heights (m) at which the
+/// displacement `x` interpolated linearly between masses (and from the pivot, `x = 0`)
+/// changes sign. With the pivot, these are the mode's nodes.
+fn crossings(x: &[f64], z: &[f64]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for i in 1..x.len() {
+        let (a, b) = (x[i - 1], x[i]);
+        if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
+            out.push(z[i - 1] + (z[i] - z[i - 1]) * a / (a - b));
+        }
+    }
+    out
+}
+
 /// One panel per mode: the chain displaced in its mode shape (horizontal displacement
-/// scaled to a quarter of the chain's length), the hanging chain in grey.
+/// scaled to a quarter of the chain's length: mode shapes have no size of their own), the
+/// hanging chain in grey, the nodes (the pivot and the crossings of the vertical) marked;
+/// heights in metres.
 fn plot_modes(path: &Path, chain: &Chain<Dyn>, shapes: &[(usize, f64, Vec<f64>)]) -> CliResult<()> {
     fonts();
     let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
     let panels = shapes.len();
-    let root = BitMapBackend::new(path, (200 * panels as u32, 420)).into_drawing_area();
+    let root = BitMapBackend::new(path, (240 * panels as u32, 460)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     let total: f64 = chain.lengths().iter().sum();
     let z = hanging_depths(chain);
     for (area, (k, omega, x)) in root.split_evenly((1, panels)).iter().zip(shapes) {
         let peak = x.iter().fold(0.0_f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
         let scale = 0.25 * total / peak;
+        let nodes: Vec<f64> = std::iter::once(0.0).chain(crossings(x, &z)).collect();
         let mut chart = ChartBuilder::on(area)
-            .caption(format!("mode {k}: ω = {omega:.3} rad/s"), ("sans-serif", 14))
+            .caption(format!("mode {k}: ω = {omega:.3} rad/s, {} node{}", nodes.len(), if nodes.len() == 1 { "" } else { "s" }), ("sans-serif", 14))
             .margin(6)
+            .x_label_area_size(34)
+            .y_label_area_size(44)
             .build_cartesian_2d(-0.4 * total..0.4 * total, -1.05 * total..0.05 * total)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(3)
+            .x_label_formatter(&|_| String::new())
+            .y_labels(6)
+            .x_desc("displacement (peak = L/4)")
+            .y_desc("height (m)")
+            .light_line_style(BLACK.mix(0.04))
+            .label_style(("sans-serif", 11))
+            .axis_desc_style(("sans-serif", 12))
+            .draw()
             .map_err(|e| fail(&e))?;
         let rest = std::iter::once((0.0, 0.0)).chain(z.iter().map(|&z| (0.0, z)));
         chart
@@ -103,6 +135,21 @@ fn plot_modes(path: &Path, chain: &Chain<Dyn>, shapes: &[(usize, f64, Vec<f64>)]
         chart
             .draw_series(points[1..].iter().map(|&p| Circle::new(p, 3, BLUE.filled())))
             .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(nodes.iter().map(|&h| Circle::new((0.0, h), 6, RED.stroke_width(2))))
+            .map_err(|e| fail(&e))?;
     }
     root.present().map_err(|e| fail(&e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::crossings;
+
+    #[test]
+    fn nodes_are_where_the_chain_crosses_the_vertical() {
+        // 1 + sign changes: the pivot and one crossing halfway between heights −1 and −2.
+        assert_eq!(crossings(&[1.0, -1.0, -2.0], &[-1.0, -2.0, -3.0]), vec![-1.5]);
+        assert_eq!(crossings(&[0.2, 0.6], &[-1.0, -2.0]), Vec::<f64>::new());
+    }
 }
