@@ -104,7 +104,14 @@ fn plot_modes(path: &Path, chain: &Chain<Dyn>, shapes: &[(usize, f64, Vec<f64>)]
         let scale = 0.25 * total / peak;
         let nodes: Vec<f64> = std::iter::once(0.0).chain(crossings(x, &z)).collect();
         let mut chart = ChartBuilder::on(area)
-            .caption(format!("mode {k}: ω = {omega:.3} rad/s, {} node{}", nodes.len(), if nodes.len() == 1 { "" } else { "s" }), ("sans-serif", 14))
+            .caption(
+                format!(
+                    "mode {k}: ω = {omega:.3} rad/s, {} node{}",
+                    nodes.len(),
+                    if nodes.len() == 1 { "" } else { "s" }
+                ),
+                ("sans-serif", 14),
+            )
             .margin(6)
             .x_label_area_size(34)
             .y_label_area_size(44)

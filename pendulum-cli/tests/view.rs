@@ -201,3 +201,28 @@ fn the_server_serves_the_page_until_ctrl_c_and_refuses_a_port_in_use() {
     assert!(sent.elapsed() < std::time::Duration::from_secs(1), "{:?}", sent.elapsed());
     assert_eq!(lines.next().unwrap().unwrap(), "pendulum: stopped");
 }
+
+/// A whirl's page opens at its end, where the answer is, and says it plainly: counts that
+/// agree with their nouns, numbers that do not wrap (issue 34).
+#[test]
+fn a_whirls_page_opens_at_its_answer_and_says_it_plainly() {
+    let dir = scratch("view-whirl-answer");
+    let chain = ["--dim", "3", "--n", "20", "--lengths", "0.05", "--masses", "0.05", "--damping", "3e-4"];
+    let drive =
+        ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "60"];
+    let out = run_in(&dir, &[&["simulate", "--no-plots"][..], &chain, &drive, &["--out", "run"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = run_in(&dir, &["view", "run", "--export", "page.html"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let Some(out) = browser(&dir.join("page.html"), "", &["--dump-dom"]) else { return };
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let text = |id: &str| {
+        let start = dom.find(&format!("id=\"{id}\">")).expect(id) + id.len() + 6;
+        dom[start..start + dom[start..].find('<').unwrap()].to_string()
+    };
+    let samples = common::Csv::read(&dir.join("run/trajectory.csv")).rows.len();
+    assert!(text("time").ends_with(&format!("({samples}/{samples})")), "opens at the end: {}", text("time"));
+    let shape = text("shape");
+    assert!(shape.starts_with("2 nodes (1 axis crossing; the pivot counts)\ntip radius 0.0"), "{shape}");
+    assert!(!shape.contains("e-"), "a plain hyphen lets a number wrap: {shape}");
+}

@@ -59,7 +59,9 @@
   let low = Math.min(...values), high = Math.max(...values);
   if (!(high > low)) { low -= 1e-9 + Math.abs(low) * 1e-6; high += 1e-9 + Math.abs(high) * 1e-6; }
   const t0 = S.times[0], t1 = S.times[count - 1] > t0 ? S.times[count - 1] : t0 + 1;
-  const px = (t) => 36 + (plot.width - 44) * (t - t0) / (t1 - t0);
+  // The plot right of its value labels (LEFT px), above its time labels.
+  const LEFT = 70;
+  const px = (t) => LEFT + (plot.width - LEFT - 8) * (t - t0) / (t1 - t0);
   const py = (v) => plot.height - 18 - (plot.height - 28) * (v - low) / (high - low);
   function series(data, colour, dash) {
     pctx.strokeStyle = colour; pctx.lineWidth = 1.5; pctx.setLineDash(dash); pctx.beginPath();
@@ -74,9 +76,15 @@
   function drawEnergy() {
     pctx.fillStyle = "#fff"; pctx.fillRect(0, 0, plot.width, plot.height);
     pctx.fillStyle = "#000"; pctx.font = "11px system-ui, sans-serif";
-    pctx.fillText(high.toPrecision(5), 0, 12); pctx.fillText(low.toPrecision(5), 0, plot.height - 20);
-    pctx.fillText(`${t0.toFixed(1)} s`, 36, plot.height - 4);
-    pctx.fillText(`${t1.toFixed(1)} s`, plot.width - 48, plot.height - 4);
+    pctx.textAlign = "right";
+    pctx.fillText(`${high.toPrecision(5)} J`, LEFT - 6, py(high) + 4);
+    pctx.fillText(`${low.toPrecision(5)} J`, LEFT - 6, py(low) + 4);
+    pctx.fillText(`${t1.toFixed(1)} s`, plot.width - 4, plot.height - 3);
+    pctx.textAlign = "left";
+    pctx.fillText(`${t0.toFixed(1)} s`, LEFT, plot.height - 3);
+    pctx.strokeStyle = "#999"; pctx.lineWidth = 1;
+    pctx.beginPath(); pctx.moveTo(LEFT - 2, 4); pctx.lineTo(LEFT - 2, plot.height - 15);
+    pctx.lineTo(plot.width - 4, plot.height - 15); pctx.stroke();
     series(S.energy, ROD, []);
     series(S.predicted, PIVOT, [4, 3]);
     const x = px(S.times[view.frame]);
@@ -127,9 +135,13 @@
   $("parameters").textContent = S.parameters.join("\n") +
     `\n${count} frames shown of ${S.samples} samples (every ${S.every})`;
   const shape = S.shape;
+  // Numbers never wrap inside (a non-breaking hyphen in exponents); counts agree with their nouns.
+  const number = (x, digits) => Number(x).toPrecision(digits).replace("-", "\u2011");
+  const count_of = (k, noun) => `${k} ${noun}${k === 1 ? "" : "s"}`;
   $("shape").textContent = shape
-    ? `${shape.nodes} nodes (${shape.axis_crossings} axis crossings), tip radius ${Number(shape.tip_radius).toExponential(4)} m\n` +
-      `${shape.settled ? "settled" : "not settled"} (drift ${Number(shape.drift).toExponential(1)} m)`
+    ? `${count_of(shape.nodes, "node")} (${count_of(shape.axis_crossings, "axis crossing")}; the pivot counts)\n` +
+      `tip radius ${number(shape.tip_radius, 4)} m\n` +
+      `${shape.settled ? "settled" : "not settled"} (drift ${number(shape.drift, 2)} m)`
     : "(no shape.json: not a whirled 3D run)";
 
   // For each of three samples: the slider moved there, what is shown and whether the
@@ -148,7 +160,9 @@
     $("selftest").hidden = false;
   }
 
+  // A whirl opens at its end, where its answer (the shape it settled in) is; other runs at
+  // the start. `#t=K` opens at sample K.
   const at = /^#t=(\d+)$/.exec(location.hash);
-  show(at ? Number(at[1]) : 0);
+  show(at ? Number(at[1]) : shape ? count - 1 : 0);
   if (location.hash === "#selftest") selftest();
 })();
