@@ -61,6 +61,10 @@ fn each_slip_is_diagnosed_and_corrected() {
             "a missing term: the reference has `+ sum(j = 1..i) M[i] l[i] l[j] thetadot[j]^2",
             "+ sum(j = 1..i) M[i]",
         ),
+        // Issue 34: a sum stopping short is diagnosed at either end and at any depth.
+        ("a missing term: the sum `sum(k = i+1..n) m[k]", "sum(k = i..n) m[k]"),
+        ("a missing term: the sum `sum(k = max(i,j)+1..n) m[k]", "M[i,j] = sum(k = max(i,j)..n) m[k]"),
+        ("a missing term: the sum `sum(i = 1..n-1)", "T = 1 / 2 sum(i = 1..n) sum(j = 1..n)"),
     ];
     let found = outcomes("slips.claims");
     assert_eq!(found.len(), expected.len());

@@ -237,8 +237,11 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
             }
         }
     }
-    // A missing part of a sum: the rest of its index range, with the tail-mass index as
-    // written or as one of the choices above.
+    // A missing part of a sum, at either end of its range and at any depth of nesting:
+    // the rest of the chain's range (1..from−1, to+1..n), or the one term next to either
+    // end, with the tail-mass index as written or as one of the choices above. The sum is
+    // mended where it stands, so a sum inside another keeps its bound indices; where the
+    // body is the claim's own, the corrected sum runs over the whole range.
     for (k, b) in entry.branches.iter().enumerate() {
         let sums = |e: &Expr| matches!(e, Expr::Sum { .. });
         for site in 0..count(&b.value, &sums) {
@@ -248,9 +251,18 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
                 e.clone()
             });
             let Some(Expr::Sum { var, from, to, body, when, pos }) = found.pop() else { continue };
+            let below = shifted(&from, -1);
+            let above = shifted(&to, 1);
+            // (low, high) of the missing part, and the range it makes with the claim's.
             let rests = [
-                (Index::Int(1), shifted(&from, -1)),
-                (shifted(&to, 1), Index::Var("n".into(), Pos::default())),
+                (Index::Int(1), below.clone(), (Index::Int(1), to.clone())),
+                (
+                    above.clone(),
+                    Index::Var("n".into(), Pos::default()),
+                    (from.clone(), Index::Var("n".into(), Pos::default())),
+                ),
+                (below.clone(), below.clone(), (below.clone(), to.clone())),
+                (above.clone(), above.clone(), (from.clone(), above.clone())),
             ];
             let mut bodies = vec![(*body).clone()];
             let tail = |e: &Expr| matches!(e, Expr::Sym { name, index: Some(_), .. } if name == "M");
@@ -262,22 +274,35 @@ fn candidates(entry: &Entry, tally: &Tally) -> Vec<(String, Entry)> {
                     }));
                 }
             }
-            for (low, high) in &rests {
-                for body in &bodies {
-                    let term = Expr::Sum {
-                        var: var.clone(),
-                        from: low.clone(),
-                        to: high.clone(),
-                        body: Box::new(body.clone()),
-                        when: when.clone(),
-                        pos,
+            let sum = |low: &Index, high: &Index, body: &Expr| Expr::Sum {
+                var: var.clone(),
+                from: low.clone(),
+                to: high.clone(),
+                body: Box::new(body.clone()),
+                when: when.clone(),
+                pos,
+            };
+            let claimed = sum(&from, &to, &body);
+            for (low, high, (whole_low, whole_high)) in &rests {
+                for (b_index, mended_body) in bodies.iter().enumerate() {
+                    let term = sum(low, high, mended_body);
+                    let (slip, mended) = if b_index == 0 {
+                        let whole = sum(whole_low, whole_high, &body);
+                        (
+                            format!(
+                                "a missing term: the sum `{claimed}` stops short; the reference's runs over \
+                                 {var} = {whole_low}..{whole_high} (it has `+ {term}` that the claim lacks)"
+                            ),
+                            whole,
+                        )
+                    } else {
+                        (
+                            format!("a missing term: the reference has `+ {term}` that the claim lacks"),
+                            Expr::Add(Box::new(claimed.clone()), Box::new(term.clone())),
+                        )
                     };
-                    let changed =
-                        with_branch(entry, k, Expr::Add(Box::new(b.value.clone()), Box::new(term.clone())));
-                    out.push((
-                        format!("a missing term: the reference has `+ {term}` that the claim lacks"),
-                        changed,
-                    ));
+                    let value = replace_nth(&b.value, site, &mut 0, &sums, &mut |_| mended.clone());
+                    out.push((slip, with_branch(entry, k, value)));
                 }
             }
         }
