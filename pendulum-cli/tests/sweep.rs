@@ -103,6 +103,11 @@ fn a_row_per_point_and_kind_with_the_node_counts_of_simulate() {
             drifts[i]
         );
     }
+    // Every point's energy balance closes (issue 34: said per point, a warning if off).
+    let scale = json["points"][0]["result"]["balance"]["scale"].as_f64().unwrap();
+    for residual in csv.column("balance_residual_j") {
+        assert!(residual.is_finite() && residual < 1e-6 * scale, "{residual} J of {scale} J");
+    }
     // The files: sweep.json has every point's result, sweep.png is a picture.
     assert_eq!(json["status"], "completed");
     assert_eq!(json["points"].as_array().unwrap().len(), 9);

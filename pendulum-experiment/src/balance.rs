@@ -6,15 +6,18 @@
 
 use serde::{Deserialize, Serialize};
 
+use pendulum_core::{Balance, Ledger};
+
 use crate::assemble::Sample;
 use crate::description::RunConfig;
 
 /// The fraction of the energy scale beyond which the balance is reported as off.
 pub const BALANCE_TOLERANCE: f64 = 1e-2;
 
-/// The worst energy-balance error of a run and the scale it is judged against.
+/// The worst energy-balance error of a run ([`Balance`] at every sample) and the scale it
+/// is judged against.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Balance {
+pub struct RunBalance {
     /// `max |H − H0 − W|` over the samples, J.
     pub residual: f64,
     /// The energy scale, J: the larger of [`potential_scale`] and the largest energy that
@@ -25,28 +28,43 @@ pub struct Balance {
 /// The work gravity could do on the chain, `Σ_k m_k g (l_1 + … + l_k)` (J), with
 /// `g ≥ 1 m/s²` so that a chain without gravity still has a scale.
 pub fn potential_scale(config: &RunConfig) -> f64 {
+    chain_scale(&config.masses, &config.lengths, config.gravity)
+}
+
+/// [`potential_scale`] of a chain of `masses` (kg) and `lengths` (m) under `gravity` (m/s²).
+pub fn chain_scale(masses: &[f64], lengths: &[f64], gravity: f64) -> f64 {
     let mut reach = 0.0;
     let mut scale = 0.0;
-    for (m, l) in config.masses.iter().zip(&config.lengths) {
+    for (m, l) in masses.iter().zip(lengths) {
         reach += l;
-        scale += m * config.gravity.max(1.0) * reach;
+        scale += m * gravity.max(1.0) * reach;
     }
     scale
 }
 
-impl Balance {
+impl RunBalance {
     /// Nothing seen yet: no residual, the chain's [`potential_scale`].
     pub fn new(config: &RunConfig) -> Self {
-        Self { residual: 0.0, scale: potential_scale(config) }
+        Self::of_scale(potential_scale(config))
+    }
+
+    /// Nothing seen yet, with the potential scale `scale` (J) of the chain.
+    pub fn of_scale(scale: f64) -> Self {
+        Self { residual: 0.0, scale }
     }
 
     /// Takes one sample; `h0` is the first sample's energy, J.
     pub fn push(&mut self, sample: &Sample, h0: f64) {
-        let ledger = &sample.ledger;
-        let change = sample.energy - h0;
+        self.add(sample.energy, &sample.ledger, h0);
+    }
+
+    /// Takes the energy `energy` (J) and the ledger at one instant; `h0` is the energy at
+    /// the start, J.
+    pub fn add(&mut self, energy: f64, ledger: &Ledger, h0: f64) {
+        let change = energy - h0;
+        let residual = Balance::between(h0, energy, &Ledger::default(), ledger).residual.abs();
         // NaN compares false: `max` keeps the finite value, so a non-finite residual is
         // kept explicitly.
-        let residual = (change - ledger.net()).abs();
         self.residual = if residual.is_nan() { f64::NAN } else { self.residual.max(residual) };
         for exchanged in [change.abs(), ledger.drive.abs(), ledger.torque.abs(), ledger.damped.abs()] {
             self.scale = self.scale.max(exchanged);

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::balance::Balance;
+use crate::balance::RunBalance;
 use serde::{Deserialize, Serialize};
 
 use crate::description::RunConfig;
@@ -52,7 +52,7 @@ pub struct Outcome {
     /// The energy balance: `max |H − H0 − W|` and the scale it is judged against (absent
     /// in files of earlier versions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub balance: Option<Balance>,
+    pub balance: Option<RunBalance>,
     /// What the reader of the run should know: an energy balance that is off (absent when
     /// there is nothing to say).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

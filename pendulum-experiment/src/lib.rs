@@ -72,7 +72,7 @@ pub mod whirl;
 pub mod words;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};
-pub use balance::{BALANCE_TOLERANCE, Balance};
+pub use balance::{BALANCE_TOLERANCE, RunBalance};
 pub use csv::Csv;
 pub use description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, InitialConfig, IntegratorKind, RunConfig, StageSolver, View,

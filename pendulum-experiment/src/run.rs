@@ -11,7 +11,7 @@ use pendulum_core::integrate::State;
 use pendulum_core::trajectory;
 
 use crate::assemble::{AnySimulation, Method, Motion, Sample, Simulation};
-use crate::balance::Balance;
+use crate::balance::RunBalance;
 use crate::description::{Dimension, RunConfig};
 use crate::error::Result;
 use crate::file::{IntegratorWork, Outcome};
@@ -92,7 +92,7 @@ pub struct Report {
     /// The state the run ended in, exactly.
     pub final_state: FinalState,
     /// The energy balance over the samples.
-    pub balance: Balance,
+    pub balance: RunBalance,
     /// A whirled chain (3D, pivot circling the vertical) that completed its run: the
     /// shape it took, or why the analysis failed. `None` for other runs.
     pub shape: Option<Result<ShapeReport>>,
@@ -168,7 +168,7 @@ fn run<P: Motion>(
     let mut stop_error = None;
     let mut blew_up = None;
     let mut initial_energy = None;
-    let mut balance = Balance::new(config);
+    let mut balance = RunBalance::new(config);
     let mut samples: u64 = 0;
     // Every step comes back here, so that `observe` (progress, Ctrl-C) hears of each one
     // however sparse the samples; every `every`-th and the last are sampled.

@@ -13,7 +13,7 @@ use super::point::{Point, Status};
 use crate::error::CliResult;
 
 /// The columns of sweep.csv.
-pub const HEADER: [&str; 16] = [
+pub const HEADER: [&str; 17] = [
     "kind",
     "omega_rad_s",
     "omega_over_sqrt_g_over_L",
@@ -30,6 +30,7 @@ pub const HEADER: [&str; 16] = [
     "growth_rate_1_s",
     "t_end_s",
     "wall_s",
+    "balance_residual_j",
 ];
 
 /// Writes sweep.csv: [`HEADER`], then one row per point, in the order of the points.
@@ -59,6 +60,7 @@ pub fn write(path: &Path, points: &[Point]) -> CliResult<()> {
                 }
                 row.push(number(r.t));
                 row.push(format!("{:.3}", r.wall_seconds));
+                row.push(r.balance.map_or(String::new(), |b| number(b.residual)));
             }
             None => row.extend(std::iter::repeat_n(String::new(), HEADER.len() - 4)),
         }

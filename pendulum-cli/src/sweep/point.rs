@@ -2,6 +2,7 @@
 //! (the shape report in plain numbers, as sweep.csv and sweep.json hold it).
 
 use pendulum_core::ShapeReport;
+use pendulum_experiment::RunBalance;
 use serde::{Deserialize, Serialize};
 
 use super::SweepKind;
@@ -95,6 +96,10 @@ pub struct Outcome {
     pub nearest_error: Option<String>,
     /// Wall-clock time of the run and its analysis, s.
     pub wall_seconds: f64,
+    /// The run's energy balance: `max |H − H0 − W|` over the samples fed to the analysis
+    /// and its scale, J (absent in files of earlier versions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub balance: Option<RunBalance>,
 }
 
 /// The damped steady shape nearest a point's final shape.
@@ -118,7 +123,7 @@ pub struct Nearest {
 }
 
 impl Outcome {
-    pub fn of(report: &ShapeReport, steps: u64, wall_seconds: f64) -> Self {
+    pub fn of(report: &ShapeReport, steps: u64, wall_seconds: f64, balance: RunBalance) -> Self {
         let (shape, settling) = (&report.shape, &report.settling);
         let (nearest, nearest_error) = match &report.nearest {
             Ok(n) => (
@@ -150,6 +155,7 @@ impl Outcome {
             nearest,
             nearest_error,
             wall_seconds,
+            balance: Some(balance),
         }
     }
 }

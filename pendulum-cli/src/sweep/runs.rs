@@ -13,9 +13,12 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Dyn};
 use pendulum_core::integrate::State;
-use pendulum_core::{Chain, ShapeOptions, ShapeTracker, TurningFrame, trajectory};
+use pendulum_core::{Accounted, Chain, ShapeOptions, ShapeTracker, TurningFrame, trajectory};
 use pendulum_experiment::assemble::whirl_model;
-use pendulum_experiment::{DriveConfig, IntegratorKind, Method, directions_integrator, turning_drive};
+use pendulum_experiment::balance::chain_scale;
+use pendulum_experiment::{
+    DriveConfig, IntegratorKind, Method, RunBalance, directions_integrator, turning_drive,
+};
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
@@ -226,24 +229,33 @@ impl Sweep {
         let failed = |e: &dyn std::fmt::Display| Stop::Failed(e.to_string());
         let turning =
             turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
-        let model = whirl_model(self.chain.clone(), turning);
+        // The motion with its energy ledger: the ledger's components ride along and do not
+        // change the motion's steps.
+        let system = Accounted::of(whirl_model(self.chain.clone(), turning));
+        let model = system.motion_system();
         let x0 = match start {
             Some(x) => x,
             None => model.hanging(),
         };
+        let motion_len = x0.len();
+        let x0 = system.start(x0.as_slice()).map_err(|e| failed(&e))?;
         let options = ShapeOptions {
             periods: c.settle_periods,
             tolerance: c.settle_tolerance,
             ..ShapeOptions::default()
         };
-        let mut tracker = ShapeTracker::new(&model, options).map_err(|e| failed(&e))?;
+        let mut tracker = ShapeTracker::new(model, options).map_err(|e| failed(&e))?;
         let mut solver =
-            directions_integrator(Method::of_kind(IntegratorKind::Rk4), &model).map_err(|e| failed(&e))?;
+            directions_integrator(Method::of_kind(IntegratorKind::Rk4), &system).map_err(|e| failed(&e))?;
         let mut state = State::new(0.0, x0);
         let mut push_error = None;
+        let mut balance = RunBalance::of_scale(chain_scale(&c.masses, &c.lengths, c.gravity));
+        let mut initial_energy = None;
         let summary =
-            trajectory::run(&mut *solver, &model, &mut state, c.duration, c.step, c.feed_every, |t, x| {
-                if let Err(e) = tracker.push(t, x) {
+            trajectory::run(&mut *solver, &system, &mut state, c.duration, c.step, c.feed_every, |t, x| {
+                let energy = system.energy(t, x);
+                balance.add(energy, &system.ledger(x), *initial_energy.get_or_insert(energy));
+                if let Err(e) = tracker.push(t, &x.rows(0, motion_len).into_owned()) {
                     push_error = Some(e);
                     return ControlFlow::Break(());
                 }
@@ -261,9 +273,10 @@ impl Sweep {
             return Err(Stop::Interrupted);
         }
         let report = tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
-        let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64());
+        let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64(), balance);
         let phase = model.drive().phase(state.t());
-        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(state.x().as_slice()))))
+        let motion = &state.x().as_slice()[..motion_len];
+        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(motion))))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
@@ -272,6 +285,13 @@ impl Sweep {
         let point = &mut s.points[i];
         match ended {
             Ok(outcome) => {
+                if let Some(warning) = outcome.balance.and_then(|b| b.warning()) {
+                    eprintln!(
+                        "pendulum: warning: {} at ω = {} rad/s: {warning}",
+                        point.kind.name(),
+                        point.omega
+                    );
+                }
                 point.status = Status::Completed;
                 point.result = Some(outcome);
             }
