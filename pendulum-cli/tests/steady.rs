@@ -34,7 +34,12 @@ fn uniform(n: usize, length: f64) -> Chain<Dyn> {
 
 #[test]
 fn a_single_link_turns_as_the_conical_pendulum() {
-    let (dir, _) = steady("steady-conical", &["--n", "1", "--lengths", "0.5", "--omega-max", "12"]);
+    let (dir, stdout) = steady("steady-conical", &["--n", "1", "--lengths", "0.5", "--omega-max", "12"]);
+    // Issue 34: steady never said which chain it analysed.
+    assert_eq!(
+        stdout.lines().next().unwrap(),
+        "steady rotation of 1 link of 0.5 m, 1 kg (L = 0.5 m, M = 1 kg), g = 9.81 m/s²; pivot fixed"
+    );
     let csv = Table::read(&dir.join("branches.csv"));
     let (omega, theta) = (csv.column("omega"), csv.column("theta1"));
     assert!((omega[0] - (9.81_f64 / 0.5).sqrt()).abs() < 1e-9, "critical speed {}", omega[0]);
