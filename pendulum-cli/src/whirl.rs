@@ -6,6 +6,7 @@ use std::path::Path;
 
 use pendulum_core::{NearestSteady, ShapeReport, WhirlShape};
 use pendulum_experiment::words::growth_words;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use crate::error::CliResult;
@@ -119,20 +120,16 @@ fn frame(width: f64, depth: f64, px: (f64, f64)) -> Frame {
     }
 }
 
+/// A chart in metres on both axes.
+type Metres<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
 /// The shape plot's layout on `root`, over `x` × `y` (m).
 fn layout<'a, DB: DrawingBackend>(
     root: &'a DrawingArea<DB, plotters::coord::Shift>,
     caption: &str,
     x: (f64, f64),
     y: (f64, f64),
-) -> Result<
-    ChartContext<
-        'a,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
-    DrawingAreaErrorKind<DB::ErrorType>,
-> {
+) -> Result<Metres<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
     ChartBuilder::on(root)
         .caption(caption, ("sans-serif", 20))
         .margin(14)

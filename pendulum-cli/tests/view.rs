@@ -207,10 +207,8 @@ fn the_server_serves_the_page_until_ctrl_c_and_refuses_a_port_in_use() {
 #[test]
 fn a_whirls_page_opens_at_its_answer_and_says_it_plainly() {
     let dir = scratch("view-whirl-answer");
-    let chain = ["--dim", "3", "--n", "20", "--lengths", "0.05", "--masses", "0.05", "--damping", "3e-4"];
-    let drive =
-        ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "60"];
-    let out = run_in(&dir, &[&["simulate", "--no-plots"][..], &chain, &drive, &["--out", "run"]].concat());
+    let run = [&["simulate", "--no-plots"][..], &common::WHIRL_20, &["--end", "60", "--out", "run"]].concat();
+    let out = run_in(&dir, &run);
     assert!(out.status.success(), "{}", stderr(&out));
     let out = run_in(&dir, &["view", "run", "--export", "page.html"]);
     assert!(out.status.success(), "{}", stderr(&out));

@@ -217,10 +217,8 @@ fn the_default_whirl_is_drawn_co_rotating_and_warns_about_nothing() {
     // Issue 34: with the defaults, 300 s of whirl at 6 rad/s got about 500 samples, 1.8
     // per drive period, and the side-view GIF warned the user to change --step.
     let dir = scratch("default-whirl-view");
-    let chain = ["--dim", "3", "--n", "20", "--lengths", "0.05", "--masses", "0.05", "--damping", "3e-4"];
-    let drive =
-        ["--initial", "hanging", "--drive", "circle", "--radius", "0.02", "--omega", "6", "--end", "300"];
-    let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--out", "run"]].concat());
+    let whirl = [&["simulate"][..], &common::WHIRL_20, &["--end", "300"]].concat();
+    let out = run_in(&dir, &[&whirl[..], &["--out", "run"]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
     let message = stderr(&out);
     assert!(!message.contains("warning"), "{message}");
@@ -230,7 +228,7 @@ fn the_default_whirl_is_drawn_co_rotating_and_warns_about_nothing() {
     );
     assert_eq!(common::run_json(&dir.join("run"))["config"]["view"], "co-rotating");
     // A side view asked for still warns: the samples are too far apart for it.
-    let out = run_in(&dir, &[&["simulate"][..], &chain, &drive, &["--view", "xz", "--out", "side"]].concat());
+    let out = run_in(&dir, &[&whirl[..], &["--view", "xz", "--out", "side"]].concat());
     assert!(stderr(&out).contains("the drive may look aliased"), "{}", stderr(&out));
     // The co-rotating view needs a pivot on a circle.
     let out = run_in(&dir, &["simulate", "--dim", "3", "--view", "co-rotating", "--out", "bad"]);

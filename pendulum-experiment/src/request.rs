@@ -234,7 +234,10 @@ pub fn sample_bytes(dim: Dimension, links: usize) -> f64 {
 /// [`TRAJECTORY_BUDGET`]; returns `every` and why. A chain so large that the first and the
 /// last state alone pass the budget is an error that says what to give instead.
 fn default_every(config: &Request, step: f64) -> Result<(usize, String)> {
-    let steps = pendulum_core::trajectory::plan(0.0, config.end, step)?.0.max(1) as f64;
+    // An absurd step is refused by the configuration's check, with its message.
+    let steps = pendulum_core::trajectory::plan(0.0, config.end, step)
+        .map_or((config.end / step).ceil(), |(n, _)| n as f64)
+        .max(1.0);
     let k = (config.end / (step * TARGET_SAMPLES)).floor().max(1.0);
     let row = sample_bytes(config.dim, config.masses.len());
     // Samples at t = 0, every k steps, and at the end.

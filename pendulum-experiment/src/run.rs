@@ -176,7 +176,7 @@ fn run<P: Motion>(
     let (last_step, _) = trajectory::plan(0.0, config.end, config.step)?;
     let mut step: u64 = 0;
     let result = trajectory::run(&mut *solver, system, &mut state, config.end, config.step, 1, |t, x| {
-        let sampled = step % config.every as u64 == 0 || step == last_step;
+        let sampled = step.is_multiple_of(config.every as u64) || step == last_step;
         step += 1;
         // A run stopped between samples ends with a sample of where it stopped.
         let stopped = !sampled && observe(t).is_break();

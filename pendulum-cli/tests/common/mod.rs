@@ -11,6 +11,29 @@ pub fn pendulum() -> Command {
     Command::new(env!("CARGO_BIN_EXE_pendulum"))
 }
 
+/// The sweep section's 20-link chain (L = 1 m, M = 1 kg, λ = 3e-4 N·m·s), hanging, whirled
+/// on a 2 cm circle at 6 rad/s; `--end` is the test's.
+pub const WHIRL_20: [&str; 18] = [
+    "--dim",
+    "3",
+    "--n",
+    "20",
+    "--lengths",
+    "0.05",
+    "--masses",
+    "0.05",
+    "--damping",
+    "3e-4",
+    "--initial",
+    "hanging",
+    "--drive",
+    "circle",
+    "--radius",
+    "0.02",
+    "--omega",
+    "6",
+];
+
 /// Runs `pendulum args...` in `dir`.
 pub fn run_in(dir: &Path, args: &[&str]) -> Output {
     pendulum().args(args).current_dir(dir).output().expect("the pendulum binary runs")
