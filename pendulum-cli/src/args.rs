@@ -68,6 +68,12 @@ pub struct SteadyArgs {
     /// damped steady shape being the 3D relative equilibrium on the circling pivot.
     #[arg(long, allow_hyphen_values = true, value_name = "VALUE|LIST|FILE")]
     pub damping: Option<String>,
+    /// Instead of the chain, the continuum it approaches: Kolodner's heavy string of the
+    /// chain's length L under its gravity (its critical speeds (j_0k/2)·√(g/L), its steady
+    /// shapes at the --omega speeds and its branches up to --omega-max): continuum.csv,
+    /// continuum.png.
+    #[arg(long)]
+    pub continuum: bool,
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR", default_value = "pendulum-steady")]
     pub out: PathBuf,

@@ -377,3 +377,37 @@ fn bad_speed_lists_are_named() {
         assert!(!dir.join("s").exists(), "{args:?} wrote files");
     }
 }
+
+#[test]
+fn the_continuum_has_the_strings_critical_speeds_and_the_chains_shapes_within_one_over_n() {
+    // The 100-link chain of the README whirl, its pivot on a 2 cm circle.
+    let chain = ["--n", "100", "--masses", "0.01", "--lengths", "0.01"];
+    let (dir, stdout) = steady(
+        "steady-continuum",
+        &[&chain[..], &["--continuum", "--radius", "0.02", "--omega", "3,5"]].concat(),
+    );
+    let mut lines = stdout.lines();
+    assert!(lines.next().unwrap().starts_with("heavy string (Kolodner) of length L = 1 m, g = 9.81 m/s²"));
+    // ω_k = (j_0k/2) √(g/L).
+    assert_eq!(
+        lines.next().unwrap(),
+        "critical speeds ω_k = (j_0k/2)·√(g/L) (rad/s): 3.766067, 8.644696, 13.552136 (√(g/L) = 3.132092 rad/s)"
+    );
+    let csv = Table::read(&dir.join("continuum.csv"));
+    let (omega, nodes, tips) = (csv.column("omega"), csv.column("nodes"), csv.column("tip_radius"));
+    assert_eq!(omega, [3.0, 5.0, 5.0, 5.0]);
+    assert_eq!(nodes, [1.0, 2.0, 2.0, 1.0]);
+    // The 100-link chain's forced shapes (`steady --radius 0.02`): 0.07353, 0.06172,
+    // 0.86411 m; the string's differ by about 1/n.
+    for (tip, chain) in [(tips[0], 0.073534), (tips[2], 0.061716), (tips[3], 0.864108)] {
+        assert!((tip - chain).abs() < 2.0 / 100.0 * chain, "{tip} against the chain's {chain}");
+    }
+    assert!(std::fs::read(dir.join("continuum.png")).unwrap().starts_with(b"\x89PNG"));
+    // The chain's options that do not apply to the string are refused.
+    let out = run_in(&scratch("steady-continuum-bad"), &["steady", "--continuum", "--damping", "0.01"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).trim(),
+        "error: --continuum: --damping and --branches apply to the chain, not to the string"
+    );
+}

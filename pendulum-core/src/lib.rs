@@ -55,10 +55,10 @@ pub mod systems;
 pub mod trajectory;
 
 pub use analysis::{
-    Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, Stability,
-    SteadyRotation, SteadyShape, Verdict, bernoulli_frequency, bessel_j0_zero, equal_link_frequencies,
-    fastest_decay_bound, fastest_frequency_bound, laguerre_zeros, linearise, normal_modes,
-    relative_equilibrium, relative_spectrum, sign_changes, stability,
+    Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, RotatingString,
+    Stability, SteadyRotation, SteadyShape, StringShape, Verdict, bernoulli_frequency, bessel_j0_zero,
+    equal_link_frequencies, fastest_decay_bound, fastest_frequency_bound, laguerre_zeros, linearise,
+    normal_modes, relative_equilibrium, relative_spectrum, sign_changes, stability,
 };
 pub use analysis::{Lqr, STEADY_TOLERANCE, StateSpace, linearize, lqr};
 pub use analysis::{

@@ -9,6 +9,7 @@
 //! linearisation in the turning frame ([`stability`]); damped, see [`shapes`].
 
 pub(crate) mod branches;
+mod continuum;
 mod csv;
 pub(crate) mod plots;
 mod shapes;
@@ -23,11 +24,14 @@ use crate::spec::{expand, per_link};
 
 /// Margin of the default `--omega-max` over the third critical speed (below the fourth for
 /// uniform chains: ω_4/ω_3 = 1.37 at n = 12, 1.36 in the continuum).
-const DEFAULT_MARGIN: f64 = 1.25;
+pub(crate) const DEFAULT_MARGIN: f64 = 1.25;
 
 /// Runs `pendulum steady`.
 pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     let chain = chain_of(&args.chain)?;
+    if args.continuum {
+        return continuum::run(args, &chain);
+    }
     let n = chain.links();
     let problem = SteadyRotation::new(&chain, args.radius)?;
     if args.radius != 0.0 && args.branches.is_some() {
@@ -95,7 +99,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
 
 /// Parses `--omega`: a comma list of finite, non-negative speeds (rad/s), at least one,
 /// no empty entry. Errors name the list and the entry.
-fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
+pub(crate) fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
     let tokens: Vec<&str> = list.split(',').map(str::trim).collect();
     if tokens.iter().all(|t| t.is_empty()) {
         return Err(CliError::invalid(format!(
@@ -119,7 +123,7 @@ fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
         .collect()
 }
 
-fn check_omega_max(omega_max: f64) -> CliResult<()> {
+pub(crate) fn check_omega_max(omega_max: f64) -> CliResult<()> {
     if omega_max.is_finite() && omega_max > 0.0 {
         Ok(())
     } else {

@@ -1,7 +1,8 @@
 //! What the equations say about a chain beyond one trajectory: its normal modes about the
 //! hanging rest (`modes`, with Bernoulli's continuum frequencies from the zeros of J0,
 //! `bessel`, and the equal-link chain's exact ones from the zeros of L_n, `laguerre`), the undamped steady shapes turning rigidly about the vertical
-//! as branches over the speed ω (`steady_branches`) and their stability (`stability`),
+//! as branches over the speed ω (`steady_branches`) and the heavy string they approach
+//! (`continuum`, Kolodner's) and their stability (`stability`),
 //! and the relative equilibria of the full 3D chain on a circling pivot, damping included,
 //! with their spectrum (`relative_equilibrium`); the shape a whirled chain takes, seen in
 //! the frame turning with its pivot, whether it settled and the damped steady shape nearest
@@ -9,6 +10,7 @@
 //! analytic derivatives (`state_space`) and the LQR gain for it (`lqr`).
 
 pub(crate) mod bessel;
+pub(crate) mod continuum;
 pub(crate) mod laguerre;
 pub(crate) mod lqr;
 pub(crate) mod modes;
@@ -19,6 +21,7 @@ pub(crate) mod state_space;
 pub(crate) mod steady_branches;
 
 pub use bessel::bessel_j0_zero;
+pub use continuum::{RotatingString, StringShape};
 pub use laguerre::laguerre_zeros;
 pub use lqr::{Lqr, lqr};
 pub use modes::{

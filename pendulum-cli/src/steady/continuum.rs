@@ -1,0 +1,186 @@
+//! `pendulum steady --continuum`: Kolodner's heavy rotating string of the chain's length
+//! and gravity ([`RotatingString`]) — its critical speeds, its steady shapes at the
+//! `--omega` speeds (stdout, continuum.csv) and its branches, tip radius against ω up to
+//! `--omega-max` (continuum.png).
+
+use nalgebra::Dyn;
+use pendulum_core::{Chain, RotatingString, StringShape};
+use pendulum_experiment::Csv;
+use pendulum_experiment::csv::number;
+use plotters::prelude::*;
+
+use super::{DEFAULT_MARGIN, check_omega_max, parse_speeds, plots::colour, round_up};
+use crate::args::SteadyArgs;
+use crate::error::{CliError, CliResult};
+use crate::plot::{drawing_failed, fonts};
+
+/// Speeds of the branch diagram.
+const DIAGRAM_SPEEDS: usize = 240;
+
+/// Runs `pendulum steady --continuum` for the string of `chain`'s length and gravity.
+pub fn run(args: &SteadyArgs, chain: &Chain<Dyn>) -> CliResult<()> {
+    if args.damping.is_some() || args.branches.is_some() {
+        return Err(CliError::invalid(
+            "--continuum: --damping and --branches apply to the chain, not to the string",
+        ));
+    }
+    let length: f64 = chain.lengths().iter().sum();
+    let string = RotatingString::new(length, chain.gravity(), args.radius)?;
+    let critical = string.critical_speeds(3);
+    let listed = args.omega.as_deref().map(parse_speeds).transpose()?;
+    let omega_max = match args.omega_max {
+        Some(w) => {
+            check_omega_max(w)?;
+            w
+        }
+        None => listed.iter().flatten().fold(round_up(DEFAULT_MARGIN * critical[2]), |a, &b| a.max(b)),
+    };
+    let speeds = listed.unwrap_or_else(|| vec![omega_max]);
+    let pivot = if args.radius == 0.0 {
+        "top fixed".to_string()
+    } else {
+        format!("top on a circle of radius {} m", args.radius)
+    };
+    println!(
+        "heavy string (Kolodner) of length L = {} m, g = {} m/s², the continuum of the chain of {} links; {pivot}",
+        round(length),
+        chain.gravity(),
+        chain.links()
+    );
+    let list: Vec<String> = critical.iter().map(|w| format!("{w:.6}")).collect();
+    println!(
+        "critical speeds ω_k = (j_0k/2)·√(g/L) (rad/s): {} (√(g/L) = {:.6} rad/s)",
+        list.join(", "),
+        (chain.gravity() / length).sqrt()
+    );
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+    })?;
+    let mut found = Vec::new();
+    for &omega in &speeds {
+        found.extend(string.shapes_at(omega)?);
+    }
+    table(&found, args.radius);
+    csv(&args.out.join("continuum.csv"), &found)?;
+    let png = args.out.join("continuum.png");
+    diagram(&png, &string, omega_max, &critical, args.radius, length)?;
+    eprintln!(
+        "pendulum: {} shape{} of the string at {} speed{}; files in {} (continuum.csv, continuum.png)",
+        found.len(),
+        if found.len() == 1 { "" } else { "s" },
+        speeds.len(),
+        if speeds.len() == 1 { "" } else { "s" },
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// `x` without the round-off of a sum (12 significant digits).
+fn round(x: f64) -> f64 {
+    let scale = 10f64.powi(11 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
+}
+
+/// The shapes on stdout: speed, nodes, tip radius and side.
+fn table(found: &[StringShape], radius: f64) {
+    println!();
+    println!(
+        "steady shapes of the string (nodes = axis crossings + 1, the top counted; tip radius = the free end's distance from the axis)"
+    );
+    println!("ω (rad/s)     nodes  tip radius (m)  tip side");
+    for s in found {
+        let side = if radius == 0.0 {
+            "either (mirror images)"
+        } else if s.tip > 0.0 {
+            "pivot's"
+        } else {
+            "opposite"
+        };
+        println!("{:<12}  {:>5}  {:>14.6}  {side}", s.omega, s.nodes, s.tip_radius());
+    }
+}
+
+/// continuum.csv: one row per shape (omega, nodes, signed tip, tip radius).
+fn csv(path: &std::path::Path, found: &[StringShape]) -> CliResult<()> {
+    let mut csv = Csv::create(path, &["omega", "nodes", "tip_signed", "tip_radius"])?;
+    for s in found {
+        csv.fields(&[number(s.omega), s.nodes.to_string(), number(s.tip), number(s.tip_radius())])?;
+    }
+    csv.finish()
+}
+
+/// continuum.png: the tip radius of every steady shape against ω (colour: node count),
+/// the critical speeds marked.
+fn diagram(
+    path: &std::path::Path,
+    string: &RotatingString,
+    omega_max: f64,
+    critical: &[f64],
+    radius: f64,
+    length: f64,
+) -> CliResult<()> {
+    fonts();
+    let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
+    let mut points: Vec<(f64, f64, usize)> = Vec::new();
+    for i in 1..=DIAGRAM_SPEEDS {
+        let omega = omega_max * i as f64 / DIAGRAM_SPEEDS as f64;
+        for s in string.sketch_at(omega)? {
+            points.push((omega, s.tip_radius(), s.nodes));
+        }
+    }
+    let root = BitMapBackend::new(path, (760, 520)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let top = points.iter().map(|p| p.1).fold(length, f64::max) * 1.05;
+    let caption = if radius == 0.0 {
+        format!("heavy string of length {} m, top fixed: tip radius of the steady shapes", round(length))
+    } else {
+        format!("heavy string of length {} m, top on a circle of radius {radius} m", round(length))
+    };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 17))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..omega_max, 0.0..top)
+        .map_err(|e| fail(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("ω (rad/s)")
+        .y_desc("tip radius (m)")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    for (k, &w) in critical.iter().enumerate().filter(|(_, w)| **w <= omega_max) {
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(DashedLineSeries::new(vec![(w, 0.0), (w, top)], 6, 5, grey.stroke_width(1)))
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("ω_{}", k + 1),
+                (w, top * 0.97),
+                ("sans-serif", 13),
+            )))
+            .map_err(|e| fail(&e))?;
+    }
+    let most = points.iter().map(|p| p.2).max().unwrap_or(1);
+    for nodes in 1..=most {
+        let c = colour(Some(nodes));
+        chart
+            .draw_series(
+                points.iter().filter(|p| p.2 == nodes).map(|&(w, r, _)| Circle::new((w, r), 2, c.filled())),
+            )
+            .map_err(|e| fail(&e))?
+            .label(if nodes == 1 { "1 node".to_string() } else { format!("{nodes} nodes") })
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    root.present().map_err(|e| fail(&e))
+}
