@@ -1,8 +1,13 @@
 //! The branches of `pendulum steady`, each ending exactly at `ω_max`, with the node count
 //! and the undamped verdict of every point; for a fixed pivot also the vertical.
 
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
 use nalgebra::DVector;
 use pendulum_core::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};
+use rayon::prelude::*;
 
 use super::{Judged, judge, nodes, nodes_name};
 use crate::error::{CliError, CliResult};
@@ -121,10 +126,11 @@ pub fn follow(
             raw.push((name, None, branch));
         }
     }
-    announce(problem, raw.iter().map(|(_, _, b)| b.points.len()).sum());
+    let progress = Progress::new(raw.iter().map(|(_, _, b)| b.points.len()).sum());
+    announce(problem, progress.total);
     let branches = raw
         .into_iter()
-        .map(|(name, critical, branch)| labelled(problem, name, critical, branch))
+        .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &progress))
         .collect::<CliResult<_>>()?;
     Ok(Family { branches, vertical, critical })
 }
@@ -134,23 +140,67 @@ fn announce(problem: &SteadyRotation, points: usize) {
     let n = problem.links();
     if n >= 40 {
         eprintln!(
-            "pendulum: stability of {points} steady shapes, {} eigenvalues each: this takes a while",
+            "pendulum: stability of {points} steady shapes, {} eigenvalues each, on all cores: this takes a while",
             4 * n
         );
     }
 }
 
 /// Node counts and verdicts of every point of `branch` (each verdict a dense eigenvalue
-/// problem of size 4n: seconds for n = 50, a minute for n = 100).
+/// problem of size 4n: seconds for n = 50, half a minute for n = 100), the points judged
+/// in parallel on all cores (each on its own: the same verdicts whatever the threads).
 fn labelled(
     problem: &SteadyRotation,
     name: String,
     critical: Option<f64>,
     branch: Branch,
+    progress: &Progress,
 ) -> CliResult<Labelled> {
     let nodes = branch.points.iter().map(nodes).collect();
-    let judged = branch.points.iter().map(|p| judge(problem, p)).collect::<CliResult<_>>()?;
+    let judged = branch
+        .points
+        .par_iter()
+        .map(|p| {
+            let verdict = judge(problem, p);
+            progress.tick();
+            verdict
+        })
+        .collect::<CliResult<_>>()?;
     Ok(Labelled { name, critical, branch, nodes, judged })
+}
+
+/// How far the stability of the branches' points is: nothing in the first 2 s, then a
+/// line on stderr every 5 s with the points judged and the time to go.
+struct Progress {
+    total: usize,
+    done: AtomicUsize,
+    started: Instant,
+    /// When the last line was printed (the start: the first after 2 s).
+    last: Mutex<Instant>,
+}
+
+impl Progress {
+    fn new(total: usize) -> Self {
+        let started = Instant::now();
+        let first = started.checked_sub(Duration::from_secs(3)).unwrap_or(started);
+        Self { total, done: AtomicUsize::new(0), started, last: Mutex::new(first) }
+    }
+
+    /// One more point judged.
+    fn tick(&self) {
+        let done = self.done.fetch_add(1, Ordering::SeqCst) + 1;
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        if last.elapsed() < Duration::from_secs(5) || done == self.total {
+            return;
+        }
+        *last = Instant::now();
+        let elapsed = self.started.elapsed().as_secs_f64();
+        let to_go = elapsed * (self.total - done) as f64 / done as f64;
+        eprintln!(
+            "pendulum: stability: {done} of {} steady shapes judged, {elapsed:.0} s elapsed, about {to_go:.0} s to go",
+            self.total
+        );
+    }
 }
 
 /// The branch with its last point at exactly `omega_max`: a branch that reached it ends
