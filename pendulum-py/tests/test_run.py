@@ -159,3 +159,20 @@ def test_a_written_run_shows_as_the_viewer_page_in_a_notebook(tmp_path):
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match="holds no run: no run.json"):
         pendulum.page(tmp_path / "empty")
+
+
+def test_the_heavy_string_has_kolodners_speeds_and_the_chains_shapes():
+    string = pendulum.HeavyString(length=1.0, radius=0.02)
+    speeds = string.critical_speeds(3)
+    # (j_0k / 2) sqrt(g / L), with the zeros of J0 to 10 digits.
+    expected = [2.404825558, 5.520078110, 8.653727913]
+    assert np.allclose(speeds, [0.5 * j * np.sqrt(9.81) for j in expected], rtol=1e-9)
+    shapes = string.shapes_at(3.0)
+    assert len(shapes) == 1 and shapes[0]["nodes"] == 1
+    # The 100-link chain's forced shape at 3 rad/s: tip radius 0.0735 m; the string's
+    # within 1/n.
+    assert abs(shapes[0]["tip_radius"] - 0.073534) < 0.02 * 0.073534
+    x, depth = shapes[0]["x"], shapes[0]["depth"]
+    assert x[0] == pytest.approx(0.02) and depth[0] == 0.0 and x.shape == depth.shape
+    with pytest.raises(ValueError, match="string length must be finite and positive, got 0"):
+        pendulum.HeavyString(length=0.0)
