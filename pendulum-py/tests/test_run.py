@@ -115,8 +115,11 @@ def test_an_energy_balance_that_is_off_is_a_runtime_warning():
 
 
 def test_ctrl_c_interrupts_a_long_run_within_a_second():
+    # Python's own Ctrl-C handler, even when started from a shell that ignores SIGINT in
+    # the background (as a CI job may be): then Python would ignore it too.
     code = (
-        "import pendulum, sys\n"
+        "import pendulum, signal, sys\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "run = pendulum.Run(dim=3, n=200, initial='hanging', drive='circle', radius=0.02, omega=6.0,"
         " integrator='rk4', step=1e-4, end=1e4, every=1000)\n"
         "print('started', flush=True)\n"
