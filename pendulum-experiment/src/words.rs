@@ -28,8 +28,9 @@ pub fn chain_words(masses: &[f64], lengths: &[f64], gravity: f64, damping: &[f64
     format!("{each} (L = {} m, M = {} kg), g = {gravity} m/s²{damped}", round(length), round(mass))
 }
 
-/// `x` without the round-off of a sum (12 significant digits).
-fn round(x: f64) -> f64 {
+/// `x` without the round-off of a sum, to be written for a reader (12 significant
+/// digits: a chain of 100 links of 0.01 m is 1 m long, not 1.0000000000000007 m).
+pub fn round(x: f64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }

@@ -7,6 +7,7 @@ use nalgebra::Dyn;
 use pendulum_core::{Chain, RotatingString, StringShape};
 use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number;
+use pendulum_experiment::words::round;
 use plotters::prelude::*;
 
 use super::{DEFAULT_MARGIN, check_omega_max, parse_speeds, plots::colour, round_up};
@@ -73,12 +74,6 @@ pub fn run(args: &SteadyArgs, chain: &Chain<Dyn>) -> CliResult<()> {
         args.out.display()
     );
     Ok(())
-}
-
-/// `x` without the round-off of a sum (12 significant digits).
-fn round(x: f64) -> f64 {
-    let scale = 10f64.powi(11 - x.abs().log10().floor() as i32);
-    (x * scale).round() / scale
 }
 
 /// The shapes on stdout: speed, nodes, tip radius and side.
