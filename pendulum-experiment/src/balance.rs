@@ -63,9 +63,9 @@ impl RunBalance {
     pub fn add(&mut self, energy: f64, ledger: &Ledger, h0: f64) {
         let change = energy - h0;
         let residual = Balance::between(h0, energy, &Ledger::default(), ledger).residual.abs();
-        // NaN compares false: `max` keeps the finite value, so a non-finite residual is
-        // kept explicitly.
-        self.residual = if residual.is_nan() { f64::NAN } else { self.residual.max(residual) };
+        // `max` drops a NaN for the other value: once NaN, the residual stays NaN.
+        self.residual =
+            if residual.is_nan() || self.residual.is_nan() { f64::NAN } else { self.residual.max(residual) };
         for exchanged in [change.abs(), ledger.drive.abs(), ledger.torque.abs(), ledger.damped.abs()] {
             self.scale = self.scale.max(exchanged);
         }
@@ -94,5 +94,22 @@ impl RunBalance {
                 100.0 * BALANCE_TOLERANCE
             )
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_worst_residual_is_kept_and_a_nan_is_never_forgotten() {
+        let mut b = RunBalance::of_scale(100.0);
+        let ledger = Ledger { drive: 1.0, torque: 0.0, damped: 0.5 };
+        b.add(5.3, &ledger, 5.0); // H − H0 − W = 0.3 − 0.5 = −0.2
+        b.add(5.5, &ledger, 5.0); // 0.0
+        assert!((b.residual - 0.2).abs() < 1e-12 && b.scale == 100.0 && !b.is_off());
+        b.add(f64::NAN, &ledger, 5.0);
+        b.add(5.5, &ledger, 5.0);
+        assert!(b.residual.is_nan() && b.is_off() && b.warning().is_some());
     }
 }
