@@ -58,7 +58,8 @@ pub use analysis::{
     Branch, BranchEnd, ContinuationOptions, Linearisation, NormalModes, RelativeEquilibrium, RotatingString,
     Stability, SteadyRotation, SteadyShape, StringShape, Verdict, bernoulli_frequency, bessel_j0_zero,
     equal_link_frequencies, fastest_decay_bound, fastest_frequency_bound, laguerre_zeros, linearise,
-    normal_modes, relative_equilibrium, relative_spectrum, sign_changes, stability,
+    normal_modes, relative_equilibrium, relative_spectrum, relative_spectrum_near_origin, sign_changes,
+    stability, stability_dense,
 };
 pub use analysis::{Lqr, STEADY_TOLERANCE, StateSpace, linearize, lqr};
 pub use analysis::{

@@ -4,7 +4,7 @@
 
 use nalgebra::Dyn;
 use pendulum_core::{
-    BranchEnd, Chain, ContinuationOptions, SteadyRotation, equal_link_frequencies, stability,
+    BranchEnd, Chain, ContinuationOptions, SteadyRotation, equal_link_frequencies, stability, stability_dense,
 };
 
 const J0_ZEROS: [f64; 3] = [2.404825557695773, 5.520078110286311, 8.653727912911013];
@@ -140,7 +140,7 @@ fn rotating_frame_spectrum_matches_the_spatial_model_jacobian() {
     let omega = 1.3 * problem.bifurcation_speeds(3).unwrap()[2];
     for k in 1..=3 {
         let shape = problem.branch(k, omega, &ContinuationOptions::default()).unwrap().points.pop().unwrap();
-        let ours = stability(&problem, &shape, None).unwrap();
+        let ours = stability_dense(&problem, &shape, None).unwrap();
         let (q, qd) = spatial_state(&shape.theta, shape.omega);
         let x0 = nalgebra::DVector::from_iterator(20, q.iter().chain(qd.iter()).copied());
         let inputs = model.zero_inputs();

@@ -127,7 +127,6 @@ pub fn follow(
         }
     }
     let progress = Progress::new(raw.iter().map(|(_, _, b)| b.points.len()).sum());
-    announce(problem, progress.total);
     let branches = raw
         .into_iter()
         .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &progress))
@@ -135,20 +134,9 @@ pub fn follow(
     Ok(Family { branches, vertical, critical })
 }
 
-/// A note on stderr before a slow classification (n ≥ 40: a 4n × 4n spectrum per point).
-fn announce(problem: &SteadyRotation, points: usize) {
-    let n = problem.links();
-    if n >= 40 {
-        eprintln!(
-            "pendulum: stability of {points} steady shapes, {} eigenvalues each, on all cores: this takes a while",
-            4 * n
-        );
-    }
-}
-
-/// Node counts and verdicts of every point of `branch` (each verdict a dense eigenvalue
-/// problem of size 4n: seconds for n = 50, half a minute for n = 100), the points judged
-/// in parallel on all cores (each on its own: the same verdicts whatever the threads).
+/// Node counts and verdicts of every point of `branch` (each verdict `O(n)` work per
+/// Arnoldi step, [`pendulum_core::stability`]: about 1 ms at n = 100), the points judged in
+/// parallel on all cores (each on its own: the same verdicts whatever the threads).
 fn labelled(
     problem: &SteadyRotation,
     name: String,

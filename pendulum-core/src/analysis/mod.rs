@@ -9,16 +9,19 @@
 //! it (`shape`); the state-space linearisation about a steady state from the models'
 //! analytic derivatives (`state_space`) and the LQR gain for it (`lqr`).
 
+pub(crate) mod arnoldi;
 pub(crate) mod bessel;
 pub(crate) mod continuum;
 pub(crate) mod laguerre;
 pub(crate) mod lqr;
 pub(crate) mod modes;
+pub(crate) mod quasiseparable;
 pub(crate) mod relative_equilibrium;
 pub(crate) mod shape;
 pub(crate) mod stability;
 pub(crate) mod state_space;
 pub(crate) mod steady_branches;
+pub(crate) mod turning_pencil;
 
 pub use bessel::bessel_j0_zero;
 pub use continuum::{RotatingString, StringShape};
@@ -28,11 +31,13 @@ pub use modes::{
     NormalModes, bernoulli_frequency, equal_link_frequencies, fastest_decay_bound, fastest_frequency_bound,
     normal_modes, sign_changes,
 };
-pub use relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
+pub use relative_equilibrium::{
+    RelativeEquilibrium, relative_equilibrium, relative_spectrum, relative_spectrum_near_origin,
+};
 pub use shape::{
     NearestSteady, Settling, ShapeOptions, ShapeReport, ShapeTracker, WhirlShape, co_rotating_positions,
     nearest_steady, shape_report, whirl_shape,
 };
-pub use stability::{Linearisation, Stability, Verdict, linearise, stability};
+pub use stability::{Linearisation, Stability, Verdict, linearise, stability, stability_dense};
 pub use state_space::{STEADY_TOLERANCE, StateSpace, linearize};
 pub use steady_branches::{Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape};

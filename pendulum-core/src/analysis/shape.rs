@@ -34,7 +34,7 @@
 //! chain on [`Circle`]`(R, φ̇(t))` nearest the latest shape ([`relative_equilibrium`],
 //! Newton from the latest shape's link angles), its distance to the latest shape
 //! (`max_i |r̃_i − r̃_i^eq|`, m) and its spectrum's largest real part, the growth rate
-//! (1/s, [`relative_spectrum`]); stable when below `growth_tolerance · |ω|`.
+//! (1/s, [`relative_spectrum_near_origin`]); stable when below `growth_tolerance · |ω|`.
 //!
 //! [`SteadyShape::nodes`]: crate::analysis::steady_branches::SteadyShape::nodes
 
@@ -44,7 +44,9 @@ use std::f64::consts::TAU;
 use nalgebra::{DVector, U3, Vector3};
 
 use crate::analysis::modes::sign_changes;
-use crate::analysis::relative_equilibrium::{RelativeEquilibrium, relative_equilibrium, relative_spectrum};
+use crate::analysis::relative_equilibrium::{
+    RelativeEquilibrium, relative_equilibrium, relative_spectrum_near_origin,
+};
 use crate::drive::{Circle, Turning};
 use crate::error::{Error, Result};
 use crate::kinematics::TurningFrame;
@@ -261,7 +263,8 @@ pub struct NearestSteady {
 /// at the drive's radius and speed `φ̇(t)`: Newton ([`relative_equilibrium`]) from the
 /// link angles of `shape` — `u_i = (r̃_i − r̃_{i−1}) / |…|` (`r̃_0 = (R, 0, 0)`),
 /// `θ_i = atan2(u_x, −u_z)`, `ψ_i = asin u_y` — then its spectrum
-/// ([`relative_spectrum`]). Costs `O(n²)` model evaluations and an `O(n³)` eigensolve.
+/// (those eigenvalues that can grow, [`relative_spectrum_near_origin`]). Costs `O(n²)`
+/// model evaluations and dense `2n × 2n` LU factors.
 ///
 /// Errors: [`Error::LengthMismatch`] when `shape` has not one position per link;
 /// [`Error::SteadyNotConverged`] when Newton fails (no steady shape near this one); those
@@ -292,8 +295,10 @@ pub fn nearest_steady<Dr: Turning>(
         .collect();
     let equilibrium = relative_equilibrium(&steady, &guess)?;
     let eq_shape = WhirlShape::from_positions(turned(&steady, 0.0, &equilibrium.state))?;
-    let growth_rate =
-        relative_spectrum(&steady, &equilibrium)?.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    let growth_rate = relative_spectrum_near_origin(&steady, &equilibrium)?
+        .iter()
+        .map(|z| z.re)
+        .fold(f64::NEG_INFINITY, f64::max);
     Ok(NearestSteady {
         omega,
         distance: eq_shape.distance(shape),

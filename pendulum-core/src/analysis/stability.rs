@@ -49,7 +49,10 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+use crate::analysis::arnoldi::{Arnoldi, Ritz};
+use crate::analysis::quasiseparable::Quasiseparable;
 use crate::analysis::steady_branches::{SteadyRotation, SteadyShape};
+use crate::analysis::turning_pencil::{Combination, combination, stiffness_index};
 use crate::error::{Error, Result};
 
 /// The linearised equations `M δq̈ + G δq̇ + H δq = 0` about a steady shape (module
@@ -221,36 +224,241 @@ pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation
     Linearisation { mass, gyroscopic, stiffness }
 }
 
-/// Classify `shape` by the eigenvalues of the linearisation, with damping `λ_i` (N·m·s,
-/// one per link, applied to `θ̇_i` and `ψ̇_i` in the turning frame) or `None`.
+/// Checks damping `λ_i` (N·m·s): one per link, finite and non-negative.
+fn check_damping(damping: Option<&[f64]>, n: usize) -> Result<()> {
+    if let Some(d) = damping {
+        if d.len() != n {
+            return Err(Error::LengthMismatch { what: "damping", expected: n, got: d.len() });
+        }
+        if let Some((i, &v)) = d.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+            return Err(Error::InvalidDamping { link: i + 1, value: v });
+        }
+    }
+    Ok(())
+}
+
+/// The number of eigenvalues of the rotational symmetry set aside (module docs): for free
+/// rotation (`R = 0`) off the vertical, two undamped (a Jordan block), one damped.
+fn symmetry_zeros(problem: &SteadyRotation, shape: &SteadyShape, damped: bool) -> usize {
+    let symmetric = problem.radius() == 0.0 && shape.theta.iter().any(|t| t.sin().abs() > 1e-12);
+    match (symmetric, damped) {
+        (false, _) => 0,
+        (true, false) => 2,
+        (true, true) => 1,
+    }
+}
+
+/// The tolerance (1/s) above which a real part counts as growth: `1e-8` times the larger
+/// of `ω`, `sqrt(g/L)` and the spectrum's size `|ω| + 2 max_a sqrt(|E_a| / (m_a l_a²))`
+/// (the fastest link oscillation, against which round-off in the eigenvalues is measured).
+fn growth_tolerance(problem: &SteadyRotation, shape: &SteadyShape) -> f64 {
+    let (m, l, _) = problem.parameters();
+    let h = combination(problem, shape, None, Combination::STIFFNESS);
+    let w2 = shape.omega * shape.omega;
+    let (_, _, tails) = problem.parameters();
+    let fastest = (0..problem.links())
+        .map(|a| {
+            // E_a = H_θθ,aa + ω² W_aa cos² θ_a.
+            let e = h.diagonal[2 * a] + w2 * tails[a] * l[a] * l[a] * shape.theta[a].cos().powi(2);
+            (e.abs() / (m[a] * l[a] * l[a])).sqrt()
+        })
+        .fold(0.0, f64::max);
+    1e-8 * (shape.omega.abs() + 2.0 * fastest).max(problem.reference_speed())
+}
+
+/// Classify `shape` by the eigenvalues of the linearisation nearest the origin, with
+/// damping `λ_i` (N·m·s, one per link, applied to `θ̇_i` and `ψ̇_i` in the turning frame)
+/// or `None`, in `O(n)` per Arnoldi step.
 ///
-/// Eigenvalues are those of `[[0, I], [−M⁻¹H, −M⁻¹(G + D)]]` (dense Schur, O(n³)),
-/// sorted by modulus; a real part counts as growth when above `1e-8 max(|λ|_max, ω,
-/// sqrt(g/L))`. For free rotation (`R = 0`) off the vertical the smallest eigenvalues
-/// are the rotational symmetry's zeros (two undamped, one damped) and are left out of
-/// the growth rate.
+/// Only eigenvalues near the origin can leave the imaginary axis: an eigenvalue with
+/// `Re λ > 0` has `|λ|² = −p*Hp / p*Mp` (undamped) or less (damped), so it lies among the
+/// modes the amended potential softens. The index of `H` comes from the signs of its
+/// `L D Lᵀ` pivots ([`crate::analysis::turning_pencil`]); the eigenvalues nearest the
+/// origin from shift-and-invert Arnoldi on the quadratic pencil `λ²M + λ(G + D) + H`
+/// (each step one `O(n)` quasiseparable solve), until they account for the whole index:
+/// undamped, `k_r + 2 k_c + 2 k_i⁻ = index` (real, complex-quartet and imaginary
+/// negative-energy eigenvalues, the Krein signature `|λ|² p*Mp + p*Hp < 0`); damped,
+/// `index` eigenvalues in the right half-plane (Kelvin–Tait–Chetaev). Then no other
+/// eigenvalue can grow, and the verdict is that of [`stability_dense`], which computes all
+/// `4n`. `eigenvalues` holds those found (at least 8, sorted by modulus); `growth_rate`
+/// is their largest real part. Falls back to the whole spectrum when the count is not
+/// reached.
 ///
 /// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
-/// [`Error::NotPositiveDefinite`] if `M` fails to factor.
+/// [`Error::NotPositiveDefinite`] if no shift gives a regular pencil.
 pub fn stability(
     problem: &SteadyRotation,
     shape: &SteadyShape,
     damping: Option<&[f64]>,
 ) -> Result<Stability> {
+    nearest_origin(problem, shape, damping, false)
+}
+
+/// The undamped or damped count of eigenvalues the index of `H` accounts for (see
+/// [`stability`]).
+fn counted(found: &[(Complex<f64>, f64)], damped: bool, tolerance: f64) -> usize {
+    found
+        .iter()
+        .map(|&(z, energy)| {
+            if damped {
+                usize::from(z.re > tolerance)
+            } else if z.re > tolerance {
+                if z.im.abs() <= tolerance {
+                    1
+                } else if z.im > 0.0 {
+                    2
+                } else {
+                    0
+                }
+            } else if z.re.abs() <= tolerance && z.im > tolerance && energy < 0.0 {
+                2
+            } else {
+                0
+            }
+        })
+        .sum()
+}
+
+/// [`stability`]; `exhaustive` runs Arnoldi to the whole space (tests of the count).
+pub(crate) fn nearest_origin(
+    problem: &SteadyRotation,
+    shape: &SteadyShape,
+    damping: Option<&[f64]>,
+    exhaustive: bool,
+) -> Result<Stability> {
+    const MIN_FOUND: usize = 8;
+    const CONVERGED: f64 = 1e-10;
     let n = problem.links();
+    check_damping(damping, n)?;
+    let Some(index) = stiffness_index(problem, shape, 1e-9) else {
+        return stability_dense(problem, shape, damping);
+    };
+    let damped = damping.is_some();
+    let zeros = symmetry_zeros(problem, shape, damped);
+    let tolerance = growth_tolerance(problem, shape);
+    let tolerance_scale = tolerance / 1e-8;
+    let mass = combination(problem, shape, damping, Combination::MASS);
+    let velocity = combination(problem, shape, damping, Combination::VELOCITY);
+    let stiffness = combination(problem, shape, damping, Combination::STIFFNESS);
+    let (mut sigma, mut factor) = (1e-2 * problem.reference_speed(), None);
+    for _ in 0..6 {
+        let q = combination(problem, shape, damping, Combination::at(sigma));
+        let scale = q.diagonal.iter().fold(0.0, |a: f64, d| a.max(d.abs()));
+        factor = q.factor().filter(|f| f.pivots().iter().all(|p| p.abs() > 1e-13 * scale)).map(|f| (q, f));
+        if factor.is_some() {
+            break;
+        }
+        sigma *= 1.618;
+    }
+    let Some((pencil, factor)) = factor else { return Err(Error::NotPositiveDefinite) };
+    let size = 2 * n;
+    let (mut t, mut r, mut check) = (vec![0.0; size], vec![0.0; size], vec![0.0; size]);
+    // (A − σ)⁻¹ (b1, b2) = (p, b1 + σ p) with Q(σ) p = −(M (b2 + σ b1) + (G + D) b1), one
+    // step of iterative refinement (the factor is unpivoted).
+    let mut apply = |b: &[f64], out: &mut [f64]| {
+        let (b1, b2) = b.split_at(size);
+        for k in 0..size {
+            t[k] = b2[k] + sigma * b1[k];
+        }
+        mass.mul(&t, &mut r);
+        velocity.mul(b1, &mut t);
+        let (p, v) = out.split_at_mut(size);
+        for k in 0..size {
+            r[k] = -(r[k] + t[k]);
+            p[k] = r[k];
+        }
+        factor.solve(p);
+        pencil.mul(p, &mut check);
+        for k in 0..size {
+            t[k] = r[k] - check[k];
+        }
+        factor.solve(&mut t);
+        for k in 0..size {
+            p[k] += t[k];
+            v[k] = b1[k] + sigma * p[k];
+        }
+    };
+    let quadratic = |q: &Quasiseparable<3>, x: &[Complex<f64>]| -> f64 {
+        let (re, im): (Vec<f64>, Vec<f64>) = x.iter().map(|z| (z.re, z.im)).unzip();
+        let mut y = vec![0.0; x.len()];
+        q.mul(&re, &mut y);
+        let mut sum: f64 = re.iter().zip(&y).map(|(a, b)| a * b).sum();
+        q.mul(&im, &mut y);
+        sum += im.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
+        sum
+    };
+    let dim = 4 * n;
+    let mut arnoldi = Arnoldi::new(dim);
+    let mut steps = if exhaustive { dim } else { (2 * index + 24).min(dim) };
+    loop {
+        arnoldi.extend(steps - arnoldi.steps(), &mut apply);
+        let complete = arnoldi.complete();
+        // The symmetry's zeros form a Jordan block, whose Ritz values converge only to
+        // O(sqrt(ε)): they do not end the run of converged values nearest the origin.
+        let zero = |theta: Complex<f64>| {
+            complete
+                || (zeros > 0 && (Complex::new(sigma, 0.0) + theta.inv()).norm() < 1e-6 * tolerance_scale)
+        };
+        let ritz = arnoldi.ritz(CONVERGED, zero);
+        let converged = ritz.iter().take_while(|r| r.residual <= CONVERGED || zero(r.value));
+        let mut found: Vec<(Complex<f64>, &Ritz)> =
+            converged.map(|r| (Complex::new(sigma, 0.0) + r.value.inv(), r)).collect();
+        found.sort_by(|a, b| a.0.norm().total_cmp(&b.0.norm()));
+        let counted_from = zeros.min(found.len());
+        let energies: Vec<(Complex<f64>, f64)> = found[counted_from..]
+            .iter()
+            .map(|(z, r)| {
+                let needed = !damped && z.re.abs() <= tolerance && z.im > tolerance;
+                let energy = if needed {
+                    let vector = arnoldi.vector(r);
+                    let p = &vector[..size];
+                    z.norm_sqr() * quadratic(&mass, p) + quadratic(&stiffness, p)
+                } else {
+                    0.0
+                };
+                (*z, energy)
+            })
+            .collect();
+        let enough = found.len() >= MIN_FOUND.min(dim) && counted(&energies, damped, tolerance) >= index;
+        if complete || (enough && !exhaustive) {
+            let eigenvalues: Vec<Complex<f64>> = found.iter().map(|(z, _)| *z).collect();
+            let growth_rate =
+                eigenvalues[counted_from..].iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+            return Ok(Stability {
+                eigenvalues,
+                growth_rate,
+                index,
+                spectrally_stable: growth_rate <= tolerance,
+            });
+        }
+        steps = (steps + 16 + steps / 2).min(dim);
+    }
+}
+
+/// Classify `shape` by all `4n` eigenvalues of the linearisation (the reference route of
+/// [`stability`]), with damping `λ_i` (N·m·s, one per link, applied to `θ̇_i` and `ψ̇_i` in
+/// the turning frame) or `None`.
+///
+/// Eigenvalues are those of `[[0, I], [−M⁻¹H, −M⁻¹(G + D)]]` (dense Schur, O(n³)),
+/// sorted by modulus; a real part counts as growth above `1e-8` times the spectrum's size
+/// (see [`stability`]). For free rotation (`R = 0`) off the vertical the smallest
+/// eigenvalues are the rotational symmetry's zeros (two undamped, one damped) and are
+/// left out of the growth rate.
+///
+/// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
+/// [`Error::NotPositiveDefinite`] if `M` fails to factor.
+pub fn stability_dense(
+    problem: &SteadyRotation,
+    shape: &SteadyShape,
+    damping: Option<&[f64]>,
+) -> Result<Stability> {
+    let n = problem.links();
+    check_damping(damping, n)?;
     let lin = linearise(problem, shape);
     let mut friction = lin.gyroscopic.clone();
-    if let Some(d) = damping {
-        if d.len() != n {
-            return Err(Error::LengthMismatch { what: "damping", expected: n, got: d.len() });
-        }
-        for (i, &v) in d.iter().enumerate() {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::InvalidDamping { link: i + 1, value: v });
-            }
-            friction[(i, i)] += v;
-            friction[(n + i, n + i)] += v;
-        }
+    for (i, &v) in damping.unwrap_or(&[]).iter().enumerate() {
+        friction[(i, i)] += v;
+        friction[(n + i, n + i)] += v;
     }
     let chol = lin.mass.clone().cholesky().ok_or(Error::NotPositiveDefinite)?;
     let k = chol.solve(&lin.stiffness);
@@ -264,16 +472,10 @@ pub fn stability(
     // Free rotation off the vertical: turning the shape about the axis is an exact
     // symmetry, a double zero eigenvalue undamped (a Jordan block, split by round-off to
     // O(sqrt(ε)|A|)), a single one damped; it is set aside, not counted as growth.
-    let symmetric = problem.radius() == 0.0 && shape.theta.iter().any(|t| t.sin().abs() > 1e-12);
-    let zeros = match (symmetric, damping.is_some()) {
-        (false, _) => 0,
-        (true, false) => 2,
-        (true, true) => 1,
-    };
+    let zeros = symmetry_zeros(problem, shape, damping.is_some());
     let counted = &eigenvalues[zeros.min(eigenvalues.len())..];
     let growth_rate = counted.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
-    let largest = eigenvalues.last().map_or(0.0, |z| z.norm());
-    let tolerance = 1e-8 * largest.max(shape.omega).max(problem.reference_speed());
+    let tolerance = growth_tolerance(problem, shape);
     let scale = lin.stiffness.amax();
     let h_eigen: DVector<f64> = lin.stiffness.symmetric_eigenvalues();
     let index = h_eigen.iter().filter(|&&v| v < -1e-9 * scale).count();

@@ -48,6 +48,7 @@
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dim, allocator::Allocator};
 
 use crate::analysis::modes::sign_changes;
+use crate::analysis::quasiseparable::Quasiseparable;
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 
@@ -239,6 +240,68 @@ impl SteadyRotation {
         })
     }
 
+    /// The Hessian `H` of [`hessian`](Self::hessian) as a quasiseparable matrix
+    /// (`H_de = −ω² M_d l_d cos θ_d · l_e cos θ_e` below the diagonal, `d > e`), for
+    /// `O(n)` solves and eigenvalue counts.
+    pub(crate) fn hessian_quasiseparable(&self, theta: &DVector<f64>, omega2: f64) -> Quasiseparable<1> {
+        let n = self.links();
+        let s = self.moments(&self.displacements(theta));
+        let mut h = Quasiseparable {
+            diagonal: Vec::with_capacity(n),
+            lower_rows: Vec::with_capacity(n),
+            lower_columns: Vec::with_capacity(n),
+            upper_rows: Vec::with_capacity(n),
+            upper_columns: Vec::with_capacity(n),
+        };
+        for d in 0..n {
+            let (sin, cos) = theta[d].sin_cos();
+            let (l, tail) = (self.lengths[d], self.tails[d]);
+            let c = l * cos;
+            let soft = -omega2 * tail * c;
+            h.diagonal.push(l * (self.gravity * tail * cos + omega2 * sin * s[d]) + soft * c);
+            h.lower_rows.push([soft]);
+            h.lower_columns.push([c]);
+            h.upper_rows.push([c]);
+            h.upper_columns.push([soft]);
+        }
+        h
+    }
+
+    /// Solves `H(θ, ω²) x = b` in `O(n)` ([`hessian_quasiseparable`](Self::hessian_quasiseparable),
+    /// one step of iterative refinement); `None` when a pivot vanishes.
+    fn solve_hessian(&self, theta: &DVector<f64>, omega2: f64, b: &DVector<f64>) -> Option<DVector<f64>> {
+        let h = self.hessian_quasiseparable(theta, omega2);
+        refined(&h, b)
+    }
+
+    /// Solves the bordered system `[H, ∂F/∂p; row] x = b` (`row` of length n + 1, the
+    /// pseudo-arclength equation) in `O(n)`: the border is one more rank of the
+    /// quasiseparable generators. `None` when a pivot vanishes.
+    fn solve_bordered(
+        &self,
+        theta: &DVector<f64>,
+        omega2: f64,
+        row: &DVector<f64>,
+        b: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
+        let n = self.links();
+        let h = self.hessian_quasiseparable(theta, omega2);
+        let dp = self.speed_derivative(theta) * (self.scale * self.scale);
+        let mut q = Quasiseparable::<2> {
+            diagonal: h.diagonal,
+            lower_rows: h.lower_rows.iter().map(|x| [x[0], 0.0]).collect(),
+            lower_columns: h.lower_columns.iter().zip(row.iter()).map(|(y, &t)| [y[0], t]).collect(),
+            upper_rows: h.upper_rows.iter().zip(dp.iter()).map(|(p, &f)| [p[0], f]).collect(),
+            upper_columns: h.upper_columns.iter().map(|z| [z[0], 0.0]).collect(),
+        };
+        q.diagonal.push(row[n]);
+        q.lower_rows.push([0.0, 1.0]);
+        q.lower_columns.push([0.0, 0.0]);
+        q.upper_rows.push([0.0, 0.0]);
+        q.upper_columns.push([0.0, 1.0]);
+        refined(&q, b)
+    }
+
     /// `∂F/∂(ω²) = −l_d cos θ_d S_d`, N·m·s².
     pub fn speed_derivative(&self, theta: &DVector<f64>) -> DVector<f64> {
         let s = self.moments(&self.displacements(theta));
@@ -297,7 +360,7 @@ impl SteadyRotation {
                 iterations: it,
                 residual: self.residual(theta, omega2).norm(),
             };
-            let mut step = self.hessian(&theta, omega2).lu().solve(&(-&f)).ok_or_else(|| fail(&theta))?;
+            let mut step = self.solve_hessian(&theta, omega2, &(-&f)).ok_or_else(|| fail(&theta))?;
             let size = step.amax();
             if !size.is_finite() {
                 return Err(fail(&theta));
@@ -328,15 +391,19 @@ impl SteadyRotation {
     }
 
     /// The number of negative eigenvalues of the Hessian `H(0, ω) = K − ω² W` at the
-    /// vertical: the number of critical speeds below `ω`.
+    /// vertical: the number of critical speeds below `ω` (from `O(n)` pivots).
     pub fn unstable_directions_at_vertical(&self, omega: f64) -> usize {
         let zero = DVector::zeros(self.links());
         let scale = self.force_scale();
-        self.hessian(&zero, omega * omega)
-            .symmetric_eigenvalues()
-            .iter()
-            .filter(|&&v| v < -1e-13 * scale)
-            .count()
+        // Sylvester: the signs of the L D Lᵀ pivots are those of the eigenvalues; a pivot
+        // that vanishes exactly (ω on a critical speed) is nudged to count as zero.
+        let mut h = self.hessian_quasiseparable(&zero, omega * omega);
+        loop {
+            if let Some(factor) = h.factor() {
+                return factor.pivots().iter().filter(|&&v| v < 0.0).count();
+            }
+            h.diagonal.iter_mut().for_each(|d| *d += 1e-15 * scale);
+        }
     }
 
     /// The first `count` speeds (rad/s, ascending) where a branch leaves the vertical:
@@ -397,12 +464,20 @@ impl SteadyRotation {
         let omega_k = self.bifurcation_speeds(k)?[k - 1];
         let n = self.links();
         let zero = DVector::zeros(n);
-        let eigen = self.hessian(&zero, omega_k * omega_k).symmetric_eigen();
-        let (null, _) =
-            eigen.eigenvalues.iter().enumerate().fold((0, f64::INFINITY), |(bi, bv), (i, v)| {
-                if v.abs() < bv { (i, v.abs()) } else { (bi, bv) }
-            });
-        let mut v: DVector<f64> = eigen.eigenvectors.column(null).into_owned();
+        // The null vector by inverse iteration (H is singular to round-off at ω_k).
+        let mut h = self.hessian_quasiseparable(&zero, omega_k * omega_k);
+        let scale = self.force_scale();
+        let factor = loop {
+            match h.factor() {
+                Some(f) => break f,
+                None => h.diagonal.iter_mut().for_each(|d| *d += 1e-15 * scale),
+            }
+        };
+        let mut v = DVector::from_fn(n, |i, _| 1.0 + 0.1 * (i as f64).sin());
+        for _ in 0..3 {
+            factor.solve(v.as_mut_slice());
+            v /= v.norm();
+        }
         let end_x: f64 = v.iter().zip(&self.lengths).map(|(a, l)| a * l).sum();
         if end_x < 0.0 {
             v = -v;
@@ -430,16 +505,15 @@ impl SteadyRotation {
         self.check_guess(&start.theta)?;
         let n = self.links();
         // Tangent: [H  F_p; e_pᵀ] τ = [0; 1], then normalised and signed.
-        let mut a = self.bordered(&start.theta, start.omega * start.omega);
-        a.row_mut(n).fill(0.0);
-        a[(n, n)] = 1.0;
         let mut rhs = DVector::zeros(n + 1);
         rhs[n] = 1.0;
-        let tangent = a.lu().solve(&rhs).ok_or(Error::SteadyNotConverged {
-            omega: start.omega,
-            iterations: 0,
-            residual: self.residual(&start.theta, start.omega * start.omega).norm(),
-        })?;
+        let tangent = self.solve_bordered(&start.theta, start.omega * start.omega, &rhs, &rhs).ok_or(
+            Error::SteadyNotConverged {
+                omega: start.omega,
+                iterations: 0,
+                residual: self.residual(&start.theta, start.omega * start.omega).norm(),
+            },
+        )?;
         let tangent = tangent.normalize() * if increasing { 1.0 } else { -1.0 };
         Ok(self.follow(start.clone(), tangent, omega_max, options))
     }
@@ -466,16 +540,6 @@ impl SteadyRotation {
             }
         }
         found
-    }
-
-    /// The n × (n+1) Jacobian `[H, ∂F/∂p]` in an (n+1) × (n+1) matrix with a zero last row.
-    fn bordered(&self, theta: &DVector<f64>, omega2: f64) -> DMatrix<f64> {
-        let n = self.links();
-        let mut a = DMatrix::zeros(n + 1, n + 1);
-        a.view_mut((0, 0), (n, n)).copy_from(&self.hessian(theta, omega2));
-        let dp = self.speed_derivative(theta) * (self.scale * self.scale);
-        a.view_mut((0, n), (n, 1)).copy_from(&dp);
-        a
     }
 
     /// Pseudo-arclength continuation from `start` along `tangent` (unit, in `(θ, p)`).
@@ -506,12 +570,10 @@ impl SteadyRotation {
             for it in 1..=10 {
                 let theta = z.rows(0, n).into_owned();
                 let omega2 = z[n] * s2;
-                let mut a = self.bordered(&theta, omega2);
-                a.row_mut(n).copy_from(&tangent.transpose());
                 let mut g = DVector::zeros(n + 1);
                 g.rows_mut(0, n).copy_from(&self.residual(&theta, omega2));
                 g[n] = tangent.dot(&(&z - &y)) - h;
-                let Some(step) = a.clone().lu().solve(&(-g)) else { break };
+                let Some(step) = self.solve_bordered(&theta, omega2, &tangent, &(-g)) else { break };
                 if !step.amax().is_finite() || step.amax() > 0.5 {
                     break;
                 }
@@ -521,11 +583,11 @@ impl SteadyRotation {
                         && self.residual(&z.rows(0, n).into_owned(), z[n] * s2).norm() < 1e-12 * scale)
                 {
                     // New tangent from the converged Jacobian, oriented along the old one.
-                    let mut b = self.bordered(&z.rows(0, n).into_owned(), z[n] * s2);
-                    b.row_mut(n).copy_from(&tangent.transpose());
                     let mut rhs = DVector::zeros(n + 1);
                     rhs[n] = 1.0;
-                    if let Some(t) = b.lu().solve(&rhs) {
+                    if let Some(t) =
+                        self.solve_bordered(&z.rows(0, n).into_owned(), z[n] * s2, &tangent, &rhs)
+                    {
                         converged = Some((it, t.normalize()));
                     }
                     break;
@@ -551,6 +613,20 @@ impl SteadyRotation {
             }
         }
     }
+}
+
+/// `Q x = b` by the unpivoted quasiseparable LU and one step of iterative refinement
+/// (`x += Q⁻¹ (b − Q x)`, `O(n)`); `None` when a pivot vanishes or the result is not finite.
+fn refined<const R: usize>(q: &Quasiseparable<R>, b: &DVector<f64>) -> Option<DVector<f64>> {
+    let factor = q.factor()?;
+    let mut x = b.clone();
+    factor.solve(x.as_mut_slice());
+    let mut r = DVector::zeros(b.len());
+    q.mul(x.as_slice(), r.as_mut_slice());
+    let mut correction = b - r;
+    factor.solve(correction.as_mut_slice());
+    x += correction;
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 #[cfg(test)]
