@@ -9,13 +9,14 @@
 //! pivot (`R > 0`): the chain's own damping of the inertial rates (`½ Σ λ_i |u̇_i|²`, as in
 //! `pendulum simulate`); the damped steady shape is the relative equilibrium of the 3D
 //! chain in unit directions on the circling pivot ([`relative_equilibrium`], Newton from
-//! the undamped planar shape), and its verdict is that of [`relative_spectrum`], growth
-//! counted above `1e-6 max(|λ|_max, ω, sqrt(g/L))` (central-difference eigenvalues).
+//! the undamped planar shape), and its verdict is that of the eigenvalues that can grow
+//! ([`relative_spectrum_near_origin`]), growth counted above `1e-6` times the spectrum's
+//! size ([`SteadyRotation::spectrum_scale`]).
 
 use nalgebra::{Dyn, U3, Vector3};
 use pendulum_core::{
-    Chain, Circle, Directions, SteadyRotation, SteadyShape, Verdict, relative_equilibrium, relative_spectrum,
-    stability,
+    Chain, Circle, Directions, SteadyRotation, SteadyShape, Verdict, relative_equilibrium,
+    relative_spectrum_near_origin, stability,
 };
 
 use super::branches::Family;
@@ -114,10 +115,9 @@ fn damped(
     let model = Directions::<U3>::new(chain.clone().with_damping(d)?).with_drive(circle);
     let guess: Vec<(f64, f64)> = shape.theta.iter().map(|&t| (t, 0.0)).collect();
     let Ok(eq) = relative_equilibrium(&model, &guess) else { return Ok(None) };
-    let spectrum = relative_spectrum(&model, &eq)
+    let spectrum = relative_spectrum_near_origin(&model, &eq)
         .map_err(|e| CliError::failed(format!("damped spectrum at ω = {omega} rad/s: {e}")))?;
-    let largest = spectrum.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    let tolerance = 1e-6 * largest.max(omega).max(problem.reference_speed());
+    let tolerance = 1e-6 * problem.spectrum_scale(shape);
     let verdict = Verdict::of_spectrum(&spectrum, None, tolerance);
     let growth_rate = spectrum.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
     // Masses of the damped shape, r_i = (R, 0, 0) + Σ_{j≤i} l_j u_j, against (x_i, 0, z_i).

@@ -191,20 +191,13 @@ impl std::fmt::Display for Verdict {
 /// The linearisation of the 3D equations in the turning frame about `shape` (module docs).
 pub fn linearise(problem: &SteadyRotation, shape: &SteadyShape) -> Linearisation {
     let n = problem.links();
-    let (m, l, tails) = problem.parameters();
-    let g = problem.gravity();
+    let (_, l, tails) = problem.parameters();
     let omega = shape.omega;
     let w2 = omega * omega;
     let theta = &shape.theta;
-    let (sin, cos): (Vec<f64>, Vec<f64>) = theta.iter().map(|t| t.sin_cos()).unzip();
-    let mut s = vec![0.0; n];
-    let mut acc = 0.0;
-    for i in (0..n).rev() {
-        acc += m[i] * shape.displacements[i];
-        s[i] = acc;
-    }
+    let cos: Vec<f64> = theta.iter().map(|t| t.cos()).collect();
     let w = |a: usize, b: usize| tails[a.max(b)] * l[a] * l[b];
-    let e: Vec<f64> = (0..n).map(|a| l[a] * (g * tails[a] * cos[a] + w2 * sin[a] * s[a])).collect();
+    let e = problem.rod_stiffness(theta, &shape.displacements, w2);
     let mut mass = DMatrix::zeros(2 * n, 2 * n);
     let mut gyroscopic = DMatrix::zeros(2 * n, 2 * n);
     let mut stiffness = DMatrix::zeros(2 * n, 2 * n);
@@ -248,22 +241,11 @@ fn symmetry_zeros(problem: &SteadyRotation, shape: &SteadyShape, damped: bool) -
     }
 }
 
-/// The tolerance (1/s) above which a real part counts as growth: `1e-8` times the larger
-/// of `ω`, `sqrt(g/L)` and the spectrum's size `|ω| + 2 max_a sqrt(|E_a| / (m_a l_a²))`
-/// (the fastest link oscillation, against which round-off in the eigenvalues is measured).
+/// The tolerance (1/s) above which a real part counts as growth: `1e-8` times the
+/// spectrum's size ([`SteadyRotation::spectrum_scale`]), against which round-off in the
+/// eigenvalues is measured.
 fn growth_tolerance(problem: &SteadyRotation, shape: &SteadyShape) -> f64 {
-    let (m, l, _) = problem.parameters();
-    let h = combination(problem, shape, None, Combination::STIFFNESS);
-    let w2 = shape.omega * shape.omega;
-    let (_, _, tails) = problem.parameters();
-    let fastest = (0..problem.links())
-        .map(|a| {
-            // E_a = H_θθ,aa + ω² W_aa cos² θ_a.
-            let e = h.diagonal[2 * a] + w2 * tails[a] * l[a] * l[a] * shape.theta[a].cos().powi(2);
-            (e.abs() / (m[a] * l[a] * l[a])).sqrt()
-        })
-        .fold(0.0, f64::max);
-    1e-8 * (shape.omega.abs() + 2.0 * fastest).max(problem.reference_speed())
+    1e-8 * problem.spectrum_scale(shape)
 }
 
 /// Classify `shape` by the eigenvalues of the linearisation nearest the origin, with

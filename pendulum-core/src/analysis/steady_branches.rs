@@ -217,6 +217,19 @@ impl SteadyRotation {
         s
     }
 
+    /// `E_d = l_d (g M_d cos θ_d + ω² sin θ_d S_d)` (N·m): the tension of rod `d` times its
+    /// length, the diagonal of `H` beyond the centrifugal term, for angles `theta` with
+    /// horizontal distances `x` (m) at `ω² = omega2`.
+    pub(crate) fn rod_stiffness(&self, theta: &DVector<f64>, x: &[f64], omega2: f64) -> Vec<f64> {
+        let s = self.moments(x);
+        (0..self.links())
+            .map(|d| {
+                let (sin, cos) = theta[d].sin_cos();
+                self.lengths[d] * (self.gravity * self.tails[d] * cos + omega2 * sin * s[d])
+            })
+            .collect()
+    }
+
     /// The shape equations `F_d = l_d [g M_d sin θ_d − ω² cos θ_d S_d]` (N·m), module docs.
     pub fn residual(&self, theta: &DVector<f64>, omega2: f64) -> DVector<f64> {
         let s = self.moments(&self.displacements(theta));
@@ -228,13 +241,13 @@ impl SteadyRotation {
     /// The Jacobian `∂F/∂θ`, the Hessian of the effective potential (N·m/rad), module docs.
     pub fn hessian(&self, theta: &DVector<f64>, omega2: f64) -> DMatrix<f64> {
         let n = self.links();
-        let s = self.moments(&self.displacements(theta));
-        let (sin, cos): (Vec<f64>, Vec<f64>) = theta.iter().map(|t| t.sin_cos()).unzip();
+        let stiffness = self.rod_stiffness(theta, &self.displacements(theta), omega2);
+        let cos: Vec<f64> = theta.iter().map(|t| t.cos()).collect();
         DMatrix::from_fn(n, n, |d, e| {
             let w = self.tails[d.max(e)] * self.lengths[d] * self.lengths[e];
             let mut h = -omega2 * w * cos[d] * cos[e];
             if d == e {
-                h += self.lengths[d] * (self.gravity * self.tails[d] * cos[d] + omega2 * sin[d] * s[d]);
+                h += stiffness[d];
             }
             h
         })
@@ -245,7 +258,7 @@ impl SteadyRotation {
     /// `O(n)` solves and eigenvalue counts.
     pub(crate) fn hessian_quasiseparable(&self, theta: &DVector<f64>, omega2: f64) -> Quasiseparable<1> {
         let n = self.links();
-        let s = self.moments(&self.displacements(theta));
+        let stiffness = self.rod_stiffness(theta, &self.displacements(theta), omega2);
         let mut h = Quasiseparable {
             diagonal: Vec::with_capacity(n),
             lower_rows: Vec::with_capacity(n),
@@ -254,11 +267,9 @@ impl SteadyRotation {
             upper_columns: Vec::with_capacity(n),
         };
         for d in 0..n {
-            let (sin, cos) = theta[d].sin_cos();
-            let (l, tail) = (self.lengths[d], self.tails[d]);
-            let c = l * cos;
-            let soft = -omega2 * tail * c;
-            h.diagonal.push(l * (self.gravity * tail * cos + omega2 * sin * s[d]) + soft * c);
+            let c = self.lengths[d] * theta[d].cos();
+            let soft = -omega2 * self.tails[d] * c;
+            h.diagonal.push(stiffness[d] + soft * c);
             h.lower_rows.push([soft]);
             h.lower_columns.push([c]);
             h.upper_rows.push([c]);
@@ -300,6 +311,19 @@ impl SteadyRotation {
         q.upper_rows.push([0.0, 0.0]);
         q.upper_columns.push([0.0, 1.0]);
         refined(&q, b)
+    }
+
+    /// The size of the spectrum of `shape`'s linearisation, 1/s, without computing it:
+    /// `max(|ω| + 2 max_a sqrt(|E_a| / (m_a l_a²)), sqrt(g/L))`, with
+    /// `E_a = l_a (g M_a cos θ_a + ω² sin θ_a S_a)` the tension of rod `a` times its length
+    /// (`2 sqrt(E_a / m_a l_a²)` is the fastest oscillation of a link against its
+    /// neighbours).
+    pub fn spectrum_scale(&self, shape: &SteadyShape) -> f64 {
+        let stiffness = self.rod_stiffness(&shape.theta, &shape.displacements, shape.omega * shape.omega);
+        let fastest = (0..self.links())
+            .map(|a| (stiffness[a].abs() / (self.masses[a] * self.lengths[a] * self.lengths[a])).sqrt())
+            .fold(0.0, f64::max);
+        (shape.omega.abs() + 2.0 * fastest).max(self.scale)
     }
 
     /// `∂F/∂(ω²) = −l_d cos θ_d S_d`, N·m·s².

@@ -51,16 +51,10 @@ pub(crate) fn combination(
     c: Combination,
 ) -> Quasiseparable<3> {
     let n = problem.links();
-    let (m, l, tails) = problem.parameters();
-    let g = problem.gravity();
+    let (_, l, tails) = problem.parameters();
     let omega = shape.omega;
     let w2 = omega * omega;
-    let mut s = vec![0.0; n];
-    let mut acc = 0.0;
-    for i in (0..n).rev() {
-        acc += m[i] * shape.displacements[i];
-        s[i] = acc;
-    }
+    let stiffness = problem.rod_stiffness(&shape.theta, &shape.displacements, w2);
     let size = 2 * n;
     let mut q = Quasiseparable {
         diagonal: Vec::with_capacity(size),
@@ -74,7 +68,7 @@ pub(crate) fn combination(
         let (sin, cos) = shape.theta[a].sin_cos();
         let tl = tails[a] * l[a];
         let waa = tl * l[a];
-        let e = l[a] * (g * tails[a] * cos + w2 * sin * s[a]);
+        let e = stiffness[a];
         let d = damping.map_or(0.0, |d| d[a]) * c.damping;
         let gyro = 2.0 * omega * c.gyroscopic;
         // θ_a
