@@ -403,6 +403,7 @@ fn the_continuum_has_the_strings_critical_speeds_and_the_chains_shapes_within_on
         assert!((tip - chain).abs() < 2.0 / 100.0 * chain, "{tip} against the chain's {chain}");
     }
     assert!(std::fs::read(dir.join("continuum.png")).unwrap().starts_with(b"\x89PNG"));
+    assert!(std::fs::read(dir.join("convergence.png")).unwrap().starts_with(b"\x89PNG"));
     // The chain's options that do not apply to the string are refused.
     let out = run_in(&scratch("steady-continuum-bad"), &["steady", "--continuum", "--damping", "0.01"]);
     assert_eq!(out.status.code(), Some(2));

@@ -1,10 +1,11 @@
 //! `pendulum steady --continuum`: Kolodner's heavy rotating string of the chain's length
 //! and gravity ([`RotatingString`]) — its critical speeds, its steady shapes at the
 //! `--omega` speeds (stdout, continuum.csv) and its branches, tip radius against ω up to
-//! `--omega-max` (continuum.png).
+//! `--omega-max` (continuum.png); and how uniform chains of 10 to 1000 links of the same
+//! length and mass approach it (convergence.png).
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, RotatingString, StringShape};
+use pendulum_core::{Chain, RotatingString, SteadyRotation, StringShape};
 use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number;
 use pendulum_experiment::words::round;
@@ -65,8 +66,16 @@ pub fn run(args: &SteadyArgs, chain: &Chain<Dyn>) -> CliResult<()> {
     csv(&args.out.join("continuum.csv"), &found)?;
     let png = args.out.join("continuum.png");
     diagram(&png, &string, omega_max, &critical, args.radius, length)?;
+    let mass: f64 = chain.masses().iter().sum();
+    let tip_speed = speeds.iter().copied().find(|&w| w > critical[0] && args.radius == 0.0);
+    let tip = match tip_speed {
+        Some(w) => string.shapes_at(w)?.into_iter().find(|s| s.nodes == 1),
+        None => None,
+    };
+    let errors = approach(length, mass, chain.gravity(), &critical, tip.as_ref())?;
+    convergence(&args.out.join("convergence.png"), &errors, tip.as_ref().map(|t| t.omega), length)?;
     eprintln!(
-        "pendulum: {} shape{} of the string at {} speed{}; files in {} (continuum.csv, continuum.png)",
+        "pendulum: {} shape{} of the string at {} speed{}; files in {} (continuum.csv, continuum.png, convergence.png)",
         found.len(),
         if found.len() == 1 { "" } else { "s" },
         speeds.len(),
@@ -172,6 +181,137 @@ fn diagram(
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    root.present().map_err(|e| fail(&e))
+}
+
+/// Link counts of the convergence picture.
+const SIZES: [usize; 7] = [10, 20, 50, 100, 200, 500, 1000];
+
+/// One chain of the convergence picture: its link count, the relative errors of its first
+/// three critical speeds against the string's, and of its one-node tip radius (if asked).
+struct Approach {
+    links: usize,
+    speeds: [f64; 3],
+    tip: Option<f64>,
+}
+
+/// The uniform chains of [`SIZES`] links with the string's length `length` (m), mass
+/// `mass` (kg) and gravity: their critical speeds ([`SteadyRotation::bifurcation_speeds`],
+/// O(n) per bisection step) and, for a fixed top, the tip radius of the one-node shape at
+/// the speed of `tip` (Newton from the string's shape), each as `(chain − string) / string`.
+fn approach(
+    length: f64,
+    mass: f64,
+    gravity: f64,
+    critical: &[f64],
+    tip: Option<&StringShape>,
+) -> CliResult<Vec<Approach>> {
+    SIZES
+        .iter()
+        .map(|&n| {
+            let chain = Chain::<Dyn>::uniform(n, mass / n as f64, length / n as f64, gravity)?;
+            let problem = SteadyRotation::new(&chain, 0.0)?;
+            let found = problem.bifurcation_speeds(3.min(n))?;
+            let mut speeds = [f64::NAN; 3];
+            for (k, w) in found.iter().enumerate() {
+                speeds[k] = (w - critical[k]) / critical[k];
+            }
+            let tip = match tip {
+                Some(shape) => {
+                    // The string's points at the link ends, then the link angles between them.
+                    let steps = shape.x.len() - 1;
+                    let at = |i: usize| {
+                        let k = (i * steps + n / 2) / n;
+                        (shape.x[k], shape.depth[k])
+                    };
+                    let guess = nalgebra::DVector::from_fn(n, |i, _| {
+                        let ((x0, d0), (x1, d1)) = (at(i), at(i + 1));
+                        (x1 - x0).atan2(d1 - d0)
+                    });
+                    let found = problem.solve(shape.omega, &guess)?;
+                    let radius = found.displacements.last().map_or(0.0, |x| x.abs());
+                    Some((radius - shape.tip_radius()) / shape.tip_radius())
+                }
+                None => None,
+            };
+            Ok(Approach { links: n, speeds, tip })
+        })
+        .collect()
+}
+
+/// convergence.png: `|chain − string| / string` against the link count on log–log axes,
+/// for the first three critical speeds and the one-node tip radius at `tip_speed`, with the
+/// slope of `1/n`.
+fn convergence(path: &std::path::Path, errors: &[Approach], tip_speed: Option<f64>, length: f64) -> CliResult<()> {
+    fonts();
+    let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
+    let root = BitMapBackend::new(path, (760, 520)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let values = errors.iter().flat_map(|a| a.speeds.iter().copied().chain(a.tip)).filter(|v| v.is_finite() && *v != 0.0);
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v.abs()), hi.max(v.abs())));
+    let (first, last) = (SIZES[0] as f64, SIZES[SIZES.len() - 1] as f64);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("uniform chains of n links against the heavy string of {} m", round(length)),
+            ("sans-serif", 17),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((first * 0.8..last * 1.25).log_scale(), (lo * 0.5..hi * 2.0).log_scale())
+        .map_err(|e| fail(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("links n")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_desc("|chain − string| / string")
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    let mut series: Vec<(String, Vec<(f64, f64)>)> = (0..3)
+        .map(|k| {
+            let points = errors.iter().filter(|a| a.speeds[k].is_finite()).map(|a| (a.links as f64, a.speeds[k].abs()));
+            (format!("critical speed ω_{} (chain below)", k + 1), points.collect())
+        })
+        .collect();
+    if let Some(w) = tip_speed {
+        let points = errors.iter().filter_map(|a| a.tip.map(|t| (a.links as f64, t.abs())));
+        series.push((format!("one-node tip radius at {} rad/s (chain outside)", round(w)), points.collect()));
+    }
+    for (i, (label, points)) in series.into_iter().enumerate() {
+        let c = colour(Some(i + 1));
+        chart
+            .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
+            .map_err(|e| fail(&e))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+        chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(|e| fail(&e))?;
+    }
+    // The slope of an O(1/n) approach, between the curves: a third of the first speed's
+    // error at the first n.
+    if let Some(a) = errors.first().filter(|a| a.speeds[0].is_finite()) {
+        let c0 = a.speeds[0].abs() * first / 3.0;
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(first, c0 / first), (last, c0 / last)],
+                6,
+                5,
+                grey.stroke_width(1),
+            ))
+            .map_err(|e| fail(&e))?
+            .label("slope 1/n")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(1)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
