@@ -1,9 +1,10 @@
 //! Ctrl-C in every command.
 //!
 //! A phase that can stop itself and leave valid files (`simulate`'s run loop, `sweep`'s
-//! runs, `view`'s server) holds a [`StopsItself`] guard: a Ctrl-C then sets
-//! [`INTERRUPTED`] and the phase ends at its next check. Anywhere else (plotting, GIF
-//! encoding, `steady`, `render`) a Ctrl-C exits at once with status 130, after removing the
+//! runs, `view`'s server, `steady`'s judging of the branch points) holds a [`StopsItself`]
+//! guard: a Ctrl-C then sets [`INTERRUPTED`] and the phase ends at its next check.
+//! Anywhere else (plotting, GIF encoding, `steady`'s continuation, `render`) a Ctrl-C exits
+//! at once with status 130, after removing the
 //! partial files registered as [`Partial`]: what was finished before stays, nothing
 //! half-written does. A second Ctrl-C always exits at once.
 

@@ -75,16 +75,16 @@ fn ctrl_c_while_rendering_exits_at_once_without_a_partial_file() {
 #[test]
 fn ctrl_c_in_steady_exits_at_once() {
     let dir = scratch("interrupt-steady");
-    // Several seconds of continuation and spectra.
+    // Several seconds of continuation (O(n) a step, 1000 links, a test build).
     let child = common::pendulum()
         .args([
             "steady",
             "--n",
-            "40",
+            "1000",
             "--lengths",
-            "0.025",
+            "0.001",
             "--masses",
-            "0.025",
+            "0.001",
             "--omega",
             "6",
             "--out",

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::{Judged, judge, nodes, nodes_name};
 use crate::error::{CliError, CliResult};
+use crate::interrupt::{INTERRUPTED, StopsItself};
 
 /// One branch as the command shows it.
 #[derive(Debug, Clone)]
@@ -46,6 +47,9 @@ pub struct Family {
     pub vertical: Vec<(f64, f64, Judged)>,
     /// The critical speeds of the chain on a fixed pivot below `ω_max`, rad/s.
     pub critical: Vec<f64>,
+    /// Ctrl-C cut the judging: `(judged, total)` points; each branch holds its points up
+    /// to the last one judged in a row.
+    pub cut: Option<(usize, usize)>,
 }
 
 /// Follows the branches of `problem` up to exactly `omega_max` (rad/s): for a fixed pivot
@@ -127,11 +131,16 @@ pub fn follow(
         }
     }
     let progress = Progress::new(raw.iter().map(|(_, _, b)| b.points.len()).sum());
-    let branches = raw
+    // Ctrl-C while judging stops the judging; the points judged so far are kept.
+    let stops = StopsItself::enter();
+    let branches: Vec<Labelled> = raw
         .into_iter()
         .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &progress))
         .collect::<CliResult<_>>()?;
-    Ok(Family { branches, vertical, critical })
+    drop(stops);
+    let cut =
+        INTERRUPTED.load(Ordering::SeqCst).then(|| (progress.done.load(Ordering::SeqCst), progress.total));
+    Ok(Family { branches, vertical, critical, cut })
 }
 
 /// Node counts and verdicts of every point of `branch` (each verdict `O(n)` work per
@@ -144,16 +153,24 @@ fn labelled(
     branch: Branch,
     progress: &Progress,
 ) -> CliResult<Labelled> {
-    let nodes = branch.points.iter().map(nodes).collect();
-    let judged = branch
+    let judged: Vec<Option<Judged>> = branch
         .points
         .par_iter()
         .map(|p| {
-            let verdict = judge(problem, p);
+            if INTERRUPTED.load(Ordering::SeqCst) {
+                return Ok(None);
+            }
+            let verdict = judge(problem, p)?;
             progress.tick();
-            verdict
+            Ok(Some(verdict))
         })
         .collect::<CliResult<_>>()?;
+    // After Ctrl-C: the points up to the first one not judged.
+    let kept = judged.iter().take_while(|j| j.is_some()).count();
+    let mut branch = branch;
+    branch.points.truncate(kept);
+    let judged: Vec<Judged> = judged.into_iter().take(kept).flatten().collect();
+    let nodes = branch.points.iter().map(nodes).collect();
     Ok(Labelled { name, critical, branch, nodes, judged })
 }
 

@@ -247,12 +247,20 @@ fn approach(
 /// convergence.png: `|chain − string| / string` against the link count on log–log axes,
 /// for the first three critical speeds and the one-node tip radius at `tip_speed`, with the
 /// slope of `1/n`.
-fn convergence(path: &std::path::Path, errors: &[Approach], tip_speed: Option<f64>, length: f64) -> CliResult<()> {
+fn convergence(
+    path: &std::path::Path,
+    errors: &[Approach],
+    tip_speed: Option<f64>,
+    length: f64,
+) -> CliResult<()> {
     fonts();
     let fail = |e: &dyn std::fmt::Display| drawing_failed(path, e);
     let root = BitMapBackend::new(path, (760, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let values = errors.iter().flat_map(|a| a.speeds.iter().copied().chain(a.tip)).filter(|v| v.is_finite() && *v != 0.0);
+    let values = errors
+        .iter()
+        .flat_map(|a| a.speeds.iter().copied().chain(a.tip))
+        .filter(|v| v.is_finite() && *v != 0.0);
     let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v.abs()), hi.max(v.abs())));
     let (first, last) = (SIZES[0] as f64, SIZES[SIZES.len() - 1] as f64);
     let mut chart = ChartBuilder::on(&root)
@@ -276,7 +284,10 @@ fn convergence(path: &std::path::Path, errors: &[Approach], tip_speed: Option<f6
         .map_err(|e| fail(&e))?;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = (0..3)
         .map(|k| {
-            let points = errors.iter().filter(|a| a.speeds[k].is_finite()).map(|a| (a.links as f64, a.speeds[k].abs()));
+            let points = errors
+                .iter()
+                .filter(|a| a.speeds[k].is_finite())
+                .map(|a| (a.links as f64, a.speeds[k].abs()));
             (format!("critical speed ω_{} (chain below)", k + 1), points.collect())
         })
         .collect();

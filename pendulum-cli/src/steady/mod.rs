@@ -65,12 +65,19 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         }
     };
     let family = branches::follow(&problem, &free, omega_max, args.branches)?;
+    if let Some((judged, total)) = family.cut {
+        create_out(args)?;
+        csv::branches(&args.out.join("branches.csv"), &family, n)?;
+        return Err(CliError::interrupted(format!(
+            "interrupted while judging the steady shapes: {judged} of {total} judged; {} holds \
+             each branch up to its last judged point",
+            args.out.join("branches.csv").display()
+        )));
+    }
     let speeds = listed.unwrap_or_else(|| vec![omega_max]);
     let found = shapes::at(&problem, &chain, &family, &speeds, damping.as_deref())?;
 
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    create_out(args)?;
     let pivot = if args.radius == 0.0 {
         "pivot fixed".to_string()
     } else {
@@ -95,6 +102,13 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Creates `--out`.
+fn create_out(args: &SteadyArgs) -> CliResult<()> {
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
+    })
 }
 
 /// Parses `--omega`: a comma list of finite, non-negative speeds (rad/s), at least one,
