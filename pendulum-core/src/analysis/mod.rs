@@ -7,7 +7,10 @@
 //! with their spectrum (`relative_equilibrium`); the shape a whirled chain takes, seen in
 //! the frame turning with its pivot, whether it settled and the damped steady shape nearest
 //! it (`shape`); the state-space linearisation about a steady state from the models'
-//! analytic derivatives (`state_space`) and the LQR gain for it (`lqr`).
+//! analytic derivatives (`state_space`) and the LQR gain for it (`lqr`). Shared linear
+//! algebra: quasiseparable matrices (O(n) LU, solves and inertia, `quasiseparable`), the
+//! turning-frame linearisation in that form (`turning_pencil`) and shift-and-invert
+//! Arnoldi (`arnoldi`).
 
 pub(crate) mod arnoldi;
 pub(crate) mod bessel;
