@@ -25,6 +25,26 @@ pub fn drawing_failed(path: &Path, e: impl std::fmt::Display) -> CliError {
     CliError::failed(format!("cannot draw {}: {e}", path.display()))
 }
 
+/// The chart's key at `position`: white, framed, 13 px labels.
+pub fn key<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    path: &Path,
+) -> CliResult<()>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(|e| drawing_failed(path, e))
+}
+
 /// Plots the inertial-frame energy `H_in(t)` (J) and the energy the ledger predicts,
 /// `H_in(0) + W_drive + W_torque − E_damped`, against time (s). The two coincide for an
 /// exact integration; for a conservative run both are the flat line `H_in(0)`.

@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use super::{DEFAULT_MARGIN, check_omega_max, parse_speeds, plots::colour, round_up};
 use crate::args::SteadyArgs;
 use crate::error::{CliError, CliResult};
-use crate::plot::{drawing_failed, fonts};
+use crate::plot::{drawing_failed, fonts, key};
 
 /// Speeds of the branch diagram.
 const DIAGRAM_SPEEDS: usize = 240;
@@ -178,14 +178,7 @@ fn diagram(
             .label(if nodes == 1 { "1 node".to_string() } else { format!("{nodes} nodes") })
             .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|e| fail(&e))?;
+    key(&mut chart, SeriesLabelPosition::UpperLeft, path)?;
     root.present().map_err(|e| fail(&e))
 }
 
@@ -320,13 +313,6 @@ fn convergence(
             .label("slope 1/n")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(1)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|e| fail(&e))?;
+    key(&mut chart, SeriesLabelPosition::LowerLeft, path)?;
     root.present().map_err(|e| fail(&e))
 }
