@@ -68,6 +68,7 @@ pub mod record;
 pub mod request;
 pub mod run;
 pub mod run_dir;
+pub mod steady;
 pub mod whirl;
 pub mod words;
 

@@ -3,10 +3,12 @@
 //! `--omega` with its node count and stability (`shapes`), printed (`table`), written as
 //! branches.csv and shapes.csv (`csv`) and drawn as branches.png and shapes.png (`plots`).
 //!
-//! Node count: `1 + ` the sign changes of `x_1 … x_n` ([`SteadyShape::nodes`]: the axis
-//! crossings plus the pivot, the seed's convention); the vertical itself (on the axis, no
-//! crossing to count) is given none. Stability: [`Verdict`] of the undamped 3D
-//! linearisation in the turning frame ([`stability`]); damped, see [`shapes`].
+//! Node count: `1 + ` the sign changes of `x_1 … x_n` ([`pendulum_core::SteadyShape::nodes`]:
+//! the axis crossings plus the pivot, the seed's convention); the vertical itself (on the
+//! axis, no crossing to count) is given none. Stability: [`pendulum_core::Verdict`] of the
+//! undamped 3D linearisation in the turning frame ([`pendulum_core::stability`]); damped,
+//! see [`shapes`]. The branches and verdicts themselves are the run library's
+//! ([`pendulum_experiment::steady`]), shared with the Python package.
 
 pub(crate) mod branches;
 mod continuum;
@@ -15,7 +17,7 @@ pub(crate) mod plots;
 mod shapes;
 mod table;
 
-use pendulum_core::{SteadyRotation, SteadyShape, Verdict, stability};
+use pendulum_core::SteadyRotation;
 
 use crate::args::SteadyArgs;
 use crate::chain_args::{self, chain_of};
@@ -64,8 +66,8 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
             listed.iter().flatten().fold(default, |a, &b| a.max(b))
         }
     };
-    let family = branches::follow(&problem, &free, omega_max, args.branches)?;
-    if let Some((judged, total)) = family.cut {
+    let (family, cut) = branches::follow(&problem, &free, omega_max, args.branches)?;
+    if let Some((judged, total)) = cut {
         create_out(args)?;
         csv::branches(&args.out.join("branches.csv"), &family, n)?;
         return Err(CliError::interrupted(format!(
@@ -165,35 +167,7 @@ fn rate(g: f64) -> String {
     }
 }
 
-/// The node count of a shape, `None` for the vertical (every mass on the axis).
-fn nodes(shape: &SteadyShape) -> Option<usize> {
-    (shape.amplitude() > 0.0).then(|| shape.nodes())
-}
-
-/// `"1 node"`, `"3 nodes"`.
-fn nodes_name(k: usize) -> String {
-    format!("{k} node{}", if k == 1 { "" } else { "s" })
-}
-
-/// The undamped verdict of one shape and the numbers behind it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Judged {
-    /// Stable, gyroscopic (index) or unstable (growth rate).
-    pub verdict: Verdict,
-    /// Negative eigenvalues of the amended potential's Hessian `H`, in and out of the plane.
-    pub index: usize,
-    /// Largest real part of the eigenvalues, 1/s (round-off when not unstable; without the
-    /// rotational symmetry's zeros for a fixed pivot).
-    pub growth_rate: f64,
-}
-
-/// [`stability`] of `shape`, undamped, as a [`Judged`].
-fn judge(problem: &SteadyRotation, shape: &SteadyShape) -> CliResult<Judged> {
-    let st = stability(problem, shape, None).map_err(|e| {
-        CliError::failed(format!("stability of the steady shape at ω = {} rad/s: {e}", shape.omega))
-    })?;
-    Ok(Judged { verdict: st.verdict(), index: st.index, growth_rate: st.growth_rate })
-}
+pub use pendulum_experiment::steady::{Judged, judge, nodes, nodes_name};
 
 #[cfg(test)]
 mod tests {

@@ -18,9 +18,9 @@ use super::config::{SweepConfig, short};
 use super::point::{Outcome, Point};
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
-use crate::steady::branches::{Family, follow};
 use crate::steady::plots::{colour, draw_family, draw_key, family_key, reach};
 use crate::steady::round_up;
+use pendulum_experiment::steady::{Family, follow};
 
 const WIDTH: u32 = 1320;
 const HEIGHT: u32 = 1000;
@@ -96,7 +96,7 @@ pub fn draw(path: &Path, config: &SweepConfig, points: &[Point]) -> CliResult<()
     let family = config.chain().and_then(|chain| {
         let problem = SteadyRotation::new(&chain, config.radius)?;
         let free = SteadyRotation::new(&chain, 0.0)?;
-        follow(&problem, &free, omega_max, None)
+        follow(&problem, &free, omega_max, None, &|_| true)
     });
     let family = match family {
         Ok(f) => Some(f),

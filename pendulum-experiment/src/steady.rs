@@ -1,0 +1,264 @@
+//! The steady shapes of a chain as a front end shows them: the branches up to exactly
+//! `ω_max`, each point with its node count and undamped verdict (for a fixed pivot also the
+//! vertical), and the verdict of one shape ([`judge`]). `pendulum steady` and the Python
+//! package draw, tabulate and write these.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use nalgebra::DVector;
+use pendulum_core::{
+    Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape, Verdict, stability,
+};
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+
+/// The node count of a shape, `None` for the vertical (every mass on the axis).
+pub fn nodes(shape: &SteadyShape) -> Option<usize> {
+    (shape.amplitude() > 0.0).then(|| shape.nodes())
+}
+
+/// `"1 node"`, `"3 nodes"`.
+pub fn nodes_name(k: usize) -> String {
+    format!("{k} node{}", if k == 1 { "" } else { "s" })
+}
+
+/// The undamped verdict of one shape and the numbers behind it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judged {
+    /// Stable, gyroscopic (index) or unstable (growth rate).
+    pub verdict: Verdict,
+    /// Negative eigenvalues of the amended potential's Hessian `H`, in and out of the plane.
+    pub index: usize,
+    /// Largest real part of the eigenvalues found, 1/s (round-off when not unstable;
+    /// without the rotational symmetry's zeros for a fixed pivot).
+    pub growth_rate: f64,
+}
+
+/// [`stability`] of `shape`, undamped, as a [`Judged`].
+///
+/// Errors: [`Error::Failed`] naming the speed when the stability cannot be computed.
+pub fn judge(problem: &SteadyRotation, shape: &SteadyShape) -> Result<Judged> {
+    let st = stability(problem, shape, None).map_err(|e| {
+        Error::failed(format!("stability of the steady shape at ω = {} rad/s: {e}", shape.omega))
+    })?;
+    Ok(Judged { verdict: st.verdict(), index: st.index, growth_rate: st.growth_rate })
+}
+
+/// One branch, named and judged.
+#[derive(Debug, Clone)]
+pub struct Labelled {
+    /// `"2 nodes"` (fixed pivot), `"forced, 1–2 nodes"` (the node counts along it).
+    pub name: String,
+    /// Fixed pivot: the critical speed it leaves the vertical at, rad/s.
+    pub critical: Option<f64>,
+    /// The points in continuation order; the last one at exactly `ω_max` when reached.
+    pub branch: Branch,
+    /// Node count of every point (`None`: the vertical, the bifurcation point).
+    pub nodes: Vec<Option<usize>>,
+    /// Undamped verdict of every point.
+    pub judged: Vec<Judged>,
+}
+
+impl Labelled {
+    /// The point whose node count and verdict the tables and plots show for point `i`:
+    /// `i` itself, or for the bifurcation point (the vertical at a critical speed, where
+    /// `H` is singular) the next point.
+    pub fn shown(&self, i: usize) -> usize {
+        if self.nodes[i].is_none() && i + 1 < self.nodes.len() { i + 1 } else { i }
+    }
+}
+
+/// Everything [`follow`] follows.
+#[derive(Debug, Clone)]
+pub struct Family {
+    /// The branches, numbered from 1 in the tables and CSV files.
+    pub branches: Vec<Labelled>,
+    /// Fixed pivot: the vertical `θ = 0` on the stretches between consecutive critical
+    /// speeds, `(from, to, verdict)` in rad/s (it is a solution at every ω).
+    pub vertical: Vec<(f64, f64, Judged)>,
+    /// The critical speeds of the chain on a fixed pivot below `ω_max`, rad/s.
+    pub critical: Vec<f64>,
+    /// Fixed pivot: branches leaving the vertical below `ω_max` not followed (a `count`
+    /// below their number).
+    pub skipped: usize,
+    /// What the following noticed (a branch ending short of `ω_max`), one line each.
+    pub notes: Vec<String>,
+}
+
+/// Follows the branches of `problem` up to exactly `omega_max` (rad/s): for a fixed pivot
+/// the `count` lowest from the vertical (default: every one leaving it below
+/// `omega_max`); for a circling pivot the branch from rest (`ω = 0`) and those through the
+/// free chain's shapes at `omega_max` (`free`, the same chain on a fixed pivot) on either
+/// side of the axis, followed downward (they fold back up). Every point gets its node
+/// count and undamped verdict ([`judge`]), in parallel on all cores; `judged(total)` is
+/// called after each (from any thread, `total` the points to judge) and returning `false`
+/// stops the judging: each branch then
+/// keeps its points up to the first one not judged (a front end's progress and Ctrl-C).
+///
+/// Errors: [`Error::Invalid`] for a `count` outside `1..=n`; those of the continuation and
+/// of [`judge`].
+pub fn follow(
+    problem: &SteadyRotation,
+    free: &SteadyRotation,
+    omega_max: f64,
+    count: Option<usize>,
+    judged: &(dyn Fn(usize) -> bool + Sync),
+) -> Result<Family> {
+    let n = problem.links();
+    let options = ContinuationOptions::default();
+    let below = free.unstable_directions_at_vertical(omega_max).min(n);
+    let critical = free.bifurcation_speeds(below)?;
+    let mut raw: Vec<(String, Option<f64>, Branch)> = Vec::new();
+    let mut notes = Vec::new();
+    let mut skipped = 0;
+    let mut vertical = Vec::new();
+    if problem.radius() == 0.0 {
+        if let Some(count) = count
+            && (count == 0 || count > n)
+        {
+            return Err(Error::invalid(format!(
+                "the number of branches must be between 1 and n = {n}, got {count}"
+            )));
+        }
+        let count = count.unwrap_or(below);
+        skipped = below.saturating_sub(count);
+        for (k, &speed) in problem.bifurcation_speeds(count)?.iter().enumerate() {
+            if speed >= omega_max {
+                continue;
+            }
+            let branch =
+                end_exactly(problem, problem.branch(k + 1, omega_max, &options)?, omega_max, &mut notes);
+            raw.push((nodes_name(k + 1), Some(speed), branch));
+        }
+        let mut ends = vec![0.0];
+        ends.extend(critical.iter().copied());
+        ends.push(omega_max);
+        for pair in ends.windows(2) {
+            let middle = problem.shape(0.5 * (pair[0] + pair[1]), DVector::zeros(n));
+            vertical.push((pair[0], pair[1], judge(problem, &middle)?));
+        }
+    } else {
+        // The forced branch from rest: hanging below the pivot, pushed out as ω grows.
+        let start = problem.solve(0.0, &DVector::zeros(n))?;
+        let from_rest = problem.continue_from(&start, true, omega_max, &options)?;
+        let mut found = vec![end_exactly(problem, from_rest, omega_max, &mut notes)];
+        // The branches not connected to rest (they fold back): from the free chain's shapes
+        // at omega_max, on either side of the axis, followed downward.
+        for k in 1..=below {
+            let Ok(free_branch) = free.branch(k, omega_max, &options) else { continue };
+            let Some(shape) = free_branch.points.last() else { continue };
+            for sign in [1.0, -1.0] {
+                let Ok(start) = problem.solve(omega_max, &(&shape.theta * sign)) else { continue };
+                if found.iter().any(|b| on_branch(b, &start, omega_max)) {
+                    continue;
+                }
+                if let Ok(branch) = problem.continue_from(&start, false, omega_max, &options) {
+                    found.push(end_exactly(problem, branch, omega_max, &mut notes));
+                }
+            }
+        }
+        for branch in found {
+            let counts: Vec<usize> = branch.points.iter().filter_map(nodes).collect();
+            let (lo, hi) = counts.iter().fold((usize::MAX, 0), |(lo, hi), &k| (lo.min(k), hi.max(k)));
+            let name = if lo >= hi {
+                format!("forced, {}", nodes_name(hi))
+            } else {
+                format!("forced, {lo}–{hi} nodes")
+            };
+            raw.push((name, None, branch));
+        }
+    }
+    let total = raw.iter().map(|(_, _, b)| b.points.len()).sum();
+    let judged_one = || judged(total);
+    let branches = raw
+        .into_iter()
+        .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &judged_one))
+        .collect::<Result<_>>()?;
+    Ok(Family { branches, vertical, critical, skipped, notes })
+}
+
+/// Node counts and verdicts of every point of `branch` (each verdict `O(n)` work per
+/// Arnoldi step, [`pendulum_core::stability`]: about 1 ms at n = 100), the points judged in
+/// parallel on all cores (each on its own: the same verdicts whatever the threads).
+fn labelled(
+    problem: &SteadyRotation,
+    name: String,
+    critical: Option<f64>,
+    branch: Branch,
+    judged_one: &(dyn Fn() -> bool + Sync),
+) -> Result<Labelled> {
+    let stop = AtomicBool::new(false);
+    let judged: Vec<Option<Judged>> = branch
+        .points
+        .par_iter()
+        .map(|p| {
+            if stop.load(Ordering::SeqCst) {
+                return Ok(None);
+            }
+            let verdict = judge(problem, p)?;
+            if !judged_one() {
+                stop.store(true, Ordering::SeqCst);
+            }
+            Ok(Some(verdict))
+        })
+        .collect::<Result<_>>()?;
+    // Stopped: the points up to the first one not judged.
+    let kept = judged.iter().take_while(|j| j.is_some()).count();
+    let mut branch = branch;
+    branch.points.truncate(kept);
+    let judged: Vec<Judged> = judged.into_iter().take(kept).flatten().collect();
+    let nodes = branch.points.iter().map(nodes).collect();
+    Ok(Labelled { name, critical, branch, nodes, judged })
+}
+
+/// The branch with its last point at exactly `omega_max`: a branch that reached it ends
+/// one step past it, and that point is replaced by Newton's solution at `omega_max` from
+/// the linear interpolation of the last two points' angles (dropped, with a note, if
+/// Newton fails or lands on another shape).
+fn end_exactly(
+    problem: &SteadyRotation,
+    mut branch: Branch,
+    omega_max: f64,
+    notes: &mut Vec<String>,
+) -> Branch {
+    let len = branch.points.len();
+    if branch.end != BranchEnd::ReachedOmega || len < 2 || branch.points[len - 1].omega <= omega_max {
+        return branch;
+    }
+    let (a, b) = (&branch.points[len - 2], &branch.points[len - 1]);
+    let s = (omega_max - a.omega) / (b.omega - a.omega);
+    let guess = &a.theta * (1.0 - s) + &b.theta * s;
+    let step = (&b.theta - &a.theta).amax();
+    match problem.solve(omega_max, &guess) {
+        Ok(shape) if (&shape.theta - &guess).amax() <= step + 1e-3 => branch.points[len - 1] = shape,
+        _ => {
+            branch.points.pop();
+            notes.push(format!(
+                "a branch ends at ω = {} rad/s, short of ω_max (no shape solved at {omega_max})",
+                branch.points[len - 2].omega
+            ));
+        }
+    }
+    branch
+}
+
+/// `shape` lies on `branch`: at one of its points (1e-6 rad), or on a segment between two
+/// of them (same ω range, angles within 0.02 rad of the linear interpolation: continuation
+/// steps are coarse, distinct branches are much farther apart).
+fn on_branch(branch: &Branch, shape: &SteadyShape, omega_max: f64) -> bool {
+    let at_point = |p: &SteadyShape| {
+        (p.omega - shape.omega).abs() < 1e-6 * omega_max && (&p.theta - &shape.theta).amax() < 1e-6
+    };
+    branch.points.iter().any(at_point) || branch.points.windows(2).any(|w| near_segment(&w[0], &w[1], shape))
+}
+
+fn near_segment(a: &SteadyShape, b: &SteadyShape, shape: &SteadyShape) -> bool {
+    let (lo, hi) = if a.omega <= b.omega { (a, b) } else { (b, a) };
+    if !(lo.omega <= shape.omega && shape.omega <= hi.omega) || hi.omega == lo.omega {
+        return false;
+    }
+    let s = (shape.omega - lo.omega) / (hi.omega - lo.omega);
+    let interpolated = &lo.theta * (1.0 - s) + &hi.theta * s;
+    (&interpolated - &shape.theta).amax() < 0.02
+}
