@@ -13,6 +13,30 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 
+/// Margin of the default `ω_max` over the third critical speed (below the fourth for
+/// uniform chains: ω_4/ω_3 = 1.37 at n = 12, 1.36 in the continuum).
+pub const DEFAULT_MARGIN: f64 = 1.25;
+
+/// `x > 0` rounded up to three significant digits (`15.2268 → 15.3`), the nearest `f64`
+/// to that decimal.
+pub fn round_up(x: f64) -> f64 {
+    let decimals = 2 - x.log10().floor() as i32;
+    let scale = 10f64.powi(decimals);
+    let up = (x * scale * (1.0 - 1e-15)).ceil();
+    if decimals >= 0 { (up / scale).max(x) } else { (up * 10f64.powi(-decimals)).max(x) }
+}
+
+/// The default `ω_max` (rad/s): [`DEFAULT_MARGIN`] times the third critical speed of
+/// `free` (the chain on a fixed pivot; the n-th if n < 3), [`round_up`], or the largest of
+/// `listed` if higher.
+///
+/// Errors: those of [`SteadyRotation::bifurcation_speeds`].
+pub fn default_omega_max(free: &SteadyRotation, listed: &[f64]) -> Result<f64> {
+    let speeds = free.bifurcation_speeds(free.links().min(3))?;
+    let default = round_up(DEFAULT_MARGIN * speeds[speeds.len() - 1]);
+    Ok(listed.iter().fold(default, |a, &b| a.max(b)))
+}
+
 /// The node count of a shape, `None` for the vertical (every mass on the axis).
 pub fn nodes(shape: &SteadyShape) -> Option<usize> {
     (shape.amplitude() > 0.0).then(|| shape.nodes())
@@ -210,6 +234,57 @@ fn labelled(
     let judged: Vec<Judged> = judged.into_iter().take(kept).flatten().collect();
     let nodes = branch.points.iter().map(nodes).collect();
     Ok(Labelled { name, critical, branch, nodes, judged })
+}
+
+/// One steady shape at one asked speed.
+#[derive(Debug, Clone)]
+pub struct AtSpeed {
+    /// The branch's number (from 1, in the family's order), 0 for the vertical.
+    pub branch: usize,
+    /// Its name (`"vertical"` for the vertical).
+    pub name: String,
+    /// The shape, at exactly the asked speed.
+    pub shape: SteadyShape,
+    /// Node count (`None`: the vertical).
+    pub nodes: Option<usize>,
+    /// Undamped verdict.
+    pub judged: Judged,
+}
+
+impl AtSpeed {
+    /// Tip radius `|x_n|`, m: the free end's distance from the axis.
+    pub fn tip_radius(&self) -> f64 {
+        self.shape.displacements.last().map_or(0.0, |x| x.abs())
+    }
+}
+
+/// Every steady shape at each of `speeds` (rad/s) on the branches of `family` (and the
+/// vertical for a fixed pivot), speeds in the order given, branches in their order, each
+/// judged undamped. For a fixed pivot the mirror image `θ → −θ` of a shape is the same
+/// shape turned by π about the axis and is not listed again.
+///
+/// Errors: those of [`judge`].
+pub fn shapes_at(problem: &SteadyRotation, family: &Family, speeds: &[f64]) -> Result<Vec<AtSpeed>> {
+    let n = problem.links();
+    let mut found = Vec::new();
+    for &omega in speeds {
+        let mut here: Vec<(usize, String, SteadyShape)> = Vec::new();
+        if problem.radius() == 0.0 {
+            here.push((0, "vertical".into(), problem.shape(omega, DVector::zeros(n))));
+        }
+        for (b, labelled) in family.branches.iter().enumerate() {
+            for shape in problem.solutions_at(std::slice::from_ref(&labelled.branch), omega) {
+                if here.iter().all(|(_, _, s)| (&s.theta - &shape.theta).amax() > 1e-8) {
+                    here.push((b + 1, labelled.name.clone(), shape));
+                }
+            }
+        }
+        for (branch, name, shape) in here {
+            let judged = judge(problem, &shape)?;
+            found.push(AtSpeed { branch, name, nodes: nodes(&shape), shape, judged });
+        }
+    }
+    Ok(found)
 }
 
 /// The branch with its last point at exactly `omega_max`: a branch that reached it ends

@@ -24,10 +24,6 @@ use crate::chain_args::{self, chain_of};
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
 
-/// Margin of the default `--omega-max` over the third critical speed (below the fourth for
-/// uniform chains: ω_4/ω_3 = 1.37 at n = 12, 1.36 in the continuum).
-pub(crate) const DEFAULT_MARGIN: f64 = 1.25;
-
 /// Runs `pendulum steady`.
 pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     let chain = chain_of(&args.chain)?;
@@ -60,11 +56,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
             }
             w
         }
-        None => {
-            let speeds = free.bifurcation_speeds(n.min(3))?;
-            let default = round_up(DEFAULT_MARGIN * speeds[speeds.len() - 1]);
-            listed.iter().flatten().fold(default, |a, &b| a.max(b))
-        }
+        None => default_omega_max(&free, listed.as_deref().unwrap_or(&[]))?,
     };
     let (family, cut) = branches::follow(&problem, &free, omega_max, args.branches)?;
     if let Some((judged, total)) = cut {
@@ -147,15 +139,6 @@ pub(crate) fn check_omega_max(omega_max: f64) -> CliResult<()> {
     }
 }
 
-/// `x > 0` rounded up to three significant digits (`15.2268 → 15.3`), the nearest `f64`
-/// to that decimal.
-pub(crate) fn round_up(x: f64) -> f64 {
-    let decimals = 2 - x.log10().floor() as i32;
-    let scale = 10f64.powi(decimals);
-    let up = (x * scale * (1.0 - 1e-15)).ceil();
-    if decimals >= 0 { (up / scale).max(x) } else { (up * 10f64.powi(-decimals)).max(x) }
-}
-
 /// A rate (1/s) to three significant digits, in exponent form below 1e-3 and from 1e4 on.
 fn rate(g: f64) -> String {
     let magnitude = g.abs();
@@ -167,7 +150,7 @@ fn rate(g: f64) -> String {
     }
 }
 
-pub use pendulum_experiment::steady::{Judged, judge, nodes, nodes_name};
+pub use pendulum_experiment::steady::{DEFAULT_MARGIN, Judged, default_omega_max, nodes_name, round_up};
 
 #[cfg(test)]
 mod tests {

@@ -20,30 +20,24 @@ use pendulum_core::{
 };
 
 use super::branches::Family;
-use super::{Judged, judge, nodes};
 use crate::error::{CliError, CliResult};
+use pendulum_experiment::steady::AtSpeed;
 
-/// One steady shape at one listed speed.
+/// One steady shape at one listed speed ([`AtSpeed`]: branch, name, shape, nodes,
+/// undamped verdict) and, with damping, its damped verdict.
 #[derive(Debug, Clone)]
 pub struct Found {
-    /// The branch's number in the tables and CSV files, 0 for the vertical.
-    pub branch: usize,
-    /// Its name (`"vertical"` for the vertical).
-    pub name: String,
-    /// The shape, at exactly the listed speed.
-    pub shape: SteadyShape,
-    /// Node count (`None`: the vertical).
-    pub nodes: Option<usize>,
-    /// Undamped verdict.
-    pub judged: Judged,
+    /// The shape and its undamped verdict.
+    pub at: AtSpeed,
     /// With damping: the damped verdict, `None` if no damped steady shape was found.
     pub damped: Option<Damped>,
 }
 
-impl Found {
-    /// Tip radius `|x_n|`, m: the free end's distance from the axis.
-    pub fn tip_radius(&self) -> f64 {
-        self.shape.displacements.last().map_or(0.0, |x| x.abs())
+impl std::ops::Deref for Found {
+    type Target = AtSpeed;
+
+    fn deref(&self) -> &AtSpeed {
+        &self.at
     }
 }
 
@@ -70,30 +64,16 @@ pub fn at(
     speeds: &[f64],
     damping: Option<&[f64]>,
 ) -> CliResult<Vec<Found>> {
-    let n = problem.links();
-    let mut found = Vec::new();
-    for &omega in speeds {
-        let mut here: Vec<(usize, String, SteadyShape)> = Vec::new();
-        if problem.radius() == 0.0 {
-            here.push((0, "vertical".into(), problem.shape(omega, nalgebra::DVector::zeros(n))));
-        }
-        for (b, labelled) in family.branches.iter().enumerate() {
-            for shape in problem.solutions_at(std::slice::from_ref(&labelled.branch), omega) {
-                if here.iter().all(|(_, _, s)| (&s.theta - &shape.theta).amax() > 1e-8) {
-                    here.push((b + 1, labelled.name.clone(), shape));
-                }
-            }
-        }
-        for (branch, name, shape) in here {
-            let judged = judge(problem, &shape)?;
+    pendulum_experiment::steady::shapes_at(problem, family, speeds)?
+        .into_iter()
+        .map(|s| {
             let damped = match damping {
-                Some(d) => damped(problem, chain, &shape, d)?,
+                Some(d) => damped(problem, chain, &s.shape, d)?,
                 None => None,
             };
-            found.push(Found { branch, name, nodes: nodes(&shape), shape, judged, damped });
-        }
-    }
-    Ok(found)
+            Ok(Found { at: s, damped })
+        })
+        .collect()
 }
 
 /// The damped verdict of `shape` (module docs); `None` when Newton finds no damped
