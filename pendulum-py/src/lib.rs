@@ -1,6 +1,6 @@
 //! `import pendulum`: the library from Python. Thin glue: chains and models evaluated on
 //! numpy arrays (a leading batch axis: many states in one call), the run description of
-//! `pendulum-experiment` with its run loop, the normal modes and linearisation, the heavy string the chain approaches. No physics here;
+//! `pendulum-experiment` with its run loop, the normal modes and linearisation, the steady shapes and the heavy string the chain approaches. No physics here;
 //! every long call releases the GIL and answers Ctrl-C with `KeyboardInterrupt`.
 
 mod arrays;
@@ -8,6 +8,7 @@ mod chain;
 mod errors;
 mod page;
 mod run;
+mod steady;
 mod string;
 
 use pyo3::prelude::*;
@@ -21,5 +22,6 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::RunResult>()?;
     m.add_class::<string::HeavyString>()?;
     m.add_function(wrap_pyfunction!(page::page, m)?)?;
+    m.add_function(wrap_pyfunction!(steady::steady, m)?)?;
     Ok(())
 }

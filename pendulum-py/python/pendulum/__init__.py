@@ -7,6 +7,9 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).
+- ``steady(chain, ...)``: the steady shapes of the chain turning about the vertical, as
+  ``pendulum steady`` finds them: branches with every point's nodes and stability, and
+  every shape at the asked speeds.
 - ``HeavyString``: Kolodner's heavy rotating string, the continuum a uniform chain of many
   links approaches: its critical speeds and steady shapes (fixed or circling top).
 - ``page(directory)``: the self-contained page of ``pendulum view`` for a run written with
@@ -16,7 +19,17 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 SI units throughout, angles in radians. See ``docs/python.md`` in the repository.
 """
 
-from ._pendulum import Chain, HeavyString, Run, RunResult, __version__, page
+from ._pendulum import Chain, HeavyString, Run, RunResult, __version__, page, steady
 from ._plots import plot_ledger, plot_shape
 
-__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "plot_ledger", "plot_shape"]
+__all__ = [
+    "Chain",
+    "HeavyString",
+    "Run",
+    "RunResult",
+    "__version__",
+    "page",
+    "plot_ledger",
+    "plot_shape",
+    "steady",
+]

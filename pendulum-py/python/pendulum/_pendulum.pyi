@@ -7,12 +7,20 @@ from typing import Any, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page"]
+__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady"]
 __version__: str
 
 _Array = npt.NDArray[np.float64]
 
 def page(directory: Union[str, PathLike[str]], frames: int = ...) -> str: ...
+def steady(
+    chain: Chain,
+    *,
+    radius: float = ...,
+    omega: Union[float, Sequence[float], None] = ...,
+    omega_max: Optional[float] = ...,
+    branches: Optional[int] = ...,
+) -> dict[str, Any]: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
 
 @final

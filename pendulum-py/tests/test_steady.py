@@ -1,0 +1,83 @@
+"""pendulum.steady: the steady shapes of a chain, as `pendulum steady` finds them."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import pendulum
+
+
+def test_the_readme_chain_has_the_clis_branches_and_shapes():
+    # `pendulum steady --n 12 --lengths 0.1 --omega 5,10,15` (docs/rotating-chain.md).
+    chain = pendulum.Chain(masses=[1.0] * 12, lengths=[0.1] * 12, gravity=9.81)
+    found = pendulum.steady(chain, omega=[5.0, 10.0, 15.0])
+    assert found["omega_max"] == 15.3
+    assert np.allclose(found["critical_speeds"], [3.369323, 7.746832, 12.181423], atol=5e-7)
+    names = [b["name"] for b in found["branches"]]
+    assert names == ["1 node", "2 nodes", "3 nodes"]
+    one = found["branches"][0]
+    assert one["theta"].shape == (len(one["omega"]), 12) and one["x"].shape == one["theta"].shape
+    assert one["omega"][-1] == 15.3 and set(one["stability"][1:]) == {"stable"}
+    # The two-node branch turns unstable between 12.314 and 12.800 rad/s.
+    two = found["branches"][1]
+    unstable = two["omega"][np.array(two["stability"]) == "unstable"]
+    assert 12.3 < unstable.min() and unstable.max() < 12.81
+    at_15 = [s for s in found["shapes"] if s["omega"] == 15.0]
+    assert [s["name"] for s in at_15] == ["vertical", "1 node", "2 nodes", "3 nodes"]
+    assert [s["stability"] for s in at_15] == ["gyroscopic", "stable", "gyroscopic", "unstable"]
+    assert [s["index"] for s in at_15] == [6, 0, 2, 4]
+    assert np.allclose([s["tip_radius"] for s in at_15], [0.0, 1.198511, 0.337183, 0.110662], atol=5e-7)
+    assert at_15[3]["growth_rate"] == pytest.approx(0.0209, abs=5e-5)
+    assert at_15[0]["nodes"] is None and at_15[1]["nodes"] == 1
+    assert found["vertical"][0][:3] == (0.0, pytest.approx(3.369323, abs=5e-7), "stable")
+
+
+def test_a_circling_pivot_has_the_forced_branches():
+    chain = pendulum.Chain(masses=[1.0] * 12, lengths=[0.1] * 12)
+    found = pendulum.steady(chain, radius=0.05, omega=10.0)
+    assert found["branches"][0]["name"] == "forced, 1 node" and found["vertical"] == []
+    # At 10 rad/s (docs): in phase (stable), its mirror (unstable, index 1), the small
+    # two-node response (gyroscopic, index 2), two three-node shapes.
+    verdicts = sorted((s["stability"], s["index"]) for s in found["shapes"])
+    assert ("stable", 0) in verdicts and ("unstable", 1) in verdicts and ("gyroscopic", 2) in verdicts
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"branches": 0}, "branches must be between 1 and n = 12, got 0"),
+        ({"omega": [5.0, 30.0], "omega_max": 20.0}, "omega: 30 rad/s is above omega_max = 20 rad/s"),
+        ({"omega": -1.0}, "omega: -1 rad/s is not a finite, non-negative speed"),
+        ({"radius": 0.05, "branches": 2}, "branches applies to a fixed pivot"),
+        ({"radius": -0.1}, "radius"),
+    ],
+)
+def test_bad_requests_are_value_errors(kwargs, message):
+    chain = pendulum.Chain(masses=[1.0] * 12, lengths=[0.1] * 12)
+    with pytest.raises(ValueError, match=message):
+        pendulum.steady(chain, **kwargs)
+
+
+def test_ctrl_c_interrupts_a_long_steady_within_a_second():
+    code = (
+        "import pendulum, signal, sys\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "chain = pendulum.Chain(masses=[1e-4] * 10000, lengths=[1e-4] * 10000)\n"
+        "print('started', flush=True)\n"
+        "try:\n    pendulum.steady(chain, omega=6.0)\nexcept KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n    sys.exit(3)\n"
+    )
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(1.0)
+    sent = time.monotonic()
+    os.kill(child.pid, signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    elapsed = time.monotonic() - sent
+    assert child.returncode == 3 and "interrupted" in out, (child.returncode, out)
+    assert elapsed < 1.0, f"KeyboardInterrupt {elapsed:.2f} s after SIGINT"
