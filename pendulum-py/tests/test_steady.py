@@ -1,15 +1,10 @@
 """pendulum.steady: the steady shapes of a chain, as `pendulum steady` finds them."""
 
-import os
-import signal
-import subprocess
-import sys
-import time
-
 import numpy as np
 import pytest
 
 import pendulum
+from conftest import assert_ctrl_c_interrupts
 
 
 def test_the_readme_chain_has_the_clis_branches_and_shapes():
@@ -64,20 +59,7 @@ def test_bad_requests_are_value_errors(kwargs, message):
 
 
 def test_ctrl_c_interrupts_a_long_steady_within_a_second():
-    code = (
-        "import pendulum, signal, sys\n"
-        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
-        "chain = pendulum.Chain(masses=[1e-4] * 10000, lengths=[1e-4] * 10000)\n"
-        "print('started', flush=True)\n"
-        "try:\n    pendulum.steady(chain, omega=6.0)\nexcept KeyboardInterrupt:\n"
-        "    print('interrupted', flush=True)\n    sys.exit(3)\n"
+    assert_ctrl_c_interrupts(
+        "chain = pendulum.Chain(masses=[1e-4] * 10000, lengths=[1e-4] * 10000)",
+        "pendulum.steady(chain, omega=6.0)",
     )
-    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
-    assert child.stdout.readline().strip() == "started"
-    time.sleep(1.0)
-    sent = time.monotonic()
-    os.kill(child.pid, signal.SIGINT)
-    out, _ = child.communicate(timeout=60)
-    elapsed = time.monotonic() - sent
-    assert child.returncode == 3 and "interrupted" in out, (child.returncode, out)
-    assert elapsed < 1.0, f"KeyboardInterrupt {elapsed:.2f} s after SIGINT"
