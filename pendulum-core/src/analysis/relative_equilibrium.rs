@@ -95,7 +95,8 @@ fn residual(model: &Directions<U3, Circle>, angles: &[(f64, f64)]) -> Result<DVe
 }
 
 /// The relative equilibrium of `model` nearest `guess` (angles `(θ_i, ψ_i)`, rad) by
-/// Newton's method with a central-difference Jacobian (steps limited to 0.3 rad).
+/// Newton's method with a central-difference Jacobian, kept while each step at least halves the
+/// residual (the chord method; steps limited to 0.3 rad, at most 60).
 ///
 /// Errors: [`Error::LengthMismatch`] when `guess` does not have one pair per link,
 /// [`Error::NonFinite`] for a non-finite guess, [`Error::SteadyNotConverged`] when Newton
@@ -117,24 +118,33 @@ pub fn relative_equilibrium(
     let omega = model.drive().angular_frequency();
     let mut angles = guess.to_vec();
     let h = 1e-7;
-    for it in 1..=40 {
+    // The chord method: the Jacobian is kept while each step at least halves the residual
+    // and rebuilt when it does not (near the solution one factorisation serves every step).
+    let mut factor: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
+    let mut previous = f64::INFINITY;
+    for it in 1..=ITERATIONS {
         let r = residual(model, &angles)?;
-        let mut jac = DMatrix::zeros(2 * n, 2 * n);
-        for j in 0..2 * n {
-            let shift = |s: f64| {
-                let mut a = angles.clone();
-                if j % 2 == 0 {
-                    a[j / 2].0 += s
-                } else {
-                    a[j / 2].1 += s
-                }
-                a
-            };
-            let col = (residual(model, &shift(h))? - residual(model, &shift(-h))?) / (2.0 * h);
-            jac.set_column(j, &col);
+        let norm = r.norm();
+        if factor.is_none() || norm > 0.5 * previous {
+            let mut jac = DMatrix::zeros(2 * n, 2 * n);
+            for j in 0..2 * n {
+                let shift = |s: f64| {
+                    let mut a = angles.clone();
+                    if j % 2 == 0 {
+                        a[j / 2].0 += s
+                    } else {
+                        a[j / 2].1 += s
+                    }
+                    a
+                };
+                let col = (residual(model, &shift(h))? - residual(model, &shift(-h))?) / (2.0 * h);
+                jac.set_column(j, &col);
+            }
+            factor = Some(jac.lu());
         }
-        let fail = || Error::SteadyNotConverged { omega, iterations: it, residual: r.norm() };
-        let mut step = jac.lu().solve(&(-&r)).ok_or_else(fail)?;
+        previous = norm;
+        let fail = || Error::SteadyNotConverged { omega, iterations: it, residual: norm };
+        let mut step = factor.as_ref().and_then(|f| f.solve(&(-&r))).ok_or_else(fail)?;
         let size = step.amax();
         if !size.is_finite() {
             return Err(fail());
@@ -151,8 +161,15 @@ pub fn relative_equilibrium(
             return Ok(RelativeEquilibrium { angles, state });
         }
     }
-    Err(Error::SteadyNotConverged { omega, iterations: 40, residual: residual(model, &angles)?.norm() })
+    Err(Error::SteadyNotConverged {
+        omega,
+        iterations: ITERATIONS,
+        residual: residual(model, &angles)?.norm(),
+    })
 }
+
+/// Newton (chord) steps before [`relative_equilibrium`] gives up.
+const ITERATIONS: usize = 60;
 
 /// The linearisation about `eq` in the turning frame on the constraint manifold, `4n × 4n`,
 /// in the tangent coordinates of each link `i`: `4i + k` the position along `t_k`
