@@ -17,6 +17,8 @@
 //! - [`options`] turns a front end's separate options (flags, keyword arguments) into the
 //!   description's values with the shared one-line messages; [`run_dir`] reads a written
 //!   run back; [`page`] makes the self-contained page of `pendulum view` and notebooks.
+//! - [`steady`]: the steady shapes as `pendulum steady` and `pendulum.steady` show them
+//!   (the branches up to exactly ω_max with every point's verdict, the shapes at speeds).
 //!
 //! The core (`pendulum-core`) stays free of serde and files: this crate sits between it
 //! and the front ends, so an embedder of a fixed-N model builds neither.

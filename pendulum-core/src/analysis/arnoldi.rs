@@ -29,6 +29,8 @@ pub(crate) struct Arnoldi {
     /// `(m + 1) × m` Hessenberg, grown column by column.
     hessenberg: Vec<Vec<f64>>,
     invariant: bool,
+    /// The operator returned a non-finite vector: nothing more is computed.
+    broken: bool,
 }
 
 impl Arnoldi {
@@ -46,7 +48,7 @@ impl Arnoldi {
             .collect();
         let norm = start.iter().map(|v| v * v).sum::<f64>().sqrt();
         start.iter_mut().for_each(|v| *v /= norm);
-        Self { dim, basis: vec![start], hessenberg: Vec::new(), invariant: dim == 0 }
+        Self { dim, basis: vec![start], hessenberg: Vec::new(), invariant: dim == 0, broken: false }
     }
 
     /// The number of steps taken.
@@ -59,15 +61,26 @@ impl Arnoldi {
         self.invariant
     }
 
-    /// Up to `steps` more steps with `apply(x, y)`: `y = T x`; stops early when complete.
+    /// The operator gave a non-finite vector (a singular or overflowing solve): the caller
+    /// must not trust the Ritz values and should take another route.
+    pub fn broken(&self) -> bool {
+        self.broken
+    }
+
+    /// Up to `steps` more steps with `apply(x, y)`: `y = T x`; stops early when complete
+    /// or broken.
     pub fn extend(&mut self, steps: usize, apply: &mut impl FnMut(&[f64], &mut [f64])) {
         let mut w = vec![0.0; self.dim];
         for _ in 0..steps {
-            if self.invariant {
+            if self.invariant || self.broken {
                 return;
             }
             let j = self.hessenberg.len();
             apply(&self.basis[j], &mut w);
+            if w.iter().any(|v| !v.is_finite()) {
+                self.broken = true;
+                return;
+            }
             let scale = w.iter().map(|v| v * v).sum::<f64>().sqrt();
             let mut column = vec![0.0; j + 2];
             for _ in 0..2 {
@@ -94,7 +107,7 @@ impl Arnoldi {
     /// (the rest are not worth their eigenvectors).
     pub fn ritz(&self, tolerance: f64, keep: impl Fn(Complex<f64>) -> bool) -> Vec<Ritz> {
         let m = self.steps();
-        if m == 0 {
+        if m == 0 || self.broken {
             return Vec::new();
         }
         let h = DMatrix::from_fn(m, m, |i, j| self.hessenberg[j].get(i).copied().unwrap_or(0.0));
@@ -223,5 +236,15 @@ mod tests {
                 .any(|r| (r.value - Complex::new(k as f64, 0.0)).norm() < 1e-9 && r.residual < 1e-9);
             assert!(found, "eigenvalue {k}");
         }
+    }
+
+    #[test]
+    fn a_non_finite_operator_breaks_the_process_instead_of_giving_ritz_values() {
+        let mut arnoldi = Arnoldi::new(6);
+        arnoldi.extend(4, &mut |x: &[f64], y: &mut [f64]| {
+            y.copy_from_slice(x);
+            y[2] = f64::NAN;
+        });
+        assert!(arnoldi.broken() && arnoldi.steps() == 0 && arnoldi.ritz(1e-8, |_| true).is_empty());
     }
 }

@@ -248,34 +248,6 @@ fn growth_tolerance(problem: &SteadyRotation, shape: &SteadyShape) -> f64 {
     1e-8 * problem.spectrum_scale(shape)
 }
 
-/// Classify `shape` by the eigenvalues of the linearisation nearest the origin, with
-/// damping `λ_i` (N·m·s, one per link, applied to `θ̇_i` and `ψ̇_i` in the turning frame)
-/// or `None`, in `O(n)` per Arnoldi step.
-///
-/// Only eigenvalues near the origin can leave the imaginary axis: an eigenvalue with
-/// `Re λ > 0` has `|λ|² = −p*Hp / p*Mp` (undamped) or less (damped), so it lies among the
-/// modes the amended potential softens. The index of `H` comes from the signs of its
-/// `L D Lᵀ` pivots ([`crate::analysis::turning_pencil`]); the eigenvalues nearest the
-/// origin from shift-and-invert Arnoldi on the quadratic pencil `λ²M + λ(G + D) + H`
-/// (each step one `O(n)` quasiseparable solve), until they account for the whole index:
-/// undamped, `k_r + 2 k_c + 2 k_i⁻ = index` (real, complex-quartet and imaginary
-/// negative-energy eigenvalues, the Krein signature `|λ|² p*Mp + p*Hp < 0`); damped,
-/// `index` eigenvalues in the right half-plane (Kelvin–Tait–Chetaev). Then no other
-/// eigenvalue can grow, and the verdict is that of [`stability_dense`], which computes all
-/// `4n`. `eigenvalues` holds those found (at least 8, sorted by modulus); `growth_rate`
-/// is their largest real part. Falls back to the whole spectrum when the count is not
-/// reached.
-///
-/// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
-/// [`Error::NotPositiveDefinite`] if no shift gives a regular pencil.
-pub fn stability(
-    problem: &SteadyRotation,
-    shape: &SteadyShape,
-    damping: Option<&[f64]>,
-) -> Result<Stability> {
-    nearest_origin(problem, shape, damping, false)
-}
-
 /// The undamped or damped count of eigenvalues the index of `H` accounts for (see
 /// [`stability`]).
 fn counted(found: &[(Complex<f64>, f64)], damped: bool, tolerance: f64) -> usize {
@@ -301,12 +273,30 @@ fn counted(found: &[(Complex<f64>, f64)], damped: bool, tolerance: f64) -> usize
         .sum()
 }
 
-/// [`stability`]; `exhaustive` runs Arnoldi to the whole space (tests of the count).
-pub(crate) fn nearest_origin(
+/// Classify `shape` by the eigenvalues of the linearisation nearest the origin, with
+/// damping `λ_i` (N·m·s, one per link, applied to `θ̇_i` and `ψ̇_i` in the turning frame)
+/// or `None`, in `O(n)` per Arnoldi step.
+///
+/// Only eigenvalues near the origin can leave the imaginary axis: an eigenvalue with
+/// `Re λ > 0` has `|λ|² = −p*Hp / p*Mp` (undamped) or less (damped), so it lies among the
+/// modes the amended potential softens. The index of `H` comes from the signs of its
+/// `L D Lᵀ` pivots ([`crate::analysis::turning_pencil`]); the eigenvalues nearest the
+/// origin from shift-and-invert Arnoldi on the quadratic pencil `λ²M + λ(G + D) + H`
+/// (each step one `O(n)` quasiseparable solve), until they account for the whole index:
+/// undamped, `k_r + 2 k_c + 2 k_i⁻ = index` (real, complex-quartet and imaginary
+/// negative-energy eigenvalues, the Krein signature `|λ|² p*Mp + p*Hp < 0`); damped,
+/// `index` eigenvalues in the right half-plane (Kelvin–Tait–Chetaev). Then no other
+/// eigenvalue can grow, and the verdict is that of [`stability_dense`], which computes all
+/// `4n`. `eigenvalues` holds those found (at least 8, sorted by modulus); `growth_rate`
+/// is their largest real part. Falls back to the whole spectrum when the count is not
+/// reached.
+///
+/// Errors: [`Error::LengthMismatch`] / [`Error::InvalidDamping`] for bad damping,
+/// [`Error::NotPositiveDefinite`] if no shift gives a regular pencil.
+pub fn stability(
     problem: &SteadyRotation,
     shape: &SteadyShape,
     damping: Option<&[f64]>,
-    exhaustive: bool,
 ) -> Result<Stability> {
     const MIN_FOUND: usize = 8;
     const CONVERGED: f64 = 1e-10;
@@ -318,7 +308,6 @@ pub(crate) fn nearest_origin(
     let damped = damping.is_some();
     let zeros = symmetry_zeros(problem, shape, damped);
     let tolerance = growth_tolerance(problem, shape);
-    let tolerance_scale = tolerance / 1e-8;
     let mass = combination(problem, shape, damping, Combination::MASS);
     let velocity = combination(problem, shape, damping, Combination::VELOCITY);
     let stiffness = combination(problem, shape, damping, Combination::STIFFNESS);
@@ -371,15 +360,17 @@ pub(crate) fn nearest_origin(
     };
     let dim = 4 * n;
     let mut arnoldi = Arnoldi::new(dim);
-    let mut steps = if exhaustive { dim } else { (2 * index + 24).min(dim) };
+    let mut steps = (2 * index + 24).min(dim);
     loop {
         arnoldi.extend(steps - arnoldi.steps(), &mut apply);
+        if arnoldi.broken() {
+            return stability_dense(problem, shape, damping);
+        }
         let complete = arnoldi.complete();
         // The symmetry's zeros form a Jordan block, whose Ritz values converge only to
         // O(sqrt(ε)): they do not end the run of converged values nearest the origin.
         let zero = |theta: Complex<f64>| {
-            complete
-                || (zeros > 0 && (Complex::new(sigma, 0.0) + theta.inv()).norm() < 1e-6 * tolerance_scale)
+            complete || (zeros > 0 && (Complex::new(sigma, 0.0) + theta.inv()).norm() < 100.0 * tolerance)
         };
         let ritz = arnoldi.ritz(CONVERGED, zero);
         let converged = ritz.iter().take_while(|r| r.residual <= CONVERGED || zero(r.value));
@@ -402,7 +393,7 @@ pub(crate) fn nearest_origin(
             })
             .collect();
         let enough = found.len() >= MIN_FOUND.min(dim) && counted(&energies, damped, tolerance) >= index;
-        if complete || (enough && !exhaustive) {
+        if complete || enough {
             let eigenvalues: Vec<Complex<f64>> = found.iter().map(|(z, _)| *z).collect();
             let growth_rate =
                 eigenvalues[counted_from..].iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
