@@ -1,13 +1,15 @@
 //! The steady shapes of a chain as a front end shows them: the branches up to exactly
 //! `ω_max`, each point with its node count and undamped verdict (for a fixed pivot also the
-//! vertical), and the verdict of one shape ([`judge`]). `pendulum steady` and the Python
+//! vertical), the verdict of one shape ([`judge`]), the shapes at asked speeds with their
+//! damped verdicts ([`shapes_at`], [`damped_verdict`]). `pendulum steady` and the Python
 //! package draw, tabulate and write these.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use nalgebra::DVector;
+use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::{
-    Branch, BranchEnd, ContinuationOptions, SteadyRotation, SteadyShape, Verdict, stability,
+    Branch, BranchEnd, Chain, Circle, ContinuationOptions, Directions, SteadyRotation, SteadyShape, Verdict,
+    relative_equilibrium, relative_spectrum_near_origin, stability,
 };
 use rayon::prelude::*;
 
@@ -249,6 +251,9 @@ pub struct AtSpeed {
     pub nodes: Option<usize>,
     /// Undamped verdict.
     pub judged: Judged,
+    /// With damping: the damped verdict ([`damped_verdict`]), `None` if no damped steady
+    /// shape was found or none was asked.
+    pub damped: Option<Damped>,
 }
 
 impl AtSpeed {
@@ -260,11 +265,18 @@ impl AtSpeed {
 
 /// Every steady shape at each of `speeds` (rad/s) on the branches of `family` (and the
 /// vertical for a fixed pivot), speeds in the order given, branches in their order, each
-/// judged undamped. For a fixed pivot the mirror image `θ → −θ` of a shape is the same
-/// shape turned by π about the axis and is not listed again.
+/// judged undamped and, with `damping` (N·m·s per link, of `chain`), damped
+/// ([`damped_verdict`]). For a fixed pivot the mirror image `θ → −θ` of a shape is the
+/// same shape turned by π about the axis and is not listed again.
 ///
-/// Errors: those of [`judge`].
-pub fn shapes_at(problem: &SteadyRotation, family: &Family, speeds: &[f64]) -> Result<Vec<AtSpeed>> {
+/// Errors: those of [`judge`] and [`damped_verdict`].
+pub fn shapes_at(
+    problem: &SteadyRotation,
+    chain: &Chain<Dyn>,
+    family: &Family,
+    speeds: &[f64],
+    damping: Option<&[f64]>,
+) -> Result<Vec<AtSpeed>> {
     let n = problem.links();
     let mut found = Vec::new();
     for &omega in speeds {
@@ -281,10 +293,74 @@ pub fn shapes_at(problem: &SteadyRotation, family: &Family, speeds: &[f64]) -> R
         }
         for (branch, name, shape) in here {
             let judged = judge(problem, &shape)?;
-            found.push(AtSpeed { branch, name, nodes: nodes(&shape), shape, judged });
+            let damped = match damping {
+                Some(d) => damped_verdict(problem, chain, &shape, d)?,
+                None => None,
+            };
+            found.push(AtSpeed { branch, name, nodes: nodes(&shape), shape, judged, damped });
         }
     }
     Ok(found)
+}
+
+/// The damped verdict of one shape.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Damped {
+    /// Stable (every eigenvalue decays) or unstable.
+    pub verdict: Verdict,
+    /// Largest real part of the damped eigenvalues, 1/s.
+    pub growth_rate: f64,
+    /// Largest distance between corresponding masses of the damped and the undamped
+    /// shape, m (the damped shape lags out of the plane; 0 for a fixed pivot).
+    pub shift: f64,
+}
+
+/// The damped verdict of `shape` with damping `d` (N·m·s per link of `chain`); `None` when
+/// Newton finds no damped relative equilibrium near it.
+///
+/// Damped, for a fixed pivot (`R = 0`): [`stability`] with the damping `λ_i` on the link
+/// rates in the turning frame; the steady shape is unchanged, and by Kelvin–Tait–Chetaev
+/// only index-0 shapes stay stable. A fixed pivot cannot drive the rotation against a drag
+/// of the inertial rates, so that damping has no steady shape to ask about. For a circling
+/// pivot (`R > 0`): the chain's own damping of the inertial rates (`½ Σ λ_i |u̇_i|²`, as in
+/// `pendulum simulate`); the damped steady shape is the relative equilibrium of the 3D
+/// chain in unit directions on the circling pivot ([`relative_equilibrium`], Newton from
+/// the undamped planar shape), and its verdict is that of the eigenvalues that can grow
+/// ([`relative_spectrum_near_origin`]), growth counted above `1e-6` times the spectrum's
+/// size ([`SteadyRotation::spectrum_scale`]).
+///
+/// Errors: [`Error::Failed`] naming the speed when a spectrum cannot be computed; those of
+/// the chain's damping.
+pub fn damped_verdict(
+    problem: &SteadyRotation,
+    chain: &Chain<Dyn>,
+    shape: &SteadyShape,
+    d: &[f64],
+) -> Result<Option<Damped>> {
+    let omega = shape.omega;
+    if problem.radius() == 0.0 {
+        let st = stability(problem, shape, Some(d))
+            .map_err(|e| Error::failed(format!("damped stability at ω = {omega} rad/s: {e}")))?;
+        return Ok(Some(Damped { verdict: st.verdict(), growth_rate: st.growth_rate, shift: 0.0 }));
+    }
+    let radius = problem.radius();
+    let Ok(circle) = Circle::new(radius, omega) else { return Ok(None) };
+    let model = Directions::<U3>::new(chain.clone().with_damping(d)?).with_drive(circle);
+    let guess: Vec<(f64, f64)> = shape.theta.iter().map(|&t| (t, 0.0)).collect();
+    let Ok(eq) = relative_equilibrium(&model, &guess) else { return Ok(None) };
+    let spectrum = relative_spectrum_near_origin(&model, &eq)
+        .map_err(|e| Error::failed(format!("damped spectrum at ω = {omega} rad/s: {e}")))?;
+    let tolerance = 1e-6 * problem.spectrum_scale(shape);
+    let verdict = Verdict::of_spectrum(&spectrum, None, tolerance);
+    let growth_rate = spectrum.iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max);
+    // Masses of the damped shape, r_i = (R, 0, 0) + Σ_{j≤i} l_j u_j, against (x_i, 0, z_i).
+    let (mut r, mut z, mut shift) = (Vector3::new(radius, 0.0, 0.0), 0.0, 0.0_f64);
+    for (i, (&l, &theta)) in chain.lengths().iter().zip(shape.theta.iter()).enumerate() {
+        r += l * eq.state.fixed_rows::<3>(3 * i).into_owned();
+        z -= l * theta.cos();
+        shift = shift.max((r - Vector3::new(shape.displacements[i], 0.0, z)).norm());
+    }
+    Ok(Some(Damped { verdict, growth_rate, shift }))
 }
 
 /// The branch with its last point at exactly `omega_max`: a branch that reached it ends

@@ -9,11 +9,12 @@ use std::time::Duration;
 
 use numpy::PyArray1;
 use pendulum_core::{SteadyRotation, SteadyShape};
+use pendulum_experiment::options::expand;
 use pendulum_experiment::steady::{Family, Judged, default_omega_max, follow, shapes_at};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::arrays::array;
+use crate::arrays::{array, per_link};
 use crate::chain::Chain;
 use crate::errors::{core_error, invalid, run_error};
 
@@ -38,10 +39,15 @@ const SIGNAL_CHECK: Duration = Duration::from_millis(50);
 /// ``x`` (P, n) m: the distance of each mass from the axis); ``vertical`` (fixed pivot: a
 /// list of ``(from, to, stability, index)`` stretches); ``shapes``, a list of dicts
 /// (``omega``, ``branch`` (0: the vertical), ``name``, ``nodes`` (None: the vertical),
-/// ``tip_radius`` m, ``stability``, ``index``, ``growth_rate``, ``theta``, ``x``). The GIL is
-/// released while it computes; Ctrl-C raises KeyboardInterrupt.
+/// ``tip_radius`` m, ``stability``, ``index``, ``growth_rate``, ``theta``, ``x``). With
+/// ``damping`` (N·m·s, one value or one per link) every listed shape also gets
+/// ``damped_stability``, ``damped_growth_rate`` (1/s) and ``damped_shift`` (m), as
+/// ``pendulum steady --damping``: on a fixed pivot damping of the link rates in the turning
+/// frame, on a circling one the chain's own damping of the inertial rates (the damped shape
+/// lags out of the plane by the shift). The GIL is released while it computes; Ctrl-C
+/// raises KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (chain, *, radius = 0.0, omega = None, omega_max = None, branches = None))]
+#[pyo3(signature = (chain, *, radius = 0.0, omega = None, omega_max = None, branches = None, damping = None))]
 pub fn steady<'py>(
     py: Python<'py>,
     chain: &Chain,
@@ -49,6 +55,7 @@ pub fn steady<'py>(
     omega: Option<&Bound<'py, PyAny>>,
     omega_max: Option<f64>,
     branches: Option<usize>,
+    damping: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let listed: Option<Vec<f64>> = match omega {
         None => None,
@@ -81,7 +88,17 @@ pub fn steady<'py>(
     {
         return Err(invalid(format!("branches must be between 1 and n = {n}, got {count}")));
     }
+    let damping = match damping {
+        None => None,
+        Some(value) => {
+            let d = expand("damping", per_link("damping", value)?, n).map_err(run_error)?;
+            // Validated by the chain (finite, non-negative, named by link).
+            chain.inner.clone().with_damping(&d).map_err(core_error)?;
+            d.iter().any(|&v| v > 0.0).then_some(d)
+        }
+    };
     let problem = SteadyRotation::new(&chain.inner, radius).map_err(core_error)?;
+    let base = chain.inner.clone();
     let free = SteadyRotation::new(&chain.inner, 0.0).map_err(core_error)?;
     let omega_max = match omega_max {
         Some(w) => w,
@@ -98,7 +115,7 @@ pub fn steady<'py>(
         let work = || -> pendulum_experiment::Result<_> {
             let family =
                 follow(&problem, &free, omega_max, branches, &|_| !worker_stop.load(Ordering::SeqCst))?;
-            let shapes = shapes_at(&problem, &family, &speeds)?;
+            let shapes = shapes_at(&problem, &base, &family, &speeds, damping.as_deref())?;
             Ok((family, shapes))
         };
         let _ = sender.send(work());
@@ -141,6 +158,11 @@ pub fn steady<'py>(
             verdict_items(&d, &s.judged)?;
             d.set_item("theta", PyArray1::from_slice(py, s.shape.theta.as_slice()))?;
             d.set_item("x", PyArray1::from_slice(py, &s.shape.displacements))?;
+            if let Some(damped) = &s.damped {
+                d.set_item("damped_stability", damped.verdict.label())?;
+                d.set_item("damped_growth_rate", damped.growth_rate)?;
+                d.set_item("damped_shift", damped.shift)?;
+            }
             Ok(d)
         })
         .collect::<PyResult<_>>()?;

@@ -42,6 +42,23 @@ def test_a_circling_pivot_has_the_forced_branches():
     assert ("stable", 0) in verdicts and ("unstable", 1) in verdicts and ("gyroscopic", 2) in verdicts
 
 
+def test_damped_verdicts_are_the_clis():
+    # `pendulum steady --n 12 --lengths 0.1 --omega 15 --damping 0.002` (docs): every shape
+    # but the one-node one turns unstable, the one-node one decays.
+    chain = pendulum.Chain(masses=[1.0] * 12, lengths=[0.1] * 12)
+    shapes = pendulum.steady(chain, omega=15.0, damping=0.002)["shapes"]
+    assert [s["damped_stability"] for s in shapes] == ["unstable", "stable", "unstable", "unstable"]
+    assert np.allclose([s["damped_growth_rate"] for s in shapes[:3]], [0.0252, -0.00187, 0.0116], atol=5e-5)
+    assert all(s["damped_shift"] == 0.0 for s in shapes)
+    # A circling pivot at 10 rad/s: the gyroscopic shapes decay, lagging out of the plane.
+    forced = pendulum.steady(chain, radius=0.05, omega=10.0, damping=0.002)["shapes"]
+    held = [s for s in forced if s["stability"] == "gyroscopic"]
+    assert len(held) == 2 and all(s["damped_stability"] == "stable" for s in held)
+    assert np.allclose([s["damped_growth_rate"] for s in held], [-6.5e-5, -0.00167], atol=5e-6)
+    assert 0.008 < held[0]["damped_shift"] < 0.009
+    assert "damped_stability" not in pendulum.steady(chain, omega=15.0)["shapes"][0]
+
+
 @pytest.mark.parametrize(
     "kwargs, message",
     [
@@ -50,6 +67,8 @@ def test_a_circling_pivot_has_the_forced_branches():
         ({"omega": -1.0}, "omega: -1 rad/s is not a finite, non-negative speed"),
         ({"radius": 0.05, "branches": 2}, "branches applies to a fixed pivot"),
         ({"radius": -0.1}, "radius"),
+        ({"damping": [0.1, 0.2]}, "damping: got 2 values for 12 links"),
+        ({"damping": -0.1}, "damping"),
     ],
 )
 def test_bad_requests_are_value_errors(kwargs, message):

@@ -10,8 +10,8 @@ use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number as num;
 
 use super::branches::Family;
-use super::shapes::Found;
 use crate::error::CliResult;
+use pendulum_experiment::steady::AtSpeed;
 
 /// branches.csv: `branch` (its number in the table), `omega` (rad/s), `amplitude`
 /// (`max |x_i|`, m), `nodes`, `stability`, `index`, `growth_rate` (largest real part, 1/s),
@@ -39,7 +39,7 @@ pub fn branches(path: &Path, family: &Family, n: usize) -> CliResult<()> {
 /// (`|x_n|`, m), `stability`, `index`, `growth_rate` (1/s); with damping
 /// `damped_stability` (`not found` when no damped shape was found, its numbers NaN),
 /// `damped_growth_rate` (1/s), `damped_shift` (m); then `theta1..n` (rad), `x1..n` (m).
-pub fn shapes(path: &Path, found: &[Found], n: usize, damped: bool) -> CliResult<()> {
+pub fn shapes(path: &Path, found: &[AtSpeed], n: usize, damped: bool) -> CliResult<()> {
     let mut header = ["omega", "branch", "nodes", "tip_radius", "stability", "index", "growth_rate"]
         .map(String::from)
         .to_vec();

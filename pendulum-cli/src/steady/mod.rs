@@ -1,20 +1,19 @@
 //! `pendulum steady`: the chain turning steadily about the vertical. The branches of
 //! steady shapes up to exactly `--omega-max` (`branches`), every shape at the speeds of
-//! `--omega` with its node count and stability (`shapes`), printed (`table`), written as
+//! `--omega` with its node count and stability (`pendulum_experiment::steady::shapes_at`), printed (`table`), written as
 //! branches.csv and shapes.csv (`csv`) and drawn as branches.png and shapes.png (`plots`).
 //!
 //! Node count: `1 + ` the sign changes of `x_1 … x_n` ([`pendulum_core::SteadyShape::nodes`]:
 //! the axis crossings plus the pivot, the seed's convention); the vertical itself (on the
 //! axis, no crossing to count) is given none. Stability: [`pendulum_core::Verdict`] of the
 //! undamped 3D linearisation in the turning frame ([`pendulum_core::stability`]); damped,
-//! see [`shapes`]. The branches and verdicts themselves are the run library's
+//! see [`pendulum_experiment::steady::damped_verdict`]. The branches and verdicts themselves are the run library's
 //! ([`pendulum_experiment::steady`]), shared with the Python package.
 
 pub(crate) mod branches;
 mod continuum;
 mod csv;
 pub(crate) mod plots;
-mod shapes;
 mod table;
 
 use pendulum_core::SteadyRotation;
@@ -69,7 +68,8 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         )));
     }
     let speeds = listed.unwrap_or_else(|| vec![omega_max]);
-    let found = shapes::at(&problem, &chain, &family, &speeds, damping.as_deref())?;
+    let found =
+        pendulum_experiment::steady::shapes_at(&problem, &chain, &family, &speeds, damping.as_deref())?;
 
     create_out(args)?;
     let pivot = if args.radius == 0.0 {

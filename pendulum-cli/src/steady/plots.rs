@@ -15,10 +15,10 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::branches::Family;
 use super::nodes_name;
-use super::shapes::Found;
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 use pendulum_core::{Chain, Verdict};
+use pendulum_experiment::steady::AtSpeed;
 
 pub(crate) type Chart<'a> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
@@ -119,7 +119,13 @@ pub(crate) fn draw_key(
 /// the mirror branches (`θ → −θ`, the same shapes turned by π) faint and the vertical
 /// (`x_n = 0`) in grey; the shapes at the listed speeds as dots (hollow: unstable) on
 /// dotted verticals.
-pub fn branches(path: &Path, family: &Family, found: &[Found], omega_max: f64, radius: f64) -> CliResult<()> {
+pub fn branches(
+    path: &Path,
+    family: &Family,
+    found: &[AtSpeed],
+    omega_max: f64,
+    radius: f64,
+) -> CliResult<()> {
     fonts();
     draw_branches(path, family, found, omega_max, radius).map_err(|e| drawing_failed(path, e))
 }
@@ -127,7 +133,7 @@ pub fn branches(path: &Path, family: &Family, found: &[Found], omega_max: f64, r
 fn draw_branches(
     path: &Path,
     family: &Family,
-    found: &[Found],
+    found: &[AtSpeed],
     omega_max: f64,
     radius: f64,
 ) -> Result<(), String> {
@@ -273,7 +279,7 @@ pub fn shapes(
     path: &Path,
     chain: &Chain<Dyn>,
     radius: f64,
-    found: &[Found],
+    found: &[AtSpeed],
     speeds: &[f64],
 ) -> CliResult<()> {
     fonts();
@@ -294,7 +300,7 @@ fn draw_shapes(
     path: &Path,
     chain: &Chain<Dyn>,
     radius: f64,
-    found: &[Found],
+    found: &[AtSpeed],
     speeds: &[f64],
 ) -> Result<(), String> {
     let fail = |e: &dyn std::fmt::Display| e.to_string();
@@ -337,7 +343,7 @@ fn draw_shapes(
         chart
             .draw_series(DashedLineSeries::new([(0.0, 0.15 * r), (0.0, -r)], 4, 4, GREY.stroke_width(1)))
             .map_err(|e| fail(&e))?;
-        let here: Vec<&Found> = found.iter().filter(|f| f.shape.omega == omega).collect();
+        let here: Vec<&AtSpeed> = found.iter().filter(|f| f.shape.omega == omega).collect();
         for f in &here {
             let c = colour(f.nodes);
             let mut z = 0.0;

@@ -4,8 +4,8 @@
 use pendulum_core::{BranchEnd, SteadyRotation, Verdict};
 
 use super::branches::{Family, Labelled};
-use super::shapes::Found;
 use super::{Judged, nodes_name, rate};
+use pendulum_experiment::steady::AtSpeed;
 
 const NODES_NOTE: &str = "nodes = axis crossings + 1, the pivot counted";
 
@@ -119,7 +119,7 @@ pub fn stretches(labelled: &Labelled, with_nodes: bool) -> String {
 /// The shape table: speed, branch, nodes, tip radius (and side of the axis for a circling
 /// pivot), verdict, index, growth rate; with damping the damped verdict, growth rate and
 /// (circling pivot) the damped shape's shift.
-pub fn shapes(found: &[Found], radius: f64, damped: bool) {
+pub fn shapes(found: &[AtSpeed], radius: f64, damped: bool) {
     let forced = radius != 0.0;
     println!();
     println!("steady shapes ({NODES_NOTE}; tip radius = |x_n|, the free end's distance from the axis)");

@@ -20,6 +20,7 @@ def steady(
     omega: Union[float, Sequence[float], None] = ...,
     omega_max: Optional[float] = ...,
     branches: Optional[int] = ...,
+    damping: Optional[_PerLink] = ...,
 ) -> dict[str, Any]: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
 
