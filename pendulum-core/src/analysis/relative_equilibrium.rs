@@ -95,8 +95,9 @@ fn residual(model: &Directions<U3, Circle>, angles: &[(f64, f64)]) -> Result<DVe
 }
 
 /// The relative equilibrium of `model` nearest `guess` (angles `(θ_i, ψ_i)`, rad) by
-/// Newton's method with a central-difference Jacobian, kept while each step at least halves the
-/// residual (the chord method; steps limited to 0.3 rad, at most 60).
+/// Newton's method with a central-difference Jacobian (steps limited to 0.3 rad, at most 60);
+/// once the steps are below 1e-2 rad the Jacobian is kept while each step at least halves
+/// the residual (the chord method).
 ///
 /// Errors: [`Error::LengthMismatch`] when `guess` does not have one pair per link,
 /// [`Error::NonFinite`] for a non-finite guess, [`Error::SteadyNotConverged`] when Newton
@@ -118,14 +119,16 @@ pub fn relative_equilibrium(
     let omega = model.drive().angular_frequency();
     let mut angles = guess.to_vec();
     let h = 1e-7;
-    // The chord method: the Jacobian is kept while each step at least halves the residual
-    // and rebuilt when it does not (near the solution one factorisation serves every step).
+    // Newton while the steps are large (the path to the solution, and so the solution
+    // found, as with a new Jacobian every step); then the chord method: the Jacobian is
+    // kept while each step at least halves the residual (near the solution one
+    // factorisation serves every step).
     let mut factor: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
-    let mut previous = f64::INFINITY;
+    let (mut previous, mut last_step) = (f64::INFINITY, f64::INFINITY);
     for it in 1..=ITERATIONS {
         let r = residual(model, &angles)?;
         let norm = r.norm();
-        if factor.is_none() || norm > 0.5 * previous {
+        if factor.is_none() || norm > 0.5 * previous || last_step > CHORD_BELOW {
             let mut jac = DMatrix::zeros(2 * n, 2 * n);
             for j in 0..2 * n {
                 let shift = |s: f64| {
@@ -152,6 +155,7 @@ pub fn relative_equilibrium(
         if size > 0.3 {
             step *= 0.3 / size;
         }
+        last_step = size;
         for (i, a) in angles.iter_mut().enumerate() {
             a.0 += step[2 * i];
             a.1 += step[2 * i + 1];
@@ -170,6 +174,9 @@ pub fn relative_equilibrium(
 
 /// Newton (chord) steps before [`relative_equilibrium`] gives up.
 const ITERATIONS: usize = 60;
+
+/// The largest step (rad) after which [`relative_equilibrium`] keeps its Jacobian.
+const CHORD_BELOW: f64 = 1e-2;
 
 /// The linearisation about `eq` in the turning frame on the constraint manifold, `4n × 4n`,
 /// in the tangent coordinates of each link `i`: `4i + k` the position along `t_k`
