@@ -39,6 +39,73 @@ pub fn default_omega_max(free: &SteadyRotation, listed: &[f64]) -> Result<f64> {
     Ok(listed.iter().fold(default, |a, &b| a.max(b)))
 }
 
+/// How a front end names the options of a steady request, for its one-line messages
+/// (`"--omega-max"` on the command line, `"omega_max"` in Python).
+#[derive(Debug, Clone, Copy)]
+pub struct Names {
+    /// The listed speeds.
+    pub omega: &'static str,
+    /// The largest speed of the branches.
+    pub omega_max: &'static str,
+    /// The number of branches from the vertical.
+    pub branches: &'static str,
+    /// A fixed pivot, as the front end writes it (`"--radius 0"`).
+    pub fixed_pivot: &'static str,
+}
+
+/// Checks a given `ω_max` (rad/s): finite and positive.
+///
+/// Errors: [`Error::Invalid`] naming it.
+pub fn check_omega_max(omega_max: f64, names: &Names) -> Result<()> {
+    if omega_max.is_finite() && omega_max > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!("{} must be finite and positive, got {omega_max}", names.omega_max)))
+    }
+}
+
+/// Checks what a front end asked of the steady shapes of a chain of `n` links on a pivot
+/// circle of `radius` (m) — the `listed` speeds (rad/s, already finite and non-negative),
+/// `omega_max` and the number of `branches` — and returns `ω_max`: the one given, or
+/// [`default_omega_max`] of `free` (the chain on a fixed pivot).
+///
+/// Errors: [`Error::Invalid`] naming the option: `branches` for a circling pivot or
+/// outside `1..=n`, a bad `omega_max`, a listed speed above it.
+pub fn requested_omega_max(
+    free: &SteadyRotation,
+    radius: f64,
+    listed: Option<&[f64]>,
+    omega_max: Option<f64>,
+    branches: Option<usize>,
+    names: &Names,
+) -> Result<f64> {
+    let n = free.links();
+    if radius != 0.0 && branches.is_some() {
+        return Err(Error::invalid(format!(
+            "{} applies to a fixed pivot ({}) only",
+            names.branches, names.fixed_pivot
+        )));
+    }
+    if let Some(count) = branches
+        && (count == 0 || count > n)
+    {
+        return Err(Error::invalid(format!("{} must be between 1 and n = {n}, got {count}", names.branches)));
+    }
+    match omega_max {
+        Some(w) => {
+            check_omega_max(w, names)?;
+            if let Some(&above) = listed.into_iter().flatten().find(|&&v| v > w) {
+                return Err(Error::invalid(format!(
+                    "{}: {above} rad/s is above {} = {w} rad/s (the branches end there)",
+                    names.omega, names.omega_max
+                )));
+            }
+            Ok(w)
+        }
+        None => default_omega_max(free, listed.unwrap_or(&[])),
+    }
+}
+
 /// The node count of a shape, `None` for the vertical (every mass on the axis).
 pub fn nodes(shape: &SteadyShape) -> Option<usize> {
     (shape.amplitude() > 0.0).then(|| shape.nodes())
@@ -197,9 +264,11 @@ pub fn follow(
     }
     let total = raw.iter().map(|(_, _, b)| b.points.len()).sum();
     let judged_one = || judged(total);
+    // One flag for all branches: once the hook says stop, no branch judges another point.
+    let stop = AtomicBool::new(false);
     let branches = raw
         .into_iter()
-        .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &judged_one))
+        .map(|(name, critical, branch)| labelled(problem, name, critical, branch, &judged_one, &stop))
         .collect::<Result<_>>()?;
     Ok(Family { branches, vertical, critical, skipped, notes })
 }
@@ -213,8 +282,8 @@ fn labelled(
     critical: Option<f64>,
     branch: Branch,
     judged_one: &(dyn Fn() -> bool + Sync),
+    stop: &AtomicBool,
 ) -> Result<Labelled> {
-    let stop = AtomicBool::new(false);
     let judged: Vec<Option<Judged>> = branch
         .points
         .par_iter()

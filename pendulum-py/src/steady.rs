@@ -10,13 +10,17 @@ use std::time::Duration;
 use numpy::PyArray1;
 use pendulum_core::{SteadyRotation, SteadyShape};
 use pendulum_experiment::options::expand;
-use pendulum_experiment::steady::{Family, Judged, default_omega_max, follow, shapes_at};
+use pendulum_experiment::steady::{Family, Judged, Names, follow, requested_omega_max, shapes_at};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::arrays::{array, per_link};
 use crate::chain::Chain;
 use crate::errors::{core_error, invalid, run_error};
+
+/// Python's names for the options of a steady request.
+const NAMES: Names =
+    Names { omega: "omega", omega_max: "omega_max", branches: "branches", fixed_pivot: "radius = 0" };
 
 /// How often the waiting thread looks for Ctrl-C.
 const SIGNAL_CHECK: Duration = Duration::from_millis(50);
@@ -69,25 +73,7 @@ pub fn steady<'py>(
     if let Some(&bad) = listed.iter().flatten().find(|w| !(w.is_finite() && **w >= 0.0)) {
         return Err(invalid(format!("omega: {bad} rad/s is not a finite, non-negative speed")));
     }
-    if let Some(w) = omega_max {
-        if !(w.is_finite() && w > 0.0) {
-            return Err(invalid(format!("omega_max must be finite and positive, got {w}")));
-        }
-        if let Some(&above) = listed.iter().flatten().find(|&&v| v > w) {
-            return Err(invalid(format!(
-                "omega: {above} rad/s is above omega_max = {w} rad/s (the branches end there)"
-            )));
-        }
-    }
     let n = chain.inner.links();
-    if radius != 0.0 && branches.is_some() {
-        return Err(invalid("branches applies to a fixed pivot (radius = 0) only"));
-    }
-    if let Some(count) = branches
-        && (count == 0 || count > n)
-    {
-        return Err(invalid(format!("branches must be between 1 and n = {n}, got {count}")));
-    }
     let damping = match damping {
         None => None,
         Some(value) => {
@@ -100,10 +86,8 @@ pub fn steady<'py>(
     let problem = SteadyRotation::new(&chain.inner, radius).map_err(core_error)?;
     let base = chain.inner.clone();
     let free = SteadyRotation::new(&chain.inner, 0.0).map_err(core_error)?;
-    let omega_max = match omega_max {
-        Some(w) => w,
-        None => default_omega_max(&free, listed.as_deref().unwrap_or(&[])).map_err(run_error)?,
-    };
+    let omega_max = requested_omega_max(&free, radius, listed.as_deref(), omega_max, branches, &NAMES)
+        .map_err(run_error)?;
     let speeds = listed.unwrap_or_else(|| vec![omega_max]);
     // The work on a thread of its own; this one looks for Ctrl-C meanwhile, without the
     // GIL, and on Ctrl-C returns at once (the worker stops judging at its next point and

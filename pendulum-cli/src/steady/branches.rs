@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use pendulum_core::SteadyRotation;
 pub use pendulum_experiment::steady::{Family, Labelled};
 
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
 use crate::interrupt::{INTERRUPTED, StopsItself};
 
 /// The family of `problem` up to `omega_max` (rad/s), `count` branches for a fixed pivot
@@ -20,12 +20,6 @@ pub fn follow(
     omega_max: f64,
     count: Option<usize>,
 ) -> CliResult<(Family, Option<(usize, usize)>)> {
-    let n = problem.links();
-    if let Some(count) = count
-        && (count == 0 || count > n)
-    {
-        return Err(CliError::invalid(format!("--branches must be between 1 and n = {n}, got {count}")));
-    }
     let progress = Progress::new();
     // Ctrl-C while judging stops the judging; the points judged so far are kept.
     let stops = StopsItself::enter();

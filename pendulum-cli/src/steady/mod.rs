@@ -31,9 +31,6 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     }
     let n = chain.links();
     let problem = SteadyRotation::new(&chain, args.radius)?;
-    if args.radius != 0.0 && args.branches.is_some() {
-        return Err(CliError::invalid("--branches applies to a fixed pivot (--radius 0) only"));
-    }
     let listed = args.omega.as_deref().map(parse_speeds).transpose()?;
     let damping = match &args.damping {
         Some(spec) => {
@@ -45,18 +42,8 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
         None => None,
     };
     let free = SteadyRotation::new(&chain, 0.0)?;
-    let omega_max = match args.omega_max {
-        Some(w) => {
-            check_omega_max(w)?;
-            if let Some(&above) = listed.iter().flatten().find(|&&v| v > w) {
-                return Err(CliError::invalid(format!(
-                    "--omega: {above} rad/s is above --omega-max = {w} rad/s (the branches end there)"
-                )));
-            }
-            w
-        }
-        None => default_omega_max(&free, listed.as_deref().unwrap_or(&[]))?,
-    };
+    let omega_max =
+        requested_omega_max(&free, args.radius, listed.as_deref(), args.omega_max, args.branches, &NAMES)?;
     let (family, cut) = branches::follow(&problem, &free, omega_max, args.branches)?;
     if let Some((judged, total)) = cut {
         create_out(args)?;
@@ -131,12 +118,12 @@ pub(crate) fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
         .collect()
 }
 
+/// The command's names for the options of a steady request.
+pub(crate) const NAMES: Names =
+    Names { omega: "--omega", omega_max: "--omega-max", branches: "--branches", fixed_pivot: "--radius 0" };
+
 pub(crate) fn check_omega_max(omega_max: f64) -> CliResult<()> {
-    if omega_max.is_finite() && omega_max > 0.0 {
-        Ok(())
-    } else {
-        Err(CliError::invalid(format!("--omega-max must be finite and positive, got {omega_max}")))
-    }
+    pendulum_experiment::steady::check_omega_max(omega_max, &NAMES)
 }
 
 /// A rate (1/s) to three significant digits, in exponent form below 1e-3 and from 1e4 on.
@@ -150,7 +137,9 @@ fn rate(g: f64) -> String {
     }
 }
 
-pub use pendulum_experiment::steady::{DEFAULT_MARGIN, Judged, default_omega_max, nodes_name, round_up};
+pub use pendulum_experiment::steady::{
+    DEFAULT_MARGIN, Judged, Names, nodes_name, requested_omega_max, round_up,
+};
 
 #[cfg(test)]
 mod tests {
