@@ -50,6 +50,19 @@ pub enum Error {
         /// The offending value, N·m·s.
         value: f64,
     },
+    /// The chains of a batch must have the same number of links (and there must be one).
+    #[error("chain {chain} of the batch has {links} links, chain 0 has {expected}")]
+    BatchMismatch {
+        /// 0-based index of the chain in the batch.
+        chain: usize,
+        /// Its links.
+        links: usize,
+        /// Chain 0's links.
+        expected: usize,
+    },
+    /// A batch needs at least one chain.
+    #[error("a batch needs at least one chain, got 0")]
+    EmptyBatch,
     /// A state or input entry is infinite or NaN.
     #[error("{what}[{index}] must be finite, got {}", num(.value))]
     NonFinite {

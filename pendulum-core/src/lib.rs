@@ -45,9 +45,11 @@ pub mod jacobians;
 pub mod model;
 
 pub mod analysis;
+pub mod batch;
 pub mod energy;
 pub mod integrate;
 pub mod kinematics;
+pub mod lanes;
 pub mod models;
 pub mod rod_midpoint;
 pub mod rods;

@@ -4,6 +4,7 @@
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
 use numpy::PyArray1;
+use pendulum_core::batch::PlanarBatch;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -168,6 +169,19 @@ where
             Ok(())
         },
     )
+}
+
+/// `θ̈` of every planar state without torques by the batch of chains
+/// ([`PlanarBatch::repeated`]): the same numbers as [`accelerations`] row by row, and the
+/// first failing row's error.
+fn planar_batch(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<Vec<f64>> {
+    let batch = PlanarBatch::repeated(chain.clone(), b.q.count())?;
+    let mut out = vec![0.0; b.q.data.len()];
+    let failures = batch.accelerations(&b.q.data, &b.qd.data, Some(&b.pivot.data), &mut out)?;
+    match failures.into_iter().next() {
+        Some(failure) => Err(failure.error),
+        None => Ok(out),
+    }
 }
 
 /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
@@ -380,8 +394,14 @@ impl Chain {
         let kind = Kind::of(model)?;
         let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
         let numbers = b.q.data.len();
-        let out = maybe_detached(py, numbers, || with_model!(self, kind, |m| accelerations(m, &b)))
-            .map_err(core_error)?;
+        let out = maybe_detached(py, numbers, || match kind {
+            // Many planar states without torques: the SIMD batch, four states per lane group.
+            Kind::Planar if b.q.count() > 1 && b.torque.data.iter().all(|t| *t == 0.0) => {
+                planar_batch(&self.inner, &b)
+            }
+            _ => with_model!(self, kind, |m| accelerations(m, &b)),
+        })
+        .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 

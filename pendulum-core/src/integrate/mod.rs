@@ -114,6 +114,20 @@ where
         self.x
     }
 
+    /// Time, its compensation, the state and its compensation, for code that advances
+    /// states by [`kahan_add`] itself (the batch).
+    pub(crate) fn parts(&self) -> (f64, f64, &[f64], &[f64]) {
+        (self.t, self.t_carry, self.x.as_slice(), self.x_carry.as_slice())
+    }
+
+    /// Sets what [`parts`](Self::parts) gives; `x` and `x_carry` as long as the state.
+    pub(crate) fn set_parts(&mut self, t: f64, t_carry: f64, x: impl Iterator<Item = (f64, f64)>) {
+        (self.t, self.t_carry) = (t, t_carry);
+        for ((x, carry), (new, new_carry)) in self.x.iter_mut().zip(self.x_carry.iter_mut()).zip(x) {
+            (*x, *carry) = (new, new_carry);
+        }
+    }
+
     /// `t += h`, `x += increment` with compensated (Kahan) summation.
     pub(crate) fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
         (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
@@ -124,8 +138,9 @@ where
 }
 
 /// One step of compensated summation: returns the new sum `s + (δ + carry)` rounded,
-/// and the part of `δ + carry` that the rounding lost.
-fn kahan_add(sum: f64, carry: f64, delta: f64) -> (f64, f64) {
+/// and the part of `δ + carry` that the rounding lost (lane by lane for [`Lanes`](crate::lanes::Lanes)).
+#[inline(always)]
+pub(crate) fn kahan_add<V: crate::lanes::Lane>(sum: V, carry: V, delta: V) -> (V, V) {
     let corrected = delta + carry;
     let new = sum + corrected;
     (new, corrected - (new - sum))

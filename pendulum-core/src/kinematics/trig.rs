@@ -125,6 +125,26 @@ fn sin_cos_loop(angles: &[f64], out: &mut [[f64; 2]]) {
     }
 }
 
+/// [`sin_cos_into`]'s values, bit for bit, into two arrays (`sin[i]`, `cos[i]` of
+/// `angles[i]`): the layout of the batch's lanes. Inlined, so that it runs with its
+/// caller's target features.
+#[inline(always)]
+pub(crate) fn sin_cos_split(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
+    let mut outside = false;
+    for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
+        (*s, *c) = sin_cos_reduced(theta);
+        outside |= !in_range(theta);
+    }
+    if outside {
+        for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
+            if !in_range(theta) {
+                (*s, *c) = theta.sin_cos();
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use rand::{Rng, SeedableRng};

@@ -11,6 +11,7 @@ use crate::drive::{Drive, Fixed};
 use crate::error::{Error, Result};
 use crate::integrate::{Constrained, System};
 use crate::kinematics::{Chart, PlanarAngles, SphericalAngles, SphericalLink, check_polar_sin};
+use crate::lanes::Lane;
 use crate::model::check_vector;
 use crate::rods::{Load, Rods, with_scratch};
 
@@ -69,6 +70,11 @@ where
     /// The same chain with its pivot moved by `drive`.
     pub fn with_drive<D2: Drive<S>>(self, drive: D2) -> Directions<S, D2> {
         Directions { chain: self.chain, rods: self.rods, drive, space: PhantomData }
+    }
+
+    /// The tension solve's constants.
+    pub(crate) fn rods(&self) -> &Rods {
+        &self.rods
     }
 
     /// The chain's parameters.
@@ -259,15 +265,8 @@ where
         let mut tensions = tensions;
         with_scratch::<C, _>(n, |s| {
             let load = |i: usize| {
-                let (u, w) = (&directions[i * C..(i + 1) * C], &rates[i * C..(i + 1) * C]);
-                let pull = -drag[i];
-                let mut load = Load { direction: [0.0; C], rate_squared: 0.0, pair: [0.0; C] };
-                for k in 0..C {
-                    load.direction[k] = u[k];
-                    load.pair[k] = pull * w[k];
-                    load.rate_squared += w[k] * w[k];
-                }
-                load
+                let at = |v: &[f64]| -> [f64; C] { std::array::from_fn(|k| v[i * C + k]) };
+                rate_load(at(directions), at(rates), drag[i])
             };
             self.rods.solve(gravity, pivot, &mut s.rows, load, |i, a, _, t| {
                 out[i * C..(i + 1) * C].copy_from_slice(&a);
@@ -277,6 +276,21 @@ where
             });
         });
     }
+}
+
+/// Rod `i`'s [`Load`] from its direction `u_i`, rate `w_i` (1/s) and drag `λ_i / l_i` (N·s):
+/// `|u̇_i|² = |w_i|²` and the damping's force pair `F_i = −(λ_i / l_i) w_i`.
+#[inline(always)]
+pub(crate) fn rate_load<const C: usize, V: Lane>(u: [V; C], w: [V; C], drag: V) -> Load<C, V> {
+    let pull = -drag;
+    let zero = V::splat(0.0);
+    let mut load = Load { direction: [zero; C], rate_squared: zero, pair: [zero; C] };
+    for k in 0..C {
+        load.direction[k] = u[k];
+        load.pair[k] = pull * w[k];
+        load.rate_squared += w[k] * w[k];
+    }
+    load
 }
 
 impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
@@ -480,11 +494,29 @@ impl<S: DimName, Dr> Directions<S, Dr> {
         }
         let (directions, rates) = x.split_at_mut(d * n);
         for (u, w) in directions.chunks_exact_mut(d).zip(rates.chunks_exact_mut(d)) {
-            let norm = u.iter().map(|v| v * v).sum::<f64>().sqrt();
-            u.iter_mut().for_each(|v| *v /= norm);
-            let radial: f64 = u.iter().zip(w.iter()).map(|(a, b)| a * b).sum();
-            w.iter_mut().zip(u.iter()).for_each(|(b, a)| *b -= radial * a);
+            project_link(u, w);
         }
+    }
+}
+
+/// One link of [`Constrained::project`]: `u ← u/|u|`, `w ← w − (u·w) u` (`u`, `w` of the same
+/// length, at least 1).
+#[inline(always)]
+pub(crate) fn project_link<V: Lane>(u: &mut [V], w: &mut [V]) {
+    let mut norm = u[0] * u[0];
+    for v in &u[1..] {
+        norm += *v * *v;
+    }
+    let norm = norm.sqrt();
+    for v in u.iter_mut() {
+        *v = *v / norm;
+    }
+    let mut radial = u[0] * w[0];
+    for (a, b) in u[1..].iter().zip(&w[1..]) {
+        radial += *a * *b;
+    }
+    for (b, a) in w.iter_mut().zip(u.iter()) {
+        *b -= radial * *a;
     }
 }
 

@@ -7,6 +7,7 @@ use crate::error::Result;
 use crate::jacobians::{Derivatives, Jacobians, Parts};
 use crate::kinematics::trig::sin_cos_into;
 use crate::kinematics::{Chart, PlanarAngles};
+use crate::lanes::Lane;
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, ModelAlloc, check_inputs};
 use crate::models::planar::Planar;
@@ -47,6 +48,11 @@ where
         let rods =
             Rods::new(chain.masses().as_slice(), chain.lengths().as_slice(), chain.damping().as_slice());
         Self { dense: Planar::new(chain), rods }
+    }
+
+    /// The tension solve's constants.
+    pub(crate) fn rods(&self) -> &Rods {
+        &self.rods
     }
 
     /// The same chain as a dense [`Planar`] model.
@@ -103,11 +109,7 @@ where
             let (sin_cos, loads, rows) = s.staging(n);
             sin_cos_into(q.as_slice(), sin_cos);
             let (qd, torque) = (&qd.as_slice()[..n], &inputs.torque.as_slice()[..n]);
-            let build = |[sin, cos]: [f64; 2], rate: f64, pull: f64| Load {
-                direction: [sin, -cos],
-                rate_squared: rate * rate,
-                pair: [pull * cos, pull * sin],
-            };
+            let build = |[sin, cos]: [f64; 2], rate: f64, pull: f64| planar_load(sin, cos, rate, pull);
             // Without torques (the common case) the pull is the damping's alone.
             if all_zero(torque) {
                 for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
@@ -120,9 +122,8 @@ where
             }
             let loads = &*loads;
             let load = |i: usize| loads[i];
-            // θ̈_i = n_i · ü_i with n_i = (cos θ_i, sin θ_i) = (−u_y, u_x).
-            self.rods.solve(gravity, pivot, rows, load, |i, [ax, ay], &[ux, uy], t| {
-                out[i] = -uy * ax + ux * ay;
+            self.rods.solve(gravity, pivot, rows, load, |i, a, u, t| {
+                out[i] = angle_acceleration(a, u);
                 if let Some(tensions) = tensions.as_deref_mut() {
                     tensions[i] = t;
                 }
@@ -130,6 +131,20 @@ where
         });
         if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::error::Error::NotPositiveDefinite) }
     }
+}
+
+/// Rod `i`'s [`Load`] in the planar chain at angle `θ_i` (from its `sin`, `cos`), rate `θ̇_i`
+/// (rad/s) and `pull = Q_i / l_i` (N): `u_i = (sin θ_i, −cos θ_i)`, `|u̇_i|² = θ̇_i²`,
+/// `F_i = pull · n_i` with `n_i = (cos θ_i, sin θ_i)`.
+#[inline(always)]
+pub(crate) fn planar_load<V: Lane>(sin: V, cos: V, rate: V, pull: V) -> Load<2, V> {
+    Load { direction: [sin, -cos], rate_squared: rate * rate, pair: [pull * cos, pull * sin] }
+}
+
+/// `θ̈_i = n_i · ü_i` (rad/s²) from `ü_i` and `u_i`, with `n_i = (cos θ_i, sin θ_i) = (−u_y, u_x)`.
+#[inline(always)]
+pub(crate) fn angle_acceleration<V: Lane>([ax, ay]: [V; 2], &[ux, uy]: &[V; 2]) -> V {
+    -uy * ax + ux * ay
 }
 
 /// Whether every entry of `v` is zero (no early exit, so that it vectorises).

@@ -42,6 +42,8 @@
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
+use crate::lanes::Lane;
+
 mod angle_jacobians;
 mod angles;
 mod green;
@@ -53,13 +55,14 @@ pub(crate) use green::Column;
 pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
 
 /// Per-chain constants of the solve: reciprocal masses and lengths, and the drag
-/// coefficients `λ_i / l_i` the models use to build the force pairs.
+/// coefficients `λ_i / l_i` the models use to build the force pairs; for `V` = [`Lanes`](crate::lanes::Lanes)
+/// those of `W` chains side by side.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Rods {
-    inverse_mass: Vec<f64>,
-    inverse_length: Vec<f64>,
-    length: Vec<f64>,
-    drag: Vec<f64>,
+pub(crate) struct Rods<V: Lane = f64> {
+    inverse_mass: Vec<V>,
+    inverse_length: Vec<V>,
+    length: Vec<V>,
+    drag: Vec<V>,
 }
 
 /// A chain's per-link constants as the tension solve reads them, `n` entries each:
@@ -75,10 +78,18 @@ pub struct RodConstants<'a> {
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
 /// force pair `F_i` (N) acting on it (on mass `i`; the opposite on mass `i−1`).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Load<const S: usize> {
-    pub direction: [f64; S],
-    pub rate_squared: f64,
-    pub pair: [f64; S],
+pub(crate) struct Load<const S: usize, V: Lane = f64> {
+    pub direction: [V; S],
+    pub rate_squared: V,
+    pub pair: [V; S],
+}
+
+impl<const S: usize, V: Lane> Load<S, V> {
+    /// All zeros (room for a load).
+    pub fn zero() -> Self {
+        let zero = V::splat(0.0);
+        Self { direction: [zero; S], rate_squared: zero, pair: [zero; S] }
+    }
 }
 
 /// What the down pass leaves for the up pass, per rod: the direction `u_i`, the free
@@ -86,17 +97,31 @@ pub(crate) struct Load<const S: usize> {
 /// scaled eliminated right-hand side `h_i = e_i / D_i` (N) and the right-hand side `b_i`
 /// itself (kept for [`Rods::eliminate_by_pivots`]).
 #[derive(Debug, Clone, Copy)]
-struct Row<const S: usize> {
-    direction: [f64; S],
-    free: [f64; S],
-    factor: f64,
-    scaled: f64,
-    rhs: f64,
+struct Row<const S: usize, V: Lane = f64> {
+    direction: [V; S],
+    free: [V; S],
+    factor: V,
+    scaled: V,
+    rhs: V,
 }
 
 /// The rows the down pass leaves for the up pass (see [`Rods::solve`]).
-#[derive(Debug, Default)]
-pub(crate) struct Rows<const S: usize>(Vec<Row<S>>);
+#[derive(Debug)]
+pub(crate) struct Rows<const S: usize, V: Lane = f64>(Vec<Row<S, V>>);
+
+impl<const S: usize, V: Lane> Default for Rows<S, V> {
+    fn default() -> Self {
+        Self(Vec::new())
+    }
+}
+
+impl<const S: usize, V: Lane> Rows<S, V> {
+    /// Room for `n` rods.
+    pub fn with_len(n: usize) -> Self {
+        let zero = V::splat(0.0);
+        Self(vec![Row { direction: [zero; S], free: [zero; S], factor: zero, scaled: zero, rhs: zero }; n])
+    }
+}
 
 /// The per-rod buffers of one solve (allocated once per thread, see [`with_scratch`]):
 /// the solve's rows, and room for a model to prepare `(sin θ_i, cos θ_i)` and the rods'
@@ -157,8 +182,8 @@ pub(crate) fn with_scratch<const S: usize, R>(n: usize, f: impl FnOnce(&mut Scra
 }
 
 #[inline(always)]
-fn dot<const S: usize>(a: &[f64; S], b: &[f64; S]) -> f64 {
-    let mut s = 0.0;
+fn dot<const S: usize, V: Lane>(a: &[V; S], b: &[V; S]) -> V {
+    let mut s = V::splat(0.0);
     for k in 0..S {
         s += a[k] * b[k];
     }
@@ -172,12 +197,12 @@ fn dot<const S: usize>(a: &[f64; S], b: &[f64; S]) -> f64 {
 /// `|u_i|²` is 1 on the constraint manifold; keeping it makes `u_i·ü_i = −|u̇_i|²` hold
 /// exactly also at the slightly non-unit directions inside an integrator step.
 #[inline(always)]
-fn entries<const S: usize>(
-    inverse_mass: f64,
-    inverse_mass_above: f64,
-    u_above: &[f64; S],
-    u: &[f64; S],
-) -> (f64, f64) {
+fn entries<const S: usize, V: Lane>(
+    inverse_mass: V,
+    inverse_mass_above: V,
+    u_above: &[V; S],
+    u: &[V; S],
+) -> (V, V) {
     ((inverse_mass + inverse_mass_above) * dot(u, u), -dot(u_above, u) * inverse_mass_above)
 }
 
@@ -199,46 +224,44 @@ pub const CONTINUANT_RANGE: (u64, u64) = {
 /// The pivots `1/D_i` of a tridiagonal elimination as ratios of continuants (module docs),
 /// row by row: one multiply and one subtraction per row on the serial chain, the division
 /// off it; both continuants multiplied every [`BLOCK`] rows by the power of two that brings
-/// `P_{i−1}` into `[1, 2)`. The pivots are valid while [`in_range`](Self::in_range).
+/// `P_{i−1}` into `[1, 2)`. The pivots are valid while [`in_range`](Self::in_range) (in the
+/// lanes not flagged by [`outside`](Self::outside)).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Continuants {
+pub(crate) struct Continuants<V: Lane = f64> {
     /// `P_{i−1}`, `P_{i−2}` (`P_{−1} = 1`; `P_{−2}` only meets `c_0 = 0`).
-    above: f64,
-    above2: f64,
-    out_of_range: bool,
+    above: V,
+    above2: V,
+    out_of_range: V::Mask,
 }
 
-impl Continuants {
+impl<V: Lane> Continuants<V> {
     pub fn new() -> Self {
-        Self { above: 1.0, above2: 0.0, out_of_range: false }
+        Self { above: V::splat(1.0), above2: V::splat(0.0), out_of_range: V::none() }
     }
 
     /// `1/D_i` of row `i` (rows in order from 0) with `A_ii = diagonal`, `A_{i,i−1} = off`.
     #[inline(always)]
-    pub fn inverse_pivot(&mut self, i: usize, diagonal: f64, off: f64) -> f64 {
+    pub fn inverse_pivot(&mut self, i: usize, diagonal: V, off: V) -> V {
         if i.is_multiple_of(BLOCK) {
-            let scale = normalizer(self.above);
-            self.above *= scale;
-            self.above2 *= scale;
+            let scale = self.above.normalizer();
+            self.above = self.above * scale;
+            self.above2 = self.above2 * scale;
         }
         let p = diagonal * self.above - (off * off) * self.above2;
         let (low, span) = CONTINUANT_RANGE;
-        self.out_of_range |= p.to_bits().wrapping_sub(low) > span;
+        self.out_of_range = V::or(self.out_of_range, p.outside(low, span));
         let inverse_pivot = self.above / p;
         (self.above2, self.above) = (self.above, p);
         inverse_pivot
     }
 
-    /// Whether every continuant so far stayed inside [`CONTINUANT_RANGE`].
-    pub fn in_range(&self) -> bool {
-        !self.out_of_range
+    /// The lanes whose continuants left [`CONTINUANT_RANGE`] at some row so far.
+    pub fn outside(&self) -> V::Mask {
+        self.out_of_range
     }
-}
 
-/// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`: the exact power of two that brings a positive
-/// normal `x` into `[1, 2)`. (Only reached with `x` in [`CONTINUANT_RANGE`].)
-#[inline(always)]
-fn normalizer(x: f64) -> f64 {
-    let biased = (x.to_bits() >> 52) & 0x7ff;
-    f64::from_bits(((2046 - biased as i64) as u64 & 0x7ff) << 52)
+    /// Whether every continuant so far stayed inside [`CONTINUANT_RANGE`] (in every lane).
+    pub fn in_range(&self) -> bool {
+        !V::any(self.out_of_range)
+    }
 }

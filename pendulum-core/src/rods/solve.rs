@@ -3,6 +3,7 @@
 //! of `A T = b`, module docs of [`rods`](super)) and one up pass, O(n).
 
 use super::*;
+use crate::lanes::Lanes;
 
 impl Rods {
     /// The constants of a chain with these masses (kg) and lengths (m), both positive, and
@@ -30,15 +31,33 @@ impl Rods {
             drag: &self.drag,
         }
     }
+}
 
+impl<const W: usize> Rods<Lanes<W>> {
+    /// The constants of `W` chains with the same number of rods, chain `k` in lane `k`.
+    pub fn interleave(chains: [&Rods; W]) -> Self {
+        let n = chains[0].len();
+        let lanes = |of: fn(&Rods) -> &[f64]| -> Vec<Lanes<W>> {
+            (0..n).map(|i| Lanes(chains.map(|c| of(c)[i]))).collect()
+        };
+        Self {
+            inverse_mass: lanes(|c| &c.inverse_mass),
+            inverse_length: lanes(|c| &c.inverse_length),
+            length: lanes(|c| &c.length),
+            drag: lanes(|c| &c.drag),
+        }
+    }
+}
+
+impl<V: Lane> Rods<V> {
     /// `1 / l_i` (1/m) per rod.
-    pub fn inverse_length(&self) -> &[f64] {
+    pub fn inverse_length(&self) -> &[V] {
         &self.inverse_length
     }
 
     /// `λ_i / l_i` (N·s) per rod: damping `λ_i θ̇_i` (or `λ_i w_i`) acts on rod `i` as the
     /// force pair `−(λ_i / l_i) θ̇_i n_i` (or `−(λ_i / l_i) w_i`).
-    pub fn drag(&self) -> &[f64] {
+    pub fn drag(&self) -> &[V] {
         &self.drag
     }
 
@@ -52,42 +71,46 @@ impl Rods {
     #[inline(always)]
     pub fn solve<const S: usize>(
         &self,
-        gravity: [f64; S],
-        pivot_acceleration: [f64; S],
-        rows: &mut Rows<S>,
-        load: impl FnMut(usize) -> Load<S>,
-        emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
+        gravity: [V; S],
+        pivot_acceleration: [V; S],
+        rows: &mut Rows<S, V>,
+        load: impl FnMut(usize) -> Load<S, V>,
+        emit: impl FnMut(usize, [V; S], &[V; S], V),
     ) {
-        let rows = &mut rows.0[..self.len()];
-        if !self.eliminate(gravity, pivot_acceleration, rows, load) {
-            self.eliminate_by_pivots(rows);
+        let rows = &mut rows.0[..self.length.len()];
+        let outside = self.eliminate(gravity, pivot_acceleration, rows, load);
+        if V::any(outside) {
+            self.eliminate_by_pivots(rows, outside);
         }
         self.substitute(pivot_acceleration, rows, emit);
     }
 
     /// The down pass: free accelerations, right-hand sides and the elimination by
-    /// continuants (module docs), rescaled by a power of two every [`BLOCK`] rows. Returns
-    /// `false` when a continuant left [`CONTINUANT_RANGE`]; the rows then hold `b_i` and
-    /// the directions but not yet `f_i` and `h_i`.
+    /// continuants (module docs), rescaled by a power of two every [`BLOCK`] rows. Returns the
+    /// lanes where a continuant left [`CONTINUANT_RANGE`]; their rows then hold `b_i` and the
+    /// directions but not yet valid `f_i` and `h_i`.
     #[inline(always)]
     fn eliminate<const S: usize>(
         &self,
-        gravity: [f64; S],
-        pivot_acceleration: [f64; S],
-        rows: &mut [Row<S>],
-        mut load: impl FnMut(usize) -> Load<S>,
-    ) -> bool {
+        gravity: [V; S],
+        pivot_acceleration: [V; S],
+        rows: &mut [Row<S, V>],
+        mut load: impl FnMut(usize) -> Load<S, V>,
+    ) -> V::Mask {
         let n = rows.len();
+        let zero = V::splat(0.0);
         let mut free_above = pivot_acceleration;
-        let mut inverse_mass_above = 0.0;
-        let mut u_above = [0.0; S];
+        let mut inverse_mass_above = zero;
+        let mut u_above = [zero; S];
         let mut continuants = Continuants::new();
         // 1/D_{i−1}, e_{i−1}.
-        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+        let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
         let mut here = load(0);
         for (i, row) in rows.iter_mut().enumerate() {
-            let below = if i + 1 < n { Some(load(i + 1)) } else { None };
-            let pair_below = below.map_or([0.0; S], |b| b.pair);
+            // Below the last rod, no load (no `Option`: copied through one, a load of lanes
+            // fell apart into scalars).
+            let below = if i + 1 < n { load(i + 1) } else { Load::zero() };
+            let pair_below = below.pair;
             let im = self.inverse_mass[i];
             let u = here.direction;
             let mut a = gravity;
@@ -105,31 +128,30 @@ impl Rods {
             inverse_mass_above = im;
             u_above = u;
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
-            if let Some(b) = below {
-                here = b;
-            }
+            here = below;
         }
-        continuants.in_range()
+        continuants.outside()
     }
 
     /// The elimination by pivots, `D_i = A_ii − c_i² / D_{i−1}`, for the rows left by
     /// [`eliminate`](Self::eliminate) when its continuants left their range: the same `f_i`
     /// and `h_i` (to round-off) with a division on the serial chain, slower but needing no
-    /// rescaling.
+    /// rescaling. Only the lanes flagged in `lanes` are rewritten.
     #[cold]
     #[inline(never)]
-    fn eliminate_by_pivots<const S: usize>(&self, rows: &mut [Row<S>]) {
-        let mut inverse_mass_above = 0.0;
-        let mut u_above = [0.0; S];
-        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+    fn eliminate_by_pivots<const S: usize>(&self, rows: &mut [Row<S, V>], lanes: V::Mask) {
+        let zero = V::splat(0.0);
+        let mut inverse_mass_above = zero;
+        let mut u_above = [zero; S];
+        let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
         for (i, row) in rows.iter_mut().enumerate() {
             let (im, u) = (self.inverse_mass[i], row.direction);
             let (diagonal, off) = entries(im, inverse_mass_above, &u_above, &u);
             let factor = off * inverse_pivot_above;
-            let inverse_pivot = 1.0 / (diagonal - factor * off);
+            let inverse_pivot = V::splat(1.0) / (diagonal - factor * off);
             let eliminated = row.rhs - factor * eliminated_above;
-            row.factor = factor;
-            row.scaled = eliminated * inverse_pivot;
+            row.factor = V::select(lanes, factor, row.factor);
+            row.scaled = V::select(lanes, eliminated * inverse_pivot, row.scaled);
             inverse_mass_above = im;
             u_above = u;
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
@@ -141,15 +163,16 @@ impl Rods {
     #[inline(always)]
     fn substitute<const S: usize>(
         &self,
-        pivot_acceleration: [f64; S],
-        rows: &[Row<S>],
-        mut emit: impl FnMut(usize, [f64; S], &[f64; S], f64),
+        pivot_acceleration: [V; S],
+        rows: &[Row<S, V>],
+        mut emit: impl FnMut(usize, [V; S], &[V; S], V),
     ) {
         let n = rows.len();
-        let mut tension_below = 0.0;
-        let mut factor_below = 0.0;
-        let mut u_below = [0.0; S];
-        let mut a_below = [0.0; S];
+        let zero = V::splat(0.0);
+        let mut tension_below = zero;
+        let mut factor_below = zero;
+        let mut u_below = [zero; S];
+        let mut a_below = [zero; S];
         for i in (0..n).rev() {
             let row = &rows[i];
             // The serial chain: one multiply and one subtraction per rod.
@@ -161,7 +184,7 @@ impl Rods {
             }
             if i + 1 < n {
                 let il = self.inverse_length[i + 1];
-                let mut udd = [0.0; S];
+                let mut udd = [zero; S];
                 for k in 0..S {
                     udd[k] = (a_below[k] - a[k]) * il;
                 }
@@ -173,7 +196,7 @@ impl Rods {
             a_below = a;
         }
         let il = self.inverse_length[0];
-        let mut udd = [0.0; S];
+        let mut udd = [zero; S];
         for k in 0..S {
             udd[k] = (a_below[k] - pivot_acceleration[k]) * il;
         }
@@ -222,9 +245,9 @@ mod tests {
         };
         let (in_range, rows) = with_scratch::<S, _>(n, |s| {
             let rows = &mut s.rows.0[..n];
-            let in_range = rods.eliminate(gravity, pivot, rows, |i| loads[i]);
+            let in_range = !rods.eliminate(gravity, pivot, rows, |i| loads[i]);
             if !in_range || route == Route::Pivots {
-                rods.eliminate_by_pivots(rows);
+                rods.eliminate_by_pivots(rows, true);
             }
             rods.substitute(pivot, rows, emit);
             (in_range, rows.to_vec())
@@ -415,7 +438,7 @@ mod tests {
     #[test]
     fn normalizer_is_the_power_of_two_into_one_to_two() {
         for x in [1.0, 1.5, 3.0, 0.75, 2f64.powi(700), 1.9 * 2f64.powi(-700), f64::MIN_POSITIVE] {
-            let y = x * normalizer(x);
+            let y = x * x.normalizer();
             assert!((1.0..2.0).contains(&y), "{x:e} → {y}");
         }
     }

@@ -1,0 +1,190 @@
+//! Batches of chains against one chain per call (`docs/ensembles.md`).
+//!
+//! Every measurement evaluates or steps the same 64 different chains (random masses,
+//! lengths and damping; random states), so per-chain cost is the time divided by 64
+//! (criterion's throughput line, in chains per second):
+//! - `accelerations/{planar,spatial}/…/n`: the single-chain call in a loop
+//!   (`PlanarTension`, `Directions<U3>`) against the batch on one thread and on two;
+//! - `rk4/whirl_100`: one projected RK4 step of 1 ms of 64 whirls (3D, n = 100, each pivot on
+//!   its own circle) chain by chain against the batch, and 100 steps per batch call
+//!   (throughput in chain-steps per second).
+//!
+//! `cargo bench -p pendulum-core --bench ensembles`
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{Bencher, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use nalgebra::{DVector, Dyn, U2, U3};
+use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
+use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
+use pendulum_core::{Chain, Circle, Directions, Inputs, Model, PlanarTension};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const CHAINS: usize = 64;
+
+/// `n` links of about 1 cm and 10 g, each mass, length and damping within a factor `spread`.
+fn random_chain(n: usize, spread: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {
+    let mut around = |x: f64| (0..n).map(|_| x * r.random_range(1.0 / spread..spread)).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (around(0.01), around(0.01), around(3e-4));
+    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool")
+}
+
+/// Times `f` called from inside `pool`, as a program that runs in the pool would call it
+/// (entering the pool once per sample, not once per call).
+fn in_pool(b: &mut Bencher<'_>, pool: &rayon::ThreadPool, mut f: impl FnMut() + Send) {
+    b.iter_custom(|iters| {
+        pool.install(|| {
+            let start = Instant::now();
+            for _ in 0..iters {
+                f();
+            }
+            start.elapsed()
+        })
+    })
+}
+
+fn accelerations(c: &mut Criterion) {
+    let mut group = c.benchmark_group("accelerations");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(30);
+    group.throughput(Throughput::Elements(CHAINS as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(31);
+    for n in [8, 20, 100] {
+        let chains: Vec<_> = (0..CHAINS).map(|_| random_chain(n, 2.0, &mut r)).collect();
+        let q: Vec<f64> = (0..CHAINS * n).map(|_| r.random_range(-1.0..1.0)).collect();
+        let qd: Vec<f64> = (0..CHAINS * n).map(|_| r.random_range(-1.0..1.0)).collect();
+        let mut out = vec![0.0; CHAINS * n];
+
+        let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
+        let states: Vec<_> = (0..CHAINS)
+            .map(|k| {
+                let row = k * n..(k + 1) * n;
+                (DVector::from_column_slice(&q[row.clone()]), DVector::from_column_slice(&qd[row]))
+            })
+            .collect();
+        let inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
+        let mut one = DVector::zeros(n);
+        group.bench_with_input(BenchmarkId::new("planar/single", n), &n, |b, _| {
+            b.iter(|| {
+                for (model, (q, qd)) in singles.iter().zip(&states) {
+                    model.accelerations(q, qd, &inputs, &mut one).expect("single");
+                    black_box(&one);
+                }
+            })
+        });
+        let batch = PlanarBatch::new(chains.clone()).expect("batch");
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            group.bench_with_input(
+                BenchmarkId::new(format!("planar/batch_{threads}_threads"), n),
+                &n,
+                |b, _| {
+                    in_pool(b, &pool, || {
+                        batch.accelerations(&q, &qd, None, &mut out).expect("batch");
+                    })
+                },
+            );
+        }
+
+        let models: Vec<_> = chains.iter().cloned().map(Directions::<U3>::new).collect();
+        let x: Vec<DVector<f64>> = models
+            .iter()
+            .map(|m| {
+                let angles: Vec<f64> = (0..2 * n)
+                    .map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) })
+                    .collect();
+                m.from_spherical(&angles, &vec![0.5; 2 * n]).expect("state")
+            })
+            .collect();
+        let mut one = vec![0.0; 3 * n];
+        group.bench_with_input(BenchmarkId::new("spatial/single", n), &n, |b, _| {
+            b.iter(|| {
+                for (model, x) in models.iter().zip(&x) {
+                    model.accelerations(0.0, x, &mut one, None).expect("single");
+                    black_box(&one);
+                }
+            })
+        });
+        let batch = DirectionsBatch::new(models).expect("batch");
+        let flat: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+        let mut out = vec![0.0; CHAINS * 3 * n];
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            group.bench_with_input(
+                BenchmarkId::new(format!("spatial/batch_{threads}_threads"), n),
+                &n,
+                |b, _| {
+                    in_pool(b, &pool, || {
+                        batch.accelerations(0.0, &flat, &mut out).expect("batch");
+                    })
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+fn rk4(c: &mut Criterion) {
+    let mut group = c.benchmark_group("rk4");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2)).sample_size(20);
+    group.throughput(Throughput::Elements(CHAINS as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(11);
+    let n = 100;
+    let models: Vec<_> = (0..CHAINS)
+        .map(|_| {
+            let drive = Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
+            Directions::<U3>::new(random_chain(n, 1.1, &mut r)).with_drive(drive)
+        })
+        .collect();
+    // Each whirl 2 s into its spin-up from hanging at rest.
+    let start: Vec<State<Dyn>> = models
+        .iter()
+        .map(|m| {
+            let mut state = State::new(0.0, m.hanging());
+            let mut rk4 = Projected::new(Rk4::new(m));
+            for _ in 0..2000 {
+                rk4.step(m, &mut state, 1e-3).expect("spin-up");
+            }
+            state
+        })
+        .collect();
+    let mut solvers: Vec<_> = models.iter().map(|m| Projected::new(Rk4::new(m))).collect();
+    let mut states = start.clone();
+    group.bench_function("whirl_100/single", |b| {
+        b.iter(|| {
+            for ((model, rk4), state) in models.iter().zip(&mut solvers).zip(&mut states) {
+                rk4.step(model, state, 1e-3).expect("single");
+            }
+        })
+    });
+    let batch = DirectionsBatch::new(models).expect("batch");
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let mut states = start.clone();
+        group.bench_function(format!("whirl_100/batch_{threads}_threads"), |b| {
+            in_pool(b, &pool, || {
+                batch.step_rk4(&mut states, 1e-3).expect("batch");
+            })
+        });
+    }
+    // 100 steps per call: the states stay in lanes between steps.
+    group.throughput(Throughput::Elements(100 * CHAINS as u64));
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let mut states = start.clone();
+        group.bench_function(format!("whirl_100/batch_{threads}_threads_100_steps"), |b| {
+            in_pool(b, &pool, || {
+                batch.integrate_rk4(&mut states, 1e-3, 100).expect("batch");
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, accelerations, rk4);
+criterion_main!(benches);

@@ -1,0 +1,390 @@
+//! A batch of chains in unit link directions ([`Directions`]), planar or spatial, each with
+//! its own drive: accelerations, and whole steps of projected RK4, for many chains per call.
+
+use nalgebra::{DefaultAllocator, DimName, Dyn, allocator::Allocator};
+
+use super::{
+    F64x4, Failure, WIDTH, block_chains, check_len, check_links, for_blocks, gather, non_finite, simd_kernel,
+};
+use crate::drive::{Drive, Fixed};
+use crate::error::{Error, Result};
+use crate::integrate::State;
+use crate::integrate::kahan_add;
+use crate::lanes::Lane;
+use crate::lanes::Lanes;
+use crate::models::Directions;
+use crate::models::directions::{project_link, rate_load};
+use crate::rods::{Load, Rods, Rows};
+
+/// `B` chains in unit link directions with the same number of links `n`, each with its own
+/// masses, lengths, damping, gravity and drive (`S = U2` planar, `U3` spatial).
+///
+/// [`accelerations`](Self::accelerations) equals [`Directions::accelerations`] chain by
+/// chain, and [`step_rk4`](Self::step_rk4) one step of
+/// `Projected::new(Rk4::new(..))` ([`Projected`](crate::integrate::Projected),
+/// [`Rk4`](crate::integrate::Rk4)) on each chain, bit for bit (module docs of
+/// [`batch`](super)).
+#[derive(Debug, Clone)]
+pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
+    models: Vec<Directions<S, Dr>>,
+    blocks: Vec<Block>,
+    links: usize,
+}
+
+/// What the solve needs of one block's chains.
+#[derive(Debug, Clone)]
+struct Block {
+    rods: Rods<F64x4>,
+    /// `−g` (m/s²) per lane.
+    down: F64x4,
+}
+
+/// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
+struct Scratch<const C: usize> {
+    solve: Solve<C>,
+    /// Time and its compensation (s) per lane.
+    t: [F64x4; 2],
+    /// The compensation of the state per lane.
+    carry: Vec<F64x4>,
+    x: Vec<F64x4>,
+    y: Vec<F64x4>,
+    k: [Vec<F64x4>; 4],
+}
+
+/// The loads and rows of one solve in lanes.
+struct Solve<const C: usize> {
+    rows: Rows<C, F64x4>,
+    loads: Vec<Load<C, F64x4>>,
+}
+
+impl<const C: usize> Scratch<C> {
+    fn new(links: usize) -> Self {
+        let lanes = || vec![Lanes([0.0; WIDTH]); 2 * C * links];
+        Self {
+            solve: Solve { rows: Rows::with_len(links), loads: vec![Load::zero(); links] },
+            t: [Lanes([0.0; WIDTH]); 2],
+            carry: lanes(),
+            x: lanes(),
+            y: lanes(),
+            k: [lanes(), lanes(), lanes(), lanes()],
+        }
+    }
+}
+
+impl<S: DimName, Dr: Drive<S> + Sync> DirectionsBatch<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// The batch of `models`, all with the same number of links.
+    ///
+    /// Errors: [`Error::EmptyBatch`], [`Error::BatchMismatch`] naming the first model whose
+    /// length differs from model 0's, [`Error::LengthMismatch`] for a space other than 2 or
+    /// 3 dimensions.
+    pub fn new(models: Vec<Directions<S, Dr>>) -> Result<Self> {
+        if !(2..=3).contains(&S::DIM) {
+            return Err(Error::LengthMismatch { what: "space", expected: 3, got: S::DIM });
+        }
+        let links = check_links(models.iter().map(Directions::links))?;
+        let blocks = (0..models.len().div_ceil(WIDTH))
+            .map(|b| {
+                let lanes = block_chains(b, models.len());
+                Block {
+                    rods: Rods::interleave(lanes.map(|c| models[c].rods())),
+                    down: Lanes(lanes.map(|c| -models[c].chain().gravity())),
+                }
+            })
+            .collect();
+        Ok(Self { models, blocks, links })
+    }
+
+    /// Number of chains `B`.
+    pub fn len(&self) -> usize {
+        self.models.len()
+    }
+
+    /// Never: a batch has at least one chain.
+    pub fn is_empty(&self) -> bool {
+        self.models.is_empty()
+    }
+
+    /// Links per chain `n`.
+    pub fn links(&self) -> usize {
+        self.links
+    }
+
+    /// Chain `k`'s single-chain model.
+    pub fn model(&self, k: usize) -> &Directions<S, Dr> {
+        &self.models[k]
+    }
+
+    /// Entries of one chain's state, `2·S·n`.
+    pub fn state_len(&self) -> usize {
+        2 * S::DIM * self.links
+    }
+
+    /// The direction accelerations `ü` (1/s²) of every chain at time `t` (s), written into
+    /// `out` as `B` rows of `S·n`, at the states `x = (u, w)` given as `B` rows of `2·S·n`.
+    ///
+    /// Returns the chains that failed (a non-finite state or result), in order; their rows
+    /// of `out` are NaN. Errors: [`Error::LengthMismatch`] when an array does not hold `B`
+    /// rows.
+    pub fn accelerations(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<Vec<Failure>> {
+        let (chains, half) = (self.len(), S::DIM * self.links);
+        check_len("x", x, chains, 2 * half)?;
+        check_len("out", out, chains, half)?;
+        Ok(match S::DIM {
+            2 => self.accelerations_in::<2>(t, x, out),
+            _ => self.accelerations_in::<3>(t, x, out),
+        })
+    }
+
+    fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
+        let (chains, n) = (self.len(), self.links);
+        let (half, m) = (C * n, 2 * C * n);
+        for_blocks(
+            out,
+            half,
+            n,
+            || Scratch::<C>::new(n),
+            |s, b, out| {
+                let lanes = block_chains(b, chains);
+                gather(x, lanes, m, &mut s.x);
+                let [k1, ..] = &mut s.k;
+                self.flow_simd::<C>(b, lanes, [t; WIDTH], &s.x, &mut s.solve, k1);
+                let mut failures = Vec::new();
+                for (k, row) in out.chunks_exact_mut(half).enumerate() {
+                    for (i, v) in row.iter_mut().enumerate() {
+                        *v = s.k[0][half + i].0[k];
+                    }
+                    if !row.iter().all(|v| v.is_finite()) {
+                        let chain = lanes[k];
+                        let error = non_finite("x", &x[chain * m..(chain + 1) * m])
+                            .unwrap_or(Error::NotPositiveDefinite);
+                        row.fill(f64::NAN);
+                        failures.push(Failure { chain, error });
+                    }
+                }
+                failures
+            },
+        )
+    }
+
+    /// One step of RK4 with projection (`Projected<Rk4>`) of size `h` (s) for every chain,
+    /// each from its own state and time: [`integrate_rk4`](Self::integrate_rk4) with one step.
+    ///
+    /// Errors and failures as [`integrate_rk4`](Self::integrate_rk4).
+    pub fn step_rk4(&self, states: &mut [State<Dyn>], h: f64) -> Result<Vec<Failure>> {
+        self.integrate_rk4(states, h, 1)
+    }
+
+    /// `steps` steps of RK4 with projection (`Projected<Rk4>`) of size `h` (s) for every
+    /// chain, each from its own state and time; equal bit for bit to `steps` calls of
+    /// [`step_rk4`](Self::step_rk4), but the states stay in lanes from the first step to the
+    /// last.
+    ///
+    /// Returns the chains that failed (a non-finite state, or a step that produced one), in
+    /// order: each is left at its last good state (the error names the time of the failed
+    /// step) and the others go on. Errors: [`Error::LengthMismatch`] for a number of states
+    /// other than `B` or a state of the wrong length, [`Error::InvalidStepSize`] for a
+    /// non-finite or zero `h`.
+    pub fn integrate_rk4(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Result<Vec<Failure>> {
+        if states.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
+        }
+        if !h.is_finite() || h == 0.0 {
+            return Err(Error::InvalidStepSize { h });
+        }
+        if let Some(s) = states.iter().find(|s| s.x().len() != self.state_len()) {
+            return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() });
+        }
+        Ok(match S::DIM {
+            2 => self.rk4_in::<2>(states, h, steps),
+            _ => self.rk4_in::<3>(states, h, steps),
+        })
+    }
+
+    fn rk4_in<const C: usize>(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Vec<Failure> {
+        let n = self.links;
+        // Tasks of whole runs: a block's states stay in lanes for all the steps.
+        for_blocks(
+            states,
+            1,
+            n,
+            || Scratch::<C>::new(n),
+            |s, b, states| {
+                let chains = block_chains(b, self.len());
+                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(states.len() - 1));
+                let mut failures = Vec::new();
+                let mut alive = [0u64; WIDTH];
+                for (k, state) in states.iter().enumerate() {
+                    match non_finite("x", state.x().as_slice()) {
+                        Some(error) => failures.push(Failure { chain: chains[k], error }),
+                        None => alive[k] = 1,
+                    }
+                }
+                let parts: [_; WIDTH] = std::array::from_fn(|k| states[lanes[k]].parts());
+                s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
+                for (j, (x, carry)) in s.x.iter_mut().zip(&mut s.carry).enumerate() {
+                    *x = Lanes::from_fn(|k| parts[k].2[j]);
+                    *carry = Lanes::from_fn(|k| parts[k].3[j]);
+                }
+                for _ in 0..steps {
+                    if alive == [0; WIDTH] {
+                        break;
+                    }
+                    let failed = self.rk4_step_simd::<C>(b, chains, h, alive, s);
+                    for (k, state_failed) in failed.iter().enumerate().take(states.len()) {
+                        if *state_failed != 0 {
+                            failures.push(Failure {
+                                chain: chains[k],
+                                error: Error::NonFiniteState { t: s.t[0].0[k], h },
+                            });
+                            alive[k] = 0;
+                        }
+                    }
+                }
+                for (k, state) in states.iter_mut().enumerate() {
+                    if non_finite("x", state.x().as_slice()).is_none() {
+                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
+                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                    }
+                }
+                failures.sort_by_key(|f| f.chain);
+                failures
+            },
+        )
+    }
+
+    simd_kernel! {
+        fn rk4_step_simd, rk4_step_avx2 => rk4_step<const C: usize>(
+            b: usize,
+            chains: [usize; WIDTH],
+            h: f64,
+            alive: [u64; WIDTH],
+            s: &mut Scratch<C>,
+        ) -> [u64; WIDTH]
+    }
+
+    /// One step of `Projected<Rk4>` in lanes, applied only in the `alive` lanes: the
+    /// increment ([`rk4_increment`](Self::rk4_increment)), then `t += h` and `x += increment`
+    /// by compensated summation ([`State`]'s), the projection of every link
+    /// ([`Constrained::project`]) and the compensation cleared, as `Projected` does. Returns
+    /// the alive lanes whose increment was not finite (left as they were).
+    #[inline(always)]
+    fn rk4_step<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        h: f64,
+        alive: [u64; WIDTH],
+        s: &mut Scratch<C>,
+    ) -> [u64; WIDTH] {
+        self.rk4_increment::<C>(b, chains, s.t[0].0, h, s);
+        let mut bad = [0u64; WIDTH];
+        for y in &s.y {
+            for (bad, y) in bad.iter_mut().zip(y.0) {
+                *bad |= !y.is_finite() as u64;
+            }
+        }
+        let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !bad[k]);
+        let [t, t_carry] = &mut s.t;
+        let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; WIDTH]));
+        (*t, *t_carry) = (F64x4::select(keep, new_t, *t), F64x4::select(keep, new_carry, *t_carry));
+        let zero = Lanes([0.0; WIDTH]);
+        // k1 is spent: the next state goes there.
+        let next = &mut s.k[0];
+        for (((next, x), carry), y) in next.iter_mut().zip(&s.x).zip(&s.carry).zip(&s.y) {
+            (*next, _) = kahan_add(*x, *carry, *y);
+        }
+        let (u, w) = next.split_at_mut(C * self.links);
+        for (u, w) in u.chunks_exact_mut(C).zip(w.chunks_exact_mut(C)) {
+            project_link(u, w);
+        }
+        for ((x, carry), next) in s.x.iter_mut().zip(&mut s.carry).zip(&s.k[0]) {
+            *x = F64x4::select(keep, *next, *x);
+            *carry = F64x4::select(keep, zero, *carry);
+        }
+        std::array::from_fn(|k| alive[k] & bad[k])
+    }
+
+    simd_kernel! {
+        fn flow_simd, flow_avx2 => flow<const C: usize>(
+            b: usize,
+            chains: [usize; WIDTH],
+            t: [f64; WIDTH],
+            x: &[F64x4],
+            solve: &mut Solve<C>,
+            out: &mut [F64x4],
+        )
+    }
+
+    /// The RK4 stages of [`Rk4`](crate::integrate::Rk4) in lanes, from `s.x` at times `t`,
+    /// leaving the increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` in `s.y`.
+    #[inline(always)]
+    fn rk4_increment<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        h: f64,
+        s: &mut Scratch<C>,
+    ) {
+        let half = 0.5 * h;
+        let (x, y, rows) = (&s.x, &mut s.y, &mut s.solve);
+        let [k1, k2, k3, k4] = &mut s.k;
+        let (half_lanes, h_lanes) = (Lanes([half; WIDTH]), Lanes([h; WIDTH]));
+        let axpy = |y: &mut [F64x4], a: F64x4, k: &[F64x4]| {
+            for ((y, x), k) in y.iter_mut().zip(x).zip(k) {
+                *y = a * *k + *x;
+            }
+        };
+        let at = |dt: f64| -> [f64; WIDTH] { std::array::from_fn(|k| t[k] + dt) };
+        self.flow::<C>(b, chains, t, x, rows, k1);
+        axpy(y, half_lanes, k1);
+        self.flow::<C>(b, chains, at(half), y, rows, k2);
+        axpy(y, half_lanes, k2);
+        self.flow::<C>(b, chains, at(half), y, rows, k3);
+        axpy(y, h_lanes, k3);
+        self.flow::<C>(b, chains, at(h), y, rows, k4);
+        let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
+        for (j, y) in y.iter_mut().enumerate() {
+            *y = sixth * (k1[j] + two * (k2[j] + k3[j]) + k4[j]);
+        }
+    }
+
+    /// `out = (w, ü(t, x))` for the block's chains in lanes: [`Directions`]' right-hand side,
+    /// one tension solve, with each chain's pivot acceleration at its own time.
+    #[inline(always)]
+    fn flow<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        x: &[F64x4],
+        solve: &mut Solve<C>,
+        out: &mut [F64x4],
+    ) {
+        let half = C * self.links;
+        let block = &self.blocks[b];
+        let zero = Lanes([0.0; WIDTH]);
+        let pivots: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().acceleration(t[k]));
+        let pivot: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| pivots[k][c]));
+        let mut gravity = [zero; C];
+        gravity[C - 1] = block.down;
+        let (directions, rates) = x.split_at(half);
+        let (velocity, acceleration) = out.split_at_mut(half);
+        velocity.copy_from_slice(rates);
+        // The loads in a pass of their own: built inside the solve, the builder is not
+        // inlined.
+        let drag = block.rods.drag();
+        for (i, load) in solve.loads.iter_mut().enumerate() {
+            let at = |v: &[F64x4]| -> [F64x4; C] { std::array::from_fn(|c| v[i * C + c]) };
+            *load = rate_load(at(directions), at(rates), drag[i]);
+        }
+        let loads = &solve.loads;
+        let load = |i: usize| loads[i];
+        block.rods.solve(gravity, pivot, &mut solve.rows, load, |i, a, _, _| {
+            acceleration[i * C..(i + 1) * C].copy_from_slice(&a);
+        });
+    }
+}

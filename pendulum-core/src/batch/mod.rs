@@ -1,0 +1,193 @@
+//! Many chains per call: `B` chains with the same number of links, each with its own
+//! masses, lengths, damping, gravity, drive and state, evaluated and stepped together.
+//!
+//! A single chain's tension solve is a serial recurrence down the chain and back up it;
+//! across chains the recurrences are independent. The batch therefore runs the one solve
+//! of the [`rods`](crate::rods) module on [`Lanes`] of [`WIDTH`] chains: every number of the
+//! solve is `WIDTH` numbers, one per chain, and each operation one SIMD instruction (AVX2,
+//! detected at run time like the sine kernel's; a portable loop otherwise). Blocks of
+//! `WIDTH` chains go to the cores through rayon (the current pool: wrap a call in
+//! `ThreadPool::install` to choose the threads).
+//!
+//! **Bit for bit.** A lane does the same IEEE operations in the same order as the
+//! single-chain call (no fused multiply-add, the same sine kernel), so every chain of a
+//! batch gets exactly the single-chain result, whatever the thread count and however the
+//! chains are split into calls. The tests check it.
+//!
+//! **Failures stay in their chain.** A chain with a non-finite input, or whose result is
+//! not finite, is reported by its index ([`Failure`]) and does not stop the others; its
+//! rows of the output are NaN (accelerations) or its state is left as it was (steps).
+//!
+//! Layout: arrays are chain-major, `(B, m)` row after row as numpy stores a `(B, m)` array.
+//! Each block is gathered into lane order (`m` rows of `WIDTH`) and scattered back: O(m)
+//! copies against the O(m) solve, a small part of its cost.
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::lanes::Lanes;
+
+mod directions;
+mod planar;
+
+pub use directions::DirectionsBatch;
+pub use planar::PlanarBatch;
+
+/// Chains per block: four `f64` lanes, one AVX2 register.
+pub const WIDTH: usize = 4;
+
+/// Four chains' numbers, one per lane.
+pub(crate) type F64x4 = Lanes<WIDTH>;
+
+/// A chain of a batch that failed, and why; the other chains finished.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// The chain's 0-based index in the batch.
+    pub chain: usize,
+    /// What went wrong, as the single-chain call would say it.
+    pub error: Error,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "chain {}: {}", self.chain, self.error)
+    }
+}
+
+/// Checks that the batch has chains and that chain `k` has as many links as chain 0:
+/// `links` gives each chain's.
+pub(crate) fn check_links(links: impl ExactSizeIterator<Item = usize>) -> Result<usize> {
+    let mut expected = None;
+    for (chain, n) in links.enumerate() {
+        match expected {
+            None => expected = Some(n),
+            Some(e) if e != n => return Err(Error::BatchMismatch { chain, links: n, expected: e }),
+            Some(_) => {}
+        }
+    }
+    expected.ok_or(Error::EmptyBatch)
+}
+
+/// Checks that `v` holds `chains` rows of `per_chain` numbers.
+pub(crate) fn check_len(what: &'static str, v: &[f64], chains: usize, per_chain: usize) -> Result<()> {
+    if v.len() == chains * per_chain {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch { what, expected: chains * per_chain, got: v.len() })
+    }
+}
+
+/// The chains of block `b` of a batch of `chains`: lane `k` holds chain `WIDTH·b + k`, and
+/// the lanes past the last chain repeat it (their results are dropped).
+pub(crate) fn block_chains(b: usize, chains: usize) -> [usize; WIDTH] {
+    std::array::from_fn(|k| (WIDTH * b + k).min(chains - 1))
+}
+
+/// Lane `k` of each of the `m` numbers of the rows `rows` of `v` (`m` per row).
+#[inline(always)]
+pub(crate) fn gather(v: &[f64], rows: [usize; WIDTH], m: usize, out: &mut [F64x4]) {
+    for (j, o) in out[..m].iter_mut().enumerate() {
+        *o = Lanes::from_fn(|k| v[rows[k] * m + j]);
+    }
+}
+
+/// The first non-finite entry of `v` as the single-chain error.
+pub(crate) fn non_finite(what: &'static str, v: &[f64]) -> Option<Error> {
+    v.iter().position(|x| !x.is_finite()).map(|index| Error::NonFinite { what, index, value: v[index] })
+}
+
+/// Blocks of [`WIDTH`] chains a rayon task takes at least: about 2000 rods' work, so that
+/// short chains do not drown in scheduling.
+pub(crate) fn blocks_per_task(links: usize) -> usize {
+    (2048 / (WIDTH * links)).max(1)
+}
+
+/// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
+/// numbers each, the last one shorter) across the current rayon pool, with a `scratch` from
+/// `init` per task, and collects the failures in chain order.
+pub(crate) fn for_blocks<T: Send, S>(
+    out: &mut [T],
+    m: usize,
+    links: usize,
+    init: impl Fn() -> S + Sync + Send,
+    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<Failure> + Sync + Send,
+) -> Vec<Failure> {
+    let per_task = blocks_per_task(links);
+    if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
+        // One task's work, or one thread: no handing over to the pool (a thread's wake-up
+        // costs more than a short batch).
+        let mut scratch = init();
+        return out
+            .chunks_mut(WIDTH * m)
+            .enumerate()
+            .flat_map(|(b, rows)| block(&mut scratch, b, rows))
+            .collect();
+    }
+    out.par_chunks_mut(WIDTH * m)
+        .enumerate()
+        .with_min_len(per_task)
+        .map_init(init, |scratch, (b, rows)| block(scratch, b, rows))
+        .flat_map_iter(|failures| failures)
+        .collect()
+}
+
+/// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
+/// std).
+#[inline(always)]
+pub(crate) fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    return false;
+}
+
+/// `fn $avx2(&self, args…)`: the `#[inline(always)]` method `$kernel` compiled for AVX2 (the
+/// kernel must be inlined all the way down for its lanes to become registers), and
+/// `fn $dispatch(&self, args…)` that runs it when the CPU has AVX2, else `$kernel` as it is.
+macro_rules! simd_kernel {
+    ($(#[$meta:meta])* fn $dispatch:ident, $avx2:ident => $kernel:ident $(<const $c:ident: usize>)? ($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?) => {
+        $(#[$meta])*
+        fn $dispatch $(<const $c: usize>)? (&self, $($arg: $ty),*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            if $crate::batch::has_avx2() {
+                // SAFETY: the CPU has AVX2, checked just above.
+                return unsafe { self.$avx2 $(::<$c>)? ($($arg),*) };
+            }
+            self.$kernel $(::<$c>)? ($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        #[allow(clippy::too_many_arguments)]
+        fn $avx2 $(<const $c: usize>)? (&self, $($arg: $ty),*) $(-> $ret)? {
+            self.$kernel $(::<$c>)? ($($arg),*)
+        }
+    };
+}
+pub(crate) use simd_kernel;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_batch_must_have_chains_of_one_length() {
+        assert_eq!(check_links([3, 3, 3].into_iter()), Ok(3));
+        assert_eq!(
+            check_links([3, 3, 4].into_iter()),
+            Err(Error::BatchMismatch { chain: 2, links: 4, expected: 3 })
+        );
+        assert_eq!(check_links(std::iter::empty::<usize>()), Err(Error::EmptyBatch));
+        assert_eq!(
+            Error::BatchMismatch { chain: 2, links: 4, expected: 3 }.to_string(),
+            "chain 2 of the batch has 4 links, chain 0 has 3"
+        );
+    }
+
+    #[test]
+    fn the_last_block_repeats_the_last_chain() {
+        assert_eq!(block_chains(0, 6), [0, 1, 2, 3]);
+        assert_eq!(block_chains(1, 6), [4, 5, 5, 5]);
+        assert_eq!(block_chains(0, 1), [0, 0, 0, 0]);
+    }
+}

@@ -1,0 +1,256 @@
+//! Numbers that are one `f64` or `W` of them side by side: the scalar type of the tension
+//! solve, so that one algorithm serves a single chain (`f64`) and `W` chains at once in SIMD
+//! lanes ([`Lanes`]).
+//!
+//! [`Lanes`] does every operation lane by lane, the same IEEE operation in each, with no
+//! fused multiply-add: a lane's result is bit for bit what `f64` gives for that lane alone.
+//! Compiled for AVX2 (the batch detects it at run time, as the sine kernel does) four lanes
+//! are one instruction; on the baseline x86-64 target two; elsewhere whatever the target
+//! has.
+
+use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// The arithmetic the tension solve needs, lane by lane.
+pub trait Lane:
+    Copy
+    + std::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    /// One flag per lane.
+    type Mask: Copy + std::fmt::Debug;
+    /// Lanes.
+    const WIDTH: usize;
+
+    /// Every lane `x`.
+    fn splat(x: f64) -> Self;
+    /// The square root, correctly rounded, lane by lane.
+    fn sqrt(self) -> Self;
+    /// The flags of the lanes whose bit pattern `b` has `b − low > span` (wrapping): with
+    /// `(low, span)` = [`CONTINUANT_RANGE`](crate::rods::CONTINUANT_RANGE), the lanes
+    /// outside `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (negative, zero, infinite and NaN included).
+    fn outside(self, low: u64, span: u64) -> Self::Mask;
+    /// No lane flagged.
+    fn none() -> Self::Mask;
+    /// The flags of either.
+    fn or(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// Whether any lane is flagged.
+    fn any(mask: Self::Mask) -> bool;
+    /// `a` in the flagged lanes, `b` in the others.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`, lane by lane: the exact power of two that
+    /// brings a positive normal `x` into `[1, 2)`.
+    fn normalizer(self) -> Self;
+}
+
+impl Lane for f64 {
+    type Mask = bool;
+    const WIDTH: usize = 1;
+
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn outside(self, low: u64, span: u64) -> bool {
+        self.to_bits().wrapping_sub(low) > span
+    }
+    #[inline(always)]
+    fn none() -> bool {
+        false
+    }
+    #[inline(always)]
+    fn or(a: bool, b: bool) -> bool {
+        a | b
+    }
+    #[inline(always)]
+    fn any(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn normalizer(self) -> Self {
+        let biased = (self.to_bits() >> 52) & 0x7ff;
+        f64::from_bits(((2046 - biased as i64) as u64 & 0x7ff) << 52)
+    }
+}
+
+/// `W` numbers, one per chain of a batch, operated on lane by lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(transparent)]
+pub struct Lanes<const W: usize>(pub [f64; W]);
+
+impl<const W: usize> Lanes<W> {
+    /// The lanes as an array.
+    #[inline(always)]
+    pub fn to_array(self) -> [f64; W] {
+        self.0
+    }
+
+    /// `f(lane)` for each lane.
+    #[inline(always)]
+    pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        let mut out = self.0;
+        for x in &mut out {
+            *x = f(*x);
+        }
+        Self(out)
+    }
+
+    /// The lanes of `v` one after another: `v[i].0[k]` at `W·i + k`.
+    #[inline(always)]
+    pub fn flatten(v: &[Self]) -> &[f64] {
+        // SAFETY: `Lanes<W>` is `repr(transparent)` over `[f64; W]`, so a slice of `m` of them
+        // is `W·m` contiguous `f64`s with the same alignment.
+        unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), W * v.len()) }
+    }
+
+    /// [`flatten`](Self::flatten), mutably.
+    #[inline(always)]
+    pub fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
+        // SAFETY: as in `flatten`; the borrow of `v` is moved into the result.
+        unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast(), W * v.len()) }
+    }
+
+    /// `f(k)` in lane `k`.
+    #[inline(always)]
+    pub fn from_fn(f: impl Fn(usize) -> f64) -> Self {
+        let mut out = [0.0; W];
+        for (k, x) in out.iter_mut().enumerate() {
+            *x = f(k);
+        }
+        Self(out)
+    }
+}
+
+macro_rules! lane_op {
+    ($trait:ident, $method:ident, $assign:ident, $assign_method:ident, $op:tt) => {
+        impl<const W: usize> $trait for Lanes<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: Self) -> Self {
+                let mut out = self.0;
+                for k in 0..W {
+                    out[k] = self.0[k] $op other.0[k];
+                }
+                Self(out)
+            }
+        }
+        impl<const W: usize> $assign for Lanes<W> {
+            #[inline(always)]
+            fn $assign_method(&mut self, other: Self) {
+                *self = *self $op other;
+            }
+        }
+    };
+}
+
+impl<const W: usize> Neg for Lanes<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self.map(|x| -x)
+    }
+}
+
+lane_op!(Add, add, AddAssign, add_assign, +);
+lane_op!(Sub, sub, SubAssign, sub_assign, -);
+lane_op!(Mul, mul, MulAssign, mul_assign, *);
+lane_op!(Div, div, DivAssign, div_assign, /);
+
+impl<const W: usize> Lane for Lanes<W> {
+    /// 1 in the flagged lanes, 0 in the others (integers, so that the flags stay in a
+    /// vector register).
+    type Mask = [u64; W];
+    const WIDTH: usize = W;
+
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Self([x; W])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.map(f64::sqrt)
+    }
+    #[inline(always)]
+    fn outside(self, low: u64, span: u64) -> [u64; W] {
+        let mut out = [0; W];
+        for (o, x) in out.iter_mut().zip(self.0) {
+            *o = x.outside(low, span) as u64;
+        }
+        out
+    }
+    #[inline(always)]
+    fn none() -> [u64; W] {
+        [0; W]
+    }
+    #[inline(always)]
+    fn or(a: [u64; W], b: [u64; W]) -> [u64; W] {
+        let mut out = a;
+        for k in 0..W {
+            out[k] |= b[k];
+        }
+        out
+    }
+    #[inline(always)]
+    fn any(mask: [u64; W]) -> bool {
+        mask.iter().fold(0, |any, m| any | m) != 0
+    }
+    #[inline(always)]
+    fn select(mask: [u64; W], a: Self, b: Self) -> Self {
+        let mut out = b.0;
+        for k in 0..W {
+            if mask[k] != 0 {
+                out[k] = a.0[k];
+            }
+        }
+        Self(out)
+    }
+    #[inline(always)]
+    fn normalizer(self) -> Self {
+        self.map(f64::normalizer)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lanes_do_what_each_f64_does() {
+        let a = Lanes([1.5, -2.0, 3e-300, 7.0]);
+        let b = Lanes([0.1, 3.0, 1e300, -0.0]);
+        for k in 0..4 {
+            assert_eq!((a + b).0[k], a.0[k] + b.0[k]);
+            assert_eq!((a - b).0[k], a.0[k] - b.0[k]);
+            assert_eq!((a * b).0[k], a.0[k] * b.0[k]);
+            assert_eq!((a / b).0[k].to_bits(), (a.0[k] / b.0[k]).to_bits());
+            assert_eq!(a.normalizer().0[k], a.0[k].normalizer());
+        }
+        let mask = Lanes([1.0, 0.0, f64::NAN, 2f64.powi(900)])
+            .outside(crate::rods::CONTINUANT_RANGE.0, crate::rods::CONTINUANT_RANGE.1);
+        assert_eq!(mask, [0, 1, 1, 1]);
+        assert!(Lanes::<4>::any(mask) && !Lanes::<4>::any(Lanes::<4>::none()));
+        assert_eq!(Lanes::select(mask, a, b).0[..2], [0.1f64, -2.0][..]);
+    }
+
+    #[test]
+    fn the_normalizer_brings_a_number_into_one_to_two() {
+        for x in [1.0, 1.999, 3.0, 1e-200, 7e250, 2f64.powi(-800)] {
+            let y = x * x.normalizer();
+            assert!((1.0..2.0).contains(&y), "{x} → {y}");
+        }
+    }
+}

@@ -1,0 +1,264 @@
+//! Batches of chains (`pendulum_core::batch`): every chain of a batch gets exactly the
+//! single-chain result, whatever the thread count and however the chains are split into
+//! calls, and a failing chain is reported by its index while the others finish.
+
+use nalgebra::{DVector, Dyn, U2, U3};
+use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
+use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
+use pendulum_core::{Chain, Circle, Directions, Error, Inputs, Model, PlanarTension};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A chain of `n` links with masses, lengths and damping log-uniform over two decades and
+/// gravity between 1 and 20 m/s².
+fn random_chain(n: usize, r: &mut ChaCha8Rng) -> Chain<Dyn> {
+    let mut decades = |lo: f64| (0..n).map(|_| 10f64.powf(lo + 2.0 * r.random::<f64>())).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (decades(-2.0), decades(-2.0), decades(-5.0));
+    let g = r.random_range(1.0..20.0);
+    Chain::new(&masses, &lengths, g).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// Every entry equal bit for bit (NaN only where NaN).
+fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
+    assert_eq!(batch.len(), single.len(), "{what}");
+    for (i, (a, b)) in batch.iter().zip(single).enumerate() {
+        assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
+    }
+}
+
+fn pools() -> [rayon::ThreadPool; 2] {
+    [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
+}
+
+#[test]
+fn planar_batch_equals_each_chain_alone_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(31);
+    for (chains, n) in [(1, 1), (3, 2), (9, 8), (13, 20), (64, 8), (5, 100), (6, 40)] {
+        let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+        let batch = PlanarBatch::new(chain.clone()).expect("batch");
+        // Angles over several turns (some beyond the sine kernel's range), rates, pivots.
+        let q: Vec<f64> = (0..chains * n)
+            .map(|i| if i % 17 == 5 { r.random_range(-1e5..1e5) } else { r.random_range(-20.0..20.0) })
+            .collect();
+        let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-10.0..10.0)).collect();
+        let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+        let mut single = vec![0.0; chains * n];
+        for (k, c) in chain.iter().enumerate() {
+            let model = PlanarTension::new(c.clone());
+            let rows = k * n..(k + 1) * n;
+            let mut inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
+            inputs.pivot_acceleration = nalgebra::Vector2::new(pivot[2 * k], pivot[2 * k + 1]);
+            let mut out = DVector::zeros(n);
+            model
+                .accelerations(
+                    &DVector::from_column_slice(&q[rows.clone()]),
+                    &DVector::from_column_slice(&qd[rows.clone()]),
+                    &inputs,
+                    &mut out,
+                )
+                .expect("single");
+            single[rows].copy_from_slice(out.as_slice());
+        }
+        for pool in pools() {
+            let mut out = vec![0.0; chains * n];
+            let failures =
+                pool.install(|| batch.accelerations(&q, &qd, Some(&pivot), &mut out)).expect("batch");
+            assert!(failures.is_empty(), "{failures:?}");
+            assert_bits(
+                &out,
+                &single,
+                &format!("{chains} chains of {n}, {} threads", pool.current_num_threads()),
+            );
+        }
+        // Split into two calls at every block boundary and off it: the same numbers.
+        let cut = chains / 2;
+        if cut > 0 {
+            let (a, b) = (PlanarBatch::new(chain[..cut].to_vec()), PlanarBatch::new(chain[cut..].to_vec()));
+            let mut out = vec![0.0; chains * n];
+            let (low, high) = out.split_at_mut(cut * n);
+            a.expect("a")
+                .accelerations(&q[..cut * n], &qd[..cut * n], Some(&pivot[..2 * cut]), low)
+                .expect("a");
+            b.expect("b")
+                .accelerations(&q[cut * n..], &qd[cut * n..], Some(&pivot[2 * cut..]), high)
+                .expect("b");
+            assert_bits(&out, &single, "split");
+        }
+    }
+}
+
+#[test]
+fn one_chain_repeated_is_that_chain_at_every_state() {
+    let mut r = ChaCha8Rng::seed_from_u64(13);
+    let (count, n) = (11, 7);
+    let chain = random_chain(n, &mut r);
+    let q: Vec<f64> = (0..count * n).map(|_| r.random_range(-4.0..4.0)).collect();
+    let qd: Vec<f64> = (0..count * n).map(|_| r.random_range(-4.0..4.0)).collect();
+    let (mut a, mut b) = (vec![0.0; count * n], vec![0.0; count * n]);
+    PlanarBatch::repeated(chain.clone(), count)
+        .expect("repeated")
+        .accelerations(&q, &qd, None, &mut a)
+        .expect("a");
+    PlanarBatch::new(vec![chain; count]).expect("copies").accelerations(&q, &qd, None, &mut b).expect("b");
+    assert_bits(&a, &b, "repeated");
+}
+
+#[test]
+fn a_failing_chain_is_named_and_the_others_finish() {
+    let mut r = ChaCha8Rng::seed_from_u64(7);
+    let (chains, n) = (10, 6);
+    let batch = PlanarBatch::new((0..chains).map(|_| random_chain(n, &mut r)).collect()).expect("batch");
+    let mut q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+    let qd = vec![0.5; chains * n];
+    let mut clean = vec![0.0; chains * n];
+    assert!(batch.accelerations(&q, &qd, None, &mut clean).expect("clean").is_empty());
+    q[5 * n + 2] = f64::NAN;
+    q[9 * n] = f64::INFINITY;
+    let mut out = vec![0.0; chains * n];
+    let failures = batch.accelerations(&q, &qd, None, &mut out).expect("batch");
+    let said: Vec<_> = failures.iter().map(|f| f.to_string()).collect();
+    assert_eq!(said, ["chain 5: q[2] must be finite, got NaN", "chain 9: q[0] must be finite, got inf"]);
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [5, 9]);
+    for k in 0..chains {
+        let row = k * n..(k + 1) * n;
+        if k == 5 || k == 9 {
+            assert!(out[row].iter().all(|v| v.is_nan()));
+        } else {
+            assert_bits(&out[row.clone()], &clean[row], &format!("chain {k}"));
+        }
+    }
+}
+
+#[test]
+fn batches_need_chains_of_one_length_and_whole_rows() {
+    let mut r = ChaCha8Rng::seed_from_u64(3);
+    let err = PlanarBatch::new(vec![random_chain(4, &mut r), random_chain(5, &mut r)]).unwrap_err();
+    assert_eq!(err.to_string(), "chain 1 of the batch has 5 links, chain 0 has 4");
+    assert_eq!(PlanarBatch::new(vec![]).unwrap_err(), Error::EmptyBatch);
+    let batch = PlanarBatch::new(vec![random_chain(4, &mut r); 3]).expect("batch");
+    let err = batch.accelerations(&[0.0; 11], &[0.0; 12], None, &mut [0.0; 12]).unwrap_err();
+    assert_eq!(err.to_string(), "q has 11 entries, expected 12");
+}
+
+/// A whirl-like 3D chain: uniform random links, its pivot on a circle of random radius and
+/// speed, from a tilted swinging state.
+fn whirl(n: usize, r: &mut ChaCha8Rng) -> (Directions<U3, Circle>, DVector<f64>) {
+    let chain = random_chain(n, r);
+    let drive = Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..10.0)).expect("drive");
+    let model = Directions::<U3>::new(chain).with_drive(drive);
+    let q: Vec<f64> =
+        (0..2 * n).map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) }).collect();
+    let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-1.0..1.0)).collect();
+    let x = model.from_spherical(&q, &qd).expect("state");
+    (model, x)
+}
+
+#[test]
+fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(11);
+    for (chains, n) in [(1, 3), (7, 10), (9, 100)] {
+        let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+        let batch = DirectionsBatch::new(models.clone()).expect("batch");
+        let h = 1e-3;
+        // Chains at different times, so that each drive is evaluated at its own.
+        let start: Vec<State<Dyn>> =
+            x.iter().enumerate().map(|(k, x)| State::new(0.1 * k as f64, x.clone())).collect();
+        let mut single = start.clone();
+        for (model, state) in models.iter().zip(&mut single) {
+            let mut rk4 = Projected::new(Rk4::new(model));
+            for _ in 0..20 {
+                rk4.step(model, state, h).expect("single");
+            }
+        }
+        for pool in pools() {
+            // Step by step, and 20 steps in one call.
+            let mut states = start.clone();
+            for _ in 0..20 {
+                let failures = pool.install(|| batch.step_rk4(&mut states, h)).expect("batch");
+                assert!(failures.is_empty(), "{failures:?}");
+            }
+            let mut run = start.clone();
+            assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 20)).expect("batch").is_empty());
+            for (k, ((a, b), c)) in states.iter().zip(&single).zip(&run).enumerate() {
+                for s in [a, c] {
+                    assert_eq!(s.t().to_bits(), b.t().to_bits());
+                    assert_bits(s.x().as_slice(), b.x().as_slice(), &format!("chain {k} of {chains}×{n}"));
+                    assert_bits(s.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+                }
+            }
+        }
+        // The accelerations alone, too.
+        let m = batch.state_len();
+        let flat: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+        let mut out = vec![0.0; chains * m / 2];
+        assert!(batch.accelerations(0.3, &flat, &mut out).expect("batch").is_empty());
+        for (k, (model, x)) in models.iter().zip(&x).enumerate() {
+            let mut one = vec![0.0; m / 2];
+            model.accelerations(0.3, x, &mut one, None).expect("single");
+            assert_bits(&out[k * m / 2..(k + 1) * m / 2], &one, &format!("ü of chain {k}"));
+        }
+    }
+}
+
+#[test]
+fn a_planar_directions_batch_matches_too_and_a_blown_chain_stays_put() {
+    let mut r = ChaCha8Rng::seed_from_u64(5);
+    let n = 12;
+    let models: Vec<_> = (0..6).map(|_| Directions::<U2>::new(random_chain(n, &mut r))).collect();
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let start: Vec<State<Dyn>> = models
+        .iter()
+        .map(|m| {
+            let theta: Vec<f64> = (0..n).map(|_| r.random_range(-2.0..2.0)).collect();
+            State::new(0.0, m.from_angles(&theta, &vec![0.3; n]).expect("state"))
+        })
+        .collect();
+    let mut states = start.clone();
+    let mut bad = states[3].x().clone();
+    bad[4] = f64::NAN;
+    states[3] = State::new(0.0, bad.clone());
+    let failures = batch.step_rk4(&mut states, 2e-3).expect("batch");
+    assert_eq!(failures.len(), 1);
+    assert_eq!(failures[0].chain, 3);
+    assert_bits(states[3].x().as_slice(), bad.as_slice(), "the failed chain's state");
+    for k in [0, 1, 2, 4, 5] {
+        let mut one = start[k].clone();
+        Projected::new(Rk4::new(&models[k])).step(&models[k], &mut one, 2e-3).expect("single");
+        assert_bits(states[k].x().as_slice(), one.x().as_slice(), &format!("chain {k}"));
+    }
+    assert_eq!(batch.step_rk4(&mut states, 0.0).unwrap_err(), Error::InvalidStepSize { h: 0.0 });
+}
+
+#[test]
+fn a_chain_that_blows_up_mid_run_stops_at_its_last_good_state() {
+    let mut r = ChaCha8Rng::seed_from_u64(9);
+    let n = 10;
+    let models: Vec<_> = (0..5).map(|_| Directions::<U3>::new(random_chain(n, &mut r))).collect();
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let mut start: Vec<State<Dyn>> = models
+        .iter()
+        .map(|m| {
+            let q: Vec<f64> = (0..2 * n).map(|i| if i < n { 0.5 } else { 1.0 }).collect();
+            State::new(0.0, m.from_spherical(&q, &vec![0.2; 2 * n]).expect("state"))
+        })
+        .collect();
+    // Chain 2 spins so fast that RK4 at this step size diverges to infinity.
+    let fast: Vec<f64> = (0..2 * n).map(|i| if i < n { 0.0 } else { 1e150 }).collect();
+    let q: Vec<f64> = (0..2 * n).map(|i| if i < n { 0.5 } else { 1.0 }).collect();
+    start[2] = State::new(0.0, models[2].from_spherical(&q, &fast).expect("state"));
+    let h = 1e-3;
+    let mut states = start.clone();
+    let failures = batch.integrate_rk4(&mut states, h, 50).expect("batch");
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    assert_eq!(failures[0].chain, 2);
+    let Error::NonFiniteState { t, .. } = failures[0].error else { panic!("{failures:?}") };
+    // Chain 2 alone, step by step, fails at the same step and stops where the batch left it.
+    let mut alone = start[2].clone();
+    let mut rk4 = Projected::new(Rk4::new(&models[2]));
+    while rk4.step(&models[2], &mut alone, h).is_ok() {}
+    assert_eq!(alone.t().to_bits(), t.to_bits());
+    assert_bits(states[2].x().as_slice(), alone.x().as_slice(), "the blown chain");
+    for k in [0, 1, 3, 4] {
+        assert!((states[k].t() - 0.05).abs() < 1e-12, "chain {k} ran all 50 steps");
+    }
+}
