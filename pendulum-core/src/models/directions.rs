@@ -265,8 +265,10 @@ where
         let mut tensions = tensions;
         with_scratch::<C, _>(n, |s| {
             let load = |i: usize| {
-                let at = |v: &[f64]| -> [f64; C] { std::array::from_fn(|k| v[i * C + k]) };
-                rate_load(at(directions), at(rates), drag[i])
+                let (mut u, mut w) = ([0.0; C], [0.0; C]);
+                u.copy_from_slice(&directions[i * C..(i + 1) * C]);
+                w.copy_from_slice(&rates[i * C..(i + 1) * C]);
+                rate_load(u, w, drag[i])
             };
             self.rods.solve(gravity, pivot, &mut s.rows, load, |i, a, _, t| {
                 out[i * C..(i + 1) * C].copy_from_slice(&a);
