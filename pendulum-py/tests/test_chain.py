@@ -75,6 +75,20 @@ def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
             assert np.array_equal(batch[i, j], chain.accelerations(q[i, j], qd[i, j], torque))
     qdd, dq, dqd = chain.jacobians(q, qd)
     assert (qdd.shape, dq.shape, dqd.shape) == ((3, 5, 8), (3, 5, 8, 8), (3, 5, 8, 8))
+    # Without torques many states go through the batch of chains (four per SIMD lane
+    # group): still the states one at a time, bit for bit, and the same error for a bad one.
+    pivot = rng.normal(size=(3, 5, 2))
+    batch = chain.accelerations(q, qd, pivot_acceleration=pivot)
+    for i in range(3):
+        for j in range(5):
+            one = chain.accelerations(q[i, j], qd[i, j], pivot_acceleration=pivot[i, j])
+            assert np.array_equal(batch[i, j], one)
+    q[2, 1, 3] = np.nan
+    with pytest.raises(ValueError) as many:
+        chain.accelerations(q, qd)
+    with pytest.raises(ValueError) as one:
+        chain.accelerations(q[2, 1], qd[2, 1])
+    assert str(many.value) == str(one.value) == "q: NaN is not finite"
 
 
 def test_the_analytic_jacobians_are_the_slopes_of_the_accelerations():
