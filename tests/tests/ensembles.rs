@@ -5,7 +5,7 @@
 use nalgebra::{DVector, Dyn, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Chain, Circle, Directions, Error, Inputs, Model, PlanarTension};
+use pendulum_core::{Accounted, Chain, Circle, Directions, Error, Inputs, Model, PlanarTension};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -197,6 +197,34 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
             model.accelerations(0.3, x, &mut one, None).expect("single");
             assert_bits(&out[k * m / 2..(k + 1) * m / 2], &one, &format!("ü of chain {k}"));
         }
+    }
+}
+
+#[test]
+fn with_their_energy_ledgers_the_steps_equal_the_accounted_chain_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(17);
+    let n = 30;
+    let (models, x): (Vec<_>, Vec<_>) = (0..6).map(|_| whirl(n, &mut r)).unzip();
+    let batch = DirectionsBatch::accounted(models.clone()).expect("batch");
+    let start: Vec<State<Dyn>> = models
+        .iter()
+        .zip(&x)
+        .map(|(m, x)| State::new(0.0, Accounted::of(m.clone()).state(x).expect("state")))
+        .collect();
+    let h = 5e-4;
+    let mut states = start.clone();
+    assert!(batch.integrate_rk4(&mut states, h, 40).expect("batch").is_empty());
+    for (k, (model, state)) in models.iter().zip(&states).enumerate() {
+        let system = Accounted::of(model.clone());
+        let mut alone = start[k].clone();
+        let mut rk4 = Projected::new(Rk4::new(&system));
+        for _ in 0..40 {
+            rk4.step(&system, &mut alone, h).expect("single");
+        }
+        assert_bits(state.x().as_slice(), alone.x().as_slice(), &format!("chain {k} with its ledger"));
+        // The ledger moved: the drive did work and the damping took some.
+        let ledger = &state.x().as_slice()[batch.state_len() - 3..];
+        assert!(ledger[0] != 0.0 && ledger[2] > 0.0, "{ledger:?}");
     }
 }
 

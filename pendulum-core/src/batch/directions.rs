@@ -6,9 +6,11 @@ use nalgebra::{DefaultAllocator, DimName, Dyn, allocator::Allocator};
 use super::{
     F64x4, Failure, WIDTH, block_chains, check_len, check_links, for_blocks, gather, non_finite, simd_kernel,
 };
+use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
 use crate::error::{Error, Result};
 use crate::integrate::State;
+use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::integrate::kahan_add;
 use crate::lanes::Lane;
 use crate::lanes::Lanes;
@@ -29,6 +31,8 @@ pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     models: Vec<Directions<S, Dr>>,
     blocks: Vec<Block>,
     links: usize,
+    /// Whether the states carry the energy ledger of [`Accounted`].
+    accounted: bool,
 }
 
 /// What the solve needs of one block's chains.
@@ -37,6 +41,11 @@ struct Block {
     rods: Rods<F64x4>,
     /// `−g` (m/s²) per lane.
     down: F64x4,
+    /// Per link, the mass hanging from it (kg), its length (m) and damping `λ` (N·m·s): the
+    /// ledger's powers.
+    tails: Vec<F64x4>,
+    lengths: Vec<F64x4>,
+    damping: Vec<F64x4>,
 }
 
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
@@ -58,8 +67,8 @@ struct Solve<const C: usize> {
 }
 
 impl<const C: usize> Scratch<C> {
-    fn new(links: usize) -> Self {
-        let lanes = || vec![Lanes([0.0; WIDTH]); 2 * C * links];
+    fn new(links: usize, state_len: usize) -> Self {
+        let lanes = || vec![Lanes([0.0; WIDTH]); state_len];
         Self {
             solve: Solve { rows: Rows::with_len(links), loads: vec![Load::zero(); links] },
             t: [Lanes([0.0; WIDTH]); 2],
@@ -88,13 +97,31 @@ where
         let blocks = (0..models.len().div_ceil(WIDTH))
             .map(|b| {
                 let lanes = block_chains(b, models.len());
+                let per_link = |of: fn(&Chain<Dyn>) -> &[f64]| -> Vec<F64x4> {
+                    (0..links).map(|i| Lanes::from_fn(|k| of(models[lanes[k]].chain())[i])).collect()
+                };
                 Block {
                     rods: Rods::interleave(lanes.map(|c| models[c].rods())),
                     down: Lanes(lanes.map(|c| -models[c].chain().gravity())),
+                    tails: per_link(|c| c.tail_masses().as_slice()),
+                    lengths: per_link(|c| c.lengths().as_slice()),
+                    damping: per_link(|c| c.damping().as_slice()),
                 }
             })
             .collect();
-        Ok(Self { models, blocks, links })
+        Ok(Self { models, blocks, links, accounted: false })
+    }
+
+    /// The batch of `models` with their energy ledgers: states as
+    /// [`Accounted::state`](crate::energy::Accounted) gives them (`(u, w)` then the ledger's
+    /// drive work, torque work and damping loss, J), and
+    /// [`step_rk4`](Self::step_rk4) / [`integrate_rk4`](Self::integrate_rk4) equal bit for bit to
+    /// `Projected<Rk4>` on [`Accounted`](crate::energy::Accounted)`<Directions>`.
+    /// [`accelerations`](Self::accelerations) is unchanged (the motion alone).
+    ///
+    /// Errors: those of [`new`](Self::new).
+    pub fn accounted(models: Vec<Directions<S, Dr>>) -> Result<Self> {
+        Ok(Self { accounted: true, ..Self::new(models)? })
     }
 
     /// Number of chains `B`.
@@ -119,7 +146,7 @@ where
 
     /// Entries of one chain's state, `2·S·n`.
     pub fn state_len(&self) -> usize {
-        2 * S::DIM * self.links
+        2 * S::DIM * self.links + if self.accounted { LEDGER_LEN } else { 0 }
     }
 
     /// The direction accelerations `ü` (1/s²) of every chain at time `t` (s), written into
@@ -145,7 +172,7 @@ where
             out,
             half,
             n,
-            || Scratch::<C>::new(n),
+            || Scratch::<C>::new(n, self.state_len()),
             |s, b, out| {
                 let lanes = block_chains(b, chains);
                 gather(x, lanes, m, &mut s.x);
@@ -210,7 +237,7 @@ where
             states,
             1,
             n,
-            || Scratch::<C>::new(n),
+            || Scratch::<C>::new(n, self.state_len()),
             |s, b, states| {
                 let chains = block_chains(b, self.len());
                 let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(states.len() - 1));
@@ -296,7 +323,7 @@ where
         for (((next, x), carry), y) in next.iter_mut().zip(&s.x).zip(&s.carry).zip(&s.y) {
             (*next, _) = kahan_add(*x, *carry, *y);
         }
-        let (u, w) = next.split_at_mut(C * self.links);
+        let (u, w) = next[..2 * C * self.links].split_at_mut(C * self.links);
         for (u, w) in u.chunks_exact_mut(C).zip(w.chunks_exact_mut(C)) {
             project_link(u, w);
         }
@@ -371,9 +398,10 @@ where
         let pivot: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| pivots[k][c]));
         let mut gravity = [zero; C];
         gravity[C - 1] = block.down;
-        let (directions, rates) = x.split_at(half);
+        let (directions, rates) = (&x[..half], &x[half..2 * half]);
         let (velocity, acceleration) = out.split_at_mut(half);
         velocity.copy_from_slice(rates);
+        let (acceleration, ledger) = acceleration.split_at_mut(half);
         // The loads in a pass of their own: built inside the solve, the builder is not
         // inlined.
         let drag = block.rods.drag();
@@ -386,5 +414,13 @@ where
         block.rods.solve(gravity, pivot, &mut solve.rows, load, |i, a, _, _| {
             acceleration[i * C..(i + 1) * C].copy_from_slice(&a);
         });
+        if self.accounted {
+            // The ledger's rates, as `Accounted`'s right-hand side gives them.
+            let velocities: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
+            let velocity: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| velocities[k][c]));
+            let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
+            let (drive, damping) = direction_powers(chain, velocity, pivot, rates, acceleration);
+            ledger[..LEDGER_LEN].copy_from_slice(&[drive, zero, damping]);
+        }
     }
 }

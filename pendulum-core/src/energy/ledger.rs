@@ -6,6 +6,7 @@
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, allocator::Allocator};
 
 use crate::drive::{Drive, Driven, TorqueAt};
+use crate::lanes::Lane;
 use crate::energy::power::{Powers, inertial_energy, powers};
 use crate::error::{Error, Result};
 use crate::integrate::{Constrained, System};
@@ -321,31 +322,69 @@ where
     fn flow_and_powers(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<Powers> {
         self.flow(t, x, out)?;
         let c = self.chain();
-        let (n, d) = (c.links(), S::DIM);
-        let (tails, lengths, damping) = (c.tail_masses(), c.lengths(), c.damping());
         let drive = self.drive();
         let (pivot_velocity, pivot_acceleration) = (drive.velocity(t), drive.acceleration(t));
-        let total = tails[0];
-        let mut force = &pivot_acceleration * total;
-        force[d - 1] += total * c.gravity();
-        let mut damped = 0.0;
         let half = x.len() / 2;
         let (w, wd) = (&x[half..], &out[half..]);
-        for j in 0..n {
-            let weight = tails[j] * lengths[j];
-            let mut w2 = 0.0;
-            for k in 0..d {
-                force[k] += weight * wd[j * d + k];
-                w2 += w[j * d + k].powi(2);
-            }
-            damped += damping[j] * w2;
-        }
-        Ok(Powers { drive: pivot_velocity.dot(&force), torque: 0.0, damping: damped })
+        let (tails, lengths, damping) = (c.tail_masses().as_slice(), c.lengths().as_slice(), c.damping().as_slice());
+        let (drive, damping) = match S::DIM {
+            2 => direction_powers::<2, f64>(
+                (tails, lengths, damping, c.gravity()),
+                [pivot_velocity[0], pivot_velocity[1]],
+                [pivot_acceleration[0], pivot_acceleration[1]],
+                w,
+                wd,
+            ),
+            _ => direction_powers::<3, f64>(
+                (tails, lengths, damping, c.gravity()),
+                [pivot_velocity[0], pivot_velocity[1], pivot_velocity[2]],
+                [pivot_acceleration[0], pivot_acceleration[1], pivot_acceleration[2]],
+                w,
+                wd,
+            ),
+        };
+        Ok(Powers { drive, torque: 0.0, damping })
     }
 
     fn inertial_energy(&self, t: f64, x: &[f64]) -> f64 {
         Directions::inertial_energy(self, t, &DVector::from_column_slice(x))
     }
+}
+
+/// The powers of a chain in `C`-dimensional directions at rates `w` and accelerations
+/// `wd = ẇ` (1/s, 1/s²; `C` per link), lane by lane for [`Lanes`](crate::lanes::Lanes):
+/// `(P_drive, P_damping)` (W) with `P_drive = ṗ·F_pivot`, the pivot's force on the chain
+/// `F_pivot = M p̈ + Σ_j M_j l_j ẅ_j + M g ê_up` (`M_j` the mass hanging from link `j`,
+/// `M = M_1`), and `P_damping = Σ_i λ_i |w_i|²`. `chain` = (tail masses `M_j` (kg), lengths
+/// (m), damping `λ_j` (N·m·s), `g` (m/s²)); pivot velocity (m/s) and acceleration (m/s²).
+#[inline(always)]
+pub(crate) fn direction_powers<const C: usize, V: Lane>(
+    (tails, lengths, damping, gravity): (&[V], &[V], &[V], V),
+    pivot_velocity: [V; C],
+    pivot_acceleration: [V; C],
+    w: &[V],
+    wd: &[V],
+) -> (V, V) {
+    let total = tails[0];
+    let mut force: [V; C] = std::array::from_fn(|k| pivot_acceleration[k] * total);
+    force[C - 1] += total * gravity;
+    let zero = V::splat(0.0);
+    let mut damped = zero;
+    for j in 0..tails.len() {
+        let weight = tails[j] * lengths[j];
+        let mut w2 = zero;
+        for k in 0..C {
+            force[k] += weight * wd[j * C + k];
+            w2 += w[j * C + k] * w[j * C + k];
+        }
+        damped += damping[j] * w2;
+    }
+    // In nalgebra's order for a dot product of two or three components.
+    let mut drive = pivot_velocity[0] * force[0];
+    for k in 1..C {
+        drive += pivot_velocity[k] * force[k];
+    }
+    (drive, damped)
 }
 
 impl<S: DimName, Dr: Drive<S>> Accounted<Directions<S, Dr>>
