@@ -2,10 +2,12 @@
 //! single-chain result, whatever the thread count and however the chains are split into
 //! calls, and a failing chain is reported by its index while the others finish.
 
+use std::ops::ControlFlow;
+
 use nalgebra::{DVector, Dyn, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Accounted, Chain, Circle, Directions, Error, Inputs, Model, PlanarTension};
+use pendulum_core::{Accounted, Chain, Circle, Directions, Error, Inputs, Model, PlanarTension, trajectory};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -226,6 +228,60 @@ fn with_their_energy_ledgers_the_steps_equal_the_accounted_chain_bit_for_bit() {
         let ledger = &state.x().as_slice()[batch.state_len() - 3..];
         assert!(ledger[0] != 0.0 && ledger[2] > 0.0, "{ledger:?}");
     }
+}
+
+#[test]
+fn a_batched_run_is_each_chain_run_alone_samples_and_summaries_included() {
+    let mut r = ChaCha8Rng::seed_from_u64(23);
+    let n = 12;
+    let (models, x): (Vec<_>, Vec<_>) = (0..7).map(|_| whirl(n, &mut r)).unzip();
+    let batch = DirectionsBatch::accounted(models.clone()).expect("batch");
+    let start: Vec<State<Dyn>> = models
+        .iter()
+        .zip(&x)
+        .map(|(m, x)| State::new(0.0, Accounted::of(m.clone()).state(x).expect("state")))
+        .collect();
+    // Chain 3 stops itself after its fourth sample; the others run to the end.
+    let stop_after = |k: usize| if k == 3 { 4 } else { usize::MAX };
+    let (t1, h, every) = (0.1037, 1e-3, 7);
+    let mut states = start.clone();
+    let mut seen: Vec<(usize, Vec<(f64, Vec<f64>)>)> = (0..7).map(|k| (k, Vec::new())).collect();
+    let ends = batch
+        .run_rk4(&mut states, &mut seen, t1, h, every, |(k, samples), t, x| {
+            samples.push((t, x.as_slice().to_vec()));
+            if samples.len() >= stop_after(*k) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+        })
+        .expect("batch");
+    for (k, model) in models.iter().enumerate() {
+        let system = Accounted::of(model.clone());
+        let mut alone = start[k].clone();
+        let mut samples = Vec::new();
+        let summary = trajectory::run(
+            &mut Projected::new(Rk4::new(&system)),
+            &system,
+            &mut alone,
+            t1,
+            h,
+            every,
+            |t, x| {
+                samples.push((t, x.as_slice().to_vec()));
+                if samples.len() >= stop_after(k) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            },
+        )
+        .expect("alone");
+        assert_eq!(ends[k].as_ref().expect("ran"), &summary, "chain {k}");
+        assert_eq!(seen[k].1.len(), samples.len(), "chain {k}");
+        for ((ta, xa), (tb, xb)) in seen[k].1.iter().zip(&samples) {
+            assert_eq!(ta.to_bits(), tb.to_bits());
+            assert_bits(xa, xb, &format!("chain {k} at t = {ta}"));
+        }
+        assert_bits(states[k].x().as_slice(), alone.x().as_slice(), "the end");
+    }
+    assert!(ends[3].as_ref().expect("ran").stopped_early && !ends[0].as_ref().expect("ran").stopped_early);
 }
 
 #[test]

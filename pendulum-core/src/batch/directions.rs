@@ -8,9 +8,9 @@ use super::{
 };
 use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
+use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::error::{Error, Result};
 use crate::integrate::State;
-use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::integrate::kahan_add;
 use crate::lanes::Lane;
 use crate::lanes::Lanes;
@@ -224,13 +224,34 @@ where
         if let Some(s) = states.iter().find(|s| s.x().len() != self.state_len()) {
             return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() });
         }
-        Ok(match S::DIM {
-            2 => self.rk4_in::<2>(states, h, steps),
-            _ => self.rk4_in::<3>(states, h, steps),
-        })
+        Ok(self.rk4(states, h, steps, None, 0).into_iter().map(|(failure, _)| failure).collect())
     }
 
-    fn rk4_in<const C: usize>(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Vec<Failure> {
+    /// [`integrate_rk4`](Self::integrate_rk4) of the chains `active` marks (all: `None`),
+    /// the others left alone; each failure with the number of the run's step that failed
+    /// (`first_step` for the call's first; 0 for a bad state).
+    pub(super) fn rk4(
+        &self,
+        states: &mut [State<Dyn>],
+        h: f64,
+        steps: usize,
+        active: Option<&[bool]>,
+        first_step: u64,
+    ) -> Vec<(Failure, u64)> {
+        match S::DIM {
+            2 => self.rk4_in::<2>(states, h, steps, active, first_step),
+            _ => self.rk4_in::<3>(states, h, steps, active, first_step),
+        }
+    }
+
+    fn rk4_in<const C: usize>(
+        &self,
+        states: &mut [State<Dyn>],
+        h: f64,
+        steps: usize,
+        active: Option<&[bool]>,
+        first_step: u64,
+    ) -> Vec<(Failure, u64)> {
         let n = self.links;
         // Tasks of whole runs: a block's states stay in lanes for all the steps.
         for_blocks(
@@ -243,10 +264,14 @@ where
                 let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(states.len() - 1));
                 let mut failures = Vec::new();
                 let mut alive = [0u64; WIDTH];
+                let mut run = [false; WIDTH];
                 for (k, state) in states.iter().enumerate() {
+                    if !active.is_none_or(|a| a[chains[k]]) {
+                        continue;
+                    }
                     match non_finite("x", state.x().as_slice()) {
-                        Some(error) => failures.push(Failure { chain: chains[k], error }),
-                        None => alive[k] = 1,
+                        Some(error) => failures.push((Failure { chain: chains[k], error }, first_step)),
+                        None => (alive[k], run[k]) = (1, true),
                     }
                 }
                 let parts: [_; WIDTH] = std::array::from_fn(|k| states[lanes[k]].parts());
@@ -255,28 +280,26 @@ where
                     *x = Lanes::from_fn(|k| parts[k].2[j]);
                     *carry = Lanes::from_fn(|k| parts[k].3[j]);
                 }
-                for _ in 0..steps {
+                for step in first_step..first_step + steps as u64 {
                     if alive == [0; WIDTH] {
                         break;
                     }
                     let failed = self.rk4_step_simd::<C>(b, chains, h, alive, s);
                     for (k, state_failed) in failed.iter().enumerate().take(states.len()) {
                         if *state_failed != 0 {
-                            failures.push(Failure {
-                                chain: chains[k],
-                                error: Error::NonFiniteState { t: s.t[0].0[k], h },
-                            });
+                            let error = Error::NonFiniteState { t: s.t[0].0[k], h };
+                            failures.push((Failure { chain: chains[k], error }, step));
                             alive[k] = 0;
                         }
                     }
                 }
                 for (k, state) in states.iter_mut().enumerate() {
-                    if non_finite("x", state.x().as_slice()).is_none() {
+                    if run[k] {
                         let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
                         state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
                     }
                 }
-                failures.sort_by_key(|f| f.chain);
+                failures.sort_by_key(|(f, _)| f.chain);
                 failures
             },
         )
@@ -416,7 +439,8 @@ where
         });
         if self.accounted {
             // The ledger's rates, as `Accounted`'s right-hand side gives them.
-            let velocities: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
+            let velocities: [_; WIDTH] =
+                std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
             let velocity: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| velocities[k][c]));
             let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
             let (drive, damping) = direction_powers(chain, velocity, pivot, rates, acceleration);

@@ -29,6 +29,7 @@ use crate::lanes::Lanes;
 
 mod directions;
 mod planar;
+mod run;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
@@ -104,14 +105,14 @@ pub(crate) fn blocks_per_task(links: usize) -> usize {
 
 /// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
 /// numbers each, the last one shorter) across the current rayon pool, with a `scratch` from
-/// `init` per task, and collects the failures in chain order.
-pub(crate) fn for_blocks<T: Send, S>(
+/// `init` per task, and collects the failures (or what `block` reports) in block order.
+pub(crate) fn for_blocks<T: Send, S, F: Send>(
     out: &mut [T],
     m: usize,
     links: usize,
     init: impl Fn() -> S + Sync + Send,
-    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<Failure> + Sync + Send,
-) -> Vec<Failure> {
+    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
+) -> Vec<F> {
     let per_task = blocks_per_task(links);
     if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up

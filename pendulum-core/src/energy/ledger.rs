@@ -6,10 +6,10 @@
 use nalgebra::{DVector, DefaultAllocator, Dim, DimName, Dyn, OVector, U1, allocator::Allocator};
 
 use crate::drive::{Drive, Driven, TorqueAt};
-use crate::lanes::Lane;
 use crate::energy::power::{Powers, inertial_energy, powers};
 use crate::error::{Error, Result};
 use crate::integrate::{Constrained, System};
+use crate::lanes::Lane;
 use crate::model::{InputsAt, Model, ModelAlloc};
 use crate::models::directions::Directions;
 use crate::systems::first_order::FirstOrder;
@@ -326,7 +326,8 @@ where
         let (pivot_velocity, pivot_acceleration) = (drive.velocity(t), drive.acceleration(t));
         let half = x.len() / 2;
         let (w, wd) = (&x[half..], &out[half..]);
-        let (tails, lengths, damping) = (c.tail_masses().as_slice(), c.lengths().as_slice(), c.damping().as_slice());
+        let (tails, lengths, damping) =
+            (c.tail_masses().as_slice(), c.lengths().as_slice(), c.damping().as_slice());
         let (drive, damping) = match S::DIM {
             2 => direction_powers::<2, f64>(
                 (tails, lengths, damping, c.gravity()),
