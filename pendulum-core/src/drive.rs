@@ -255,8 +255,9 @@ impl Drive<U3> for Circle {
 /// turned by `−φ(t)` about z, the pivot at `(R, 0, 0)`) is where the steady shapes of a
 /// whirled chain stand still ([`ShapeTracker`](crate::analysis::ShapeTracker) analyses
 /// them). [`Circle`] turns at a constant rate, [`RampedCircle`] ramps its rate; `&T` and
-/// `Box<T>` (also `Box<dyn Turning>`) turn when `T` does.
-pub trait Turning: Drive<U3> {
+/// `Box<T>` (also `Box<dyn Turning>`) turn when `T` does. Turning drives are `Send + Sync`,
+/// so that batches of whirls run on all cores.
+pub trait Turning: Drive<U3> + Send + Sync {
     /// The pivot's azimuth `φ(t)`, rad (unwrapped: continuous in `t`, not reduced mod 2π).
     fn phase(&self, t: f64) -> f64;
     /// Its rate `φ̇(t)`, rad/s: the angular speed of the turning frame.

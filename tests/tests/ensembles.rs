@@ -230,6 +230,9 @@ fn with_their_energy_ledgers_the_steps_equal_the_accounted_chain_bit_for_bit() {
     }
 }
 
+/// The samples of a run: times (s) and states.
+type Samples = Vec<(f64, Vec<f64>)>;
+
 #[test]
 fn a_batched_run_is_each_chain_run_alone_samples_and_summaries_included() {
     let mut r = ChaCha8Rng::seed_from_u64(23);
@@ -245,7 +248,7 @@ fn a_batched_run_is_each_chain_run_alone_samples_and_summaries_included() {
     let stop_after = |k: usize| if k == 3 { 4 } else { usize::MAX };
     let (t1, h, every) = (0.1037, 1e-3, 7);
     let mut states = start.clone();
-    let mut seen: Vec<(usize, Vec<(f64, Vec<f64>)>)> = (0..7).map(|k| (k, Vec::new())).collect();
+    let mut seen: Vec<(usize, Samples)> = (0..7).map(|k| (k, Vec::new())).collect();
     let ends = batch
         .run_rk4(&mut states, &mut seen, t1, h, every, |(k, samples), t, x| {
             samples.push((t, x.as_slice().to_vec()));

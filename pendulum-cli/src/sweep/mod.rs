@@ -2,7 +2,8 @@
 //! list or range and every way of starting it (`--kind`), the chain is run from hanging at
 //! rest (or, ramping down, from the previous point's end) with its pivot on a horizontal
 //! circle, RK4 + projection, and the shape analysis of `pendulum simulate` reports what it
-//! settled into. Points run in parallel (rayon); the results go to sweep.csv, sweep.json
+//! settled into. Points run in parallel (rayon; the independent ones as batches of chains in
+//! SIMD lanes, `pendulum_core::batch`); the results go to sweep.csv, sweep.json
 //! (enough to repeat the sweep with `--from`) and sweep.png (the chain's choices over the
 //! steady branch diagram of `pendulum steady --radius R`), and a table on stdout.
 //!

@@ -94,7 +94,8 @@ pub struct Outcome {
     /// Why no steady shape was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nearest_error: Option<String>,
-    /// Wall-clock time of the run and its analysis, s.
+    /// Wall-clock time of the run and its analysis, s (for the points run together as a
+    /// batch, sudden and ramp-up: an equal share of the batch's).
     pub wall_seconds: f64,
     /// The run's energy balance: `max |H − H0 − W|` over the samples fed to the analysis
     /// and its scale, J (absent in files of earlier versions).

@@ -1,8 +1,9 @@
 //! The runs of a sweep: one point (a chain from hanging at rest, or from the previous
 //! point's end, its pivot circling at a speed switched on or ramped; RK4 + projection; the
 //! shape analysis fed every few steps and its report at the end), and their scheduling on
-//! a rayon pool — sudden and ramp-up points independent, the ramp-down points one chain
-//! in decreasing ω — with a line per finished point on stderr, sweep.json rewritten after
+//! a rayon pool — sudden and ramp-up points independent, run as batches of chains in
+//! rounds (bit for bit the runs one at a time), the ramp-down points one chain in
+//! decreasing ω — with a line per finished point on stderr, sweep.json rewritten after
 //! each, and Ctrl-C honoured between samples.
 
 use std::ops::ControlFlow;
@@ -11,14 +12,19 @@ use std::sync::Mutex;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use nalgebra::{DVector, Dyn};
+use nalgebra::{DVector, Dyn, U3};
+use pendulum_core::batch::{DirectionsBatch, WIDTH};
 use pendulum_core::integrate::State;
-use pendulum_core::{Accounted, Chain, ShapeOptions, ShapeTracker, TurningFrame, trajectory};
+use pendulum_core::trajectory::Summary;
+use pendulum_core::{
+    Accounted, Chain, Directions, ShapeOptions, ShapeTracker, Turning, TurningFrame, trajectory,
+};
 use pendulum_experiment::assemble::whirl_model;
 use pendulum_experiment::balance::chain_scale;
 use pendulum_experiment::{
     DriveConfig, IntegratorKind, Method, RunBalance, directions_integrator, turning_drive,
 };
+use rayon::prelude::*;
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
@@ -142,19 +148,14 @@ impl Sweep {
             if !self.down.is_empty() {
                 s.spawn_fifo(|_| self.run_down(&shared));
             }
-            for &i in &self.singles {
-                let shared = &shared;
-                s.spawn_fifo(move |_| {
-                    if INTERRUPTED.load(Ordering::SeqCst) {
-                        return;
+            // The independent points as one batch of chains, four per SIMD lane group,
+            // on the pool's threads.
+            // In rounds of two blocks per thread, so that Ctrl-C keeps the rounds finished.
+            if !self.singles.is_empty() {
+                s.spawn_fifo(|_| {
+                    for round in self.singles.chunks(2 * WIDTH * self.jobs) {
+                        self.run_singles(round, &shared);
                     }
-                    let p = &self.points[i];
-                    let drive = match p.ramp_from {
-                        None => DriveConfig::Circle { radius: c.radius, omega: p.omega },
-                        Some(from) => self.ramp(from, p.omega),
-                    };
-                    let ended = self.run_point(&drive, None).map(|(outcome, _)| outcome);
-                    self.record(shared, i, ended);
                 });
             }
         });
@@ -216,6 +217,100 @@ impl Sweep {
         }
     }
 
+    /// The drive of an independent point: switched on at ω, or ramped from rest.
+    fn single_drive(&self, p: &Point) -> DriveConfig {
+        match p.ramp_from {
+            None => DriveConfig::Circle { radius: self.config.radius, omega: p.omega },
+            Some(from) => self.ramp(from, p.omega),
+        }
+    }
+
+    /// The motion of a point with `drive`, with its energy ledger (the ledger's
+    /// components ride along and do not change the motion's steps).
+    fn system(&self, drive: &DriveConfig) -> Result<Accounted<Whirl>, Stop> {
+        Ok(Accounted::of(self.model(drive)?))
+    }
+
+    /// The chain of a point with `drive`.
+    fn model(&self, drive: &DriveConfig) -> Result<Whirl, Stop> {
+        let turning =
+            turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
+        Ok(whirl_model(self.chain.clone(), turning))
+    }
+
+    /// The shape analysis and the energy balance of a point's run, fed every few steps.
+    fn observer<'a>(&self, system: &'a Accounted<Whirl>) -> Result<Observer<'a>, Stop> {
+        let c = &self.config;
+        let options = ShapeOptions {
+            periods: c.settle_periods,
+            tolerance: c.settle_tolerance,
+            ..ShapeOptions::default()
+        };
+        let tracker = ShapeTracker::new(system.motion_system(), options).map_err(|e| failed(&e))?;
+        let balance = RunBalance::of_scale(chain_scale(&c.masses, &c.lengths, c.gravity));
+        Ok(Observer { system, tracker, balance, initial_energy: None, push_error: None })
+    }
+
+    /// Independent points (sudden, ramp-up; indices into `points`), all from hanging at
+    /// rest: one batch of chains ([`DirectionsBatch::run_rk4`], the same steps as
+    /// [`run_point`](Self::run_point) bit for bit), then their shape reports in parallel.
+    fn run_singles(&self, singles: &[usize], shared: &Mutex<Shared>) {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return;
+        }
+        let clock = Instant::now();
+        let c = &self.config;
+        let drives: Vec<DriveConfig> = singles.iter().map(|&i| self.single_drive(&self.points[i])).collect();
+        let set_up = || -> Result<_, Stop> {
+            let systems = drives.iter().map(|d| self.system(d)).collect::<Result<Vec<_>, _>>()?;
+            let models = drives.iter().map(|d| self.model(d)).collect::<Result<Vec<_>, _>>()?;
+            let batch = DirectionsBatch::accounted(models).map_err(|e| failed(&e))?;
+            Ok((systems, batch))
+        };
+        let (systems, batch) = match set_up() {
+            Ok(parts) => parts,
+            Err(stop) => {
+                let message = match stop {
+                    Stop::Failed(e) => e,
+                    Stop::Interrupted => "interrupted".into(),
+                };
+                for &i in singles {
+                    self.record(shared, i, Err(Stop::Failed(message.clone())));
+                }
+                return;
+            }
+        };
+        let started = systems.iter().map(|system| {
+            let x0 = system.start(system.motion_system().hanging().as_slice()).map_err(|e| failed(&e))?;
+            Ok((State::new(0.0, x0), self.observer(system)?))
+        });
+        let (mut states, mut observers): (Vec<_>, Vec<_>) = match started.collect::<Result<Vec<_>, Stop>>() {
+            Ok(pairs) => pairs.into_iter().unzip(),
+            Err(stop) => {
+                for &i in singles {
+                    self.record(shared, i, Err(clone_stop(&stop)));
+                }
+                return;
+            }
+        };
+        let ends =
+            batch.run_rk4(&mut states, &mut observers, c.duration, c.step, c.feed_every, Observer::sample);
+        let ends: Vec<Result<Summary, Stop>> = match ends {
+            Ok(ends) => ends.into_iter().map(|end| end.map_err(|e| failed(&e))).collect(),
+            Err(e) => singles.iter().map(|_| Err(failed(&e))).collect(),
+        };
+        let mut outcomes: Vec<Result<Outcome, Stop>> =
+            observers.into_par_iter().zip(ends).map(|(observer, end)| observer.outcome(end?, 0.0)).collect();
+        // Each point's wall time: its share of the batch's.
+        let share = clock.elapsed().as_secs_f64() / singles.len() as f64;
+        for outcome in outcomes.iter_mut().flatten() {
+            outcome.wall_seconds = share;
+        }
+        for (&i, outcome) in singles.iter().zip(outcomes) {
+            self.record(shared, i, outcome);
+        }
+    }
+
     /// Runs one point with `drive` from `start` (default: hanging at rest); returns the
     /// outcome and the final state turned about the axis so that the pivot is at phase 0
     /// (the next ramp-down point's start: its drive starts there).
@@ -226,12 +321,7 @@ impl Sweep {
     ) -> Result<(Outcome, DVector<f64>), Stop> {
         let clock = Instant::now();
         let c = &self.config;
-        let failed = |e: &dyn std::fmt::Display| Stop::Failed(e.to_string());
-        let turning =
-            turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
-        // The motion with its energy ledger: the ledger's components ride along and do not
-        // change the motion's steps.
-        let system = Accounted::of(whirl_model(self.chain.clone(), turning));
+        let system = self.system(drive)?;
         let model = system.motion_system();
         let x0 = match start {
             Some(x) => x,
@@ -239,41 +329,16 @@ impl Sweep {
         };
         let motion_len = x0.len();
         let x0 = system.start(x0.as_slice()).map_err(|e| failed(&e))?;
-        let options = ShapeOptions {
-            periods: c.settle_periods,
-            tolerance: c.settle_tolerance,
-            ..ShapeOptions::default()
-        };
-        let mut tracker = ShapeTracker::new(model, options).map_err(|e| failed(&e))?;
+        let mut observer = self.observer(&system)?;
         let mut solver =
             directions_integrator(Method::of_kind(IntegratorKind::Rk4), &system).map_err(|e| failed(&e))?;
         let mut state = State::new(0.0, x0);
-        let mut push_error = None;
-        let mut balance = RunBalance::of_scale(chain_scale(&c.masses, &c.lengths, c.gravity));
-        let mut initial_energy = None;
         let summary =
             trajectory::run(&mut *solver, &system, &mut state, c.duration, c.step, c.feed_every, |t, x| {
-                let energy = system.energy(t, x);
-                balance.add(energy, &system.ledger(x), *initial_energy.get_or_insert(energy));
-                if let Err(e) = tracker.push(t, &x.rows(0, motion_len).into_owned()) {
-                    push_error = Some(e);
-                    return ControlFlow::Break(());
-                }
-                if INTERRUPTED.load(Ordering::Relaxed) {
-                    ControlFlow::Break(())
-                } else {
-                    ControlFlow::Continue(())
-                }
+                observer.sample(t, x)
             })
             .map_err(|e| failed(&e))?;
-        if let Some(e) = push_error {
-            return Err(Stop::Failed(format!("shape analysis: {e}")));
-        }
-        if summary.stopped_early {
-            return Err(Stop::Interrupted);
-        }
-        let report = tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
-        let outcome = Outcome::of(&report, summary.steps, clock.elapsed().as_secs_f64(), balance);
+        let outcome = observer.outcome(summary, clock.elapsed().as_secs_f64())?;
         let phase = model.drive().phase(state.t());
         let motion = &state.x().as_slice()[..motion_len];
         Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(motion))))
@@ -361,6 +426,58 @@ impl Sweep {
             )));
         }
         Ok(())
+    }
+}
+
+/// A 3D chain whose pivot circles the vertical, as the sweep runs it.
+type Whirl = Directions<U3, Box<dyn Turning>>;
+
+/// A step or set-up error as a failed run.
+fn failed(e: &dyn std::fmt::Display) -> Stop {
+    Stop::Failed(e.to_string())
+}
+
+/// The same stop again (for every point of a batch that could not start).
+fn clone_stop(stop: &Stop) -> Stop {
+    match stop {
+        Stop::Interrupted => Stop::Interrupted,
+        Stop::Failed(e) => Stop::Failed(e.clone()),
+    }
+}
+
+/// What a point's run feeds with its samples: the shape analysis and the energy balance.
+struct Observer<'a> {
+    system: &'a Accounted<Whirl>,
+    tracker: ShapeTracker<'a, Box<dyn Turning>>,
+    balance: RunBalance,
+    initial_energy: Option<f64>,
+    push_error: Option<pendulum_core::Error>,
+}
+
+impl Observer<'_> {
+    /// One sample at time `t` of the state `x` (motion and ledger); stops the run on a
+    /// failed analysis or Ctrl-C.
+    fn sample(&mut self, t: f64, x: &DVector<f64>) -> ControlFlow<()> {
+        let energy = self.system.energy(t, x);
+        self.balance.add(energy, &self.system.ledger(x), *self.initial_energy.get_or_insert(energy));
+        let motion_len = self.system.motion_system().state_len();
+        if let Err(e) = self.tracker.push(t, &x.rows(0, motion_len).into_owned()) {
+            self.push_error = Some(e);
+            return ControlFlow::Break(());
+        }
+        if INTERRUPTED.load(Ordering::Relaxed) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    }
+
+    /// The point's outcome after its run (`summary`, `wall_seconds` of wall-clock time).
+    fn outcome(self, summary: Summary, wall_seconds: f64) -> Result<Outcome, Stop> {
+        if let Some(e) = self.push_error {
+            return Err(Stop::Failed(format!("shape analysis: {e}")));
+        }
+        if summary.stopped_early {
+            return Err(Stop::Interrupted);
+        }
+        let report = self.tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
+        Ok(Outcome::of(&report, summary.steps, wall_seconds, self.balance))
     }
 }
 

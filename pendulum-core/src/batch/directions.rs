@@ -1,7 +1,9 @@
 //! A batch of chains in unit link directions ([`Directions`]), planar or spatial, each with
 //! its own drive: accelerations, and whole steps of projected RK4, for many chains per call.
 
-use nalgebra::{DefaultAllocator, DimName, Dyn, allocator::Allocator};
+use std::ops::ControlFlow;
+
+use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::{
     F64x4, Failure, WIDTH, block_chains, check_len, check_links, for_blocks, gather, non_finite, simd_kernel,
@@ -59,6 +61,28 @@ struct Scratch<const C: usize> {
     y: Vec<F64x4>,
     k: [Vec<F64x4>; 4],
 }
+
+/// The steps of a run in lanes: `steps` of size `h` (s), sampled every `every`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Plan {
+    pub h: f64,
+    pub steps: u64,
+    pub every: u64,
+}
+
+/// How a chain's run in lanes ended: steps taken and samples (the first included) before
+/// it stopped or finished, whether a sample stopped it, and a failure with the step that
+/// failed.
+#[derive(Debug, Default)]
+pub(super) struct End {
+    pub steps: u64,
+    pub samples: u64,
+    pub stopped: bool,
+    pub failure: Option<(Error, u64)>,
+}
+
+/// The type of "no sampling".
+type NoSample = fn(&mut (), f64, &DVector<f64>) -> ControlFlow<()>;
 
 /// The loads and rows of one solve in lanes.
 struct Solve<const C: usize> {
@@ -215,92 +239,141 @@ where
     /// other than `B` or a state of the wrong length, [`Error::InvalidStepSize`] for a
     /// non-finite or zero `h`.
     pub fn integrate_rk4(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Result<Vec<Failure>> {
-        if states.len() != self.len() {
-            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
-        }
         if !h.is_finite() || h == 0.0 {
             return Err(Error::InvalidStepSize { h });
         }
-        if let Some(s) = states.iter().find(|s| s.x().len() != self.state_len()) {
-            return Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() });
-        }
-        Ok(self.rk4(states, h, steps, None, 0).into_iter().map(|(failure, _)| failure).collect())
+        self.check_states(states)?;
+        let mut none = vec![(); states.len()];
+        let plan = Plan { h, steps: steps as u64, every: steps.max(1) as u64 };
+        let ends = self.rk4(states, &mut none, plan, None::<&NoSample>);
+        Ok(ends
+            .into_iter()
+            .filter_map(|(chain, end)| end.failure.map(|(error, _)| Failure { chain, error }))
+            .collect())
     }
 
-    /// [`integrate_rk4`](Self::integrate_rk4) of the chains `active` marks (all: `None`),
-    /// the others left alone; each failure with the number of the run's step that failed
-    /// (`first_step` for the call's first; 0 for a bad state).
-    pub(super) fn rk4(
+    /// One state per chain, each of [`state_len`](Self::state_len) entries.
+    pub(super) fn check_states(&self, states: &[State<Dyn>]) -> Result<()> {
+        if states.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
+        }
+        match states.iter().find(|s| s.x().len() != self.state_len()) {
+            Some(s) => Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() }),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs the chains `plan.steps` steps of `Projected<Rk4>` of size `plan.h` in lanes,
+    /// each block on its own from its first step to its last (no barrier between blocks),
+    /// with `sample(observers[k], t, x)` of each running chain at the start and after every
+    /// `plan.every`-th step and the last (when given). A chain stops after a sample that
+    /// returns `Break`, or at a failed step (its state left at the start of that step).
+    /// Returns how each chain ended, in chain order.
+    pub(super) fn rk4<T: Send, F>(
         &self,
         states: &mut [State<Dyn>],
-        h: f64,
-        steps: usize,
-        active: Option<&[bool]>,
-        first_step: u64,
-    ) -> Vec<(Failure, u64)> {
+        observers: &mut [T],
+        plan: Plan,
+        sample: Option<&F>,
+    ) -> Vec<(usize, End)>
+    where
+        F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
+    {
         match S::DIM {
-            2 => self.rk4_in::<2>(states, h, steps, active, first_step),
-            _ => self.rk4_in::<3>(states, h, steps, active, first_step),
+            2 => self.rk4_in::<2, T, F>(states, observers, plan, sample),
+            _ => self.rk4_in::<3, T, F>(states, observers, plan, sample),
         }
     }
 
-    fn rk4_in<const C: usize>(
+    fn rk4_in<const C: usize, T: Send, F>(
         &self,
         states: &mut [State<Dyn>],
-        h: f64,
-        steps: usize,
-        active: Option<&[bool]>,
-        first_step: u64,
-    ) -> Vec<(Failure, u64)> {
+        observers: &mut [T],
+        plan: Plan,
+        sample: Option<&F>,
+    ) -> Vec<(usize, End)>
+    where
+        F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
+    {
         let n = self.links;
-        // Tasks of whole runs: a block's states stay in lanes for all the steps.
+        let mut chains: Vec<(&mut State<Dyn>, &mut T)> =
+            states.iter_mut().zip(observers.iter_mut()).collect();
+        let solves = n.saturating_mul(4).saturating_mul(plan.steps.min(usize::MAX as u64) as usize);
+        // Tasks of whole runs: a block's states stay in lanes from the first step to the
+        // last, and go out only to be sampled.
         for_blocks(
-            states,
+            &mut chains,
             1,
-            n,
+            solves,
             || Scratch::<C>::new(n, self.state_len()),
-            |s, b, states| {
-                let chains = block_chains(b, self.len());
-                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(states.len() - 1));
-                let mut failures = Vec::new();
+            |s, b, block| {
+                let ids = block_chains(b, self.len());
+                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(block.len() - 1));
+                let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
                 let mut alive = [0u64; WIDTH];
-                let mut run = [false; WIDTH];
-                for (k, state) in states.iter().enumerate() {
-                    if !active.is_none_or(|a| a[chains[k]]) {
-                        continue;
-                    }
+                for (k, (state, _)) in block.iter().enumerate() {
                     match non_finite("x", state.x().as_slice()) {
-                        Some(error) => failures.push((Failure { chain: chains[k], error }, first_step)),
-                        None => (alive[k], run[k]) = (1, true),
+                        Some(error) => ends[k].failure = Some((error, 0)),
+                        None => alive[k] = 1,
                     }
                 }
-                let parts: [_; WIDTH] = std::array::from_fn(|k| states[lanes[k]].parts());
+                let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].0.parts());
                 s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
                 for (j, (x, carry)) in s.x.iter_mut().zip(&mut s.carry).enumerate() {
                     *x = Lanes::from_fn(|k| parts[k].2[j]);
                     *carry = Lanes::from_fn(|k| parts[k].3[j]);
                 }
-                for step in first_step..first_step + steps as u64 {
-                    if alive == [0; WIDTH] {
-                        break;
+                let ran = alive;
+                // Chain `k` of the block out of its lane into its state, and sampled.
+                let take_sample =
+                    |k: usize, s: &Scratch<C>, block: &mut [(&mut State<Dyn>, &mut T)]| -> bool {
+                        let Some(sample) = sample else { return false };
+                        let (state, observer) = &mut block[k];
+                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
+                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                        sample(observer, state.t(), state.x()).is_break()
+                    };
+                for (k, end) in ends.iter_mut().enumerate() {
+                    if alive[k] != 0 && take_sample(k, s, block) {
+                        end.stopped = true;
+                        alive[k] = 0;
                     }
-                    let failed = self.rk4_step_simd::<C>(b, chains, h, alive, s);
-                    for (k, state_failed) in failed.iter().enumerate().take(states.len()) {
-                        if *state_failed != 0 {
-                            let error = Error::NonFiniteState { t: s.t[0].0[k], h };
-                            failures.push((Failure { chain: chains[k], error }, step));
-                            alive[k] = 0;
+                }
+                let mut done = 0u64;
+                while done < plan.steps && alive != [0; WIDTH] {
+                    // Up to the next sample: every `every` steps, and the last.
+                    let chunk = plan.every.min(plan.steps - done);
+                    for step in done..done + chunk {
+                        let failed = self.rk4_step_simd::<C>(b, ids, plan.h, alive, s);
+                        for (k, end) in ends.iter_mut().enumerate() {
+                            if failed[k] != 0 {
+                                end.failure =
+                                    Some((Error::NonFiniteState { t: s.t[0].0[k], h: plan.h }, step));
+                                alive[k] = 0;
+                            }
+                        }
+                        if alive == [0; WIDTH] {
+                            break;
+                        }
+                    }
+                    done += chunk;
+                    for (k, end) in ends.iter_mut().enumerate() {
+                        if alive[k] != 0 {
+                            (end.steps, end.samples) = (done, end.samples + u64::from(sample.is_some()));
+                            if take_sample(k, s, block) {
+                                end.stopped = done < plan.steps;
+                                alive[k] = 0;
+                            }
                         }
                     }
                 }
-                for (k, state) in states.iter_mut().enumerate() {
-                    if run[k] {
+                for (k, (state, _)) in block.iter_mut().enumerate() {
+                    if ran[k] != 0 {
                         let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
                         state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
                     }
                 }
-                failures.sort_by_key(|(f, _)| f.chain);
-                failures
+                ids.into_iter().zip(ends).collect()
             },
         )
     }

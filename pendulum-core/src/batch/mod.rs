@@ -97,23 +97,25 @@ pub(crate) fn non_finite(what: &'static str, v: &[f64]) -> Option<Error> {
     v.iter().position(|x| !x.is_finite()).map(|index| Error::NonFinite { what, index, value: v[index] })
 }
 
-/// Blocks of [`WIDTH`] chains a rayon task takes at least: about 2000 rods' work, so that
-/// short chains do not drown in scheduling.
-pub(crate) fn blocks_per_task(links: usize) -> usize {
-    (2048 / (WIDTH * links)).max(1)
+/// Blocks of [`WIDTH`] chains a rayon task takes at least, for blocks of `solves` rods'
+/// solves each: about 2000 rods' solves a task, so that short work does not drown in
+/// scheduling.
+pub(crate) fn blocks_per_task(solves: usize) -> usize {
+    (2048 / (WIDTH * solves).max(1)).max(1)
 }
 
 /// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
 /// numbers each, the last one shorter) across the current rayon pool, with a `scratch` from
 /// `init` per task, and collects the failures (or what `block` reports) in block order.
+/// `solves`: rods' solves per chain of a block (links × evaluations), for the task size.
 pub(crate) fn for_blocks<T: Send, S, F: Send>(
     out: &mut [T],
     m: usize,
-    links: usize,
+    solves: usize,
     init: impl Fn() -> S + Sync + Send,
     block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
 ) -> Vec<F> {
-    let per_task = blocks_per_task(links);
+    let per_task = blocks_per_task(solves);
     if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up
         // costs more than a short batch).

@@ -4,9 +4,9 @@
 use std::ops::ControlFlow;
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
-use rayon::prelude::*;
 
 use super::DirectionsBatch;
+use super::directions::Plan;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::State;
@@ -23,8 +23,8 @@ where
     /// last, with chain `k`'s `observers[k]`. A chain stops after a sample that returns
     /// `ControlFlow::Break(())`, or at a failed step; the others go on.
     ///
-    /// Between samples the states stay in lanes; the samples of all chains are taken in
-    /// parallel.
+    /// Each block of chains runs on its own from the first step to the last; the states
+    /// leave their lanes only to be sampled (on the block's thread).
     ///
     /// Returns per chain, in order, its [`Summary`] or [`Error::StepFailed`] (its state
     /// left at the start of the failed step). Errors: [`Error::InvalidRun`] for a bad `t1`,
@@ -51,7 +51,7 @@ where
                 got: observers.len(),
             });
         }
-        self.integrate_rk4(states, 1.0, 0)?; // the lengths, checked
+        self.check_states(states)?;
         let t0 = states.first().map_or(0.0, |s| s.t());
         if let Some(s) = states.iter().find(|s| s.t() != t0) {
             return Err(Error::InvalidRun {
@@ -61,46 +61,23 @@ where
             });
         }
         let (n, step) = trajectory::plan(t0, t1, h)?;
-        let mut ends: Vec<Result<Summary>> = states
-            .iter()
-            .map(|_| Ok(Summary { steps: 0, samples: 1, h: step, t: t0, stopped_early: false }))
-            .collect();
-        let mut active = vec![true; states.len()];
-        // The samples of the active chains, on all cores: which ones asked to stop.
-        let samples = |states: &[State<Dyn>], observers: &mut [T], active: &[bool]| -> Vec<bool> {
-            (states, observers, active)
-                .into_par_iter()
-                .map(|(state, observer, &active)| active && sample(observer, state.t(), state.x()).is_break())
-                .collect()
-        };
-        for (k, stop) in samples(states, observers, &active).into_iter().enumerate() {
-            if let (true, Ok(summary)) = (stop, &mut ends[k]) {
-                summary.stopped_early = true;
-                active[k] = false;
-            }
-        }
-        let mut done = 0u64;
-        while done < n && active.contains(&true) {
-            // Up to the next sample: every `every` steps, and the last.
-            let chunk = (every as u64).min(n - done);
-            for (failure, failed_step) in self.rk4(states, step, chunk as usize, Some(&active), done) {
-                let t = states[failure.chain].t();
-                ends[failure.chain] =
-                    Err(Error::StepFailed { t, step: failed_step, source: Box::new(failure.error) });
-                active[failure.chain] = false;
-            }
-            done += chunk;
-            let stops = samples(states, observers, &active);
-            for (k, stop) in stops.into_iter().enumerate() {
-                if let (true, Ok(summary)) = (active[k], &mut ends[k]) {
-                    (summary.steps, summary.t, summary.samples) = (done, states[k].t(), summary.samples + 1);
-                    if stop {
-                        summary.stopped_early = done < n;
-                        active[k] = false;
-                    }
+        let plan = Plan { h: step, steps: n, every: every as u64 };
+        let ends = self.rk4(states, observers, plan, Some(&sample));
+        let ends = ends
+            .into_iter()
+            .map(|(k, end)| match end.failure {
+                Some((error, failed)) => {
+                    Err(Error::StepFailed { t: states[k].t(), step: failed, source: Box::new(error) })
                 }
-            }
-        }
+                None => Ok(Summary {
+                    steps: end.steps,
+                    samples: 1 + end.samples,
+                    h: step,
+                    t: states[k].t(),
+                    stopped_early: end.stopped,
+                }),
+            })
+            .collect();
         Ok(ends)
     }
 }
