@@ -202,17 +202,22 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
     }
 }
 
+/// The states `x` of `models` with empty energy ledgers, at t = 0.
+fn accounted_states(models: &[Directions<U3, Circle>], x: &[DVector<f64>]) -> Vec<State<Dyn>> {
+    models
+        .iter()
+        .zip(x)
+        .map(|(m, x)| State::new(0.0, Accounted::of(m.clone()).state(x).expect("state")))
+        .collect()
+}
+
 #[test]
 fn with_their_energy_ledgers_the_steps_equal_the_accounted_chain_bit_for_bit() {
     let mut r = ChaCha8Rng::seed_from_u64(17);
     let n = 30;
     let (models, x): (Vec<_>, Vec<_>) = (0..6).map(|_| whirl(n, &mut r)).unzip();
     let batch = DirectionsBatch::accounted(models.clone()).expect("batch");
-    let start: Vec<State<Dyn>> = models
-        .iter()
-        .zip(&x)
-        .map(|(m, x)| State::new(0.0, Accounted::of(m.clone()).state(x).expect("state")))
-        .collect();
+    let start = accounted_states(&models, &x);
     let h = 5e-4;
     let mut states = start.clone();
     assert!(batch.integrate_rk4(&mut states, h, 40).expect("batch").is_empty());
@@ -239,11 +244,7 @@ fn a_batched_run_is_each_chain_run_alone_samples_and_summaries_included() {
     let n = 12;
     let (models, x): (Vec<_>, Vec<_>) = (0..7).map(|_| whirl(n, &mut r)).unzip();
     let batch = DirectionsBatch::accounted(models.clone()).expect("batch");
-    let start: Vec<State<Dyn>> = models
-        .iter()
-        .zip(&x)
-        .map(|(m, x)| State::new(0.0, Accounted::of(m.clone()).state(x).expect("state")))
-        .collect();
+    let start = accounted_states(&models, &x);
     // Chain 3 stops itself after its fourth sample; the others run to the end.
     let stop_after = |k: usize| if k == 3 { 4 } else { usize::MAX };
     let (t1, h, every) = (0.1037, 1e-3, 7);

@@ -29,6 +29,7 @@ use crate::lanes::Lanes;
 
 mod directions;
 mod planar;
+mod rk4;
 mod run;
 
 pub use directions::DirectionsBatch;
@@ -144,26 +145,46 @@ pub(crate) fn has_avx2() -> bool {
     return false;
 }
 
-/// `fn $avx2(&self, args…)`: the `#[inline(always)]` method `$kernel` compiled for AVX2 (the
-/// kernel must be inlined all the way down for its lanes to become registers), and
-/// `fn $dispatch(&self, args…)` that runs it when the CPU has AVX2, else `$kernel` as it is.
+/// A kernel written once, in three methods: `fn kernel(&self, args…)` as given (inlined
+/// wherever it is called), `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
+/// `#[inline(always)]` all the way down for its lanes to become registers), and
+/// `fn dispatch(&self, args…)`, which runs the AVX2 one when the CPU has AVX2 and the
+/// kernel as it is otherwise:
+/// ```text
+/// simd_kernel! {
+///     /// docs
+///     fn kernel<const C: usize>(&self, a: A, …) -> R { … }
+///     dispatch pub(super) fn dispatch, avx2
+/// }
+/// ```
 macro_rules! simd_kernel {
-    ($(#[$meta:meta])* fn $dispatch:ident, $avx2:ident => $kernel:ident $(<const $c:ident: usize>)? ($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?) => {
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident $(<const $c:ident: usize>)? (&$this:ident, $($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
+        $body:block
+        dispatch $dvis:vis fn $dispatch:ident, $avx2:ident
+    ) => {
         $(#[$meta])*
-        fn $dispatch $(<const $c: usize>)? (&self, $($arg: $ty),*) $(-> $ret)? {
+        #[inline(always)]
+        #[allow(clippy::too_many_arguments)]
+        $vis fn $kernel $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? $body
+
+        /// [`Self::$kernel`] with AVX2 when the CPU has it.
+        #[allow(clippy::too_many_arguments)]
+        $dvis fn $dispatch $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             if $crate::batch::has_avx2() {
                 // SAFETY: the CPU has AVX2, checked just above.
-                return unsafe { self.$avx2 $(::<$c>)? ($($arg),*) };
+                return unsafe { $this.$avx2 $(::<$c>)? ($($arg),*) };
             }
-            self.$kernel $(::<$c>)? ($($arg),*)
+            $this.$kernel $(::<$c>)? ($($arg),*)
         }
 
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]
         #[allow(clippy::too_many_arguments)]
-        fn $avx2 $(<const $c: usize>)? (&self, $($arg: $ty),*) $(-> $ret)? {
-            self.$kernel $(::<$c>)? ($($arg),*)
+        fn $avx2 $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? {
+            $this.$kernel $(::<$c>)? ($($arg),*)
         }
     };
 }

@@ -159,8 +159,10 @@ impl PlanarBatch {
     }
 
     simd_kernel! {
-        #[allow(clippy::too_many_arguments)]
-        fn block_simd, block_avx2 => block(
+        /// One block: gather, `sin θ` and `cos θ` of all its angles at once, the solve in lanes,
+        /// scatter into `out` (the block's rows).
+        fn block(
+            &self,
             b: usize,
             lanes: [usize; WIDTH],
             q: &[f64],
@@ -168,53 +170,39 @@ impl PlanarBatch {
             pivot: Option<&[f64]>,
             s: &mut Scratch,
             out: &mut [f64],
-        )
-    }
-
-    /// One block: gather, `sin θ` and `cos θ` of all its angles at once, the solve in lanes,
-    /// scatter into `out` (the block's rows).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn block(
-        &self,
-        b: usize,
-        lanes: [usize; WIDTH],
-        q: &[f64],
-        qd: &[f64],
-        pivot: Option<&[f64]>,
-        s: &mut Scratch,
-        out: &mut [f64],
-    ) {
-        let n = self.links;
-        let block = &self.blocks[b.min(self.blocks.len() - 1)];
-        gather(q, lanes, n, &mut s.angles);
-        sin_cos_split(
-            Lanes::flatten(&s.angles),
-            Lanes::flatten_mut(&mut s.sin),
-            Lanes::flatten_mut(&mut s.cos),
-        );
-        gather(qd, lanes, n, &mut s.rates);
-        let zero = Lanes([0.0; WIDTH]);
-        let pivot = match pivot {
-            Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
-            None => [zero; 2],
-        };
-        // The loads in a pass of their own: built inside the solve, the builder is not
-        // inlined (as in the single-chain model).
-        let drag = block.rods.drag();
-        for (i, load) in s.loads.iter_mut().enumerate() {
-            *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
-        }
-        let loads = &s.loads;
-        let load = |i: usize| loads[i];
-        let accelerations = &mut s.accelerations;
-        block.rods.solve([zero, block.down], pivot, &mut s.rows, load, |i, a, u, _| {
-            accelerations[i] = angle_acceleration(a, u);
-        });
-        for (k, row) in out.chunks_exact_mut(n).enumerate() {
-            for (o, a) in row.iter_mut().zip(accelerations.iter()) {
-                *o = a.0[k];
+        ) {
+            let n = self.links;
+            let block = &self.blocks[b.min(self.blocks.len() - 1)];
+            gather(q, lanes, n, &mut s.angles);
+            sin_cos_split(
+                Lanes::flatten(&s.angles),
+                Lanes::flatten_mut(&mut s.sin),
+                Lanes::flatten_mut(&mut s.cos),
+            );
+            gather(qd, lanes, n, &mut s.rates);
+            let zero = Lanes([0.0; WIDTH]);
+            let pivot = match pivot {
+                Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
+                None => [zero; 2],
+            };
+            // The loads in a pass of their own: built inside the solve, the builder is not
+            // inlined (as in the single-chain model).
+            let drag = block.rods.drag();
+            for (i, load) in s.loads.iter_mut().enumerate() {
+                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
+            }
+            let loads = &s.loads;
+            let load = |i: usize| loads[i];
+            let accelerations = &mut s.accelerations;
+            block.rods.solve([zero, block.down], pivot, &mut s.rows, load, |i, a, u, _| {
+                accelerations[i] = angle_acceleration(a, u);
+            });
+            for (k, row) in out.chunks_exact_mut(n).enumerate() {
+                for (o, a) in row.iter_mut().zip(accelerations.iter()) {
+                    *o = a.0[k];
+                }
             }
         }
+        dispatch fn block_simd, block_avx2
     }
 }

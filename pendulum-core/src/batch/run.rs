@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::DirectionsBatch;
-use super::directions::Plan;
+use super::rk4::Plan;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::State;

@@ -1,0 +1,279 @@
+//! Steps and runs of projected RK4 for a batch of chains in directions, in lanes: the
+//! states stay in their lanes from a run's first step to its last and go out only to be
+//! sampled.
+
+use std::ops::ControlFlow;
+
+use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
+
+use super::directions::Scratch;
+use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
+use crate::drive::Drive;
+use crate::error::{Error, Result};
+use crate::integrate::{State, kahan_add};
+use crate::lanes::{Lane, Lanes};
+use crate::models::directions::project_link;
+
+use super::DirectionsBatch;
+
+/// The steps of a run in lanes: `steps` of size `h` (s), sampled every `every`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Plan {
+    pub h: f64,
+    pub steps: u64,
+    pub every: u64,
+}
+
+/// How a chain's run in lanes ended: steps taken and samples after the first before it
+/// stopped or finished, whether a sample stopped it, and a failure with the step that
+/// failed.
+#[derive(Debug, Default)]
+pub(super) struct End {
+    pub steps: u64,
+    pub samples: u64,
+    pub stopped: bool,
+    pub failure: Option<(Error, u64)>,
+}
+
+/// The type of "no sampling".
+type NoSample = fn(&mut (), f64, &DVector<f64>) -> ControlFlow<()>;
+
+impl<S: DimName, Dr: Drive<S> + Sync> DirectionsBatch<S, Dr>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// One step of RK4 with projection (`Projected<Rk4>`) of size `h` (s) for every chain,
+    /// each from its own state and time: [`integrate_rk4`](Self::integrate_rk4) with one step.
+    ///
+    /// Errors and failures as [`integrate_rk4`](Self::integrate_rk4).
+    pub fn step_rk4(&self, states: &mut [State<Dyn>], h: f64) -> Result<Vec<Failure>> {
+        self.integrate_rk4(states, h, 1)
+    }
+
+    /// `steps` steps of RK4 with projection (`Projected<Rk4>`) of size `h` (s) for every
+    /// chain, each from its own state and time; equal bit for bit to `steps` calls of
+    /// [`step_rk4`](Self::step_rk4), but the states stay in lanes from the first step to the
+    /// last.
+    ///
+    /// Returns the chains that failed (a non-finite state, or a step that produced one), in
+    /// order: each is left at its last good state (the error names the time of the failed
+    /// step) and the others go on. Errors: [`Error::LengthMismatch`] for a number of states
+    /// other than `B` or a state of the wrong length, [`Error::InvalidStepSize`] for a
+    /// non-finite or zero `h`.
+    pub fn integrate_rk4(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Result<Vec<Failure>> {
+        if !h.is_finite() || h == 0.0 {
+            return Err(Error::InvalidStepSize { h });
+        }
+        self.check_states(states)?;
+        let mut none = vec![(); states.len()];
+        let plan = Plan { h, steps: steps as u64, every: steps.max(1) as u64 };
+        let ends = self.rk4(states, &mut none, plan, None::<&NoSample>);
+        Ok(ends
+            .into_iter()
+            .filter_map(|(chain, end)| end.failure.map(|(error, _)| Failure { chain, error }))
+            .collect())
+    }
+
+    /// One state per chain, each of [`state_len`](Self::state_len) entries.
+    pub(super) fn check_states(&self, states: &[State<Dyn>]) -> Result<()> {
+        if states.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
+        }
+        match states.iter().find(|s| s.x().len() != self.state_len()) {
+            Some(s) => Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() }),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs the chains `plan.steps` steps of `Projected<Rk4>` of size `plan.h` in lanes,
+    /// each block on its own from its first step to its last (no barrier between blocks),
+    /// with `sample(observers[k], t, x)` of each running chain at the start and after every
+    /// `plan.every`-th step and the last (when given). A chain stops after a sample that
+    /// returns `Break`, or at a failed step (its state left at the start of that step).
+    /// Returns how each chain ended, in chain order.
+    pub(super) fn rk4<T: Send, F>(
+        &self,
+        states: &mut [State<Dyn>],
+        observers: &mut [T],
+        plan: Plan,
+        sample: Option<&F>,
+    ) -> Vec<(usize, End)>
+    where
+        F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
+    {
+        match S::DIM {
+            2 => self.rk4_in::<2, T, F>(states, observers, plan, sample),
+            _ => self.rk4_in::<3, T, F>(states, observers, plan, sample),
+        }
+    }
+
+    fn rk4_in<const C: usize, T: Send, F>(
+        &self,
+        states: &mut [State<Dyn>],
+        observers: &mut [T],
+        plan: Plan,
+        sample: Option<&F>,
+    ) -> Vec<(usize, End)>
+    where
+        F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
+    {
+        let n = self.links();
+        let mut chains: Vec<(&mut State<Dyn>, &mut T)> =
+            states.iter_mut().zip(observers.iter_mut()).collect();
+        let solves = n.saturating_mul(4).saturating_mul(plan.steps.min(usize::MAX as u64) as usize);
+        // Tasks of whole runs: a block's states stay in lanes from the first step to the
+        // last, and go out only to be sampled.
+        for_blocks(
+            &mut chains,
+            1,
+            solves,
+            || Scratch::<C>::new(n, self.state_len()),
+            |s, b, block| {
+                let ids = block_chains(b, self.len());
+                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(block.len() - 1));
+                let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
+                let mut alive = [0u64; WIDTH];
+                for (k, (state, _)) in block.iter().enumerate() {
+                    match non_finite("x", state.x().as_slice()) {
+                        Some(error) => ends[k].failure = Some((error, 0)),
+                        None => alive[k] = 1,
+                    }
+                }
+                let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].0.parts());
+                s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
+                for (j, (x, carry)) in s.x.iter_mut().zip(&mut s.carry).enumerate() {
+                    *x = Lanes::from_fn(|k| parts[k].2[j]);
+                    *carry = Lanes::from_fn(|k| parts[k].3[j]);
+                }
+                let ran = alive;
+                // Chain `k` of the block out of its lane into its state, and sampled.
+                let take_sample =
+                    |k: usize, s: &Scratch<C>, block: &mut [(&mut State<Dyn>, &mut T)]| -> bool {
+                        let Some(sample) = sample else { return false };
+                        let (state, observer) = &mut block[k];
+                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
+                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                        sample(observer, state.t(), state.x()).is_break()
+                    };
+                for (k, end) in ends.iter_mut().enumerate() {
+                    if alive[k] != 0 && take_sample(k, s, block) {
+                        end.stopped = true;
+                        alive[k] = 0;
+                    }
+                }
+                let mut done = 0u64;
+                while done < plan.steps && alive != [0; WIDTH] {
+                    // Up to the next sample: every `every` steps, and the last.
+                    let chunk = plan.every.min(plan.steps - done);
+                    for step in done..done + chunk {
+                        let failed = self.rk4_step_simd::<C>(b, ids, plan.h, alive, s);
+                        for (k, end) in ends.iter_mut().enumerate() {
+                            if failed[k] != 0 {
+                                end.failure =
+                                    Some((Error::NonFiniteState { t: s.t[0].0[k], h: plan.h }, step));
+                                alive[k] = 0;
+                            }
+                        }
+                        if alive == [0; WIDTH] {
+                            break;
+                        }
+                    }
+                    done += chunk;
+                    for (k, end) in ends.iter_mut().enumerate() {
+                        if alive[k] != 0 {
+                            (end.steps, end.samples) = (done, end.samples + u64::from(sample.is_some()));
+                            if take_sample(k, s, block) {
+                                end.stopped = done < plan.steps;
+                                alive[k] = 0;
+                            }
+                        }
+                    }
+                }
+                for (k, (state, _)) in block.iter_mut().enumerate() {
+                    if ran[k] != 0 {
+                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
+                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                    }
+                }
+                ids.into_iter().zip(ends).collect()
+            },
+        )
+    }
+
+    simd_kernel! {
+        /// One step of `Projected<Rk4>` in lanes, applied only in the `alive` lanes: the
+        /// increment ([`rk4_increment`](Self::rk4_increment)), then `t += h` and `x += increment`
+        /// by compensated summation ([`State`]'s), the projection of every link
+        /// ([`Constrained::project`]) and the compensation cleared, as `Projected` does. Returns
+        /// the alive lanes whose increment was not finite (left as they were).
+        fn rk4_step<const C: usize>(
+            &self,
+            b: usize,
+            chains: [usize; WIDTH],
+            h: f64,
+            alive: [u64; WIDTH],
+            s: &mut Scratch<C>,
+        ) -> [u64; WIDTH] {
+            self.rk4_increment::<C>(b, chains, s.t[0].0, h, s);
+            let mut bad = [0u64; WIDTH];
+            for y in &s.y {
+                for (bad, y) in bad.iter_mut().zip(y.0) {
+                    *bad |= !y.is_finite() as u64;
+                }
+            }
+            let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !bad[k]);
+            let [t, t_carry] = &mut s.t;
+            let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; WIDTH]));
+            (*t, *t_carry) = (F64x4::select(keep, new_t, *t), F64x4::select(keep, new_carry, *t_carry));
+            let zero = Lanes([0.0; WIDTH]);
+            // k1 is spent: the next state goes there.
+            let next = &mut s.k[0];
+            for (((next, x), carry), y) in next.iter_mut().zip(&s.x).zip(&s.carry).zip(&s.y) {
+                (*next, _) = kahan_add(*x, *carry, *y);
+            }
+            let (u, w) = next[..2 * C * self.links()].split_at_mut(C * self.links());
+            for (u, w) in u.chunks_exact_mut(C).zip(w.chunks_exact_mut(C)) {
+                project_link(u, w);
+            }
+            for ((x, carry), next) in s.x.iter_mut().zip(&mut s.carry).zip(&s.k[0]) {
+                *x = F64x4::select(keep, *next, *x);
+                *carry = F64x4::select(keep, zero, *carry);
+            }
+            std::array::from_fn(|k| alive[k] & bad[k])
+        }
+        dispatch fn rk4_step_simd, rk4_step_avx2
+    }
+    /// The RK4 stages of [`Rk4`](crate::integrate::Rk4) in lanes, from `s.x` at times `t`,
+    /// leaving the increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` in `s.y`.
+    #[inline(always)]
+    fn rk4_increment<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        h: f64,
+        s: &mut Scratch<C>,
+    ) {
+        let half = 0.5 * h;
+        let (x, y, rows) = (&s.x, &mut s.y, &mut s.solve);
+        let [k1, k2, k3, k4] = &mut s.k;
+        let (half_lanes, h_lanes) = (Lanes([half; WIDTH]), Lanes([h; WIDTH]));
+        let axpy = |y: &mut [F64x4], a: F64x4, k: &[F64x4]| {
+            for ((y, x), k) in y.iter_mut().zip(x).zip(k) {
+                *y = a * *k + *x;
+            }
+        };
+        let at = |dt: f64| -> [f64; WIDTH] { std::array::from_fn(|k| t[k] + dt) };
+        self.flow::<C>(b, chains, t, x, rows, k1);
+        axpy(y, half_lanes, k1);
+        self.flow::<C>(b, chains, at(half), y, rows, k2);
+        axpy(y, half_lanes, k2);
+        self.flow::<C>(b, chains, at(half), y, rows, k3);
+        axpy(y, h_lanes, k3);
+        self.flow::<C>(b, chains, at(h), y, rows, k4);
+        let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
+        for (j, y) in y.iter_mut().enumerate() {
+            *y = sixth * (k1[j] + two * (k2[j] + k3[j]) + k4[j]);
+        }
+    }
+}
