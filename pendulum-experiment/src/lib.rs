@@ -72,6 +72,7 @@ pub mod run;
 pub mod run_dir;
 pub mod steady;
 pub mod whirl;
+pub mod whirls;
 pub mod words;
 
 pub use assemble::{AnySimulation, Method, Sample, build, chain, directions_integrator, turning_drive};

@@ -6,25 +6,17 @@
 //! decreasing ω — with a line per finished point on stderr, sweep.json rewritten after
 //! each, and Ctrl-C honoured between samples.
 
-use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use nalgebra::{DVector, Dyn, U3};
-use pendulum_core::batch::{DirectionsBatch, WIDTH};
-use pendulum_core::integrate::State;
-use pendulum_core::trajectory::Summary;
-use pendulum_core::{
-    Accounted, Chain, Directions, ShapeOptions, ShapeTracker, Turning, TurningFrame, trajectory,
-};
-use pendulum_experiment::assemble::whirl_model;
+use nalgebra::DVector;
+use pendulum_core::batch::WIDTH;
+use pendulum_core::{ShapeOptions, TurningFrame};
+use pendulum_experiment::DriveConfig;
 use pendulum_experiment::balance::chain_scale;
-use pendulum_experiment::{
-    DriveConfig, IntegratorKind, Method, RunBalance, directions_integrator, turning_drive,
-};
-use rayon::prelude::*;
+use pendulum_experiment::whirls::{WhirlRuns, WhirlStop};
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
@@ -44,7 +36,8 @@ enum Stop {
 pub struct Sweep {
     config: SweepConfig,
     derived: Derived,
-    chain: Chain<Dyn>,
+    /// The chain, the runs' length, step and analysis.
+    whirls: WhirlRuns,
     out: PathBuf,
     jobs: usize,
     quiet: bool,
@@ -62,7 +55,18 @@ impl Sweep {
     /// speeds in the order given, ramp-down in decreasing ω.
     pub fn new(config: SweepConfig, out: PathBuf, jobs: usize, quiet: bool) -> CliResult<Self> {
         let derived = config.derived()?;
-        let chain = config.damped_chain()?;
+        let whirls = WhirlRuns {
+            chain: config.damped_chain()?,
+            duration: config.duration,
+            step: config.step,
+            feed_every: config.feed_every,
+            shape: ShapeOptions {
+                periods: config.settle_periods,
+                tolerance: config.settle_tolerance,
+                ..ShapeOptions::default()
+            },
+            energy_scale: chain_scale(&config.masses, &config.lengths, config.gravity),
+        };
         let scale = config.reference_speed();
         let point = |kind, omega: f64, ramp_from, start: String| Point {
             kind,
@@ -101,7 +105,7 @@ impl Sweep {
                 }
             }
         }
-        Ok(Self { config, derived, chain, out, jobs, quiet, points, singles, down, started: Instant::now() })
+        Ok(Self { config, derived, whirls, out, jobs, quiet, points, singles, down, started: Instant::now() })
     }
 
     /// The configuration.
@@ -225,89 +229,24 @@ impl Sweep {
         }
     }
 
-    /// The motion of a point with `drive`, with its energy ledger (the ledger's
-    /// components ride along and do not change the motion's steps).
-    fn system(&self, drive: &DriveConfig) -> Result<Accounted<Whirl>, Stop> {
-        Ok(Accounted::of(self.model(drive)?))
-    }
-
-    /// The chain of a point with `drive`.
-    fn model(&self, drive: &DriveConfig) -> Result<Whirl, Stop> {
-        let turning =
-            turning_drive(drive).map_err(|e| failed(&e))?.ok_or(Stop::Failed("no circle".into()))?;
-        Ok(whirl_model(self.chain.clone(), turning))
-    }
-
-    /// The shape analysis and the energy balance of a point's run, fed every few steps.
-    fn observer<'a>(&self, system: &'a Accounted<Whirl>) -> Result<Observer<'a>, Stop> {
-        let c = &self.config;
-        let options = ShapeOptions {
-            periods: c.settle_periods,
-            tolerance: c.settle_tolerance,
-            ..ShapeOptions::default()
-        };
-        let tracker = ShapeTracker::new(system.motion_system(), options).map_err(|e| failed(&e))?;
-        let balance = RunBalance::of_scale(chain_scale(&c.masses, &c.lengths, c.gravity));
-        Ok(Observer { system, tracker, balance, initial_energy: None, push_error: None })
-    }
-
     /// Independent points (sudden, ramp-up; indices into `points`), all from hanging at
-    /// rest: one batch of chains ([`DirectionsBatch::run_rk4`], the same steps as
-    /// [`run_point`](Self::run_point) bit for bit), then their shape reports in parallel.
+    /// rest: one batch of chains ([`WhirlRuns::run_batch`], the same steps as
+    /// [`run_point`](Self::run_point) bit for bit).
     fn run_singles(&self, singles: &[usize], shared: &Mutex<Shared>) {
         if INTERRUPTED.load(Ordering::SeqCst) {
             return;
         }
         let clock = Instant::now();
-        let c = &self.config;
         let drives: Vec<DriveConfig> = singles.iter().map(|&i| self.single_drive(&self.points[i])).collect();
-        let set_up = || -> Result<_, Stop> {
-            let systems = drives.iter().map(|d| self.system(d)).collect::<Result<Vec<_>, _>>()?;
-            let models = drives.iter().map(|d| self.model(d)).collect::<Result<Vec<_>, _>>()?;
-            let batch = DirectionsBatch::accounted(models).map_err(|e| failed(&e))?;
-            Ok((systems, batch))
-        };
-        let (systems, batch) = match set_up() {
-            Ok(parts) => parts,
-            Err(stop) => {
-                let message = match stop {
-                    Stop::Failed(e) => e,
-                    Stop::Interrupted => "interrupted".into(),
-                };
-                for &i in singles {
-                    self.record(shared, i, Err(Stop::Failed(message.clone())));
-                }
-                return;
-            }
-        };
-        let started = systems.iter().map(|system| {
-            let x0 = system.start(system.motion_system().hanging().as_slice()).map_err(|e| failed(&e))?;
-            Ok((State::new(0.0, x0), self.observer(system)?))
-        });
-        let (mut states, mut observers): (Vec<_>, Vec<_>) = match started.collect::<Result<Vec<_>, Stop>>() {
-            Ok(pairs) => pairs.into_iter().unzip(),
-            Err(stop) => {
-                for &i in singles {
-                    self.record(shared, i, Err(clone_stop(&stop)));
-                }
-                return;
-            }
-        };
-        let ends =
-            batch.run_rk4(&mut states, &mut observers, c.duration, c.step, c.feed_every, Observer::sample);
-        let ends: Vec<Result<Summary, Stop>> = match ends {
-            Ok(ends) => ends.into_iter().map(|end| end.map_err(|e| failed(&e))).collect(),
-            Err(e) => singles.iter().map(|_| Err(failed(&e))).collect(),
-        };
-        let mut outcomes: Vec<Result<Outcome, Stop>> =
-            observers.into_par_iter().zip(ends).map(|(observer, end)| observer.outcome(end?, 0.0)).collect();
+        let ends = self.whirls.run_batch(&drives, &interrupted);
         // Each point's wall time: its share of the batch's.
         let share = clock.elapsed().as_secs_f64() / singles.len() as f64;
-        for outcome in outcomes.iter_mut().flatten() {
-            outcome.wall_seconds = share;
-        }
-        for (&i, outcome) in singles.iter().zip(outcomes) {
-            self.record(shared, i, outcome);
+        for (&i, end) in singles.iter().zip(ends) {
+            self.record(
+                shared,
+                i,
+                end.map(|e| Outcome::of(&e.report, e.steps, share, e.balance)).map_err(Stop::of),
+            );
         }
     }
 
@@ -320,28 +259,10 @@ impl Sweep {
         start: Option<DVector<f64>>,
     ) -> Result<(Outcome, DVector<f64>), Stop> {
         let clock = Instant::now();
-        let c = &self.config;
-        let system = self.system(drive)?;
-        let model = system.motion_system();
-        let x0 = match start {
-            Some(x) => x,
-            None => model.hanging(),
-        };
-        let motion_len = x0.len();
-        let x0 = system.start(x0.as_slice()).map_err(|e| failed(&e))?;
-        let mut observer = self.observer(&system)?;
-        let mut solver =
-            directions_integrator(Method::of_kind(IntegratorKind::Rk4), &system).map_err(|e| failed(&e))?;
-        let mut state = State::new(0.0, x0);
-        let summary =
-            trajectory::run(&mut *solver, &system, &mut state, c.duration, c.step, c.feed_every, |t, x| {
-                observer.sample(t, x)
-            })
-            .map_err(|e| failed(&e))?;
-        let outcome = observer.outcome(summary, clock.elapsed().as_secs_f64())?;
-        let phase = model.drive().phase(state.t());
-        let motion = &state.x().as_slice()[..motion_len];
-        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(motion))))
+        let (end, t, motion) = self.whirls.run_one(drive, start, &interrupted).map_err(Stop::of)?;
+        let outcome = Outcome::of(&end.report, end.steps, clock.elapsed().as_secs_f64(), end.balance);
+        let phase = self.whirls.model(drive).map_err(Stop::of)?.drive().phase(t);
+        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(motion.as_slice()))))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
@@ -429,55 +350,18 @@ impl Sweep {
     }
 }
 
-/// A 3D chain whose pivot circles the vertical, as the sweep runs it.
-type Whirl = Directions<U3, Box<dyn Turning>>;
-
-/// A step or set-up error as a failed run.
-fn failed(e: &dyn std::fmt::Display) -> Stop {
-    Stop::Failed(e.to_string())
+/// Whether Ctrl-C was pressed.
+fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::Relaxed)
 }
 
-/// The same stop again (for every point of a batch that could not start).
-fn clone_stop(stop: &Stop) -> Stop {
-    match stop {
-        Stop::Interrupted => Stop::Interrupted,
-        Stop::Failed(e) => Stop::Failed(e.clone()),
-    }
-}
-
-/// What a point's run feeds with its samples: the shape analysis and the energy balance.
-struct Observer<'a> {
-    system: &'a Accounted<Whirl>,
-    tracker: ShapeTracker<'a, Box<dyn Turning>>,
-    balance: RunBalance,
-    initial_energy: Option<f64>,
-    push_error: Option<pendulum_core::Error>,
-}
-
-impl Observer<'_> {
-    /// One sample at time `t` of the state `x` (motion and ledger); stops the run on a
-    /// failed analysis or Ctrl-C.
-    fn sample(&mut self, t: f64, x: &DVector<f64>) -> ControlFlow<()> {
-        let energy = self.system.energy(t, x);
-        self.balance.add(energy, &self.system.ledger(x), *self.initial_energy.get_or_insert(energy));
-        let motion_len = self.system.motion_system().state_len();
-        if let Err(e) = self.tracker.push(t, &x.rows(0, motion_len).into_owned()) {
-            self.push_error = Some(e);
-            return ControlFlow::Break(());
+impl Stop {
+    /// A whirl's stop as the sweep's.
+    fn of(stop: WhirlStop) -> Self {
+        match stop {
+            WhirlStop::Interrupted => Self::Interrupted,
+            WhirlStop::Failed(e) => Self::Failed(e),
         }
-        if INTERRUPTED.load(Ordering::Relaxed) { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
-    }
-
-    /// The point's outcome after its run (`summary`, `wall_seconds` of wall-clock time).
-    fn outcome(self, summary: Summary, wall_seconds: f64) -> Result<Outcome, Stop> {
-        if let Some(e) = self.push_error {
-            return Err(Stop::Failed(format!("shape analysis: {e}")));
-        }
-        if summary.stopped_early {
-            return Err(Stop::Interrupted);
-        }
-        let report = self.tracker.report().map_err(|e| failed(&format!("shape analysis: {e}")))?;
-        Ok(Outcome::of(&report, summary.steps, wall_seconds, self.balance))
     }
 }
 

@@ -1,0 +1,202 @@
+//! Many whirls at once: a chain run from hanging at rest with its pivot on a horizontal
+//! circle (switched on or ramped), RK4 with projection and the energy ledger, the shape
+//! analysis fed every few steps, for a list of drives as one batch of chains
+//! ([`DirectionsBatch::run_rk4`]: four chains per SIMD lane group, on the current rayon
+//! pool). Each whirl is bit for bit the run of [`run_one`], so a front end (the CLI's
+//! `sweep`, Python's `pendulum.whirls`) may batch whatever points are independent.
+
+use std::ops::ControlFlow;
+
+use nalgebra::{DVector, Dyn, U3};
+use pendulum_core::batch::DirectionsBatch;
+use pendulum_core::integrate::State;
+use pendulum_core::trajectory::{self, Summary};
+use pendulum_core::{Accounted, Chain, Directions, ShapeOptions, ShapeReport, ShapeTracker, Turning};
+use rayon::prelude::*;
+
+use crate::assemble::{Method, directions_integrator, turning_drive, whirl_model};
+use crate::balance::RunBalance;
+use crate::description::{DriveConfig, IntegratorKind};
+
+/// A 3D chain whose pivot circles the vertical.
+pub type WhirlModel = Directions<U3, Box<dyn Turning>>;
+
+/// How the whirls of a batch run: the chain, the run's length and step (s), the samples
+/// fed to the shape analysis (every `feed_every` steps) and its options, and the energy
+/// scale (J) the balance is judged against.
+#[derive(Debug, Clone)]
+pub struct WhirlRuns {
+    pub chain: Chain<Dyn>,
+    pub duration: f64,
+    pub step: f64,
+    pub feed_every: usize,
+    pub shape: ShapeOptions,
+    pub energy_scale: f64,
+}
+
+/// What a whirl's run gave: the shape report at its end, the steps taken and the energy
+/// balance along it.
+#[derive(Debug, Clone)]
+pub struct WhirlEnd {
+    pub report: ShapeReport,
+    pub steps: u64,
+    pub balance: RunBalance,
+}
+
+/// Why a whirl did not finish.
+#[derive(Debug, Clone, PartialEq)]
+pub enum WhirlStop {
+    /// `stop` said so (Ctrl-C).
+    Interrupted,
+    /// A step or the analysis failed; the message says why.
+    Failed(String),
+}
+
+impl WhirlStop {
+    fn of(e: &dyn std::fmt::Display) -> Self {
+        Self::Failed(e.to_string())
+    }
+}
+
+/// The outcome of one whirl.
+pub type WhirlResult = Result<WhirlEnd, WhirlStop>;
+
+impl WhirlRuns {
+    /// The chain with `drive` (a circle or a ramped circle), with its energy ledger.
+    pub fn system(&self, drive: &DriveConfig) -> Result<Accounted<WhirlModel>, WhirlStop> {
+        Ok(Accounted::of(self.model(drive)?))
+    }
+
+    /// The chain with `drive`.
+    pub fn model(&self, drive: &DriveConfig) -> Result<WhirlModel, WhirlStop> {
+        let turning = turning_drive(drive)
+            .map_err(|e| WhirlStop::of(&e))?
+            .ok_or_else(|| WhirlStop::Failed("the drive is not a circle".into()))?;
+        Ok(whirl_model(self.chain.clone(), turning))
+    }
+
+    /// The shape analysis and the energy balance fed by a run of `system`; `stop()` is
+    /// asked at every sample.
+    pub fn observer<'a>(
+        &self,
+        system: &'a Accounted<WhirlModel>,
+        stop: &'a (dyn Fn() -> bool + Sync),
+    ) -> Result<Observer<'a>, WhirlStop> {
+        let tracker = ShapeTracker::new(system.motion_system(), self.shape).map_err(|e| WhirlStop::of(&e))?;
+        let balance = RunBalance::of_scale(self.energy_scale);
+        Ok(Observer { system, tracker, balance, initial_energy: None, push_error: None, stop })
+    }
+
+    /// One whirl with `drive` from the chain's state `start` (`None`: hanging at rest), by
+    /// `trajectory::run`; also returns the final state `(t, x)` of the motion.
+    pub fn run_one(
+        &self,
+        drive: &DriveConfig,
+        start: Option<DVector<f64>>,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<(WhirlEnd, f64, DVector<f64>), WhirlStop> {
+        let system = self.system(drive)?;
+        let model = system.motion_system();
+        let x0 = start.unwrap_or_else(|| model.hanging());
+        let motion_len = x0.len();
+        let x0 = system.start(x0.as_slice()).map_err(|e| WhirlStop::of(&e))?;
+        let mut observer = self.observer(&system, stop)?;
+        let mut solver = directions_integrator(Method::of_kind(IntegratorKind::Rk4), &system)
+            .map_err(|e| WhirlStop::of(&e))?;
+        let mut state = State::new(0.0, x0);
+        let summary = trajectory::run(
+            &mut *solver,
+            &system,
+            &mut state,
+            self.duration,
+            self.step,
+            self.feed_every,
+            |t, x| observer.sample(t, x),
+        )
+        .map_err(|e| WhirlStop::of(&e))?;
+        let end = observer.end(summary)?;
+        Ok((end, state.t(), state.x().rows(0, motion_len).into_owned()))
+    }
+
+    /// The whirls with `drives`, each from hanging at rest, as one batch of chains: bit for
+    /// bit [`run_one`](Self::run_one) of each; `stop()` is asked at every sample. The shape
+    /// reports at the end are computed in parallel too.
+    pub fn run_batch(&self, drives: &[DriveConfig], stop: &(dyn Fn() -> bool + Sync)) -> Vec<WhirlResult> {
+        let fail_all = |stop: WhirlStop| drives.iter().map(|_| Err(stop.clone())).collect();
+        let systems = match drives.iter().map(|d| self.system(d)).collect::<Result<Vec<_>, _>>() {
+            Ok(systems) => systems,
+            Err(e) => return fail_all(e),
+        };
+        let models = match drives.iter().map(|d| self.model(d)).collect::<Result<Vec<_>, _>>() {
+            Ok(models) => models,
+            Err(e) => return fail_all(e),
+        };
+        let batch = match DirectionsBatch::accounted(models) {
+            Ok(batch) => batch,
+            Err(e) => return fail_all(WhirlStop::of(&e)),
+        };
+        let started = systems.iter().map(|system| {
+            let x0 =
+                system.start(system.motion_system().hanging().as_slice()).map_err(|e| WhirlStop::of(&e))?;
+            Ok((State::new(0.0, x0), self.observer(system, stop)?))
+        });
+        let (mut states, mut observers): (Vec<_>, Vec<_>) =
+            match started.collect::<Result<Vec<_>, WhirlStop>>() {
+                Ok(pairs) => pairs.into_iter().unzip(),
+                Err(e) => return fail_all(e),
+            };
+        let ends = match batch.run_rk4(
+            &mut states,
+            &mut observers,
+            self.duration,
+            self.step,
+            self.feed_every,
+            Observer::sample,
+        ) {
+            Ok(ends) => ends,
+            Err(e) => return fail_all(WhirlStop::of(&e)),
+        };
+        observers
+            .into_par_iter()
+            .zip(ends)
+            .map(|(observer, end)| observer.end(end.map_err(|e| WhirlStop::of(&e))?))
+            .collect()
+    }
+}
+
+/// What a whirl's run feeds with its samples: the shape analysis and the energy balance.
+pub struct Observer<'a> {
+    system: &'a Accounted<WhirlModel>,
+    tracker: ShapeTracker<'a, Box<dyn Turning>>,
+    balance: RunBalance,
+    initial_energy: Option<f64>,
+    push_error: Option<pendulum_core::Error>,
+    stop: &'a (dyn Fn() -> bool + Sync),
+}
+
+impl Observer<'_> {
+    /// One sample at time `t` (s) of the state `x` (motion and ledger); stops the run on a
+    /// failed analysis or when asked to.
+    pub fn sample(&mut self, t: f64, x: &DVector<f64>) -> ControlFlow<()> {
+        let energy = self.system.energy(t, x);
+        self.balance.add(energy, &self.system.ledger(x), *self.initial_energy.get_or_insert(energy));
+        let motion_len = self.system.motion_system().state_len();
+        if let Err(e) = self.tracker.push(t, &x.rows(0, motion_len).into_owned()) {
+            self.push_error = Some(e);
+            return ControlFlow::Break(());
+        }
+        if (self.stop)() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    }
+
+    /// The whirl's end after its run (`summary`): the shape report, or why there is none.
+    pub fn end(self, summary: Summary) -> WhirlResult {
+        if let Some(e) = self.push_error {
+            return Err(WhirlStop::Failed(format!("shape analysis: {e}")));
+        }
+        if summary.stopped_early {
+            return Err(WhirlStop::Interrupted);
+        }
+        let report = self.tracker.report().map_err(|e| WhirlStop::Failed(format!("shape analysis: {e}")))?;
+        Ok(WhirlEnd { report, steps: summary.steps, balance: self.balance })
+    }
+}
