@@ -6,10 +6,12 @@
 mod arrays;
 mod chain;
 mod errors;
+mod interrupt;
 mod page;
 mod run;
 mod steady;
 mod string;
+mod whirls;
 
 use pyo3::prelude::*;
 
@@ -23,5 +25,6 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<string::HeavyString>()?;
     m.add_function(wrap_pyfunction!(page::page, m)?)?;
     m.add_function(wrap_pyfunction!(steady::steady, m)?)?;
+    m.add_function(wrap_pyfunction!(whirls::whirls, m)?)?;
     Ok(())
 }

@@ -3,9 +3,7 @@
 //! exactly `omega_max` with every point's node count and verdict, and every shape at the
 //! asked speeds, as numpy arrays in dicts.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, mpsc};
-use std::time::Duration;
+use std::sync::atomic::Ordering;
 
 use numpy::PyArray1;
 use pendulum_core::{SteadyRotation, SteadyShape};
@@ -17,13 +15,11 @@ use pyo3::types::PyDict;
 use crate::arrays::{array, per_link};
 use crate::chain::Chain;
 use crate::errors::{core_error, invalid, run_error};
+use crate::interrupt::interruptible;
 
 /// Python's names for the options of a steady request.
 const NAMES: Names =
     Names { omega: "omega", omega_max: "omega_max", branches: "branches", fixed_pivot: "radius = 0" };
-
-/// How often the waiting thread looks for Ctrl-C.
-const SIGNAL_CHECK: Duration = Duration::from_millis(50);
 
 /// The steady shapes of ``chain`` turning at ω about the vertical through its pivot, the
 /// pivot fixed (``radius = 0``) or driven round a horizontal circle of ``radius`` (m).
@@ -89,38 +85,12 @@ pub fn steady<'py>(
     let omega_max = requested_omega_max(&free, radius, listed.as_deref(), omega_max, branches, &NAMES)
         .map_err(run_error)?;
     let speeds = listed.unwrap_or_else(|| vec![omega_max]);
-    // The work on a thread of its own; this one looks for Ctrl-C meanwhile, without the
-    // GIL, and on Ctrl-C returns at once (the worker stops judging at its next point and
-    // its result is dropped).
-    let stop = Arc::new(AtomicBool::new(false));
-    let (sender, receiver) = mpsc::channel();
-    let worker_stop = Arc::clone(&stop);
-    std::thread::spawn(move || {
-        let work = || -> pendulum_experiment::Result<_> {
-            let family =
-                follow(&problem, &free, omega_max, branches, &|_| !worker_stop.load(Ordering::SeqCst))?;
-            let shapes = shapes_at(&problem, &base, &family, &speeds, damping.as_deref())?;
-            Ok((family, shapes))
-        };
-        let _ = sender.send(work());
-    });
-    let outcome = py.detach(move || {
-        loop {
-            match receiver.recv_timeout(SIGNAL_CHECK) {
-                Ok(outcome) => return Ok(outcome),
-                Err(mpsc::RecvTimeoutError::Timeout) => {
-                    if let Err(e) = Python::attach(|py| py.check_signals()) {
-                        stop.store(true, Ordering::SeqCst);
-                        return Err(e);
-                    }
-                }
-                Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    return Ok(Err(pendulum_experiment::Error::failed(
-                        "the steady computation stopped unexpectedly",
-                    )));
-                }
-            }
-        }
+    // Ctrl-C returns at once: the worker stops judging at its next point and its result
+    // is dropped.
+    let outcome = interruptible(py, "the steady computation", move |stop| {
+        let family = follow(&problem, &free, omega_max, branches, &|_| !stop.load(Ordering::SeqCst))?;
+        let shapes = shapes_at(&problem, &base, &family, &speeds, damping.as_deref())?;
+        Ok((family, shapes))
     })?;
     let (family, shapes) = outcome.map_err(run_error)?;
     let out = PyDict::new(py);

@@ -6,8 +6,10 @@
 use std::path::Path;
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, SteadyRotation, fastest_decay_bound, normal_modes};
-use pendulum_experiment::{DriveConfig, drive_frequency, fastest_mode, suggested_step};
+use pendulum_core::{Chain, SteadyRotation};
+use pendulum_experiment::whirls::{
+    FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
+};
 use serde::{Deserialize, Serialize};
 
 use super::point::Point;
@@ -15,25 +17,8 @@ use super::{SweepKind, SweepPhysics};
 use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
-use crate::steady::round_up;
+use pendulum_experiment::steady::round_up;
 use pendulum_experiment::write_json_atomic;
-
-/// The shape analysis is fed every this many steps (a point and the same `simulate` run
-/// with `--every 4` report the same).
-pub const FEED_EVERY: usize = 4;
-
-/// Settle window of the shape analysis, drive periods (`ShapeOptions` default).
-const SETTLE_PERIODS: f64 = 5.0;
-
-/// Settled: drift at most this times the chain's length (`ShapeOptions` default).
-const SETTLE_TOLERANCE: f64 = 1e-3;
-
-/// Default duration: this many decay times of the first mode at rest (600 s for the
-/// chain of `docs/rotating-chain.md` §4, whose first mode decays at 0.02 1/s).
-const DECAY_TIMES: f64 = 12.0;
-
-/// Default duration of an undamped sweep: this many periods of the first mode at rest.
-const UNDAMPED_PERIODS: f64 = 200.0;
 
 /// Most steps of one point.
 const MAX_STEPS: f64 = 1e8;
@@ -351,42 +336,6 @@ pub fn parse_omegas(spec: &str, scaled: bool) -> CliResult<Vec<f64>> {
     spec.split(',').map(|token| number(token, "entry")).collect()
 }
 
-/// `σ = ½ Σ λ_i v_i²`, 1/s: the decay rate of the first mode of the hanging chain under
-/// the chain's damping, `v` its mass-normalised shape in link angles.
-pub fn first_mode_decay(chain: &Chain<Dyn>) -> f64 {
-    let modes = normal_modes(chain);
-    let v = modes.shapes.column(0);
-    0.5 * chain.damping().iter().zip(v.iter()).map(|(l, v)| l * v * v).sum::<f64>()
-}
-
-/// [`DECAY_TIMES`] decay times of the first mode, rounded up to three digits; undamped,
-/// [`UNDAMPED_PERIODS`] periods of that mode.
-fn default_duration(chain: &Chain<Dyn>) -> f64 {
-    let decay = first_mode_decay(chain);
-    if decay > 0.0 {
-        round_up(DECAY_TIMES / decay)
-    } else {
-        let omega_1 = normal_modes(chain).frequencies[0];
-        round_up(UNDAMPED_PERIODS * std::f64::consts::TAU / omega_1)
-    }
-}
-
-/// The step `pendulum simulate` suggests for this chain on a circle of `radius` turning at
-/// up to `omega` (rad/s) ([`suggested_step`]: `0.5 / ω_fastest`, at most a fortieth of the
-/// drive period, `ω_fastest` with `g_eff = g + R ω²`), here also at most `1 / ν_fastest`
-/// (RK4 is stable to `h ν ≈ 2.8` on decaying modes; [`fastest_decay_bound`]); rounded
-/// down to two digits.
-fn default_step(chain: &Chain<Dyn>, radius: f64, omega: f64) -> f64 {
-    let circle = DriveConfig::Circle { radius, omega };
-    let mut h = suggested_step(fastest_mode(chain, &circle), drive_frequency(&circle));
-    let decay = fastest_decay_bound(chain);
-    if decay > 0.0 {
-        h = h.min(1.0 / decay);
-    }
-    let unit = 10f64.powi(h.log10().floor() as i32 - 1);
-    (h / unit).floor() * unit
-}
-
 /// What sweep.json holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -491,17 +440,5 @@ mod tests {
             message("1:2:2.5"),
             "--omega: '1:2:2.5' has a bad number of points '2.5' (N: a whole number ≥ 1)"
         );
-    }
-
-    #[test]
-    fn the_default_step_resolves_the_fastest_mode() {
-        // n = 20, L = 1 m: ω_fastest ≈ 2n √(g/L) = 125 rad/s; the drive adds R ω² to g.
-        let chain = Chain::<Dyn>::uniform(20, 0.05, 0.05, 9.81).unwrap();
-        let h = default_step(&chain, 0.02, 15.66);
-        assert!((3.0e-3..4.1e-3).contains(&h), "{h}");
-        assert_eq!(h, (h * 1e4).round() / 1e4);
-        // Heavy damping (λ / (m l²) = 8000 1/s) shortens it.
-        let damped = chain.with_damping(&[1.0; 20]).unwrap();
-        assert!(default_step(&damped, 0.02, 15.66) <= 1.0 / 32000.0);
     }
 }

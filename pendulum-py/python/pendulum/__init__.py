@@ -7,6 +7,9 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).
+- ``whirls(chain, radius=..., omega=..., ramp_time=...)``: many whirls from hanging at
+  rest, one per circle and speed, run together as a batch of chains on all cores: which
+  shape each ends in, as numpy arrays (the runs of ``pendulum sweep``).
 - ``steady(chain, ...)``: the steady shapes of the chain turning about the vertical, as
   ``pendulum steady`` finds them: branches with every point's nodes and stability, and
   every shape at the asked speeds.
@@ -19,7 +22,7 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 SI units throughout, angles in radians. See ``docs/python.md`` in the repository.
 """
 
-from ._pendulum import Chain, HeavyString, Run, RunResult, __version__, page, steady
+from ._pendulum import Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
 from ._plots import plot_ledger, plot_shape
 
 __all__ = [
@@ -32,4 +35,5 @@ __all__ = [
     "plot_ledger",
     "plot_shape",
     "steady",
+    "whirls",
 ]

@@ -7,7 +7,7 @@ from typing import Any, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady"]
+__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady", "whirls"]
 __version__: str
 
 _Array = npt.NDArray[np.float64]
@@ -21,6 +21,15 @@ def steady(
     omega_max: Optional[float] = ...,
     branches: Optional[int] = ...,
     damping: Optional[_PerLink] = ...,
+) -> dict[str, Any]: ...
+def whirls(
+    chain: Chain,
+    *,
+    radius: Union[float, Sequence[float], npt.ArrayLike],
+    omega: Union[float, Sequence[float], npt.ArrayLike],
+    ramp_time: Union[float, Sequence[float], npt.ArrayLike, None] = ...,
+    duration: Optional[float] = ...,
+    step: Optional[float] = ...,
 ) -> dict[str, Any]: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
 
