@@ -141,7 +141,13 @@ where
         &self.models[k]
     }
 
-    /// Entries of one chain's state, `2·S·n`.
+    /// Whether the states carry the energy ledger ([`accounted`](Self::accounted)).
+    pub fn is_accounted(&self) -> bool {
+        self.accounted
+    }
+
+    /// Entries of one chain's state: `2·S·n`, and the ledger's 3 when
+    /// [`accounted`](Self::accounted).
     pub fn state_len(&self) -> usize {
         2 * S::DIM * self.links + if self.accounted { LEDGER_LEN } else { 0 }
     }
@@ -204,7 +210,7 @@ where
             x: &[F64x4],
             solve: &mut Solve<C>,
             out: &mut [F64x4],
-        ) {
+        ) -> [F64x4; C] {
             let half = C * self.links;
             let block = &self.blocks[b];
             let zero = Lanes([0.0; WIDTH]);
@@ -215,8 +221,7 @@ where
             let (directions, rates) = (&x[..half], &x[half..2 * half]);
             let (velocity, acceleration) = out.split_at_mut(half);
             velocity.copy_from_slice(rates);
-            let (acceleration, ledger) = acceleration.split_at_mut(half);
-            // The loads in a pass of their own: built inside the solve, the builder is not
+                // The loads in a pass of their own: built inside the solve, the builder is not
             // inlined.
             let drag = block.rods.drag();
             for (i, load) in solve.loads.iter_mut().enumerate() {
@@ -228,16 +233,31 @@ where
             block.rods.solve(gravity, pivot, &mut solve.rows, load, |i, a, _, _| {
                 acceleration[i * C..(i + 1) * C].copy_from_slice(&a);
             });
-            if self.accounted {
-                // The ledger's rates, as `Accounted`'s right-hand side gives them.
-                let velocities: [_; WIDTH] =
-                    std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
-                let velocity: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| velocities[k][c]));
-                let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
-                let (drive, damping) = direction_powers(chain, velocity, pivot, rates, acceleration);
-                ledger[..LEDGER_LEN].copy_from_slice(&[drive, zero, damping]);
-            }
+            pivot
         }
         dispatch pub(super) fn flow_simd, flow_avx2
+    }
+
+    /// The ledger's rates `(P_drive, 0, P_damping)` (W) into `out[2·S·n..]` after [`flow`](Self::flow)
+    /// filled `out` at the same `(t, x)` with the pivot accelerations `pivot` (m/s²) it
+    /// returned: as `Accounted`'s right-hand side gives them.
+    #[inline(always)]
+    pub(super) fn ledger_rates<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        x: &[F64x4],
+        pivot: [F64x4; C],
+        out: &mut [F64x4],
+    ) {
+        let half = C * self.links;
+        let block = &self.blocks[b];
+        let velocities: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
+        let velocity: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| velocities[k][c]));
+        let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
+        let (rates, accelerations) = (&x[half..2 * half], &out[half..2 * half]);
+        let (drive, damping) = direction_powers(chain, velocity, pivot, rates, accelerations);
+        out[2 * half..2 * half + LEDGER_LEN].copy_from_slice(&[drive, Lanes([0.0; WIDTH]), damping]);
     }
 }

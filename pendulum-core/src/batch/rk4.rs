@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
-use super::directions::Scratch;
+use super::directions::{Scratch, Solve};
 use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
@@ -264,13 +264,21 @@ where
             }
         };
         let at = |dt: f64| -> [f64; WIDTH] { std::array::from_fn(|k| t[k] + dt) };
-        self.flow::<C>(b, chains, t, x, rows, k1);
+        // `Accounted`'s right-hand side when the states carry the ledger.
+        let accounted = self.is_accounted();
+        let flow = |t: [f64; WIDTH], x: &[F64x4], rows: &mut Solve<C>, k: &mut [F64x4]| {
+            let pivot = self.flow::<C>(b, chains, t, x, rows, k);
+            if accounted {
+                self.ledger_rates::<C>(b, chains, t, x, pivot, k);
+            }
+        };
+        flow(t, x, rows, k1);
         axpy(y, half_lanes, k1);
-        self.flow::<C>(b, chains, at(half), y, rows, k2);
+        flow(at(half), y, rows, k2);
         axpy(y, half_lanes, k2);
-        self.flow::<C>(b, chains, at(half), y, rows, k3);
+        flow(at(half), y, rows, k3);
         axpy(y, h_lanes, k3);
-        self.flow::<C>(b, chains, at(h), y, rows, k4);
+        flow(at(h), y, rows, k4);
         let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
         for (j, y) in y.iter_mut().enumerate() {
             *y = sixth * (k1[j] + two * (k2[j] + k3[j]) + k4[j]);
