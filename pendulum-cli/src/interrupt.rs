@@ -24,6 +24,18 @@ static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// The process exits with status 130 (the shell's convention after Ctrl-C).
 pub const EXIT_STATUS: i32 = 130;
 
+/// Output cut off by the reader (`pendulum modes … | head -1`) ends the process quietly,
+/// as it does any Unix tool (SIGPIPE's default action), instead of a panic in the next
+/// `println!`. Not for `view`, whose server writes to sockets the browser may close.
+pub fn quiet_on_broken_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restores a signal's default disposition at the start of `main`, before any
+    // thread that could be writing exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 /// Installs the Ctrl-C handler (once, at the start of every command).
 pub fn install_handler() {
     let installed = ctrlc::set_handler(|| {

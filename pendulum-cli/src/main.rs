@@ -48,6 +48,9 @@ fn main() -> ExitCode {
         },
     };
     interrupt::install_handler();
+    if !matches!(cli.command, Command::View(_)) {
+        interrupt::quiet_on_broken_pipe();
+    }
     let result = match &cli.command {
         Command::Simulate(args) => {
             // `pendulum simulate` alone: the demo.

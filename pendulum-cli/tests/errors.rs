@@ -170,3 +170,23 @@ fn help_lists_every_command_and_option() {
     let out = run_in(&dir, &[]);
     assert_eq!(out.status.code(), Some(2), "no command is a usage error");
 }
+
+/// Output cut off by its reader (`pendulum modes … | head -1`) ends the command quietly,
+/// by SIGPIPE as any Unix tool, not with a panic.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_output_without_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = scratch("closed-pipe");
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = common::pendulum()
+        .args(["modes", "--n", "12", "--lengths", "0.1", "--count", "4", "--out", "modes"])
+        .current_dir(&dir)
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.signal(), Some(13), "{:?}: {}", out.status, stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+}
