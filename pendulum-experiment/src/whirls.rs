@@ -12,8 +12,8 @@ use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::integrate::State;
 use pendulum_core::trajectory::{self, Summary};
 use pendulum_core::{
-    Accounted, Chain, Directions, ShapeOptions, ShapeReport, ShapeTracker, Turning, fastest_decay_bound,
-    normal_modes,
+    Accounted, Chain, Directions, ShapeOptions, ShapeReport, ShapeTracker, Turning, TurningFrame,
+    fastest_decay_bound, normal_modes,
 };
 use rayon::prelude::*;
 
@@ -146,13 +146,14 @@ impl WhirlRuns {
     }
 
     /// One whirl with `drive` from the chain's state `start` (`None`: hanging at rest), by
-    /// `trajectory::run`; also returns the final state `(t, x)` of the motion.
+    /// `trajectory::run`; also returns the final state of the motion turned about the axis
+    /// so that the pivot is at phase 0 (where a drive starting from it begins).
     pub fn run_one(
         &self,
         drive: &DriveConfig,
         start: Option<DVector<f64>>,
         stop: &(dyn Fn() -> bool + Sync),
-    ) -> Result<(WhirlEnd, f64, DVector<f64>), WhirlStop> {
+    ) -> Result<(WhirlEnd, DVector<f64>), WhirlStop> {
         let system = self.system(drive)?;
         let model = system.motion_system();
         let x0 = start.unwrap_or_else(|| model.hanging());
@@ -173,7 +174,8 @@ impl WhirlRuns {
         )
         .map_err(|e| WhirlStop::of(&e))?;
         let end = observer.end(summary)?;
-        Ok((end, state.t(), state.x().rows(0, motion_len).into_owned()))
+        let frame = TurningFrame::at(model.drive().phase(state.t()));
+        Ok((end, DVector::from_vec(frame.turn_vectors(&state.x().as_slice()[..motion_len]))))
     }
 
     /// The whirls with `drives`, each from hanging at rest, as one batch of chains: bit for

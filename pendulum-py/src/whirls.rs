@@ -19,8 +19,7 @@ use crate::chain::Chain;
 use crate::errors::invalid;
 use crate::interrupt::interruptible;
 
-/// `value` as `count` numbers: one number for all, or a sequence of `count` (or, when
-/// `count` is not known yet, of any length ≥ 1).
+/// `value` as numbers: one number, or a non-empty sequence.
 fn numbers(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     if let Ok(x) = value.extract::<f64>() {
         return Ok(vec![x]);
@@ -124,10 +123,6 @@ pub fn whirls<'py>(
         Ok(runs.run_batch(&drives, &|| stop.load(Ordering::SeqCst)))
     })?
     .map_err(crate::errors::run_error)?;
-    if ends.iter().any(|e| matches!(e, Err(WhirlStop::Interrupted))) {
-        // Only a stop asked for by Ctrl-C gets here, which raised above; be safe.
-        return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err("the whirls were interrupted"));
-    }
     let column = |f: &dyn Fn(&pendulum_experiment::whirls::WhirlEnd) -> f64| -> Vec<f64> {
         ends.iter().map(|e| e.as_ref().map_or(f64::NAN, f)).collect()
     };
@@ -165,8 +160,10 @@ pub fn whirls<'py>(
     let errors: Vec<Option<String>> = ends
         .iter()
         .map(|e| match e {
+            Ok(_) => None,
             Err(WhirlStop::Failed(m)) => Some(m.clone()),
-            _ => None,
+            // Only Ctrl-C stops a whirl, and it raised KeyboardInterrupt before this.
+            Err(WhirlStop::Interrupted) => Some("interrupted".into()),
         })
         .collect();
     out.set_item("error", errors)?;

@@ -12,25 +12,17 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use nalgebra::DVector;
+use pendulum_core::ShapeOptions;
 use pendulum_core::batch::WIDTH;
-use pendulum_core::{ShapeOptions, TurningFrame};
 use pendulum_experiment::DriveConfig;
 use pendulum_experiment::balance::chain_scale;
-use pendulum_experiment::whirls::{WhirlRuns, WhirlStop};
+use pendulum_experiment::whirls::{WhirlRuns, WhirlStop as Stop};
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
 use super::point::{Outcome, Point, Status};
 use crate::error::{CliError, CliResult};
 use crate::interrupt::INTERRUPTED;
-
-/// Why a run did not finish.
-enum Stop {
-    /// Ctrl-C.
-    Interrupted,
-    /// A step or the analysis failed.
-    Failed(String),
-}
 
 /// A sweep set up to run: its configuration and points, where to write, how many threads.
 pub struct Sweep {
@@ -152,9 +144,8 @@ impl Sweep {
             if !self.down.is_empty() {
                 s.spawn_fifo(|_| self.run_down(&shared));
             }
-            // The independent points as one batch of chains, four per SIMD lane group,
-            // on the pool's threads.
-            // In rounds of two blocks per thread, so that Ctrl-C keeps the rounds finished.
+            // The independent points as batches of chains, four per SIMD lane group, on the
+            // pool's threads, in rounds of two blocks per thread (Ctrl-C keeps finished rounds).
             if !self.singles.is_empty() {
                 s.spawn_fifo(|_| {
                     for round in self.singles.chunks(2 * WIDTH * self.jobs) {
@@ -242,11 +233,7 @@ impl Sweep {
         // Each point's wall time: its share of the batch's.
         let share = clock.elapsed().as_secs_f64() / singles.len() as f64;
         for (&i, end) in singles.iter().zip(ends) {
-            self.record(
-                shared,
-                i,
-                end.map(|e| Outcome::of(&e.report, e.steps, share, e.balance)).map_err(Stop::of),
-            );
+            self.record(shared, i, end.map(|e| Outcome::of(&e.report, e.steps, share, e.balance)));
         }
     }
 
@@ -259,10 +246,8 @@ impl Sweep {
         start: Option<DVector<f64>>,
     ) -> Result<(Outcome, DVector<f64>), Stop> {
         let clock = Instant::now();
-        let (end, t, motion) = self.whirls.run_one(drive, start, &interrupted).map_err(Stop::of)?;
-        let outcome = Outcome::of(&end.report, end.steps, clock.elapsed().as_secs_f64(), end.balance);
-        let phase = self.whirls.model(drive).map_err(Stop::of)?.drive().phase(t);
-        Ok((outcome, DVector::from_vec(TurningFrame::at(phase).turn_vectors(motion.as_slice()))))
+        let (end, turned) = self.whirls.run_one(drive, start, &interrupted)?;
+        Ok((Outcome::of(&end.report, end.steps, clock.elapsed().as_secs_f64(), end.balance), turned))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
@@ -353,16 +338,6 @@ impl Sweep {
 /// Whether Ctrl-C was pressed.
 fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::Relaxed)
-}
-
-impl Stop {
-    /// A whirl's stop as the sweep's.
-    fn of(stop: WhirlStop) -> Self {
-        match stop {
-            WhirlStop::Interrupted => Self::Interrupted,
-            WhirlStop::Failed(e) => Self::Failed(e),
-        }
-    }
 }
 
 /// What the threads share.

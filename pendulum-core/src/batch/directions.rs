@@ -221,7 +221,7 @@ where
             let (directions, rates) = (&x[..half], &x[half..2 * half]);
             let (velocity, acceleration) = out.split_at_mut(half);
             velocity.copy_from_slice(rates);
-                // The loads in a pass of their own: built inside the solve, the builder is not
+            // The loads in a pass of their own: built inside the solve, the builder is not
             // inlined.
             let drag = block.rods.drag();
             for (i, load) in solve.loads.iter_mut().enumerate() {

@@ -364,6 +364,49 @@ mod tests {
         }
     }
 
+    #[test]
+    fn in_lanes_only_the_lanes_out_of_range_fall_back_and_each_lane_is_its_chain() {
+        // Four chains of 40 rods side by side; lane 2 has masses of 1e-150 kg, whose
+        // continuants leave their range (redone by pivots), the others stay on the
+        // continuants. Every lane must equal its chain's scalar solve bit for bit.
+        let mut chains: Vec<(Rods, Vec<Load<2>>)> =
+            (0..4).map(|k| random_chain(40, (-1.0, 1.0), 30 + k)).collect();
+        let tiny: Vec<f64> = (0..40).map(|i| 1e-150 * (1.0 + (i % 3) as f64)).collect();
+        chains[2].0 = Rods::new(&tiny, &[0.5; 40], &[0.0; 40]);
+        let mut scalar = Vec::new();
+        for (k, (rods, loads)) in chains.iter().enumerate() {
+            let (solution, in_range, _) = solve_as(rods, [0.0, -9.81], loads, Route::Solve);
+            assert_eq!(in_range, k != 2, "chain {k}");
+            scalar.push(solution);
+        }
+        let lanes = Rods::<Lanes<4>>::interleave([&chains[0].0, &chains[1].0, &chains[2].0, &chains[3].0]);
+        let load = |i: usize| {
+            let of = |k: usize| chains[k].1[i];
+            let lane = |f: &dyn Fn(Load<2>) -> f64| Lanes([f(of(0)), f(of(1)), f(of(2)), f(of(3))]);
+            Load {
+                direction: [lane(&|l| l.direction[0]), lane(&|l| l.direction[1])],
+                rate_squared: lane(&|l| l.rate_squared),
+                pair: [lane(&|l| l.pair[0]), lane(&|l| l.pair[1])],
+            }
+        };
+        let (mut udd, mut tension) = (vec![[Lanes([0.0; 4]); 2]; 40], vec![Lanes([0.0; 4]); 40]);
+        let mut rows = Rows::with_len(40);
+        let g = Lanes([-9.81; 4]);
+        let zero = Lanes([0.0; 4]);
+        lanes.solve([zero, g], [zero; 2], &mut rows, load, |i, a, _, t| {
+            udd[i] = a;
+            tension[i] = t;
+        });
+        for (k, (scalar_udd, scalar_tension)) in scalar.iter().enumerate() {
+            for i in 0..40 {
+                assert_eq!(tension[i].0[k].to_bits(), scalar_tension[i].to_bits(), "lane {k}, rod {i}");
+                for c in 0..2 {
+                    assert_eq!(udd[i][c].0[k].to_bits(), scalar_udd[i][c].to_bits(), "lane {k}, rod {i}");
+                }
+            }
+        }
+    }
+
     /// The worst relative residual of Newton's law for every mass and of the rigidity of
     /// every rod, for the solution `(ü, T)` of `loads` with the pivot at rest — written
     /// from the module docs' mechanics, apart from the tridiagonal system (`entries`)
