@@ -180,7 +180,8 @@ impl Scaled {
 
     /// `v^k`.
     pub fn powi(self, k: i32) -> Scaled {
-        let s = if k >= 0 { self.s.powi(k) } else { self.s.powi(-k) / self.v.abs().powi(-2 * k) };
+        // k < 0: s^|k| / |v|^(2|k|) = (v²/s)^k, with no |k| or 2|k| to overflow an i32.
+        let s = if k >= 0 { self.s.powi(k) } else { (self.v * self.v / self.s).powi(k) };
         Scaled { v: self.v.powi(k), s, exact: false }
     }
 
@@ -321,6 +322,18 @@ fn parse(value: &Value, symbols: &Symbols) -> Result<Expr, String> {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    #[test]
+    fn a_huge_negative_power_has_a_scale_and_no_overflow() {
+        // Found by the fuzzer: ["^", 1, -2008667332] overflowed `-2 * k`.
+        for (v, k) in [(1.0, -2_008_667_332), (2.0, i32::MIN), (0.5, -3), (3.0, -1)] {
+            let p = Scaled::exact(v).powi(k);
+            assert_eq!(p.v, f64::powi(v, k));
+            let expected = f64::powi(v * v / v.abs(), k);
+            assert_eq!(p.s, expected, "{v}^{k}");
+        }
+        assert_eq!(Scaled::exact(2.0).powi(-3).s, 0.125);
+    }
 
     fn table() -> Symbols {
         let mut s = Symbols::new();
