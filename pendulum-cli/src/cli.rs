@@ -1,9 +1,10 @@
-//! The command line: `pendulum simulate | eval | linearize | modes | steady | render | sweep | view`, the
+//! The command line: `pendulum simulate | eval | linearize | modes | steady | render | sweep | atlas | view`, the
 //! top of the CLI (it names every command's options; nothing imports it but `main`).
 
 use clap::{Parser, Subcommand};
 
 use crate::args::{EvalArgs, LinearizeArgs, ModesArgs, SimulateArgs, SteadyArgs};
+use crate::atlas::AtlasArgs;
 use crate::render::RenderArgs;
 use crate::sweep::SweepArgs;
 use crate::view::ViewArgs;
@@ -85,6 +86,16 @@ pub enum Command {
     /// chosen against ω over the steady branch diagram of `pendulum steady --radius R`),
     /// and prints a table. Ctrl-C stops: finished points are kept, the files stay valid.
     Sweep(Box<SweepArgs>),
+    /// Which shape a whirled 3D chain at rest ends in over a grid of two parameters: two of
+    /// --omega, --radius, --damping and --ramp-time given as A:B:N (or lists) are the axes,
+    /// the others fixed; each point is the run of `pendulum sweep` (sudden or ramp-up start)
+    /// with its parameters. Points run as batches of chains on all cores (--jobs).
+    ///
+    /// Writes atlas.csv (a row per point and kind), atlas.json (every parameter and the
+    /// results so far: Ctrl-C keeps finished points, --from resumes) and atlas.png (the map
+    /// coloured by node count, unsettled points marked, the basins' boundaries and the
+    /// critical speeds drawn, one panel per kind), and prints the map in characters.
+    Atlas(Box<AtlasArgs>),
     /// A run in the browser: served on http://127.0.0.1:PORT/ until Ctrl-C, or exported
     /// as one self-contained HTML file (--export FILE: data and scripts inline, nothing
     /// fetched; opens offline). The page shows the chain under an orbit

@@ -3,6 +3,7 @@
 //! a model's terms as JSON, or find the normal modes and steady rotations of a chain.
 
 mod args;
+mod atlas;
 mod chain_args;
 mod cli;
 mod error;
@@ -64,6 +65,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::render(args),
         Command::View(args) => view::view(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::Atlas(args) => atlas::atlas(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -55,6 +55,7 @@
 //! ```
 
 pub mod assemble;
+pub mod atlas;
 pub mod balance;
 pub mod csv;
 pub mod description;
@@ -66,6 +67,7 @@ pub mod initial;
 pub mod json;
 pub mod options;
 pub mod page;
+pub mod points;
 pub mod record;
 pub mod request;
 pub mod run;

@@ -127,6 +127,52 @@ pub fn by_name<T: DeserializeOwned>(what: &str, name: &str, choices: &str) -> Re
         .map_err(|_| Error::invalid(format!("{what}: '{name}' is not one of {choices}")))
 }
 
+/// Parses the values of `option` (e.g. `--omega`): a comma list `V1,V2,…` or a range
+/// `A:B:N` (N evenly spaced values from A to B, B exactly; N = 1 is A), every value finite
+/// and ≥ 0. `noun` names one value and many ("speed", "speeds") and `unit` their unit, in
+/// the messages, which name the bad value.
+pub fn parse_values(option: &str, spec: &str, noun: (&str, &str), unit: &str) -> Result<Vec<f64>> {
+    let (noun, nouns) = noun;
+    let bad = |why: String| Error::invalid(format!("{option}: '{spec}' {why}"));
+    let number = |token: &str, what: &str| -> Result<f64> {
+        let token = token.trim();
+        match token.parse::<f64>() {
+            Ok(v) if !v.is_finite() => Err(bad(format!("has a non-finite {what} {token}"))),
+            Ok(v) if v < 0.0 => Err(bad(format!("has a negative {what} {token} ({nouns} are ≥ 0 {unit})"))),
+            Ok(v) => Ok(v),
+            Err(_) if token.is_empty() => Err(bad(format!("has an empty {what}"))),
+            Err(_) => Err(bad(format!("has a bad {what} '{token}' (not a number)"))),
+        }
+    };
+    if spec.trim().is_empty() || spec.split(',').all(|t| t.trim().is_empty()) {
+        return Err(bad(format!(
+            "lists no {noun} (give V1,V2,… or A:B:N in {unit}, e.g. {option} 2,4 or {option} 1:5:9)"
+        )));
+    }
+    if spec.contains(':') {
+        let parts: Vec<&str> = spec.split(':').collect();
+        if parts.len() != 3 || spec.contains(',') {
+            return Err(bad("is not a range A:B:N (start, end, number of points)".into()));
+        }
+        let (a, b) = (number(parts[0], "start")?, number(parts[1], "end")?);
+        let count = parts[2].trim();
+        let n: usize = match count.parse::<i64>() {
+            Ok(n) if n < 1 => return Err(bad(format!("asks for {n} points (N must be at least 1)"))),
+            Ok(n) => n as usize,
+            Err(_) => {
+                return Err(bad(format!("has a bad number of points '{count}' (N: a whole number ≥ 1)")));
+            }
+        };
+        if n == 1 {
+            return Ok(vec![a]);
+        }
+        return Ok((0..n)
+            .map(|k| if k == n - 1 { b } else { a + (b - a) * k as f64 / (n - 1) as f64 })
+            .collect());
+    }
+    spec.split(',').map(|token| number(token, "entry")).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -122,15 +122,7 @@ pub type WhirlResult = Result<WhirlEnd, WhirlStop>;
 impl WhirlRuns {
     /// The chain with `drive` (a circle or a ramped circle), with its energy ledger.
     pub fn system(&self, drive: &DriveConfig) -> Result<Accounted<WhirlModel>, WhirlStop> {
-        Ok(Accounted::of(self.model(drive)?))
-    }
-
-    /// The chain with `drive`.
-    pub fn model(&self, drive: &DriveConfig) -> Result<WhirlModel, WhirlStop> {
-        let turning = turning_drive(drive)
-            .map_err(|e| WhirlStop::of(&e))?
-            .ok_or_else(|| WhirlStop::Failed("the drive is not a circle".into()))?;
-        Ok(whirl_model(self.chain.clone(), turning))
+        Ok(Accounted::of(model(&self.chain, drive)?))
     }
 
     /// The shape analysis and the energy balance fed by a run of `system`; `stop()` is
@@ -182,13 +174,30 @@ impl WhirlRuns {
     /// bit [`run_one`](Self::run_one) of each; `stop()` is asked at every sample. The shape
     /// reports at the end are computed in parallel too.
     pub fn run_batch(&self, drives: &[DriveConfig], stop: &(dyn Fn() -> bool + Sync)) -> Vec<WhirlResult> {
-        let fail_all = |stop: WhirlStop| drives.iter().map(|_| Err(stop.clone())).collect();
-        let systems = match drives.iter().map(|d| self.system(d)).collect::<Result<Vec<_>, _>>() {
-            Ok(systems) => systems,
+        let whirls: Vec<(&Chain<Dyn>, &DriveConfig)> = drives.iter().map(|d| (&self.chain, d)).collect();
+        self.run_batch_of(&whirls, stop)
+    }
+
+    /// The whirls of chains with drives, each from hanging at rest, as one batch: bit for
+    /// bit [`run_one`](Self::run_one) of a `WhirlRuns` with that chain. The chains have the
+    /// same number of links and may differ in anything else but the masses, lengths and
+    /// gravity the energy scale was taken from (`self.chain` is not used).
+    pub fn run_batch_of(
+        &self,
+        whirls: &[(&Chain<Dyn>, &DriveConfig)],
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Vec<WhirlResult> {
+        let fail_all = |stop: WhirlStop| whirls.iter().map(|_| Err(stop.clone())).collect();
+        let models = match whirls.iter().map(|(c, d)| model(c, d)).collect::<Result<Vec<_>, _>>() {
+            Ok(models) => models,
             Err(e) => return fail_all(e),
         };
-        let models = match drives.iter().map(|d| self.model(d)).collect::<Result<Vec<_>, _>>() {
-            Ok(models) => models,
+        let systems = match whirls
+            .iter()
+            .map(|(c, d)| Ok(Accounted::of(model(c, d)?)))
+            .collect::<Result<Vec<_>, _>>()
+        {
+            Ok(systems) => systems,
             Err(e) => return fail_all(e),
         };
         let batch = match DirectionsBatch::accounted(models) {
@@ -222,6 +231,14 @@ impl WhirlRuns {
             .map(|(observer, end)| observer.end(end.map_err(|e| WhirlStop::of(&e))?))
             .collect()
     }
+}
+
+/// `chain` with `drive` (a circle or a ramped circle).
+pub fn model(chain: &Chain<Dyn>, drive: &DriveConfig) -> Result<WhirlModel, WhirlStop> {
+    let turning = turning_drive(drive)
+        .map_err(|e| WhirlStop::of(&e))?
+        .ok_or_else(|| WhirlStop::Failed("the drive is not a circle".into()))?;
+    Ok(whirl_model(chain.clone(), turning))
 }
 
 /// What a whirl's run feeds with its samples: the shape analysis and the energy balance.

@@ -38,6 +38,12 @@ pub fn round(x: f64) -> f64 {
     (x * scale).round() / scale
 }
 
+/// `x` to six significant digits, in the shortest form (`1`, `0.02`, `0.00056237`): for
+/// titles and tables, where `1.0000000000000002 m` would be noise.
+pub fn short(x: f64) -> String {
+    format!("{x:.5e}").parse::<f64>().map_or_else(|_| x.to_string(), |v| v.to_string())
+}
+
 /// A growth rate `rate` (1/s) in words: `0 within round-off, |rate| ≤ 6.0e-6 1/s` when
 /// its magnitude is at most `bound` (the spectrum's round-off, 1/s), else `-5.57e-2 1/s`.
 pub fn growth_words(rate: f64, bound: f64) -> String {

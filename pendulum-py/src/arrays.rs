@@ -105,3 +105,17 @@ pub fn per_link(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     }
     value.extract().map_err(|_| invalid(format!("{what}: not a number or a sequence of numbers")))
 }
+
+/// `value` as numbers: one number, or a non-empty sequence.
+pub fn numbers(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(vec![x]);
+    }
+    let v = value
+        .extract::<Vec<f64>>()
+        .map_err(|_| invalid(format!("{what}: a number or a sequence of numbers")))?;
+    if v.is_empty() {
+        return Err(invalid(format!("{what}: an empty sequence")));
+    }
+    Ok(v)
+}

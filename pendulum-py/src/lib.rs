@@ -4,6 +4,7 @@
 //! every long call releases the GIL and answers Ctrl-C with `KeyboardInterrupt`.
 
 mod arrays;
+mod atlas;
 mod chain;
 mod errors;
 mod interrupt;
@@ -26,5 +27,6 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(page::page, m)?)?;
     m.add_function(wrap_pyfunction!(steady::steady, m)?)?;
     m.add_function(wrap_pyfunction!(whirls::whirls, m)?)?;
+    m.add_class::<atlas::AtlasPlan>()?;
     Ok(())
 }

@@ -15,23 +15,10 @@ use pendulum_experiment::whirls::{
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::arrays::numbers;
 use crate::chain::Chain;
 use crate::errors::invalid;
 use crate::interrupt::interruptible;
-
-/// `value` as numbers: one number, or a non-empty sequence.
-fn numbers(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Ok(x) = value.extract::<f64>() {
-        return Ok(vec![x]);
-    }
-    let v = value
-        .extract::<Vec<f64>>()
-        .map_err(|_| invalid(format!("{what}: a number or a sequence of numbers")))?;
-    if v.is_empty() {
-        return Err(invalid(format!("{what}: an empty sequence")));
-    }
-    Ok(v)
-}
 
 /// Many whirls of ``chain`` (3D): each from hanging at rest, its pivot on a horizontal
 /// circle of radius ``radius`` (m) turning at ``omega`` (rad/s), switched on at t = 0 or,

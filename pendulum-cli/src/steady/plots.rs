@@ -38,7 +38,7 @@ pub(crate) fn colour(nodes: Option<usize>) -> RGBColor {
 }
 
 /// `c` blended toward white, 35 % of it left (the mirror branches).
-fn faint(c: RGBColor) -> RGBColor {
+pub(crate) fn faint(c: RGBColor) -> RGBColor {
     let blend = |v: u8| (255.0 - 0.35 * (255.0 - f64::from(v))).round() as u8;
     RGBColor(blend(c.0), blend(c.1), blend(c.2))
 }

@@ -17,6 +17,7 @@ use super::{SweepKind, SweepPhysics};
 use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
 use crate::spec::{expand, per_link};
+use pendulum_experiment::options::parse_values;
 use pendulum_experiment::steady::round_up;
 use pendulum_experiment::write_json_atomic;
 
@@ -268,12 +269,6 @@ pub struct Derived {
     pub steps_per_point: u64,
 }
 
-/// `x` to six significant digits, in the shortest form (`1`, `0.02`, `0.00056237`): for
-/// titles and tables, where `1.0000000000000002 m` would be noise.
-pub fn short(x: f64) -> String {
-    format!("{x:.5e}").parse::<f64>().map_or_else(|_| x.to_string(), |v| v.to_string())
-}
-
 fn check_radius(radius: f64) -> CliResult<()> {
     if radius.is_finite() && radius > 0.0 {
         Ok(())
@@ -295,45 +290,7 @@ fn check_duration(duration: f64) -> CliResult<()> {
 /// Parses `--omega`: a comma list of speeds or `A:B:N`, every speed finite and ≥ 0 (in
 /// rad/s, or in units of √(g/L) when `scaled`). Errors name the value.
 pub fn parse_omegas(spec: &str, scaled: bool) -> CliResult<Vec<f64>> {
-    let unit = if scaled { "√(g/L)" } else { "rad/s" };
-    let bad = |why: String| CliError::invalid(format!("--omega: '{spec}' {why}"));
-    let number = |token: &str, what: &str| -> CliResult<f64> {
-        let token = token.trim();
-        match token.parse::<f64>() {
-            Ok(v) if !v.is_finite() => Err(bad(format!("has a non-finite {what} {token}"))),
-            Ok(v) if v < 0.0 => Err(bad(format!("has a negative {what} {token} (speeds are ≥ 0 {unit})"))),
-            Ok(v) => Ok(v),
-            Err(_) if token.is_empty() => Err(bad(format!("has an empty {what}"))),
-            Err(_) => Err(bad(format!("has a bad {what} '{token}' (not a number)"))),
-        }
-    };
-    if spec.trim().is_empty() || spec.split(',').all(|t| t.trim().is_empty()) {
-        return Err(bad(format!(
-            "lists no speed (give W1,W2,… or A:B:N in {unit}, e.g. --omega 2,4 or --omega 1:5:9)"
-        )));
-    }
-    if spec.contains(':') {
-        let parts: Vec<&str> = spec.split(':').collect();
-        if parts.len() != 3 || spec.contains(',') {
-            return Err(bad("is not a range A:B:N (start, end, number of points)".into()));
-        }
-        let (a, b) = (number(parts[0], "start")?, number(parts[1], "end")?);
-        let count = parts[2].trim();
-        let n: usize = match count.parse::<i64>() {
-            Ok(n) if n < 1 => return Err(bad(format!("asks for {n} points (N must be at least 1)"))),
-            Ok(n) => n as usize,
-            Err(_) => {
-                return Err(bad(format!("has a bad number of points '{count}' (N: a whole number ≥ 1)")));
-            }
-        };
-        if n == 1 {
-            return Ok(vec![a]);
-        }
-        return Ok((0..n)
-            .map(|k| if k == n - 1 { b } else { a + (b - a) * k as f64 / (n - 1) as f64 })
-            .collect());
-    }
-    spec.split(',').map(|token| number(token, "entry")).collect()
+    parse_values("--omega", spec, ("speed", "speeds"), if scaled { "√(g/L)" } else { "rad/s" })
 }
 
 /// What sweep.json holds.

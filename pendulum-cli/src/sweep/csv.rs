@@ -6,11 +6,13 @@ use std::path::Path;
 
 use pendulum_experiment::Csv;
 use pendulum_experiment::csv::number;
+use pendulum_experiment::points::result_fields;
 use pendulum_experiment::words::growth_words;
 
-use super::config::{SweepConfig, short};
+use super::config::SweepConfig;
 use super::point::{Point, Status};
 use crate::error::CliResult;
+use pendulum_experiment::words::short;
 
 /// The columns of sweep.csv.
 pub const HEADER: [&str; 17] = [
@@ -39,31 +41,12 @@ pub fn write(path: &Path, points: &[Point]) -> CliResult<()> {
     for p in points {
         let mut row: Vec<String> =
             vec![p.kind.name().into(), number(p.omega), number(p.omega_scaled), p.status.name().into()];
-        match &p.result {
-            Some(r) => {
-                row.extend([
-                    r.nodes.to_string(),
-                    r.axis_crossings.to_string(),
-                    number(r.tip_radius),
-                    number(r.tip_signed),
-                    r.settled.to_string(),
-                    number(r.drift),
-                ]);
-                match &r.nearest {
-                    Some(n) => row.extend([
-                        number(n.distance),
-                        n.nodes.to_string(),
-                        n.stable.to_string(),
-                        number(n.growth_rate),
-                    ]),
-                    None => row.extend(std::iter::repeat_n(String::new(), 4)),
-                }
-                row.push(number(r.t));
-                row.push(format!("{:.3}", r.wall_seconds));
-                row.push(r.balance.map_or(String::new(), |b| number(b.residual)));
-            }
-            None => row.extend(std::iter::repeat_n(String::new(), HEADER.len() - 4)),
-        }
+        let mut result = result_fields(p.result.as_ref());
+        // wall_s before the last column, balance_residual_j.
+        let balance = result.pop().unwrap_or_default();
+        row.extend(result);
+        row.push(p.result.as_ref().and_then(|r| r.wall_seconds).map_or(String::new(), |w| format!("{w:.3}")));
+        row.push(balance);
         csv.fields(&row)?;
     }
     csv.finish()
@@ -130,8 +113,10 @@ pub fn table(config: &SweepConfig, points: &[Point]) {
         };
         let _ = writeln!(
             out,
-            "{head}  {:>5}  {:>+15.4}  {settled:<19}  {distance:>16}  {nodes:>7}  {stability:<26}  {:>8.1}",
-            r.nodes, r.tip_signed, r.wall_seconds
+            "{head}  {:>5}  {:>+15.4}  {settled:<19}  {distance:>16}  {nodes:>7}  {stability:<26}  {:>8}",
+            r.nodes,
+            r.tip_signed,
+            r.wall_seconds.map_or("-".into(), |w| format!("{w:.1}"))
         );
     }
     let chosen: Vec<String> = config

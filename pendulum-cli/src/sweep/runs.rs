@@ -233,7 +233,7 @@ impl Sweep {
         // Each point's wall time: its share of the batch's.
         let share = clock.elapsed().as_secs_f64() / singles.len() as f64;
         for (&i, end) in singles.iter().zip(ends) {
-            self.record(shared, i, end.map(|e| Outcome::of(&e.report, e.steps, share, e.balance)));
+            self.record(shared, i, end.map(|e| Outcome::of(&e.report, e.steps, Some(share), e.balance)));
         }
     }
 
@@ -247,7 +247,7 @@ impl Sweep {
     ) -> Result<(Outcome, DVector<f64>), Stop> {
         let clock = Instant::now();
         let (end, turned) = self.whirls.run_one(drive, start, &interrupted)?;
-        Ok((Outcome::of(&end.report, end.steps, clock.elapsed().as_secs_f64(), end.balance), turned))
+        Ok((Outcome::of(&end.report, end.steps, Some(clock.elapsed().as_secs_f64()), end.balance), turned))
     }
 
     /// Records the end of point `i`: status and result, a line on stderr, sweep.json.
@@ -369,11 +369,11 @@ fn progress_line(p: &Point) -> String {
                 None => "no steady shape found nearby".into(),
             };
             format!(
-                "{head}: {}, tip radius {:.4} m, {settled} (drift {:.1e} m); {nearest}; {:.1} s",
+                "{head}: {}, tip radius {:.4} m, {settled} (drift {:.1e} m); {nearest}{}",
                 nodes_name(r.nodes),
                 r.tip_radius,
                 r.drift,
-                r.wall_seconds
+                r.wall_seconds.map_or(String::new(), |w| format!("; {w:.1} s"))
             )
         }
         (None, status) => match &p.error {

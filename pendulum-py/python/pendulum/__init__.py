@@ -10,6 +10,9 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``whirls(chain, radius=..., omega=..., ramp_time=...)``: many whirls from hanging at
   rest, one per circle and speed, run together as a batch of chains on all cores: which
   shape each ends in, as numpy arrays (the runs of ``pendulum sweep``).
+- ``atlas(chain, omega=..., radius=..., client=None)``: which shape the chain ends in from
+  rest over a grid of two parameters (the map of ``pendulum atlas``), here on all cores or
+  in chunks on a Dask cluster (``client``), bit for bit the same.
 - ``steady(chain, ...)``: the steady shapes of the chain turning about the vertical, as
   ``pendulum steady`` finds them: branches with every point's nodes and stability, and
   every shape at the asked speeds.
@@ -22,10 +25,14 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 SI units throughout, angles in radians. See ``docs/python.md`` in the repository.
 """
 
-from ._pendulum import Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
+from ._atlas import Atlas, atlas
+from ._pendulum import AtlasPlan, Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
 from ._plots import plot_ledger, plot_shape
 
 __all__ = [
+    "Atlas",
+    "AtlasPlan",
+    "atlas",
     "Chain",
     "HeavyString",
     "Run",

@@ -7,7 +7,7 @@ from typing import Any, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady", "whirls"]
+__all__ = ["AtlasPlan", "Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady", "whirls"]
 __version__: str
 
 _Array = npt.NDArray[np.float64]
@@ -32,6 +32,30 @@ def whirls(
     step: Optional[float] = ...,
 ) -> dict[str, Any]: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
+
+@final
+class AtlasPlan:
+    def __new__(
+        cls,
+        chain: Chain,
+        *,
+        omega: Union[float, Sequence[float]],
+        radius: Union[float, Sequence[float]],
+        damping: Union[float, Sequence[float], None] = ...,
+        ramp_time: Union[float, Sequence[float], None] = ...,
+        kinds: Sequence[str] = ...,
+        scaled: bool = ...,
+        duration: Optional[float] = ...,
+        step: Optional[float] = ...,
+    ) -> AtlasPlan: ...
+    @staticmethod
+    def from_json(text: str) -> AtlasPlan: ...
+    def to_json(self) -> str: ...
+    def __reduce__(self) -> tuple[Any, tuple[str]]: ...
+    def __len__(self) -> int: ...
+    def derived_json(self) -> str: ...
+    def run(self, indices: Sequence[int], threads: Optional[int] = None) -> str: ...
+    def save(self, directory: Union[str, PathLike[str]], points: str) -> None: ...
 
 @final
 class Chain:
