@@ -66,6 +66,15 @@ pendulum sweep --n 20 --lengths 0.05 --masses 0.05 --radius 0.02 --damping 5.623
     --omega 0.5:5:24 --scaled --kind sudden,ramp-up,ramp-down --duration 600 --ramp-time 200 \
     --out "$runs/sweep" --quiet > "$runs/sweep.txt"
 cp "$runs/sweep/sweep.png" "$gallery/sweep.png"
+# The chain's choice over ω and R: 32 × 32 sudden starts (about 2.5 min with 2 cores), and
+# 16 × 16 sudden and ramped side by side (about 75 s).
+pendulum atlas --n 20 --lengths 0.05 --masses 0.05 --damping 5.6237e-4 --omega 0.5:5:32 --scaled \
+    --radius 0.005:0.05:32 --duration 600 --out "$runs/atlas" --quiet > "$runs/atlas.txt"
+cp "$runs/atlas/atlas.png" "$gallery/atlas.png"
+pendulum atlas --n 20 --lengths 0.05 --masses 0.05 --damping 5.6237e-4 --omega 0.5:5:16 --scaled \
+    --radius 0.005:0.05:16 --kind sudden,ramp-up --ramp-time 200 --duration 600 \
+    --out "$runs/atlas-kinds" --quiet > "$runs/atlas-kinds.txt"
+cp "$runs/atlas-kinds/atlas.png" "$gallery/atlas-kinds.png"
 # The viewer (needs chromium for the screenshot): the 6 rad/s whirl with the defaults, 300 s.
 pendulum simulate --dim 3 --n 100 --masses 0.01 --lengths 0.01 --damping 3e-4 --initial hanging \
     --drive circle --radius 0.02 --omega 6 --end 300 --out "$runs/whirl-6-defaults" --quiet > /dev/null

@@ -3,11 +3,14 @@
 //! with a dot: it had not settled; grey: failed or not run), black lines between cells of
 //! different node counts (the boundaries of the basins), and, on an ω axis, the critical
 //! speeds of the chain on a fixed pivot (dashed: where the shapes of 1, 2, 3 … nodes are
-//! born as R → 0).
+//! born as R → 0) and the folds of the steady branches on the pivot's circle (the lowest ω
+//! of each forced branch at each R: right of its line, its shapes exist).
 
 use std::path::Path;
 
-use pendulum_experiment::atlas::{AtlasConfig, AtlasKind, AtlasPoint, Axis, Derived, Parameter};
+use pendulum_experiment::atlas::{AtlasConfig, AtlasKind, AtlasPoint, Axis, Derived, Fold, Parameter, folds};
+use pendulum_experiment::steady::round_up;
+use rayon::prelude::*;
 use pendulum_experiment::words::{chain_words, short};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -27,10 +30,34 @@ const TITLE: u32 = 74;
 /// Failed or not run.
 const MISSING: RGBColor = RGBColor(190, 190, 190);
 
-/// Draws atlas.png (module docs).
+/// Draws atlas.png (module docs). With an ω axis, the steady branches are followed at
+/// every radius of the grid (in parallel) for their folds; if that fails the picture is
+/// drawn without them (with a note).
 pub fn draw(path: &Path, config: &AtlasConfig, derived: &Derived, points: &[AtlasPoint]) -> CliResult<()> {
     fonts();
-    render(path, config, derived, points).map_err(|e| drawing_failed(path, e))
+    let folds = match branch_folds(config) {
+        Ok(folds) => folds,
+        Err(e) => {
+            eprintln!("pendulum: note: atlas.png without the steady branches' folds ({e})");
+            Vec::new()
+        }
+    };
+    render(path, config, derived, points, &folds).map_err(|e| drawing_failed(path, e))
+}
+
+/// The folds of the steady branches at every radius of the grid (`(R, folds)`), where ω
+/// is an axis; none otherwise.
+fn branch_folds(config: &AtlasConfig) -> pendulum_experiment::Result<Vec<(f64, Vec<Fold>)>> {
+    let Some(omega) = config.axis(Parameter::Omega) else { return Ok(Vec::new()) };
+    let radii = match (config.radius, config.axis(Parameter::Radius)) {
+        (Some(r), _) => vec![r],
+        (None, Some(axis)) => axis.values.clone(),
+        (None, None) => return Ok(Vec::new()),
+    };
+    let top = omega.values.iter().copied().fold(0.0, f64::max);
+    let omega_max = round_up(1.05 * top.max(config.reference_speed()));
+    let chain = config.chain()?;
+    radii.par_iter().map(|&r| Ok((r, folds(&chain, r, omega_max)?))).collect()
 }
 
 /// The values of an axis as plotted (ω in units of √(g/L) when given so).
@@ -65,7 +92,13 @@ fn kind_caption(config: &AtlasConfig, kind: AtlasKind) -> String {
     }
 }
 
-fn render(path: &Path, config: &AtlasConfig, derived: &Derived, points: &[AtlasPoint]) -> Result<(), String> {
+fn render(
+    path: &Path,
+    config: &AtlasConfig,
+    derived: &Derived,
+    points: &[AtlasPoint],
+    folds: &[(f64, Vec<Fold>)],
+) -> Result<(), String> {
     let fail = |e: &dyn std::fmt::Display| e.to_string();
     let kinds = config.kinds.len();
     let width = PANEL * kinds as u32 + KEY;
@@ -168,6 +201,41 @@ fn render(path: &Path, config: &AtlasConfig, derived: &Derived, points: &[AtlasP
                 }
             }
         }
+        // The folds of the steady branches: a line per branch through its lowest ω at each
+        // radius (a vertical line where R is fixed), in the colour of its node count there.
+        let omega_on_x = config.x.parameter == Parameter::Omega;
+        let radius_axis = config.axis(Parameter::Radius).is_some();
+        let place = |w: f64, r: f64, end: usize| -> (f64, f64) {
+            let w = w / omega_unit;
+            match (omega_on_x, radius_axis) {
+                (true, true) => (w, r),
+                (false, true) => (r, w),
+                (true, false) => (w, if end == 0 { ey[0] } else { ey[ny] }),
+                (false, false) => (if end == 0 { ex[0] } else { ex[nx] }, w),
+            }
+        };
+        let inside = |(x, y): (f64, f64)| x >= ex[0] && x <= ex[nx] && y >= ey[0] && y <= ey[ny];
+        let branches: std::collections::BTreeSet<usize> =
+            folds.iter().flat_map(|(_, f)| f.iter().map(|f| f.branch)).collect();
+        for b in branches {
+            let mut line: Vec<(f64, f64)> = Vec::new();
+            let mut shade = BLACK;
+            for (r, f) in folds {
+                if let Some(f) = f.iter().find(|f| f.branch == b) {
+                    shade = colour(f.nodes);
+                    let ends: &[usize] = if radius_axis { &[0] } else { &[0, 1] };
+                    line.extend(ends.iter().map(|&e| place(f.omega, *r, e)).filter(|p| inside(*p)));
+                }
+            }
+            chart.draw_series([PathElement::new(line.clone(), WHITE.stroke_width(5))]).map_err(|e| fail(&e))?;
+            chart.draw_series([PathElement::new(line.clone(), shade.stroke_width(2))]).map_err(|e| fail(&e))?;
+            if radius_axis {
+                chart
+                    .draw_series(line.iter().map(|&p| Circle::new(p, 3, WHITE.filled())))
+                    .map_err(|e| fail(&e))?;
+                chart.draw_series(line.iter().map(|&p| Circle::new(p, 3, shade.stroke_width(1)))).map_err(|e| fail(&e))?;
+            }
+        }
         // The critical speeds on an ω axis.
         let dashed = BLACK.mix(0.8).stroke_width(2);
         for (i, &w) in critical.iter().enumerate() {
@@ -206,6 +274,11 @@ fn render(path: &Path, config: &AtlasConfig, derived: &Derived, points: &[AtlasP
         entries.push((Swatch::Dashed, "critical speed ωk (small R):".into()));
         entries.push((Swatch::None, "the k-node shape is born".into()));
     }
+    if folds.iter().any(|(_, f)| !f.is_empty()) {
+        entries.push((Swatch::Fold, "fold of a steady branch: its".into()));
+        entries.push((Swatch::None, "shapes exist at higher ω".into()));
+        entries.push((Swatch::None, "(colour: their node count)".into()));
+    }
     entries.push((Swatch::None, "nodes = axis crossings + 1".into()));
     entries.push((Swatch::None, "(the pivot counted)".into()));
     entries.push((Swatch::None, format!("{} points, {} s each", points.len(), short(config.duration))));
@@ -229,6 +302,13 @@ fn render(path: &Path, config: &AtlasConfig, derived: &Derived, points: &[AtlasP
                     key.draw(&PathElement::new([(x, y + 6), (x + 8, y + 6)], line)).map_err(|e| fail(&e))?;
                 }
             }
+            Swatch::Fold => {
+                key.draw(&PathElement::new([(12, y + 6), (34, y + 6)], WHITE.stroke_width(5))).map_err(|e| fail(&e))?;
+                key.draw(&PathElement::new([(12, y + 6), (34, y + 6)], colour(Some(2)).stroke_width(2)))
+                    .map_err(|e| fail(&e))?;
+                key.draw(&Circle::new((23, y + 6), 3, WHITE.filled())).map_err(|e| fail(&e))?;
+                key.draw(&Circle::new((23, y + 6), 3, colour(Some(2)).stroke_width(1))).map_err(|e| fail(&e))?;
+            }
             Swatch::None => {}
         }
         key.draw_text(label, &text, (46, y - 1)).map_err(|e| fail(&e))?;
@@ -242,5 +322,6 @@ enum Swatch {
     Cell(RGBColor, bool),
     Line,
     Dashed,
+    Fold,
     None,
 }
