@@ -73,6 +73,7 @@ pub mod request;
 pub mod run;
 pub mod run_dir;
 pub mod steady;
+pub mod sweep;
 pub mod whirl;
 pub mod whirls;
 pub mod words;

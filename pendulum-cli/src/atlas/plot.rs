@@ -10,10 +10,10 @@ use std::path::Path;
 
 use pendulum_experiment::atlas::{AtlasConfig, AtlasKind, AtlasPoint, Axis, Derived, Fold, Parameter, folds};
 use pendulum_experiment::steady::round_up;
-use rayon::prelude::*;
 use pendulum_experiment::words::{chain_words, short};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use rayon::prelude::*;
 
 use super::csv::axis_name;
 use crate::error::CliResult;
@@ -227,13 +227,19 @@ fn render(
                     line.extend(ends.iter().map(|&e| place(f.omega, *r, e)).filter(|p| inside(*p)));
                 }
             }
-            chart.draw_series([PathElement::new(line.clone(), WHITE.stroke_width(5))]).map_err(|e| fail(&e))?;
-            chart.draw_series([PathElement::new(line.clone(), shade.stroke_width(2))]).map_err(|e| fail(&e))?;
+            chart
+                .draw_series([PathElement::new(line.clone(), WHITE.stroke_width(5))])
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series([PathElement::new(line.clone(), shade.stroke_width(2))])
+                .map_err(|e| fail(&e))?;
             if radius_axis {
                 chart
                     .draw_series(line.iter().map(|&p| Circle::new(p, 3, WHITE.filled())))
                     .map_err(|e| fail(&e))?;
-                chart.draw_series(line.iter().map(|&p| Circle::new(p, 3, shade.stroke_width(1)))).map_err(|e| fail(&e))?;
+                chart
+                    .draw_series(line.iter().map(|&p| Circle::new(p, 3, shade.stroke_width(1))))
+                    .map_err(|e| fail(&e))?;
             }
         }
         // The critical speeds on an ω axis.
@@ -303,11 +309,13 @@ fn render(
                 }
             }
             Swatch::Fold => {
-                key.draw(&PathElement::new([(12, y + 6), (34, y + 6)], WHITE.stroke_width(5))).map_err(|e| fail(&e))?;
+                key.draw(&PathElement::new([(12, y + 6), (34, y + 6)], WHITE.stroke_width(5)))
+                    .map_err(|e| fail(&e))?;
                 key.draw(&PathElement::new([(12, y + 6), (34, y + 6)], colour(Some(2)).stroke_width(2)))
                     .map_err(|e| fail(&e))?;
                 key.draw(&Circle::new((23, y + 6), 3, WHITE.filled())).map_err(|e| fail(&e))?;
-                key.draw(&Circle::new((23, y + 6), 3, colour(Some(2)).stroke_width(1))).map_err(|e| fail(&e))?;
+                key.draw(&Circle::new((23, y + 6), 3, colour(Some(2)).stroke_width(1)))
+                    .map_err(|e| fail(&e))?;
             }
             Swatch::None => {}
         }

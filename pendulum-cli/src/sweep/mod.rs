@@ -7,50 +7,29 @@
 //! (enough to repeat the sweep with `--from`) and sweep.png (the chain's choices over the
 //! steady branch diagram of `pendulum steady --radius R`), and a table on stdout.
 //!
-//! The parts: the options and the command ([`SweepArgs`], [`sweep`]), the resolved
-//! parameters and sweep.json ([`config`]), the runs and their scheduling ([`runs`]), the
-//! CSV file and the table ([`csv`]), the picture ([`plot`]).
+//! The parts: the options and the command ([`SweepArgs`], [`sweep`]), the lines on stderr
+//! and sweep.json after each point ([`report`]), the table ([`table`]), the picture
+//! ([`plot`]). The sweep itself (its parameters, sweep.json and sweep.csv, the runs) is
+//! the run library's ([`pendulum_experiment::sweep`]), shared with Python.
 
-mod config;
-mod csv;
 mod plot;
-mod point;
-mod runs;
+mod report;
+mod table;
 
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
 
-use clap::{Args, ValueEnum};
-use serde::{Deserialize, Serialize};
+use clap::Args;
+use pendulum_experiment::sweep::{Sweep, SweepFile, SweepRequest};
 
 use crate::args::ChainOptions;
+use crate::chain_args::per_link_values;
 use crate::error::{CliError, CliResult};
+use crate::interrupt::INTERRUPTED;
+use crate::spec::{expand, per_link};
 
-use config::{SweepConfig, SweepFile};
-
-/// How a point of the sweep is started.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, ValueEnum, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SweepKind {
-    /// From hanging at rest, the pivot circling at ω from t = 0.
-    Sudden,
-    /// From hanging at rest, the speed ramped linearly from 0 to ω over --ramp-time, then held.
-    RampUp,
-    /// The points in decreasing ω, one after the other: the first ramped up from rest like
-    /// ramp-up, every next one starting from the previous point's final state, the speed
-    /// ramped from the previous ω to its own over --ramp-time, then held.
-    RampDown,
-}
-
-impl SweepKind {
-    /// The name on the command line and in the files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sudden => "sudden",
-            Self::RampUp => "ramp-up",
-            Self::RampDown => "ramp-down",
-        }
-    }
-}
+pub use pendulum_experiment::sweep::SweepKind;
 
 /// Options of `pendulum sweep`.
 #[derive(Debug, Args)]
@@ -128,6 +107,30 @@ pub struct SweepPhysics {
 }
 
 impl SweepPhysics {
+    /// The request these options make.
+    fn request(&self) -> CliResult<SweepRequest> {
+        if let Some(dim) = &self.dim {
+            return Err(CliError::invalid(format!(
+                "--dim {dim}: not an option of pendulum sweep: sweeps are 3D (the pivot circles the vertical axis)"
+            )));
+        }
+        let (masses, lengths) = per_link_values(&self.chain)?;
+        let damping = expand("--damping", per_link("--damping", &self.damping)?, masses.len())?;
+        Ok(SweepRequest {
+            masses,
+            lengths,
+            gravity: self.chain.gravity,
+            damping,
+            radius: self.radius,
+            omega_spec: self.omega.clone().unwrap_or_default(),
+            scaled: self.scaled,
+            kinds: self.kind.clone(),
+            duration: self.duration,
+            ramp_time: self.ramp_time,
+            step: self.step,
+        })
+    }
+
     /// The ids of the options that define a sweep.
     fn ids() -> Vec<clap::Id> {
         Self::augment_args(clap::Command::new("sweep"))
@@ -149,7 +152,7 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
             }
             file.config
         }
-        None => SweepConfig::from_args(&args.physics)?,
+        None => args.physics.request()?.resolve()?,
     };
     let jobs = match args.jobs {
         Some(0) => return Err(CliError::invalid("--jobs must be at least 1, got 0")),
@@ -159,15 +162,25 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
     })?;
-    let sweep = runs::Sweep::new(config, args.out.clone(), jobs, args.quiet)?;
+    let sweep = Sweep::new(config)?;
+    let started = Instant::now();
+    if !args.quiet {
+        report::header(&sweep, jobs);
+    }
+    let out = &args.out;
+    sweep.file(sweep.points()).write_atomic(&out.join("sweep.json"))?;
     let points = {
         let _stops = crate::interrupt::StopsItself::enter();
-        sweep.run()?
+        let stop = || INTERRUPTED.load(Ordering::Relaxed);
+        let on_point = |points: &[_], i, finished| {
+            report::point_done(&sweep, out, args.quiet, started, (points, i, finished))
+        };
+        sweep.run(jobs, &stop, &on_point)?
     };
+    sweep.file(&points).write_atomic(&out.join("sweep.json"))?;
     let config = sweep.config();
-    csv::write(&args.out.join("sweep.csv"), &points)?;
-    csv::table(config, &points);
-    let png = args.out.join("sweep.png");
-    plot::draw(&png, config, &points)?;
-    sweep.conclude(&points)
+    pendulum_experiment::sweep::csv::write(&out.join("sweep.csv"), &points)?;
+    table::table(config, &points);
+    plot::draw(&out.join("sweep.png"), config, &points)?;
+    report::conclude(&sweep, &points, out, (jobs, args.quiet), started)
 }

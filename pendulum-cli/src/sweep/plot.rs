@@ -13,14 +13,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::SweepKind;
-use super::config::SweepConfig;
-use super::point::{Outcome, Point};
 use crate::error::CliResult;
 use crate::plot::{drawing_failed, fonts};
 use crate::steady::plots::{colour, draw_family, draw_key, family_key, reach};
 use crate::steady::round_up;
 use pendulum_experiment::steady::{Family, follow};
+use pendulum_experiment::sweep::{Outcome, Point, SweepConfig, SweepKind};
 use pendulum_experiment::words::short;
 
 const WIDTH: u32 = 1320;

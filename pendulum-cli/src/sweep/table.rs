@@ -1,56 +1,9 @@
-//! sweep.csv (one row per point and kind, numbers in the shortest form that reads back to
-//! the same bits, empty fields where a point has no result) and the table on stdout.
+//! The table on stdout: the sweep's parameters, then one line per point.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
-use pendulum_experiment::Csv;
-use pendulum_experiment::csv::number;
-use pendulum_experiment::points::result_fields;
-use pendulum_experiment::words::growth_words;
-
-use super::config::SweepConfig;
-use super::point::{Point, Status};
-use crate::error::CliResult;
-use pendulum_experiment::words::short;
-
-/// The columns of sweep.csv.
-pub const HEADER: [&str; 17] = [
-    "kind",
-    "omega_rad_s",
-    "omega_over_sqrt_g_over_L",
-    "status",
-    "nodes",
-    "axis_crossings",
-    "tip_radius_m",
-    "tip_signed_m",
-    "settled",
-    "drift_m",
-    "nearest_distance_m",
-    "nearest_nodes",
-    "stable",
-    "growth_rate_1_s",
-    "t_end_s",
-    "wall_s",
-    "balance_residual_j",
-];
-
-/// Writes sweep.csv: [`HEADER`], then one row per point, in the order of the points.
-pub fn write(path: &Path, points: &[Point]) -> CliResult<()> {
-    let mut csv = Csv::create(path, &HEADER)?;
-    for p in points {
-        let mut row: Vec<String> =
-            vec![p.kind.name().into(), number(p.omega), number(p.omega_scaled), p.status.name().into()];
-        let mut result = result_fields(p.result.as_ref());
-        // wall_s before the last column, balance_residual_j.
-        let balance = result.pop().unwrap_or_default();
-        row.extend(result);
-        row.push(p.result.as_ref().and_then(|r| r.wall_seconds).map_or(String::new(), |w| format!("{w:.3}")));
-        row.push(balance);
-        csv.fields(&row)?;
-    }
-    csv.finish()
-}
+use pendulum_experiment::sweep::{Point, Status, SweepConfig};
+use pendulum_experiment::words::{growth_words, short};
 
 /// The table on stdout: the sweep's parameters, then one line per point.
 pub fn table(config: &SweepConfig, points: &[Point]) {

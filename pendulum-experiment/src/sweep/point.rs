@@ -1,11 +1,11 @@
 //! One point of a sweep: its speed and kind, where it stands, and what the chain did there
-//! (the run library's [`Outcome`] and [`Status`]).
+//! ([`Outcome`] and [`Status`] of [`crate::points`]).
 
 use serde::{Deserialize, Serialize};
 
 use super::SweepKind;
 
-pub use pendulum_experiment::points::{Outcome, Status};
+pub use crate::points::{Outcome, Status};
 
 /// One point of the sweep: a speed and a kind, how it starts, and its result once run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

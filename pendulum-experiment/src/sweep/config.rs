@@ -1,5 +1,5 @@
-//! The resolved parameters of a sweep ([`SweepConfig`], from the command line or a
-//! sweep.json), their checks and defaults (duration from the damping, step from the
+//! The resolved parameters of a sweep ([`SweepConfig`], from a front end's
+//! [`SweepRequest`] or a sweep.json), their checks and defaults (duration from the damping, step from the
 //! chain's fastest mode), the `--omega` list or range, and sweep.json itself
 //! ([`SweepFile`]: the parameters, derived numbers and every point's result so far).
 
@@ -7,19 +7,17 @@ use std::path::Path;
 
 use nalgebra::Dyn;
 use pendulum_core::{Chain, SteadyRotation};
-use pendulum_experiment::whirls::{
-    FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
-};
 use serde::{Deserialize, Serialize};
 
+use super::SweepKind;
 use super::point::Point;
-use super::{SweepKind, SweepPhysics};
-use crate::chain_args::per_link_values;
-use crate::error::{CliError, CliResult};
-use crate::spec::{expand, per_link};
-use pendulum_experiment::options::parse_values;
-use pendulum_experiment::steady::round_up;
-use pendulum_experiment::write_json_atomic;
+use crate::error::{Error, Result};
+use crate::options::parse_values;
+use crate::steady::round_up;
+use crate::whirls::{
+    FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
+};
+use crate::write_json_atomic;
 
 /// Most steps of one point.
 const MAX_STEPS: f64 = 1e8;
@@ -77,42 +75,163 @@ impl SweepConfig {
     }
 
     /// The chain without damping (the steady shapes).
-    pub fn chain(&self) -> CliResult<Chain<Dyn>> {
+    pub fn chain(&self) -> Result<Chain<Dyn>> {
         Ok(Chain::<Dyn>::new(&self.masses, &self.lengths, self.gravity)?)
     }
 
     /// The damped chain of the runs.
-    pub fn damped_chain(&self) -> CliResult<Chain<Dyn>> {
-        self.chain()?.with_damping(&self.damping).map_err(|e| CliError::from(e).context("--damping"))
+    pub fn damped_chain(&self) -> Result<Chain<Dyn>> {
+        self.chain()?.with_damping(&self.damping).map_err(|e| Error::from(e).context("--damping"))
     }
 
-    /// Resolves the command line into a complete configuration.
-    pub fn from_args(p: &SweepPhysics) -> CliResult<Self> {
-        if let Some(dim) = &p.dim {
-            return Err(CliError::invalid(format!(
-                "--dim {dim}: not an option of pendulum sweep: sweeps are 3D (the pivot circles the vertical axis)"
+    /// Checks what building the chain and the drives does not: counts, signs, times.
+    pub fn check(&self) -> Result<()> {
+        let n = self.links();
+        if n == 0 {
+            return Err(Error::invalid("masses: a chain needs at least 1 link, got 0"));
+        }
+        for (what, got) in [("lengths", self.lengths.len()), ("damping", self.damping.len())] {
+            if got != n {
+                return Err(Error::invalid(format!("{what}: got {got} values, expected {n}")));
+            }
+        }
+        if !(self.gravity.is_finite() && self.gravity > 0.0) {
+            return Err(Error::invalid(format!(
+                "gravity must be finite and positive for a sweep, got {}",
+                self.gravity
             )));
         }
-        let (masses, lengths) = per_link_values(&p.chain)?;
-        let n = masses.len();
-        let damping = expand("--damping", per_link("--damping", &p.damping)?, n)?;
-        if !(p.chain.gravity.is_finite() && p.chain.gravity > 0.0) {
-            return Err(CliError::invalid(format!(
+        self.damped_chain()?;
+        check_radius(self.radius)?;
+        if self.omegas.is_empty() {
+            return Err(Error::invalid("--omega: no speed to sweep"));
+        }
+        if let Some(w) = self.omegas.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
+            return Err(Error::invalid(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
+        }
+        if self.kinds.is_empty() {
+            return Err(Error::invalid("--kind: no kind of experiment given"));
+        }
+        check_duration(self.duration)?;
+        let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
+        match (self.ramp_time, ramps) {
+            (Some(t), true) => {
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(Error::invalid(format!(
+                        "--ramp-time must be finite and positive, got {t} (s)"
+                    )));
+                }
+                if t >= self.duration {
+                    return Err(Error::invalid(format!(
+                        "--ramp-time {t} s must be shorter than --duration {} s (the speed is held at ω after the ramp)",
+                        self.duration
+                    )));
+                }
+            }
+            (None, true) => return Err(Error::invalid("ramp_time: the ramp kinds need a ramp time")),
+            (Some(_), false) => return Err(Error::invalid("ramp_time: given without a ramp kind")),
+            (None, false) => {}
+        }
+        if !(self.step.is_finite() && self.step > 0.0) {
+            return Err(Error::invalid(format!("--step must be finite and positive, got {}", self.step)));
+        }
+        let steps = (self.duration / self.step).ceil();
+        if steps > MAX_STEPS {
+            return Err(Error::invalid(format!(
+                "--duration {} s with --step {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
+                self.duration, self.step
+            )));
+        }
+        if self.feed_every == 0 {
+            return Err(Error::invalid("feed_every must be at least 1 step, got 0"));
+        }
+        if !(self.settle_periods.is_finite() && self.settle_periods > 0.0) {
+            return Err(Error::invalid(format!(
+                "settle_periods must be finite and positive, got {}",
+                self.settle_periods
+            )));
+        }
+        if !(self.settle_tolerance.is_finite() && self.settle_tolerance >= 0.0) {
+            return Err(Error::invalid(format!(
+                "settle_tolerance must be finite and non-negative, got {}",
+                self.settle_tolerance
+            )));
+        }
+        Ok(())
+    }
+
+    /// Numbers derived from the parameters, for the reader (not read back).
+    pub fn derived(&self) -> Result<Derived> {
+        let chain = self.damped_chain()?;
+        let free = SteadyRotation::new(&chain, 0.0)?;
+        let critical = free.bifurcation_speeds(self.links().min(4))?;
+        let (steps, _) = pendulum_core::trajectory::plan(0.0, self.duration, self.step)?;
+        Ok(Derived {
+            length: self.length(),
+            reference_speed: self.reference_speed(),
+            first_mode_decay_rate: first_mode_decay(&chain),
+            critical_speeds: critical,
+            steps_per_point: steps,
+        })
+    }
+}
+
+/// A sweep as a front end asks for it: the chain (damping per link), the circle, the
+/// speeds as `--omega` writes them, the kinds, and the times (`None`: the defaults).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRequest {
+    /// Masses `m_i`, kg.
+    pub masses: Vec<f64>,
+    /// Rod lengths `l_i`, m.
+    pub lengths: Vec<f64>,
+    /// Gravity `g`, m/s².
+    pub gravity: f64,
+    /// Damping `λ_i`, N·m·s, one per link.
+    pub damping: Vec<f64>,
+    /// Radius `R` of the pivot's circle, m.
+    pub radius: f64,
+    /// The speeds: a comma list or `A:B:N` (`--omega`).
+    pub omega_spec: String,
+    /// Whether the speeds are in units of `√(g/L)`.
+    pub scaled: bool,
+    /// The kinds of experiment, in order (repeats dropped).
+    pub kinds: Vec<SweepKind>,
+    /// Simulated time of every point, s (default: [`default_duration`]).
+    pub duration: Option<f64>,
+    /// Length of the ramps, s (default: a third of the duration).
+    pub ramp_time: Option<f64>,
+    /// RK4 step, s (default: [`default_step`] at the largest ω).
+    pub step: Option<f64>,
+}
+
+impl SweepRequest {
+    /// Resolves the request into a complete configuration; errors name the bad value.
+    pub fn resolve(&self) -> Result<SweepConfig> {
+        let p = self;
+        let (masses, lengths, damping) = (p.masses.clone(), p.lengths.clone(), p.damping.clone());
+        if !(p.gravity.is_finite() && p.gravity > 0.0) {
+            return Err(Error::invalid(format!(
                 "--gravity must be finite and positive for a sweep (the chain starts hanging at rest), got {}",
-                p.chain.gravity
+                p.gravity
+            )));
+        }
+        if damping.len() != masses.len() {
+            return Err(Error::invalid(format!(
+                "--damping: got {} values, expected {}",
+                damping.len(),
+                masses.len()
             )));
         }
         // The chain's own checks (positive masses and lengths, damping ≥ 0), named by link.
-        let chain = Chain::<Dyn>::new(&masses, &lengths, p.chain.gravity)?;
-        let damped =
-            chain.clone().with_damping(&damping).map_err(|e| CliError::from(e).context("--damping"))?;
+        let chain = Chain::<Dyn>::new(&masses, &lengths, p.gravity)?;
+        let damped = chain.clone().with_damping(&damping).map_err(|e| Error::from(e).context("--damping"))?;
         check_radius(p.radius)?;
-        let spec = p.omega.clone().unwrap_or_default();
+        let spec = p.omega_spec.clone();
         let listed = parse_omegas(&spec, p.scaled)?;
-        let scale = (p.chain.gravity / lengths.iter().sum::<f64>()).sqrt();
+        let scale = (p.gravity / lengths.iter().sum::<f64>()).sqrt();
         let omegas: Vec<f64> = if p.scaled { listed.iter().map(|w| w * scale).collect() } else { listed };
         let mut kinds = Vec::new();
-        for &k in &p.kind {
+        for &k in &p.kinds {
             if !kinds.contains(&k) {
                 kinds.push(k);
             }
@@ -129,7 +248,7 @@ impl SweepConfig {
             (Some(t), true) => Some(t),
             (None, true) => Some(round_up(duration / 3.0)),
             (Some(_), false) => {
-                return Err(CliError::invalid(
+                return Err(Error::invalid(
                     "--ramp-time applies to the kinds ramp-up and ramp-down only (--kind sudden has no ramp)",
                 ));
             }
@@ -140,10 +259,10 @@ impl SweepConfig {
             Some(h) => h,
             None => default_step(&damped, p.radius, fastest_drive),
         };
-        let config = Self {
+        let config = SweepConfig {
             masses,
             lengths,
-            gravity: p.chain.gravity,
+            gravity: p.gravity,
             damping,
             radius: p.radius,
             omega_spec: spec,
@@ -159,97 +278,6 @@ impl SweepConfig {
         };
         config.check()?;
         Ok(config)
-    }
-
-    /// Checks what building the chain and the drives does not: counts, signs, times.
-    pub fn check(&self) -> CliResult<()> {
-        let n = self.links();
-        if n == 0 {
-            return Err(CliError::invalid("masses: a chain needs at least 1 link, got 0"));
-        }
-        for (what, got) in [("lengths", self.lengths.len()), ("damping", self.damping.len())] {
-            if got != n {
-                return Err(CliError::invalid(format!("{what}: got {got} values, expected {n}")));
-            }
-        }
-        if !(self.gravity.is_finite() && self.gravity > 0.0) {
-            return Err(CliError::invalid(format!(
-                "gravity must be finite and positive for a sweep, got {}",
-                self.gravity
-            )));
-        }
-        self.damped_chain()?;
-        check_radius(self.radius)?;
-        if self.omegas.is_empty() {
-            return Err(CliError::invalid("--omega: no speed to sweep"));
-        }
-        if let Some(w) = self.omegas.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
-            return Err(CliError::invalid(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
-        }
-        if self.kinds.is_empty() {
-            return Err(CliError::invalid("--kind: no kind of experiment given"));
-        }
-        check_duration(self.duration)?;
-        let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
-        match (self.ramp_time, ramps) {
-            (Some(t), true) => {
-                if !(t.is_finite() && t > 0.0) {
-                    return Err(CliError::invalid(format!(
-                        "--ramp-time must be finite and positive, got {t} (s)"
-                    )));
-                }
-                if t >= self.duration {
-                    return Err(CliError::invalid(format!(
-                        "--ramp-time {t} s must be shorter than --duration {} s (the speed is held at ω after the ramp)",
-                        self.duration
-                    )));
-                }
-            }
-            (None, true) => return Err(CliError::invalid("ramp_time: the ramp kinds need a ramp time")),
-            (Some(_), false) => return Err(CliError::invalid("ramp_time: given without a ramp kind")),
-            (None, false) => {}
-        }
-        if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(CliError::invalid(format!("--step must be finite and positive, got {}", self.step)));
-        }
-        let steps = (self.duration / self.step).ceil();
-        if steps > MAX_STEPS {
-            return Err(CliError::invalid(format!(
-                "--duration {} s with --step {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
-                self.duration, self.step
-            )));
-        }
-        if self.feed_every == 0 {
-            return Err(CliError::invalid("feed_every must be at least 1 step, got 0"));
-        }
-        if !(self.settle_periods.is_finite() && self.settle_periods > 0.0) {
-            return Err(CliError::invalid(format!(
-                "settle_periods must be finite and positive, got {}",
-                self.settle_periods
-            )));
-        }
-        if !(self.settle_tolerance.is_finite() && self.settle_tolerance >= 0.0) {
-            return Err(CliError::invalid(format!(
-                "settle_tolerance must be finite and non-negative, got {}",
-                self.settle_tolerance
-            )));
-        }
-        Ok(())
-    }
-
-    /// Numbers derived from the parameters, for the reader (not read back).
-    pub fn derived(&self) -> CliResult<Derived> {
-        let chain = self.damped_chain()?;
-        let free = SteadyRotation::new(&chain, 0.0)?;
-        let critical = free.bifurcation_speeds(self.links().min(4))?;
-        let (steps, _) = pendulum_core::trajectory::plan(0.0, self.duration, self.step)?;
-        Ok(Derived {
-            length: self.length(),
-            reference_speed: self.reference_speed(),
-            first_mode_decay_rate: first_mode_decay(&chain),
-            critical_speeds: critical,
-            steps_per_point: steps,
-        })
     }
 }
 
@@ -269,27 +297,27 @@ pub struct Derived {
     pub steps_per_point: u64,
 }
 
-fn check_radius(radius: f64) -> CliResult<()> {
+fn check_radius(radius: f64) -> Result<()> {
     if radius.is_finite() && radius > 0.0 {
         Ok(())
     } else {
-        Err(CliError::invalid(format!(
+        Err(Error::invalid(format!(
             "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
         )))
     }
 }
 
-fn check_duration(duration: f64) -> CliResult<()> {
+fn check_duration(duration: f64) -> Result<()> {
     if duration.is_finite() && duration > 0.0 {
         Ok(())
     } else {
-        Err(CliError::invalid(format!("--duration must be finite and positive, got {duration} (s)")))
+        Err(Error::invalid(format!("--duration must be finite and positive, got {duration} (s)")))
     }
 }
 
 /// Parses `--omega`: a comma list of speeds or `A:B:N`, every speed finite and ≥ 0 (in
 /// rad/s, or in units of √(g/L) when `scaled`). Errors name the value.
-pub fn parse_omegas(spec: &str, scaled: bool) -> CliResult<Vec<f64>> {
+pub fn parse_omegas(spec: &str, scaled: bool) -> Result<Vec<f64>> {
     parse_values("--omega", spec, ("speed", "speeds"), if scaled { "√(g/L)" } else { "rad/s" })
 }
 
@@ -329,7 +357,7 @@ impl SweepFile {
         Self {
             program: "pendulum".into(),
             command: "sweep".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
+            version: crate::VERSION.into(),
             conventions: CONVENTIONS.into(),
             config,
             derived,
@@ -339,14 +367,11 @@ impl SweepFile {
     }
 
     /// Reads and checks a sweep.json; errors name the file and the problem.
-    pub fn read(path: &Path) -> CliResult<Self> {
+    pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
+            .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
         let not_sweep = |why: String| {
-            CliError::invalid(format!(
-                "--from: {} is not a sweep.json of pendulum sweep: {why}",
-                path.display()
-            ))
+            Error::invalid(format!("--from: {} is not a sweep.json of pendulum sweep: {why}", path.display()))
         };
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| not_sweep(format!("not JSON ({e})")))?;
@@ -367,8 +392,8 @@ impl SweepFile {
         Ok(file)
     }
 
-    /// Writes the file atomically ([`write_json_atomic`](crate::json_file::write_json_atomic)).
-    pub fn write_atomic(&self, path: &Path) -> CliResult<()> {
+    /// Writes the file atomically ([`write_json_atomic`]).
+    pub fn write_atomic(&self, path: &Path) -> Result<()> {
         write_json_atomic(path, self)
     }
 }
