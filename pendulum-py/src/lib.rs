@@ -12,6 +12,7 @@ mod page;
 mod run;
 mod steady;
 mod string;
+mod sweep;
 mod whirls;
 
 use pyo3::prelude::*;
@@ -28,5 +29,6 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(steady::steady, m)?)?;
     m.add_function(wrap_pyfunction!(whirls::whirls, m)?)?;
     m.add_class::<atlas::AtlasPlan>()?;
+    m.add_function(wrap_pyfunction!(sweep::run_sweep, m)?)?;
     Ok(())
 }

@@ -10,6 +10,8 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``whirls(chain, radius=..., omega=..., ramp_time=...)``: many whirls from hanging at
   rest, one per circle and speed, run together as a batch of chains on all cores: which
   shape each ends in, as numpy arrays (the runs of ``pendulum sweep``).
+- ``sweep(chain, omega=..., kinds=...)``: ``pendulum sweep``: which shape the chain chooses
+  along a line of speeds, started suddenly, ramped up, or ramped down from point to point.
 - ``atlas(chain, omega=..., radius=..., client=None)``: which shape the chain ends in from
   rest over a grid of two parameters (the map of ``pendulum atlas``), here on all cores or
   in chunks on a Dask cluster (``client``), bit for bit the same.
@@ -27,6 +29,7 @@ SI units throughout, angles in radians. See ``docs/python.md`` in the repository
 
 from ._atlas import Atlas, atlas
 from ._pendulum import AtlasPlan, Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
+from ._sweep import SweepResult, sweep
 from ._plots import plot_ledger, plot_shape
 
 __all__ = [
@@ -42,5 +45,7 @@ __all__ = [
     "plot_ledger",
     "plot_shape",
     "steady",
+    "sweep",
+    "SweepResult",
     "whirls",
 ]

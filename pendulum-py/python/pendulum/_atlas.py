@@ -10,6 +10,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 import numpy as np
 
 from ._pendulum import AtlasPlan, Chain
+from ._points import result_arrays
 
 Numbers = Union[float, Sequence[float], np.ndarray]
 
@@ -75,15 +76,6 @@ class Atlas:
         ax.set_title(f"nodes, {self.kinds[kind]} start")
         ax.figure.colorbar(image, ax=ax, label="nodes")
         return ax
-
-
-def _grid(points: list[dict[str, Any]], shape: tuple[int, int, int], value: Callable[[dict], Any], empty: Any, dtype: Any) -> np.ndarray:
-    return np.array([value(p) if p.get("result") else empty for p in points], dtype=dtype).reshape(shape)
-
-
-def _nearest(p: dict[str, Any], key: str, empty: Any) -> Any:
-    n = p["result"].get("nearest")
-    return n[key] if n else empty
 
 
 def atlas(
@@ -167,8 +159,7 @@ def _assemble(plan: AtlasPlan, points: list[dict[str, Any]]) -> Atlas:
     derived = json.loads(plan.derived_json())
     x, y = np.array(config["x"]["values"]), np.array(config["y"]["values"])
     kinds = tuple(config["kinds"])
-    shape = (len(kinds), len(y), len(x))
-    r = lambda key: (lambda p: p["result"][key])  # noqa: E731
+    grids = {k: v.reshape(len(kinds), len(y), len(x)) for k, v in result_arrays(points).items()}
     return Atlas(
         plan=plan,
         x_name=config["x"]["parameter"],
@@ -176,14 +167,14 @@ def _assemble(plan: AtlasPlan, points: list[dict[str, Any]]) -> Atlas:
         y_name=config["y"]["parameter"],
         y=y,
         kinds=kinds,
-        nodes=_grid(points, shape, r("nodes"), -1, np.int64),
-        settled=_grid(points, shape, r("settled"), False, bool),
-        tip_radius=_grid(points, shape, r("tip_radius"), np.nan, float),
-        tip_signed=_grid(points, shape, r("tip_signed"), np.nan, float),
-        nearest_nodes=_grid(points, shape, lambda p: _nearest(p, "nodes", -1), -1, np.int64),
-        stable=_grid(points, shape, lambda p: _nearest(p, "stable", False), False, bool),
-        growth_rate=_grid(points, shape, lambda p: _nearest(p, "growth_rate", np.nan), np.nan, float),
-        status=np.array([p["status"] for p in points], dtype=object).reshape(shape),
+        nodes=grids["nodes"],
+        settled=grids["settled"],
+        tip_radius=grids["tip_radius"],
+        tip_signed=grids["tip_signed"],
+        nearest_nodes=grids["nearest_nodes"],
+        stable=grids["stable"],
+        growth_rate=grids["growth_rate"],
+        status=grids["status"],
         duration=float(config["duration"]),
         step=float(config["step"]),
         critical_speeds=np.array(derived["critical_speeds"]),

@@ -7,7 +7,18 @@ from typing import Any, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["AtlasPlan", "Chain", "HeavyString", "Run", "RunResult", "__version__", "page", "steady", "whirls"]
+__all__ = [
+    "AtlasPlan",
+    "Chain",
+    "HeavyString",
+    "Run",
+    "RunResult",
+    "__version__",
+    "page",
+    "run_sweep",
+    "steady",
+    "whirls",
+]
 __version__: str
 
 _Array = npt.NDArray[np.float64]
@@ -31,6 +42,18 @@ def whirls(
     duration: Optional[float] = ...,
     step: Optional[float] = ...,
 ) -> dict[str, Any]: ...
+def run_sweep(
+    chain: Chain,
+    omega: str,
+    radius: float,
+    kinds: Sequence[str],
+    scaled: bool,
+    duration: Optional[float],
+    ramp_time: Optional[float],
+    step: Optional[float],
+    jobs: Optional[int],
+    out: Union[str, PathLike[str], None],
+) -> str: ...
 _PerLink = Union[float, Sequence[float], npt.ArrayLike]
 
 @final
