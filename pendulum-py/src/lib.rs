@@ -6,6 +6,7 @@
 mod arrays;
 mod atlas;
 mod chain;
+mod claims;
 mod errors;
 mod interrupt;
 mod page;
@@ -30,5 +31,6 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(whirls::whirls, m)?)?;
     m.add_class::<atlas::AtlasPlan>()?;
     m.add_function(wrap_pyfunction!(sweep::run_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(claims::check_claims, m)?)?;
     Ok(())
 }

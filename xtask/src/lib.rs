@@ -3,13 +3,14 @@
 //! One module per task or concern; `main.rs` is a flat match on subcommands.
 
 pub mod bench;
-pub mod case;
-pub mod claims;
-pub mod expr;
+pub mod claims_proof;
 pub mod regen;
-pub mod sample;
 pub mod test;
 pub mod verify;
+
+// The sympy reference cases, their expressions, the sample states and the claims checker
+// live in `pendulum-reference` (the Python package checks claims with them too).
+pub use pendulum_reference::{case, claims, expr, sample};
 
 use std::path::PathBuf;
 

@@ -50,7 +50,7 @@ fn main() -> anyhow::Result<()> {
         },
         Task::Reference { claims: Some(path), links, .. } => {
             let cases = xtask::case::load_all(&xtask::cases_dir())?;
-            xtask::claims::proof::run(&path, &cases, links, 20, xtask::verify::DEFAULT_SEED)
+            xtask::claims_proof::run(&path, &cases, links, 20, xtask::verify::DEFAULT_SEED)
         }
         Task::Reference { check, .. } => xtask::regen::run(check),
         Task::Bench(options) => xtask::bench::run(&options),

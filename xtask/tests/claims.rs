@@ -197,7 +197,7 @@ fn sympy_proves_identities_and_refutes_a_near_miss() {
     let found = outcomes("almost.claims");
     assert!(found.iter().all(|o| o.verdict().as_str() == "agrees"), "both agree numerically");
     let error =
-        xtask::claims::proof::run(&file("almost.claims"), &cases(), 2, 6, SEED).unwrap_err().to_string();
+        xtask::claims_proof::run(&file("almost.claims"), &cases(), 2, 6, SEED).unwrap_err().to_string();
     assert!(error.starts_with("sympy does not confirm 2 identities:"), "{error}");
     assert!(error.contains("nearly the mass matrix (as written): refuted"), "{error}");
     assert!(!error.contains("velocity terms"), "the identity is proven: {error}");

@@ -18,6 +18,8 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``steady(chain, ...)``: the steady shapes of the chain turning about the vertical, as
   ``pendulum steady`` finds them: branches with every point's nodes and stability, and
   every shape at the asked speeds.
+- ``check_claims(path)``: a hand derivation (a claims file, equations in index notation)
+  checked against the sympy reference built into the package, slips diagnosed.
 - ``HeavyString``: Kolodner's heavy rotating string, the continuum a uniform chain of many
   links approaches: its critical speeds and steady shapes (fixed or circling top).
 - ``page(directory)``: the self-contained page of ``pendulum view`` for a run written with
@@ -28,6 +30,7 @@ SI units throughout, angles in radians. See ``docs/python.md`` in the repository
 """
 
 from ._atlas import Atlas, atlas
+from ._claims import ClaimCheck, ClaimsReport, check_claims
 from ._pendulum import AtlasPlan, Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
 from ._sweep import SweepResult, sweep
 from ._plots import plot_ledger, plot_shape
@@ -37,6 +40,9 @@ __all__ = [
     "AtlasPlan",
     "atlas",
     "Chain",
+    "ClaimCheck",
+    "ClaimsReport",
+    "check_claims",
     "HeavyString",
     "Run",
     "RunResult",

@@ -14,6 +14,7 @@ __all__ = [
     "Run",
     "RunResult",
     "__version__",
+    "check_claims",
     "page",
     "run_sweep",
     "steady",
@@ -42,6 +43,13 @@ def whirls(
     duration: Optional[float] = ...,
     step: Optional[float] = ...,
 ) -> dict[str, Any]: ...
+def check_claims(
+    path: Union[str, PathLike[str], None] = None,
+    *,
+    text: Optional[str] = None,
+    states: int = ...,
+    seed: int = ...,
+) -> tuple[list[dict[str, Any]], str]: ...
 def run_sweep(
     chain: Chain,
     omega: str,

@@ -35,11 +35,7 @@ use crate::case::{Case, load_all};
 use bounds::BOUND;
 use report::Report;
 
-/// Default number of random states per case.
-pub const DEFAULT_STATES: usize = 200;
-
-/// Default seed: "pendulum" in ASCII.
-pub const DEFAULT_SEED: u64 = 0x7065_6e64_756c_756d;
+pub use crate::sample::{DEFAULT_SEED, DEFAULT_STATES};
 
 /// Parses `--states`: a positive count.
 fn at_least_one(text: &str) -> Result<usize, String> {

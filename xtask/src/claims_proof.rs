@@ -9,11 +9,13 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, bail};
 
-use super::check::{combinations, covered, quantity_of};
-use super::eval::{Bindings, EvalError, Quantity, Symbol, each_term, holds, index_value};
-use super::syntax::{Entry, Expr, Pos};
-use super::{Verdict, check_all, load};
-use crate::case::{Case, Kind};
+use pendulum_reference::case::{Case, Kind};
+use pendulum_reference::claims::check::{combinations, covered, quantity_of};
+use pendulum_reference::claims::eval::{
+    Bindings, EvalError, Quantity, Symbol, each_term, holds, index_value,
+};
+use pendulum_reference::claims::syntax::{Entry, Expr, Pos};
+use pendulum_reference::claims::{Verdict, check_all, load};
 
 /// Python's name of a quantity (`reference/prove.py`).
 fn python_name(q: Quantity) -> String {
@@ -221,7 +223,7 @@ pub fn run(path: &Path, cases: &[Case], links: usize, states: usize, seed: u64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::claims::syntax::parse;
+    use pendulum_reference::claims::syntax::parse;
 
     #[test]
     fn sums_unroll_and_symbols_take_derive_names() {

@@ -5,15 +5,14 @@
 //! [`syntax`] reads a file (every error with its line and column), [`eval`] gives its
 //! names their meaning and evaluates an entry at one state, [`check`] compares an entry
 //! with the reference at random states of every case it covers, [`diagnose`] tries the
-//! common slips on a disagreeing entry and prints the corrected entry; [`proof`] has
-//! sympy prove the agreeing ones exactly (`cargo xtask reference --claims FILE`).
+//! common slips on a disagreeing entry and prints the corrected entry. (Having sympy prove
+//! the agreeing ones exactly, `cargo xtask reference --claims FILE`, is xtask's.)
 
 pub mod check;
 pub mod diagnose;
 pub mod eval;
 mod lex;
 mod print;
-pub mod proof;
 pub(crate) mod state;
 pub mod syntax;
 
@@ -93,24 +92,27 @@ fn worst(entries: &[EntryOutcome]) -> f64 {
 }
 
 /// `file:line:col: found: expected …`, one line per error.
-fn located(file: &Path, line: usize, col: usize, found: &str, expected: &str, source: &str) -> String {
+fn located(file: &str, line: usize, col: usize, found: &str, expected: &str, source: &str) -> String {
     let text = source.lines().nth(line.saturating_sub(1)).unwrap_or("");
-    format!("{}:{line}:{col}: found {found}; expected {expected}\n    | {text}", file.display())
+    format!("{file}:{line}:{col}: found {found}; expected {expected}\n    | {text}")
 }
 
 /// Reads and parses a claims file: every syntax error, or the claims.
 pub fn load(path: &Path) -> anyhow::Result<Vec<Claim>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    parse(&text).map_err(|errors| {
-        let all: Vec<String> = errors
-            .iter()
-            .map(|e| located(path, e.pos.line, e.pos.col, &e.found, &e.message, &text))
-            .collect();
+    parse_named(&text, &path.display().to_string())
+}
+
+/// Parses the text of a claims file named `file` (in the errors): every syntax error, or
+/// the claims.
+pub fn parse_named(text: &str, file: &str) -> anyhow::Result<Vec<Claim>> {
+    parse(text).map_err(|errors| {
+        let all: Vec<String> =
+            errors.iter().map(|e| located(file, e.pos.line, e.pos.col, &e.found, &e.message, text)).collect();
         anyhow::anyhow!(
-            "{} error{} in {}:\n{}",
+            "{} error{} in {file}:\n{}",
             all.len(),
             if all.len() == 1 { "" } else { "s" },
-            path.display(),
             all.join("\n")
         )
     })
@@ -127,6 +129,18 @@ pub fn check_all(
     seed: u64,
 ) -> anyhow::Result<Vec<Outcome>> {
     let source = std::fs::read_to_string(path).unwrap_or_default();
+    check_source(&path.display().to_string(), &source, claims, cases, states, seed)
+}
+
+/// [`check_all`] of the claims parsed from `source`, the text of the file named `file`.
+pub fn check_source(
+    file: &str,
+    source: &str,
+    claims: Vec<Claim>,
+    cases: &[Case],
+    states: usize,
+    seed: u64,
+) -> anyhow::Result<Vec<Outcome>> {
     let mut outcomes = Vec::new();
     let mut errors = Vec::new();
     let samples = Samples::new(seed);
@@ -143,7 +157,7 @@ pub fn check_all(
                         out.push(EntryOutcome { entry: entry.clone(), tally, diagnosis });
                     }
                     Err(found) => errors.extend(found.into_iter().map(|(line, col, what, expected)| {
-                        located(path, line, col, &what, &expected, &source)
+                        located(file, line, col, &what, &expected, source)
                     })),
                 }
             }
@@ -157,10 +171,9 @@ pub fn check_all(
     if !errors.is_empty() {
         errors.dedup();
         bail!(
-            "{} error{} in {}:\n{}",
+            "{} error{} in {file}:\n{}",
             errors.len(),
             if errors.len() == 1 { "" } else { "s" },
-            path.display(),
             errors.join("\n")
         );
     }

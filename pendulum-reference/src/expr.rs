@@ -120,7 +120,7 @@ impl Expr {
 
 /// A value `v` with its absolute round-off scale `s ≥ |v|`: the natural size of its
 /// round-off, the one scale rule of `verify` (for the reference, [`Expr::eval_with_scale`])
-/// and of the document check (for the printed formulas, `crate::verify::document`).
+/// and of the document check (for the printed formulas, xtask's `verify::document`).
 ///
 /// The scale is the value computed with every input replaced by its absolute value and
 /// every sum by the sum of its terms' scales, so cancellation does not shrink it:

@@ -130,7 +130,7 @@ pub fn quantity_of(entry: &Entry, kind: Kind) -> Result<Quantity, EvalError> {
 
 /// Every combination of the entry's indices for the quantity's shape, 1-based, with the
 /// bindings of its index names; a fixed index outside the shape is an error.
-pub(crate) fn combinations(
+pub fn combinations(
     entry: &Entry,
     shape: &[usize],
     n: usize,

@@ -177,7 +177,14 @@ impl Case {
     pub fn load(path: &Path) -> Result<Case> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read"))?;
-        let json: Value = serde_json::from_str(&text).with_context(|| format!("{file}: invalid JSON"))?;
+        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+        Self::parse(&text, &file, stem)
+    }
+
+    /// A case from the text of its file, named `file` in errors, whose name must be `stem`
+    /// (the file's name without `.json`): the checks of [`load`](Self::load).
+    pub fn parse(text: &str, file: &str, stem: &str) -> Result<Case> {
+        let json: Value = serde_json::from_str(text).with_context(|| format!("{file}: invalid JSON"))?;
         let root = json.as_object().ok_or_else(|| anyhow!("{file}: expected a JSON object"))?;
         let get = |key: &str| root.get(key).ok_or_else(|| anyhow!("{file}: missing key {key:?}"));
         let string = |key: &str| {
@@ -188,7 +195,6 @@ impl Case {
         ensure!(format == FORMAT, "{file}: format is {format:?}, expected {FORMAT:?}");
         let name = string("case")?;
         let at = format!("{file}: case {name}");
-        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
         ensure!(stem == name, "{at}: the file is named {stem:?}; expected the case name");
         let kind = match string("kind")?.as_str() {
             "planar" => Kind::Planar,
@@ -236,7 +242,7 @@ impl Case {
             name,
             kind,
             links,
-            path: path.to_owned(),
+            path: PathBuf::from(file),
             layout,
         })
     }

@@ -11,6 +11,12 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::case::{Kind, Params, Point};
 
+/// Default number of random states per case.
+pub const DEFAULT_STATES: usize = 200;
+
+/// Default seed: "pendulum" in ASCII.
+pub const DEFAULT_SEED: u64 = 0x7065_6e64_756c_756d;
+
 /// Masses (kg) and lengths (m) are log-uniform over `[MIN_SIZE, MAX_SIZE]`.
 pub const MIN_SIZE: f64 = 0.1;
 /// See [`MIN_SIZE`].
