@@ -14,12 +14,12 @@
 use std::path::Path;
 
 use nalgebra::Dyn;
-use pendulum_core::{Chain, ShapeOptions, SteadyRotation};
+use pendulum_core::{Chain, SteadyRotation};
 use serde::{Deserialize, Serialize};
 
-use crate::balance::chain_scale;
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
+use crate::json::read_command_file;
 use crate::points::{Outcome, Status};
 use crate::steady::{follow, round_up};
 use crate::whirls::{
@@ -619,18 +619,13 @@ impl Atlas {
             }
             (None, None) => return Err(Error::invalid("--damping: no value given")),
         };
-        let whirls = WhirlRuns {
-            chain: chains[0].clone(),
-            duration: config.duration,
-            step: config.step,
-            feed_every: config.feed_every,
-            shape: ShapeOptions {
-                periods: config.settle_periods,
-                tolerance: config.settle_tolerance,
-                ..ShapeOptions::default()
-            },
-            energy_scale: chain_scale(&config.masses, &config.lengths, config.gravity),
-        };
+        let whirls = WhirlRuns::new(
+            chains[0].clone(),
+            config.duration,
+            config.step,
+            config.feed_every,
+            (config.settle_periods, config.settle_tolerance),
+        );
         Ok(Self { config, whirls, chains })
     }
 
@@ -647,12 +642,6 @@ impl Atlas {
             (_, Parameter::Damping) => &self.chains[iy],
             _ => &self.chains[0],
         }
-    }
-
-    /// The whirl runner of point `index` (its chain, the run's length, step and analysis):
-    /// `run_one` of its drive is the point's run alone.
-    pub fn whirl(&self, index: usize) -> WhirlRuns {
-        WhirlRuns { chain: self.chain(index).clone(), ..self.whirls.clone() }
     }
 
     /// Runs the points `indices` (each < [`AtlasConfig::len`]) as one batch of chains on
@@ -775,28 +764,12 @@ impl AtlasFile {
 
     /// Reads and checks an atlas.json; errors name the file and the problem.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
-        let not_atlas = |why: String| {
-            Error::invalid(format!(
-                "--from: {} is not an atlas.json of pendulum atlas: {why}",
-                path.display()
-            ))
-        };
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| not_atlas(format!("not JSON ({e})")))?;
-        let field = |name: &str| value.get(name).and_then(|v| v.as_str()).map(str::to_owned);
-        match (field("program"), field("command")) {
-            (Some(p), _) if p != "pendulum" => return Err(not_atlas(format!("written by '{p}'"))),
-            (Some(_), Some(c)) if c != "atlas" => return Err(not_atlas(format!("written by pendulum {c}"))),
-            (None, _) | (Some(_), None) => return Err(not_atlas("no \"command\": \"atlas\" in it".into())),
-            _ => {}
-        }
-        let file: Self = serde_json::from_value(value).map_err(|e| not_atlas(e.to_string()))?;
+        let file: Self = read_command_file(path, "atlas")?;
         file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
         if file.points.len() != file.config.len() {
-            return Err(not_atlas(format!(
-                "{} points recorded, its configuration has {}",
+            return Err(Error::invalid(format!(
+                "--from: {}: {} points recorded, its configuration has {}",
+                path.display(),
                 file.points.len(),
                 file.config.len()
             )));

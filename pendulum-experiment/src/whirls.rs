@@ -18,7 +18,7 @@ use pendulum_core::{
 use rayon::prelude::*;
 
 use crate::assemble::{Method, directions_integrator, turning_drive, whirl_model};
-use crate::balance::RunBalance;
+use crate::balance::{RunBalance, chain_scale};
 use crate::description::{DriveConfig, IntegratorKind};
 use crate::request::{drive_frequency, fastest_mode, suggested_step};
 use crate::steady::round_up;
@@ -120,6 +120,24 @@ impl WhirlStop {
 pub type WhirlResult = Result<WhirlEnd, WhirlStop>;
 
 impl WhirlRuns {
+    /// The runs of `chain` for `duration` at `step` (s), the shape analysis fed every
+    /// `feed_every` steps and settled within `settle_tolerance` × L over `settle_periods`
+    /// drive periods, the energy balance judged against the chain's scale
+    /// ([`chain_scale`]).
+    pub fn new(
+        chain: Chain<Dyn>,
+        duration: f64,
+        step: f64,
+        feed_every: usize,
+        (settle_periods, settle_tolerance): (f64, f64),
+    ) -> Self {
+        let energy_scale =
+            chain_scale(chain.masses().as_slice(), chain.lengths().as_slice(), chain.gravity());
+        let shape =
+            ShapeOptions { periods: settle_periods, tolerance: settle_tolerance, ..ShapeOptions::default() };
+        Self { chain, duration, step, feed_every, shape, energy_scale }
+    }
+
     /// The chain with `drive` (a circle or a ramped circle), with its energy ledger.
     pub fn system(&self, drive: &DriveConfig) -> Result<Accounted<WhirlModel>, WhirlStop> {
         Ok(Accounted::of(model(&self.chain, drive)?))

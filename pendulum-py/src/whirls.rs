@@ -6,9 +6,7 @@
 use std::sync::atomic::Ordering;
 
 use numpy::PyArray1;
-use pendulum_core::ShapeOptions;
 use pendulum_experiment::DriveConfig;
-use pendulum_experiment::balance::chain_scale;
 use pendulum_experiment::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, WhirlRuns, WhirlStop, default_duration, default_step,
 };
@@ -94,18 +92,7 @@ pub fn whirls<'py>(
             }
         })
         .collect();
-    let runs = WhirlRuns {
-        chain: c.clone(),
-        duration,
-        step,
-        feed_every: FEED_EVERY,
-        shape: ShapeOptions {
-            periods: SETTLE_PERIODS,
-            tolerance: SETTLE_TOLERANCE,
-            ..ShapeOptions::default()
-        },
-        energy_scale: chain_scale(c.masses().as_slice(), c.lengths().as_slice(), c.gravity()),
-    };
+    let runs = WhirlRuns::new(c.clone(), duration, step, FEED_EVERY, (SETTLE_PERIODS, SETTLE_TOLERANCE));
     let ends = interruptible(py, "the whirls", move |stop| {
         Ok(runs.run_batch(&drives, &|| stop.load(Ordering::SeqCst)))
     })?

@@ -12,12 +12,12 @@ use serde::{Deserialize, Serialize};
 use super::SweepKind;
 use super::point::Point;
 use crate::error::{Error, Result};
+use crate::json::{read_command_file, write_json_atomic};
 use crate::options::parse_values;
 use crate::steady::round_up;
 use crate::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
 };
-use crate::write_json_atomic;
 
 /// Most steps of one point.
 const MAX_STEPS: f64 = 1e8;
@@ -368,26 +368,7 @@ impl SweepFile {
 
     /// Reads and checks a sweep.json; errors name the file and the problem.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
-        let not_sweep = |why: String| {
-            Error::invalid(format!("--from: {} is not a sweep.json of pendulum sweep: {why}", path.display()))
-        };
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| not_sweep(format!("not JSON ({e})")))?;
-        let field = |name: &str| value.get(name).and_then(|v| v.as_str()).map(str::to_owned);
-        match (field("program"), field("command")) {
-            (Some(p), _) if p != "pendulum" => return Err(not_sweep(format!("written by '{p}'"))),
-            (Some(_), Some(c)) if c != "sweep" => return Err(not_sweep(format!("written by pendulum {c}"))),
-            (Some(_), None) if value.get("config").is_some_and(|c| c.get("dim").is_some()) => {
-                return Err(not_sweep(
-                    "a run.json of pendulum simulate (repeat it with pendulum simulate --from)".into(),
-                ));
-            }
-            (None, _) | (Some(_), None) => return Err(not_sweep("no \"command\": \"sweep\" in it".into())),
-            _ => {}
-        }
-        let file: Self = serde_json::from_value(value).map_err(|e| not_sweep(e.to_string()))?;
+        let file: Self = read_command_file(path, "sweep")?;
         file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
         Ok(file)
     }

@@ -6,32 +6,21 @@ use std::path::Path;
 use super::point::Point;
 use crate::csv::{Csv, number};
 use crate::error::Result;
-use crate::points::result_fields;
+use crate::points::{RESULT_COLUMNS, result_fields};
 
-/// The columns of sweep.csv.
-pub const HEADER: [&str; 17] = [
-    "kind",
-    "omega_rad_s",
-    "omega_over_sqrt_g_over_L",
-    "status",
-    "nodes",
-    "axis_crossings",
-    "tip_radius_m",
-    "tip_signed_m",
-    "settled",
-    "drift_m",
-    "nearest_distance_m",
-    "nearest_nodes",
-    "stable",
-    "growth_rate_1_s",
-    "t_end_s",
-    "wall_s",
-    "balance_residual_j",
-];
+/// The columns of sweep.csv: the point, then [`RESULT_COLUMNS`] with the wall-clock time
+/// before the last (the energy balance's residual).
+pub fn header() -> Vec<&'static str> {
+    let (last, results) = RESULT_COLUMNS.split_last().expect("result columns");
+    let mut header = vec!["kind", "omega_rad_s", "omega_over_sqrt_g_over_L", "status"];
+    header.extend(results);
+    header.extend(["wall_s", last]);
+    header
+}
 
-/// Writes sweep.csv: [`HEADER`], then one row per point, in the order of the points.
+/// Writes sweep.csv: its [`header`], then one row per point, in the order of the points.
 pub fn write(path: &Path, points: &[Point]) -> Result<()> {
-    let mut csv = Csv::create(path, &HEADER)?;
+    let mut csv = Csv::create(path, &header())?;
     for p in points {
         let mut row: Vec<String> =
             vec![p.kind.name().into(), number(p.omega), number(p.omega_scaled), p.status.name().into()];

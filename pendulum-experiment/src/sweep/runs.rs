@@ -10,13 +10,11 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use nalgebra::DVector;
-use pendulum_core::ShapeOptions;
 use pendulum_core::batch::WIDTH;
 
 use super::SweepKind;
 use super::config::{Derived, SweepConfig, SweepFile};
 use super::point::{Outcome, Point, Status};
-use crate::balance::chain_scale;
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
 use crate::whirls::{WhirlRuns, WhirlStop};
@@ -46,18 +44,13 @@ impl Sweep {
     pub fn new(config: SweepConfig) -> Result<Self> {
         config.check()?;
         let derived = config.derived()?;
-        let whirls = WhirlRuns {
-            chain: config.damped_chain()?,
-            duration: config.duration,
-            step: config.step,
-            feed_every: config.feed_every,
-            shape: ShapeOptions {
-                periods: config.settle_periods,
-                tolerance: config.settle_tolerance,
-                ..ShapeOptions::default()
-            },
-            energy_scale: chain_scale(&config.masses, &config.lengths, config.gravity),
-        };
+        let whirls = WhirlRuns::new(
+            config.damped_chain()?,
+            config.duration,
+            config.step,
+            config.feed_every,
+            (config.settle_periods, config.settle_tolerance),
+        );
         let scale = config.reference_speed();
         let point = |kind, omega: f64, ramp_from, start: String| Point {
             kind,
