@@ -30,9 +30,10 @@ pub fn write_json_atomic<T: Serialize + ?Sized>(path: &Path, value: &T) -> Resul
 pub fn read_command_file<T: DeserializeOwned>(path: &Path, command: &str) -> Result<T> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
+    let article = if command.starts_with(['a', 'e', 'i', 'o', 'u']) { "an" } else { "a" };
     let not_it = |why: String| {
         Error::invalid(format!(
-            "--from: {} is not a {command}.json of pendulum {command}: {why}",
+            "--from: {} is not {article} {command}.json of pendulum {command}: {why}",
             path.display()
         ))
     };
