@@ -269,8 +269,9 @@ fn render(
             (Swatch::Cell(colour(Some(n)), false), format!("{n} node{}", if n == 1 { "" } else { "s" }))
         })
         .collect();
-    if let Some(&n) = counts.first() {
-        entries.push((Swatch::Cell(faint(colour(Some(n))), true), "pale, dotted: not settled".into()));
+    let unsettled = points.iter().filter_map(|p| p.result.as_ref()).find(|r| !r.settled);
+    if let Some(r) = unsettled {
+        entries.push((Swatch::Cell(faint(colour(Some(r.nodes))), true), "pale, dotted: not settled".into()));
     }
     if done < points.len() {
         entries.push((Swatch::Cell(MISSING, false), "failed or not run".into()));
