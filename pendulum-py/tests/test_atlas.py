@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import pendulum
+from conftest import assert_ctrl_c_interrupts
 
 # Six links of 0.1 m, 0.1 kg, lightly damped (first critical speed 4.68 rad/s).
 GRID = dict(omega=[3.0, 8.0, 12.0, 16.0], radius=[0.01, 0.03, 0.05], duration=12.0, step=0.002)
@@ -82,3 +83,10 @@ def test_a_dask_cluster_gives_the_local_atlas_bit_for_bit(local):
     for name in ["nodes", "settled", "tip_radius", "tip_signed", "nearest_nodes", "stable"]:
         assert np.array_equal(getattr(remote, name), getattr(local, name)), name
     assert [t for _, t in seen] == [24] * 5 and seen[-1][0] == 24
+
+
+def test_ctrl_c_stops_an_atlas():
+    assert_ctrl_c_interrupts(
+        "c = pendulum.Chain([0.05] * 20, [0.05] * 20, damping=5e-4)",
+        "pendulum.atlas(c, omega=[2.0, 3.0, 4.0, 5.0], radius=[0.01, 0.02], duration=1e5, step=0.003)",
+    )

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import pendulum
+from conftest import assert_ctrl_c_interrupts
 
 
 def chain():
@@ -53,3 +54,10 @@ def test_jobs_change_nothing_and_bad_input_says_what_is_wrong():
         pendulum.sweep(chain(), omega=[1.0], kinds="sudden", ramp_time=2.0)
     with pytest.raises(ValueError, match="jobs: at least 1, got 0"):
         pendulum.sweep(chain(), omega=[1.0], jobs=0)
+
+
+def test_ctrl_c_stops_a_sweep():
+    assert_ctrl_c_interrupts(
+        "c = pendulum.Chain([0.05] * 20, [0.05] * 20, damping=5e-4)",
+        "pendulum.sweep(c, omega=[2.0, 3.0, 4.0], duration=1e5, step=0.003)",
+    )
