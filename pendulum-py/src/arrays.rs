@@ -46,9 +46,11 @@ impl Rows {
         if last != width {
             return Err(invalid(format!("{what}: the last axis has {last} entries, expected {width}")));
         }
+        // `as_slice` is memory order, which is the rows' order only for C order (a
+        // Fortran-ordered array is contiguous too); otherwise the logical order.
         let data: Vec<f64> = match array.as_slice() {
-            Ok(contiguous) => contiguous.to_vec(),
-            Err(_) => array.as_array().iter().copied().collect(),
+            Ok(contiguous) if array.is_c_contiguous() => contiguous.to_vec(),
+            _ => array.as_array().iter().copied().collect(),
         };
         if let Some(v) = data.iter().find(|v| !v.is_finite()) {
             return Err(invalid(format!("{what}: {v} is not finite")));

@@ -3,7 +3,7 @@
 //! for one state or a leading batch of them; its normal modes and linearisation.
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pendulum_core::batch::PlanarBatch;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
@@ -182,6 +182,66 @@ fn planar_batch(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::
         Some(failure) => Err(failure.error),
         None => Ok(out),
     }
+}
+
+/// `θ̈` of many planar states given as one C-contiguous float64 array `q` of shape
+/// `(B, n)`, `qd` the same or absent, without torques or pivot acceleration: read where
+/// numpy holds them and written into the result array, no copies ([`planar_batch`]'s
+/// numbers). `None`: not this case (the general path takes it, and its errors).
+fn planar_in_place<'py>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let n = chain.links();
+    let Ok(q) = q.cast::<PyArray2<f64>>() else { return Ok(None) };
+    let q = q.readonly();
+    let [count, width] = [q.shape()[0], q.shape()[1]];
+    // C order only: `as_slice` of a Fortran-ordered array is contiguous too, column-major.
+    let Ok(qs) = q.as_slice() else { return Ok(None) };
+    if width != n || count < 2 || !q.is_c_contiguous() {
+        return Ok(None);
+    }
+    let given = match qd {
+        None => None,
+        Some(qd) => {
+            let Ok(qd) = qd.cast::<PyArray2<f64>>() else { return Ok(None) };
+            if qd.shape() != [count, n] || !qd.is_c_contiguous() {
+                return Ok(None);
+            }
+            Some(qd.readonly())
+        }
+    };
+    let zeros;
+    let qds: &[f64] = match &given {
+        Some(qd) => match qd.as_slice() {
+            Ok(slice) => slice,
+            Err(_) => return Ok(None),
+        },
+        None => {
+            zeros = vec![0.0; qs.len()];
+            &zeros
+        }
+    };
+    let out = PyArray2::<f64>::zeros(py, [count, n], false);
+    {
+        let mut written = out.readwrite();
+        let os = written.as_slice_mut().map_err(|e| invalid(e.to_string()))?;
+        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
+        let failures =
+            maybe_detached(py, qs.len(), || batch.accelerations(qs, qds, None, os)).map_err(core_error)?;
+        if let Some(failure) = failures.into_iter().next() {
+            // The general path's message for a non-finite input ([`Rows::read`]'s).
+            for (what, values) in [("q", qs), ("qd", qds)] {
+                if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                    return Err(invalid(format!("{what}: {v} is not finite")));
+                }
+            }
+            return Err(core_error(failure.error));
+        }
+    }
+    Ok(Some(out.into_any()))
 }
 
 /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
@@ -392,6 +452,13 @@ impl Chain {
         model: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let kind = Kind::of(model)?;
+        if kind == Kind::Planar
+            && torque.is_none()
+            && pivot_acceleration.is_none()
+            && let Some(out) = planar_in_place(py, &self.inner, q, qd)?
+        {
+            return Ok(out);
+        }
         let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
         let numbers = b.q.data.len();
         let out = maybe_detached(py, numbers, || match kind {

@@ -91,6 +91,32 @@ def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
     assert str(many.value) == str(one.value) == "q: NaN is not finite"
 
 
+def test_a_contiguous_table_of_planar_states_is_read_in_place_with_the_same_numbers():
+    # A (B, n) C-contiguous float64 table without torques or pivot acceleration is read
+    # where numpy holds it; any other layout takes the general path: the same numbers.
+    rng = np.random.default_rng(3)
+    chain = pendulum.Chain(rng.uniform(0.1, 1, 6), rng.uniform(0.1, 1, 6), damping=0.02)
+    q, qd = rng.uniform(-3, 3, (37, 6)), rng.normal(size=(37, 6))
+    fast = chain.accelerations(q, qd)
+    assert fast.shape == (37, 6) and fast.flags["C_CONTIGUOUS"]
+    for k in range(37):
+        assert np.array_equal(fast[k], chain.accelerations(q[k], qd[k]))
+    assert np.array_equal(chain.accelerations(np.asfortranarray(q), qd), fast)
+    assert np.array_equal(chain.accelerations(q, np.asfortranarray(qd)), fast)
+    assert np.array_equal(chain.accelerations(q[None], qd[None])[0], fast)
+    # Fortran order on the general path too (it once read such arrays in memory order).
+    torque = np.ones(6)
+    assert np.array_equal(chain.accelerations(np.asfortranarray(q[None]), qd[None], torque)[0],
+                          chain.accelerations(q, qd, torque))
+    assert np.array_equal(chain.accelerations(q), chain.accelerations(q, np.zeros_like(q)))
+    assert np.array_equal(chain.accelerations(q.tolist(), qd.tolist()), fast)
+    q[20, 2] = np.inf
+    with pytest.raises(ValueError, match="q: inf is not finite"):
+        chain.accelerations(q, qd)
+    with pytest.raises(ValueError, match="the last axis has 5 entries, expected 6"):
+        chain.accelerations(q[:, :5], qd[:, :5])
+
+
 def test_the_analytic_jacobians_are_the_slopes_of_the_accelerations():
     rng = np.random.default_rng(2)
     chain = pendulum.Chain(rng.uniform(0.2, 1, 5), rng.uniform(0.2, 1, 5), damping=0.05)
