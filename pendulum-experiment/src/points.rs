@@ -1,11 +1,17 @@
-//! A whirl's point as the sweep and the atlas record it: where it stands ([`Status`]) and
-//! what the chain did there ([`Outcome`]: the shape report in plain numbers, as sweep.csv,
-//! sweep.json, atlas.csv and atlas.json hold it).
+//! A whirl's point as the sweep and the atlas record it: where it stands ([`Status`]), what
+//! the chain did there ([`Outcome`]: the shape report in plain numbers, as sweep.csv,
+//! sweep.json, atlas.csv and atlas.json hold it), and the JSON file of a command's points
+//! ([`PointsFile`]).
+
+use std::path::Path;
 
 use pendulum_core::ShapeReport;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::balance::RunBalance;
+use crate::error::{Error, Result};
+use crate::json::{read_command_file, write_json_atomic};
 
 /// Where a point stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -178,4 +184,82 @@ pub fn result_fields(result: Option<&Outcome>) -> Vec<String> {
     row.push(number(r.t));
     row.push(r.balance.map_or(String::new(), |b| number(b.residual)));
     row
+}
+
+/// The parameters of a command whose points a [`PointsFile`] records (`pendulum sweep`'s,
+/// `pendulum atlas`'s): the command's name, the file's conventions, and their checks.
+pub trait Recorded {
+    /// The command (`"sweep"`): the file is `COMMAND.json`.
+    const COMMAND: &'static str;
+    /// Units and conventions of the file's numbers.
+    const CONVENTIONS: &'static str;
+    /// Checks the parameters read back; errors name the bad value.
+    fn check(&self) -> Result<()>;
+    /// How many points they make, where that is fixed (checked on reading).
+    fn points(&self) -> Option<usize> {
+        None
+    }
+}
+
+/// A command's JSON file of points (sweep.json, atlas.json): the program and version that
+/// wrote it, its conventions, every parameter (`config`), numbers derived from them (not
+/// read back), how the command stands (`"running"`, `"completed"`, `"interrupted"` or
+/// `"failed"`) and every point so far.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointsFile<C, D, P> {
+    /// Always `"pendulum"`.
+    pub program: String,
+    /// The command, [`Recorded::COMMAND`].
+    pub command: String,
+    /// The version that wrote the file.
+    pub version: String,
+    /// [`Recorded::CONVENTIONS`].
+    pub conventions: String,
+    pub config: C,
+    pub derived: D,
+    pub status: String,
+    pub points: Vec<P>,
+}
+
+impl<
+    C: Recorded + Serialize + DeserializeOwned,
+    D: Serialize + DeserializeOwned,
+    P: Serialize + DeserializeOwned,
+> PointsFile<C, D, P>
+{
+    /// The file of this program's version, `"running"`.
+    pub fn new(config: C, derived: D, points: Vec<P>) -> Self {
+        Self {
+            program: "pendulum".into(),
+            command: C::COMMAND.into(),
+            version: crate::VERSION.into(),
+            conventions: C::CONVENTIONS.into(),
+            config,
+            derived,
+            status: "running".into(),
+            points,
+        }
+    }
+
+    /// Reads and checks the file given to `--from`; errors name the file and the problem.
+    pub fn read(path: &Path) -> Result<Self> {
+        let file: Self = read_command_file(path, C::COMMAND)?;
+        file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
+        if let Some(expected) = file.config.points()
+            && expected != file.points.len()
+        {
+            return Err(Error::invalid(format!(
+                "--from: {}: {} points recorded, its configuration has {expected}",
+                path.display(),
+                file.points.len()
+            )));
+        }
+        Ok(file)
+    }
+
+    /// Writes the file atomically ([`write_json_atomic`]).
+    pub fn write_atomic(&self, path: &Path) -> Result<()> {
+        write_json_atomic(path, self)
+    }
 }

@@ -2,7 +2,7 @@
 //! circle (switched on or ramped), RK4 with projection and the energy ledger, the shape
 //! analysis fed every few steps, for a list of drives as one batch of chains
 //! ([`DirectionsBatch::run_rk4`]: four chains per SIMD lane group, on the current rayon
-//! pool). Each whirl is bit for bit the run of [`run_one`], so a front end (the CLI's
+//! pool). Each whirl is bit for bit the run of [`WhirlRuns::run_one`], so a front end (the CLI's
 //! `sweep`, Python's `pendulum.whirls`) may batch whatever points are independent.
 
 use std::ops::ControlFlow;
@@ -48,8 +48,8 @@ pub fn first_mode_decay(chain: &Chain<Dyn>) -> f64 {
     0.5 * chain.damping().iter().zip(v.iter()).map(|(l, v)| l * v * v).sum::<f64>()
 }
 
-/// [`DECAY_TIMES`] decay times of the first mode, rounded up to three digits; undamped,
-/// [`UNDAMPED_PERIODS`] periods of that mode.
+/// `DECAY_TIMES` (12) decay times of the first mode, rounded up to three digits; undamped,
+/// `UNDAMPED_PERIODS` (200) periods of that mode.
 pub fn default_duration(chain: &Chain<Dyn>) -> f64 {
     let decay = first_mode_decay(chain);
     if decay > 0.0 {

@@ -3,8 +3,6 @@
 //! chain's fastest mode), the `--omega` list or range, and sweep.json itself
 //! ([`SweepFile`]: the parameters, derived numbers and every point's result so far).
 
-use std::path::Path;
-
 use nalgebra::Dyn;
 use pendulum_core::{Chain, SteadyRotation};
 use serde::{Deserialize, Serialize};
@@ -12,8 +10,8 @@ use serde::{Deserialize, Serialize};
 use super::SweepKind;
 use super::point::Point;
 use crate::error::{Error, Result};
-use crate::json::{read_command_file, write_json_atomic};
 use crate::options::parse_values;
+use crate::points::{PointsFile, Recorded};
 use crate::steady::round_up;
 use crate::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
@@ -322,60 +320,20 @@ pub fn parse_omegas(spec: &str, scaled: bool) -> Result<Vec<f64>> {
 }
 
 /// What sweep.json holds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SweepFile {
-    /// Always `"pendulum"`.
-    pub program: String,
-    /// Always `"sweep"`.
-    pub command: String,
-    /// The `pendulum-cli` version that wrote the file.
-    pub version: String,
-    /// Units and conventions of the numbers.
-    pub conventions: String,
-    /// Every parameter of the sweep.
-    pub config: SweepConfig,
-    /// Numbers derived from them (not read back).
-    pub derived: Derived,
-    /// `"running"`, `"completed"`, `"interrupted"` or `"failed"`.
-    pub status: String,
-    /// Every point and kind: its status and, once run, its result.
-    pub points: Vec<Point>,
-}
+pub type SweepFile = PointsFile<SweepConfig, Derived, Point>;
 
-const CONVENTIONS: &str = "SI units: ω in rad/s (omega_scaled: ω / √(g/L), L the chain's length), lengths in m, \
-times in s, growth rates in 1/s. Each point: a 3D chain in unit link directions, RK4 + projection, its pivot on the \
-horizontal circle of radius R about the z axis; the shape in the frame turning with the pivot (pivot at (R, 0, 0)): \
-nodes = axis crossings + 1 (the pivot counts as a node), tip radius = the free end's distance from the axis \
-(tip_signed: + on the pivot's side), settled = drift ≤ settle_tolerance · L over the last settle_periods drive \
-periods; nearest = the damped steady shape (relative equilibrium) nearest the final shape, its distance, nodes \
-and growth rate (stable: below 1e-6 |ω|).";
+impl Recorded for SweepConfig {
+    const COMMAND: &'static str = "sweep";
+    const CONVENTIONS: &'static str = "SI units: ω in rad/s (omega_scaled: ω / √(g/L), L the chain's length), lengths in m, \
+    times in s, growth rates in 1/s. Each point: a 3D chain in unit link directions, RK4 + projection, its pivot on the \
+    horizontal circle of radius R about the z axis; the shape in the frame turning with the pivot (pivot at (R, 0, 0)): \
+    nodes = axis crossings + 1 (the pivot counts as a node), tip radius = the free end's distance from the axis \
+    (tip_signed: + on the pivot's side), settled = drift ≤ settle_tolerance · L over the last settle_periods drive \
+    periods; nearest = the damped steady shape (relative equilibrium) nearest the final shape, its distance, nodes \
+    and growth rate (stable: below 1e-6 |ω|).";
 
-impl SweepFile {
-    /// A sweep.json of this program's version.
-    pub fn new(config: SweepConfig, derived: Derived, points: Vec<Point>) -> Self {
-        Self {
-            program: "pendulum".into(),
-            command: "sweep".into(),
-            version: crate::VERSION.into(),
-            conventions: CONVENTIONS.into(),
-            config,
-            derived,
-            status: "running".into(),
-            points,
-        }
-    }
-
-    /// Reads and checks a sweep.json; errors name the file and the problem.
-    pub fn read(path: &Path) -> Result<Self> {
-        let file: Self = read_command_file(path, "sweep")?;
-        file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
-        Ok(file)
-    }
-
-    /// Writes the file atomically ([`write_json_atomic`]).
-    pub fn write_atomic(&self, path: &Path) -> Result<()> {
-        write_json_atomic(path, self)
+    fn check(&self) -> Result<()> {
+        SweepConfig::check(self)
     }
 }
 

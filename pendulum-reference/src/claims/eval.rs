@@ -196,7 +196,7 @@ pub fn index_value(index: &Index, bound: &Bindings, n: usize) -> Result<i64, Eva
 
 /// Calls `term` on the body of the sum `sum` once for every value of its index where its
 /// condition holds, with the index bound to it (and unbound, or as before, after). A
-/// range of [`MAX_TERMS`] or more is an error.
+/// range of `MAX_TERMS` or more is an error.
 pub fn each_term(
     sum: &Expr,
     bound: &mut Bindings,

@@ -4,7 +4,7 @@
 //!
 //! [`syntax`] reads a file (every error with its line and column), [`eval`] gives its
 //! names their meaning and evaluates an entry at one state, [`check`] compares an entry
-//! with the reference at random states of every case it covers, [`diagnose`] tries the
+//! with the reference at random states of every case it covers, [`diagnose`](mod@diagnose) tries the
 //! common slips on a disagreeing entry and prints the corrected entry. (Having sympy prove
 //! the agreeing ones exactly, `cargo xtask reference --claims FILE`, is xtask's.)
 
