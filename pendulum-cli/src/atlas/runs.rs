@@ -79,7 +79,7 @@ impl AtlasRun {
                 if c.kinds.len() == 1 { "" } else { "s" },
                 c.len(),
                 c.duration,
-                c.step,
+                pendulum_experiment::words::short(c.step),
                 self.derived.steps_per_point,
                 if kept > 0 {
                     format!("; {kept} kept from --from, {} to run", pending.len())
