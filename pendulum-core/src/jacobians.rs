@@ -86,7 +86,7 @@ pub trait Derivatives: Model
 where
     DefaultAllocator: ModelAlloc<Self::Links, Self::Dof, Self::Space> + Allocator<Self::Dof, Self::Space>,
 {
-    /// `∂(M(q) v)/∂q` at fixed `v` (kg·m²·[v]): entry `(a, x)` is `Σ_b ∂M_ab/∂q_x v_b`.
+    /// `∂(M(q) v)/∂q` at fixed `v` (kg·m² times the unit of `v`): entry `(a, x)` is `Σ_b ∂M_ab/∂q_x v_b`.
     fn mass_matrix_partials(
         &self,
         q: &OVector<f64, Self::Dof>,

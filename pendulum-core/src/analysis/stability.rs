@@ -280,7 +280,7 @@ fn counted(found: &[(Complex<f64>, f64)], damped: bool, tolerance: f64) -> usize
 /// Only eigenvalues near the origin can leave the imaginary axis: an eigenvalue with
 /// `Re λ > 0` has `|λ|² = −p*Hp / p*Mp` (undamped) or less (damped), so it lies among the
 /// modes the amended potential softens. The index of `H` comes from the signs of its
-/// `L D Lᵀ` pivots ([`crate::analysis::turning_pencil`]); the eigenvalues nearest the
+/// `L D Lᵀ` pivots (`analysis::turning_pencil`); the eigenvalues nearest the
 /// origin from shift-and-invert Arnoldi on the quadratic pencil `λ²M + λ(G + D) + H`
 /// (each step one `O(n)` quasiseparable solve), until they account for the whole index:
 /// undamped, `k_r + 2 k_c + 2 k_i⁻ = index` (real, complex-quartet and imaginary

@@ -1,5 +1,5 @@
 //! Energy in the inertial frame: the energy and the powers of drive, torques and damping
-//! ([`power`]), and the ledger that integrates those powers along a run so the balance can
+//! (`power`), and the ledger that integrates those powers along a run so the balance can
 //! be checked ([`Accounted`], one type for chains in angles and in unit directions).
 
 pub(crate) mod ledger;

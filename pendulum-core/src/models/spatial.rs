@@ -28,7 +28,7 @@ use crate::model::{Inputs, Model};
 ///   `D = ½ Σ λ_i |u̇_i|²`, the 3D analogue of eq 26).
 ///
 /// These coordinates are singular where `sin θ_i = 0` (a link straight down, where a
-/// chain rests): [`Model::accelerations`] then returns [`Error::SingularAngle`].
+/// chain rests): [`Model::accelerations`](crate::Model::accelerations) then returns [`Error::SingularAngle`](crate::Error::SingularAngle).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spatial<L: Dim = Dyn>
 where
@@ -185,7 +185,7 @@ where
 /// `Σ_b ∂M_ab/∂q_x v_b = δ_ik H_αβ(i)·Σ_j W_ij w_j + W_ik J_α(i)·∂w_k/∂β` for `a = (i, α)`,
 /// `x = (k, β)`. With `z_j = ü_j|_{q̈=0}`, `c_a = J_α(i)·Σ_j W_ij z_j` and
 /// `k_a + d_a = M_i l_i J_α(i)·(p̈ + g ẑ)`, the same product rule gives `∂F/∂q`, `∂F/∂q̇`
-/// (`z_k` by its angles and rates, [`centripetal_partials`]) and `∂F/∂p̈ = −M_i l_i J_α(i)`;
+/// (`z_k` by its angles and rates, `centripetal_partials`) and `∂F/∂p̈ = −M_i l_i J_α(i)`;
 /// `Q_φi = σ_φi − λ_i sin²θ_i φ̇_i` adds `−2 λ_i sin θ_i cos θ_i φ̇_i` by `θ_i`.
 impl<L> Derivatives for Spatial<L>
 where

@@ -38,12 +38,12 @@ mod newton;
 /// ΔH = (F_1 − μ_1 d_1)·(p(t+h) − p(t))  −  h Σ λ_i |v̄_i − v̄_{i−1}|² / l_i²
 ///      (work of the pivot)                (damping loss)
 /// ```
-/// which is what it adds to an [`Accounted`](crate::Accounted) ledger (that impl is in
+/// which is what it adds to an [`Accounted`] ledger (that impl is in
 /// `energy/ledger.rs`): the balance closes to the Newton
 /// tolerance and round-off at any step size.
 ///
 /// Each Newton iteration assembles the Newton matrix link by link (link `i`'s position and
-/// multiplier) and eliminates it in `O(n)` ([`newton`]). Start: the rods turned by `h w_i` and the
+/// multiplier) and eliminates it in `O(n)` (`newton`). Start: the rods turned by `h w_i` and the
 /// multipliers `T_i/l_i` of the tensions at `t`. A step in which a link would turn by more
 /// than 1 rad, or whose Newton iteration does not converge in 12 iterations, is taken as
 /// two halves (up to 10 times nested). The state is the [`Directions`] state `(u, w)`
@@ -94,8 +94,8 @@ pub(crate) struct StepWork {
 impl RodMidpoint {
     /// The step with its Newton iteration converged to `1e-13` of the chain's reach
     /// (`Σ l_i`) per position, at most 12 iterations; a step in which a link would turn by
-    /// more than [`MAX_TURN`], or whose iteration does not converge, is taken as two halves
-    /// (up to [`MAX_HALVINGS`] times nested).
+    /// more than `MAX_TURN`, or whose iteration does not converge, is taken as two halves
+    /// (up to `MAX_HALVINGS` times nested).
     pub fn new() -> Self {
         Self {
             stats: Stats::default(),

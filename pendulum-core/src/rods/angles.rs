@@ -67,7 +67,7 @@ pub(super) struct Link {
     pub acceleration: f64,
 }
 
-/// [`PlanarTension`](super::PlanarTension)'s solve at one state, kept for its tangents:
+/// `PlanarTension`'s solve at one state, kept for its tangents:
 /// the directional derivatives (Jacobian-vector products) of `θ̈` in O(n) each
 /// ([`jvp`](Self::jvp)), and its full Jacobians in O(n²)
 /// ([`jacobians`](Self::jacobians)), in the links' own angles (module docs).
@@ -180,8 +180,8 @@ where
     /// entries: one pass gathering `δr` and `δh` row by row and eliminating `δr` as it
     /// goes, one back substitution applying `H` (module docs). O(n), allocation-free.
     ///
-    /// The rows hold [`Columns`]' derivatives transposed (each row sums what the columns
-    /// `i − 1 … i + 1` put in it), written out per row: gathering through [`Columns`]
+    /// The rows hold `Columns`' derivatives transposed (each row sums what the columns
+    /// `i − 1 … i + 1` put in it), written out per row: gathering through `Columns`
     /// measured twice as slow. The unit tests hold the JVP to the full Jacobians.
     pub fn jvp(&mut self, dq: &[f64], dqd: &[f64], dtorque: &[f64], dpivot: [f64; 2], out: &mut [f64]) {
         let n = self.links.len();

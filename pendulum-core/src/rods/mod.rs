@@ -214,7 +214,7 @@ const BLOCK: usize = 16;
 /// The continuants `P_i` of the fast down pass must stay in `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (as bit
 /// patterns: `low ≤ bits(P_i) ≤ low + span`), far from overflow and from the subnormals
 /// where they would lose digits; otherwise the pivots are redone by
-/// [`Rods::eliminate_by_pivots`]. Negative, zero, infinite and NaN values fall outside too.
+/// `Rods::eliminate_by_pivots`. Negative, zero, infinite and NaN values fall outside too.
 pub const CONTINUANT_RANGE: (u64, u64) = {
     let low = (1023 - 800) << 52; // 2⁻⁸⁰⁰
     let high = (1023 + 800) << 52; // 2⁸⁰⁰

@@ -139,7 +139,7 @@ pub struct Targets {
     pub closed_form: Option<f64>,
     /// `(check_inputs time at n = 2, (generated − check_inputs) ÷ closed form)`.
     pub closed_form_unchecked: Option<(f64, f64)>,
-    /// Where each O(n) route of [`LINEAR`] overtakes the generated models.
+    /// Where each O(n) route of `LINEAR` overtakes the generated models.
     pub crossovers: Vec<Crossover>,
     /// The generated models' two algorithms at every measured n (issue 20).
     pub algorithms: Vec<AlgorithmRow>,

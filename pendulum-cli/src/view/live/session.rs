@@ -1,5 +1,5 @@
 //! One live chain: a 3D chain in unit link directions whose pivot the page steers
-//! ([`Steered`]), stepped by [`RodMidpoint`] at a fixed step in real time.
+//! ([`Steered`]), stepped by [`RodMidpoint`](pendulum_core::RodMidpoint) at a fixed step in real time.
 
 use nalgebra::{Dyn, U3, Vector3};
 use pendulum_core::integrate::{Integrator, State};
