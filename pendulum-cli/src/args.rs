@@ -1,11 +1,13 @@
 //! The options of the commands (clap derive) that more than one command, or the run files, use.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Arg, Args, ValueEnum};
 use pendulum_experiment::{Dimension, DriveKind, InitialSpec, IntegratorKind, StageSolver, View};
 
 use serde::Serialize;
+
+use crate::error::{CliError, CliResult};
 
 /// The chain's options, shared by `pendulum simulate`, `modes` and `steady` (`simulate`
 /// words the help of --masses and --gravity its own way, see [`Physics::run_help`]).
@@ -301,4 +303,19 @@ pub struct EvalArgs {
     /// Pivot acceleration p̈, m/s²: 2 (planar) or 3 (spatial) components (default: 0).
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
     pub pivot_acceleration: Option<String>,
+}
+
+/// Creates `--out`, the output directory, if missing; the error names it.
+pub fn create_out(out: &Path) -> CliResult<()> {
+    std::fs::create_dir_all(out)
+        .map_err(|e| CliError::invalid(format!("--out: cannot create the directory {}: {e}", out.display())))
+}
+
+/// `--jobs`: at least 1; by default the number of cores.
+pub fn threads(jobs: Option<usize>) -> CliResult<usize> {
+    match jobs {
+        Some(0) => Err(CliError::invalid("--jobs must be at least 1, got 0")),
+        Some(j) => Ok(j),
+        None => Ok(pendulum_experiment::options::all_cores()),
+    }
 }

@@ -25,9 +25,7 @@ pub fn modes(args: &ModesArgs) -> CliResult<()> {
     let total: f64 = chain.lengths().iter().sum();
     let uniform = chain.masses().iter().all(|&m| m == chain.masses()[0])
         && chain.lengths().iter().all(|&l| l == chain.lengths()[0]);
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    crate::args::create_out(&args.out)?;
     let mut header =
         vec!["k".to_string(), "omega".into(), "frequency_hz".into(), "period".into(), "nodes".into()];
     header.extend((1..=n).map(|i| format!("x{i}")));

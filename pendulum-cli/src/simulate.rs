@@ -44,9 +44,7 @@ pub fn simulate(args: &SimulateArgs, demo: bool) -> CliResult<()> {
         Some(path) => e.context(format_args!("--from {}", path.display())),
         None => e,
     })?;
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    crate::args::create_out(&args.out)?;
     let options = Options { out: args.out.clone(), plots: !args.no_plots, quiet: args.quiet };
     if !args.quiet {
         let chain = pendulum_experiment::words::chain_words(

@@ -173,6 +173,34 @@ pub fn parse_values(option: &str, spec: &str, noun: (&str, &str), unit: &str) ->
     spec.split(',').map(|token| number(token, "entry")).collect()
 }
 
+/// The number of cores (1 if unknown): the default number of threads of a front end.
+pub fn all_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Checks that `value` of `option` is finite and positive; the error names it and its
+/// `unit` (none when empty).
+pub fn check_positive(option: &str, value: f64, unit: &str) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else if unit.is_empty() {
+        Err(Error::invalid(format!("{option} must be finite and positive, got {value}")))
+    } else {
+        Err(Error::invalid(format!("{option} must be finite and positive, got {value} ({unit})")))
+    }
+}
+
+/// Checks the radius of a pivot's circle, m: finite and positive.
+pub fn check_radius(radius: f64) -> Result<()> {
+    if radius.is_finite() && radius > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
+        )))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

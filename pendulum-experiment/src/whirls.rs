@@ -40,6 +40,12 @@ const DECAY_TIMES: f64 = 12.0;
 /// Default duration of an undamped sweep: this many periods of the first mode at rest.
 const UNDAMPED_PERIODS: f64 = 200.0;
 
+/// `√(g/L)`, rad/s, `L = Σ l_i` the chain's length (m), `g` its gravity (m/s²): the unit of
+/// scaled speeds (`--scaled`).
+pub fn reference_speed(gravity: f64, lengths: &[f64]) -> f64 {
+    (gravity / lengths.iter().sum::<f64>()).sqrt()
+}
+
 /// `σ = ½ Σ λ_i v_i²`, 1/s: the decay rate of the first mode of the hanging chain under
 /// the chain's damping, `v` its mass-normalised shape in link angles.
 pub fn first_mode_decay(chain: &Chain<Dyn>) -> f64 {

@@ -130,7 +130,6 @@ impl AtlasPlan {
         }
         let atlas = self.atlas.clone();
         let points = interruptible(py, "the atlas", move |stop| {
-            let all = atlas.points();
             let stop = || stop.load(Ordering::SeqCst);
             let ends = match threads {
                 None => atlas.run(&indices, &stop),
@@ -146,7 +145,7 @@ impl AtlasPlan {
                 .iter()
                 .zip(ends)
                 .map(|(&i, end)| {
-                    let mut p = all[i].clone();
+                    let mut p = atlas.point(i);
                     p.record(end);
                     p
                 })

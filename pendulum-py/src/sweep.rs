@@ -63,7 +63,7 @@ pub fn run_sweep(
         step,
     };
     let sweep = Sweep::new(request.resolve().map_err(run_error)?).map_err(run_error)?;
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let jobs = jobs.unwrap_or_else(pendulum_experiment::options::all_cores);
     let file = interruptible(py, "the sweep", move |stop| {
         let points = sweep.run(jobs, &|| stop.load(Ordering::SeqCst), &|_, _, _| Ok(()))?;
         let mut file = sweep.file(&points);

@@ -20,7 +20,7 @@ use pendulum_experiment::options::parse_values;
 
 use crate::args::ChainOptions;
 use crate::chain_args::per_link_values;
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
 use crate::spec::{expand, per_link};
 
 /// Options of `pendulum atlas`.
@@ -142,14 +142,8 @@ pub fn atlas(args: &AtlasArgs) -> CliResult<()> {
         }
         None => (args.physics.request()?.resolve()?, None),
     };
-    let jobs = match args.jobs {
-        Some(0) => return Err(CliError::invalid("--jobs must be at least 1, got 0")),
-        Some(j) => j,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    let jobs = crate::args::threads(args.jobs)?;
+    crate::args::create_out(&args.out)?;
     let run = runs::AtlasRun::new(config, points, args.out.clone(), jobs, args.quiet)?;
     let points = {
         let _stops = crate::interrupt::StopsItself::enter();

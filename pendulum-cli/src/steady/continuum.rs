@@ -55,9 +55,7 @@ pub fn run(args: &SteadyArgs, chain: &Chain<Dyn>) -> CliResult<()> {
         list.join(", "),
         (chain.gravity() / length).sqrt()
     );
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    crate::args::create_out(&args.out)?;
     let mut found = Vec::new();
     for &omega in &speeds {
         found.extend(string.shapes_at(omega)?);

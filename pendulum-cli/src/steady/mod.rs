@@ -87,9 +87,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
 
 /// Creates `--out`.
 fn create_out(args: &SteadyArgs) -> CliResult<()> {
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })
+    crate::args::create_out(&args.out)
 }
 
 /// Parses `--omega`: a comma list of finite, non-negative speeds (rad/s), at least one,

@@ -154,14 +154,8 @@ pub fn sweep(args: &SweepArgs) -> CliResult<()> {
         }
         None => args.physics.request()?.resolve()?,
     };
-    let jobs = match args.jobs {
-        Some(0) => return Err(CliError::invalid("--jobs must be at least 1, got 0")),
-        Some(j) => j,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::invalid(format!("--out: cannot create the directory {}: {e}", args.out.display()))
-    })?;
+    let jobs = crate::args::threads(args.jobs)?;
+    crate::args::create_out(&args.out)?;
     let sweep = Sweep::new(config)?;
     let started = Instant::now();
     if !args.quiet {

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 use super::{AtlasKind, Axis, Parameter};
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
-use crate::whirls::first_mode_decay;
+use crate::options::{check_positive, check_radius};
+use crate::whirls::{first_mode_decay, reference_speed};
 
 /// Most steps of one point.
 const MAX_STEPS: f64 = 1e8;
@@ -81,7 +82,7 @@ impl AtlasConfig {
 
     /// `√(g/L)`, rad/s: the unit of scaled speeds.
     pub fn reference_speed(&self) -> f64 {
-        (self.gravity / self.length()).sqrt()
+        reference_speed(self.gravity, &self.lengths)
     }
 
     /// Points per kind: the grid's size.
@@ -203,10 +204,8 @@ impl AtlasConfig {
             Some(r) => vec![r],
             None => self.axis(Parameter::Radius).map_or(vec![], |a| a.values.clone()),
         };
-        if let Some(r) = radii.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
-            return Err(Error::invalid(format!(
-                "--radius must be finite and positive (the pivot's circle drives the chain), got {r}"
-            )));
+        for &r in &radii {
+            check_radius(r)?;
         }
         if self.kinds.is_empty() {
             return Err(Error::invalid("--kind: no kind of start given"));
@@ -216,7 +215,7 @@ impl AtlasConfig {
         if ramp_axis && self.kinds.contains(&AtlasKind::Sudden) {
             return Err(Error::invalid("--ramp-time as an axis applies to the kind ramp-up only"));
         }
-        super::request::check_positive("--duration", self.duration, "s")?;
+        check_positive("--duration", self.duration, "s")?;
         let ramp_times = match (self.ramp_time, ramp_axis) {
             (Some(_), true) => return Err(Error::invalid("--ramp-time is an axis and also given one value")),
             (Some(t), false) if ramps => vec![t],
@@ -246,7 +245,7 @@ impl AtlasConfig {
         for (what, v) in
             [("settle_periods", self.settle_periods), ("settle_tolerance", self.settle_tolerance)]
         {
-            super::request::check_positive(what, v, "")?;
+            check_positive(what, v, "")?;
         }
         if self.len() > MAX_POINTS {
             return Err(Error::invalid(format!(

@@ -7,8 +7,11 @@ use pendulum_core::Chain;
 
 use super::{AtlasConfig, AtlasKind, Axis, Parameter};
 use crate::error::{Error, Result};
+use crate::options::check_positive;
 use crate::steady::round_up;
-use crate::whirls::{FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step};
+use crate::whirls::{
+    FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, reference_speed,
+};
 
 /// The values of the four parameters as a front end gives them: one value holds a
 /// parameter fixed, two or more make it an axis (exactly two must). `damping` is either
@@ -55,8 +58,7 @@ impl AtlasRequest {
                 self.gravity
             )));
         }
-        let length: f64 = self.lengths.iter().sum();
-        let unit = if self.scaled { (self.gravity / length).sqrt() } else { 1.0 };
+        let unit = if self.scaled { reference_speed(self.gravity, &self.lengths) } else { 1.0 };
         let omega: Vec<f64> = self.omega.iter().map(|w| w * unit).collect();
         let (damping_fixed, damping_axis) = match &self.damping {
             Damping::PerLink(d) => (Some(d.clone()), vec![]),
@@ -152,13 +154,5 @@ impl AtlasRequest {
         };
         config.check()?;
         Ok(config)
-    }
-}
-
-pub(super) fn check_positive(option: &str, value: f64, unit: &str) -> Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(format!("{option} must be finite and positive, got {value} ({unit})")))
     }
 }

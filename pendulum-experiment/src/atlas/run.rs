@@ -76,19 +76,20 @@ impl Atlas {
 
     /// The points of the atlas, all pending.
     pub fn points(&self) -> Vec<AtlasPoint> {
-        (0..self.config.len())
-            .map(|i| {
-                let (kind, ix, iy) = self.config.locate(i);
-                AtlasPoint {
-                    kind,
-                    x: self.config.x.values[ix],
-                    y: self.config.y.values[iy],
-                    status: Status::Pending,
-                    error: None,
-                    result: None,
-                }
-            })
-            .collect()
+        (0..self.config.len()).map(|i| self.point(i)).collect()
+    }
+
+    /// Point `index` (< [`AtlasConfig::len`]), pending.
+    pub fn point(&self, index: usize) -> AtlasPoint {
+        let (kind, ix, iy) = self.config.locate(index);
+        AtlasPoint {
+            kind,
+            x: self.config.x.values[ix],
+            y: self.config.y.values[iy],
+            status: Status::Pending,
+            error: None,
+            result: None,
+        }
     }
 }
 

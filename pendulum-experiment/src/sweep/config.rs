@@ -10,11 +10,12 @@ use serde::{Deserialize, Serialize};
 use super::SweepKind;
 use super::point::Point;
 use crate::error::{Error, Result};
-use crate::options::parse_values;
+use crate::options::{check_positive, check_radius, parse_values};
 use crate::points::{PointsFile, Recorded};
 use crate::steady::round_up;
 use crate::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
+    reference_speed,
 };
 
 /// Most steps of one point.
@@ -69,7 +70,7 @@ impl SweepConfig {
 
     /// `√(g/L)`, rad/s: the unit of `--scaled` speeds.
     pub fn reference_speed(&self) -> f64 {
-        (self.gravity / self.length()).sqrt()
+        reference_speed(self.gravity, &self.lengths)
     }
 
     /// The chain without damping (the steady shapes).
@@ -110,7 +111,7 @@ impl SweepConfig {
         if self.kinds.is_empty() {
             return Err(Error::invalid("--kind: no kind of experiment given"));
         }
-        check_duration(self.duration)?;
+        check_positive("--duration", self.duration, "s")?;
         let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
         match (self.ramp_time, ramps) {
             (Some(t), true) => {
@@ -226,7 +227,7 @@ impl SweepRequest {
         check_radius(p.radius)?;
         let spec = p.omega_spec.clone();
         let listed = parse_omegas(&spec, p.scaled)?;
-        let scale = (p.gravity / lengths.iter().sum::<f64>()).sqrt();
+        let scale = reference_speed(p.gravity, &lengths);
         let omegas: Vec<f64> = if p.scaled { listed.iter().map(|w| w * scale).collect() } else { listed };
         let mut kinds = Vec::new();
         for &k in &p.kinds {
@@ -235,7 +236,7 @@ impl SweepRequest {
             }
         }
         if let Some(d) = p.duration {
-            check_duration(d)?;
+            check_positive("--duration", d, "s")?;
         }
         let duration = match p.duration {
             Some(d) => d,
@@ -293,24 +294,6 @@ pub struct Derived {
     pub critical_speeds: Vec<f64>,
     /// Steps of every run.
     pub steps_per_point: u64,
-}
-
-fn check_radius(radius: f64) -> Result<()> {
-    if radius.is_finite() && radius > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(format!(
-            "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
-        )))
-    }
-}
-
-fn check_duration(duration: f64) -> Result<()> {
-    if duration.is_finite() && duration > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(format!("--duration must be finite and positive, got {duration} (s)")))
-    }
 }
 
 /// Parses `--omega`: a comma list of speeds or `A:B:N`, every speed finite and ≥ 0 (in
