@@ -7,7 +7,11 @@
 //!   (`PlanarTension`, `Directions<U3>`) against the batch on one thread and on two;
 //! - `rk4/whirl_100`: one projected RK4 step of 1 ms of 64 whirls (3D, n = 100, each pivot on
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
-//!   (throughput in chain-steps per second).
+//!   (throughput in chain-steps per second);
+//! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
+//!   the same models in lanes (`UnrolledBatch`), on one thread and on two;
+//!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
+//!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps).
 //!
 //! `cargo bench -p pendulum-core --bench ensembles`
 
@@ -15,14 +19,20 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Bencher, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::{DVector, Dyn, U2, U3};
-use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
+use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
+use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Chain, Circle, Directions, Inputs, Model, PlanarTension};
+use pendulum_core::{Chain, Circle, Directions, FirstOrder, Inputs, Model, PlanarTension};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 const CHAINS: usize = 64;
+
+pendulum_macros::model! {
+    struct Planar4 { kind: planar, links: 4 }
+    struct Planar8 { kind: planar, links: 8 }
+    struct Planar16 { kind: planar, links: 16 }
+}
 
 /// `n` links of about 1 cm and 10 g, each mass, length and damping within a factor `spread`.
 fn random_chain(n: usize, spread: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {
@@ -186,5 +196,109 @@ fn rk4(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, accelerations, rk4);
+/// One generated model type: its `CHAINS` models one call each against the batch.
+fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    r: &mut ChaCha8Rng,
+) {
+    let models: Vec<M> = (0..CHAINS).map(|_| M::from(fixed_chain::<N>(r))).collect();
+    let q: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let qd: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let states: Vec<(SVector<f64, N>, SVector<f64, N>)> = (0..CHAINS)
+        .map(|k| {
+            let row = k * N..(k + 1) * N;
+            (SVector::from_column_slice(&q[row.clone()]), SVector::from_column_slice(&qd[row]))
+        })
+        .collect();
+    let inputs = Inputs::<Const<N>, U2>::zeros(Const::<N>);
+    let mut one = SVector::<f64, N>::zeros();
+    group.bench_with_input(BenchmarkId::new("planar/single", N), &N, |b, _| {
+        b.iter(|| {
+            for (model, (q, qd)) in models.iter().zip(&states) {
+                model.accelerations(q, qd, &inputs, &mut one).expect("single");
+                black_box(&one);
+            }
+        })
+    });
+    let batch = UnrolledBatch::new(models).expect("batch");
+    let mut out = vec![0.0; CHAINS * N];
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        group.bench_with_input(BenchmarkId::new(format!("planar/batch_{threads}_threads"), N), &N, |b, _| {
+            in_pool(b, &pool, || {
+                batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+            })
+        });
+    }
+}
+
+/// 100 RK4 steps of each of the `CHAINS` models alone against the batch's run.
+fn generated_rk4<M, const N: usize, const D: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    r: &mut ChaCha8Rng,
+) where
+    M: PlanarKernel<N> + From<Chain<Const<N>>> + Clone,
+    Const<N>: nalgebra::DimMul<U2, Output = Const<D>>,
+{
+    const STEPS: usize = 100;
+    // Short of the stiffest mode of 8 links of 1 cm: every chain runs all its steps.
+    const H: f64 = 1e-4;
+    let models: Vec<M> = (0..CHAINS).map(|_| M::from(fixed_chain::<N>(r))).collect();
+    let states: Vec<State<Const<D>>> = (0..CHAINS)
+        .map(|_| State::new(0.0, SVector::<f64, D>::from_fn(|_, _| r.random_range(-1.0..1.0))))
+        .collect();
+    group.throughput(Throughput::Elements((CHAINS * STEPS) as u64));
+    let systems: Vec<_> = models.iter().cloned().map(FirstOrder::new).collect();
+    let mut rk4 = Rk4::new(&systems[0]);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/single", N), &N, |b, _| {
+        b.iter(|| {
+            for (system, state) in systems.iter().zip(&states) {
+                let mut state = state.clone();
+                for _ in 0..STEPS {
+                    rk4.step(system, &mut state, H).expect("single");
+                }
+                black_box(&state);
+            }
+        })
+    });
+    let batch = UnrolledBatch::new(models).expect("batch");
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        group.bench_with_input(
+            BenchmarkId::new(format!("rk4_100_steps/batch_{threads}_threads"), N),
+            &N,
+            |b, _| {
+                in_pool(b, &pool, || {
+                    let mut run = states.clone();
+                    batch.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                    black_box(&run);
+                })
+            },
+        );
+    }
+    group.throughput(Throughput::Elements(CHAINS as u64));
+}
+
+/// [`random_chain`] of `N` links.
+fn fixed_chain<const N: usize>(r: &mut ChaCha8Rng) -> Chain<Const<N>> {
+    let chain = random_chain(N, 2.0, r);
+    Chain::new(chain.masses().as_slice(), chain.lengths().as_slice(), 9.81)
+        .and_then(|c| c.with_damping(chain.damping().as_slice()))
+        .expect("chain")
+}
+
+fn generated(c: &mut Criterion) {
+    let mut group = c.benchmark_group("generated");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(30);
+    group.throughput(Throughput::Elements(CHAINS as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(37);
+    generated_one::<Planar4, 4>(&mut group, &mut r);
+    generated_one::<Planar8, 8>(&mut group, &mut r);
+    generated_one::<Planar16, 16>(&mut group, &mut r);
+    generated_rk4::<Planar4, 4, 8>(&mut group, &mut r);
+    generated_rk4::<Planar8, 8, 16>(&mut group, &mut r);
+    group.finish();
+}
+
+criterion_group!(benches, accelerations, rk4, generated);
 criterion_main!(benches);

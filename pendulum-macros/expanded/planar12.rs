@@ -187,16 +187,9 @@ pub struct Planar12 {
     ml10: ::core::primitive::f64,
     #[doc = " `M_11 l_11` (0-based), kg·m."]
     ml11: ::core::primitive::f64,
-    #[doc = " `1/m_i` per link (0-based), 1/kg."]
-    rod_im: [::core::primitive::f64; 12],
-    #[doc = " `l_i` per link, m."]
-    rod_l: [::core::primitive::f64; 12],
-    #[doc = " `1/l_i` per link, 1/m."]
-    rod_il: [::core::primitive::f64; 12],
-    #[doc = " `λ_i/l_i` per link, N·s."]
-    rod_drag: [::core::primitive::f64; 12],
-    #[doc = " `1/m_i + 1/m_{i−1}` per link (`1/m_0` for the first), 1/kg: the tension system's diagonal."]
-    rod_diag: [::core::primitive::f64; 12],
+    #[doc = r" The tension solve's per-link constants (`1/m_i`, `l_i`, `1/l_i`, `λ_i/l_i`,"]
+    #[doc = r" the system's diagonal) and `g`."]
+    rods: ::pendulum_core::batch::LinkConstants<::core::primitive::f64, 12>,
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -326,7 +319,7 @@ const _: () = {
             let ml9 = mt9 * l9;
             let ml10 = mt10 * l10;
             let ml11 = mt11 * l11;
-            let (rod_im, rod_l, rod_il, rod_drag, rod_diag) = {
+            let rods = {
                 let masses = chain.masses();
                 let lengths = chain.lengths();
                 let damping = chain.damping();
@@ -366,8 +359,8 @@ const _: () = {
                 let lam9 = damping[9];
                 let lam10 = damping[10];
                 let lam11 = damping[11];
-                (
-                    [
+                ::pendulum_core::batch::LinkConstants {
+                    inverse_mass: [
                         1.0 / m0,
                         1.0 / m1,
                         1.0 / m2,
@@ -381,8 +374,8 @@ const _: () = {
                         1.0 / m10,
                         1.0 / m11,
                     ],
-                    [l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11],
-                    [
+                    length: [l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11],
+                    inverse_length: [
                         1.0 / l0,
                         1.0 / l1,
                         1.0 / l2,
@@ -396,7 +389,7 @@ const _: () = {
                         1.0 / l10,
                         1.0 / l11,
                     ],
-                    [
+                    drag: [
                         lam0 / l0,
                         lam1 / l1,
                         lam2 / l2,
@@ -410,7 +403,7 @@ const _: () = {
                         lam10 / l10,
                         lam11 / l11,
                     ],
-                    [
+                    diagonal: [
                         1.0 / m0,
                         1.0 / m1 + 1.0 / m0,
                         1.0 / m2 + 1.0 / m1,
@@ -424,7 +417,8 @@ const _: () = {
                         1.0 / m10 + 1.0 / m9,
                         1.0 / m11 + 1.0 / m10,
                     ],
-                )
+                    gravity: chain.gravity(),
+                }
             };
             Self {
                 chain,
@@ -518,11 +512,7 @@ const _: () = {
                 ml9,
                 ml10,
                 ml11,
-                rod_im,
-                rod_l,
-                rod_il,
-                rod_drag,
-                rod_diag,
+                rods,
             }
         }
     }
@@ -1670,288 +1660,17 @@ const _: () = {
             }
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
-            let g = self.chain.gravity();
             let mut trig = [[0.0f64; 2]; 12];
             ::pendulum_core::__private::sin_cos_into(q.as_slice(), &mut trig);
-            let pa_x = pivot[0];
-            let pa_y = pivot[1];
-            let [st0, ct0] = trig[0];
-            let dth0 = qd[0];
-            let pull0 = torque[0] * self.rod_il[0] - self.rod_drag[0] * dth0;
-            let [st1, ct1] = trig[1];
-            let dth1 = qd[1];
-            let pull1 = torque[1] * self.rod_il[1] - self.rod_drag[1] * dth1;
-            let cd1 = ct0 * ct1 + st0 * st1;
-            let sd1 = st1 * ct0 - ct1 * st0;
-            let off1 = -cd1 * self.rod_im[0];
-            let [st2, ct2] = trig[2];
-            let dth2 = qd[2];
-            let pull2 = torque[2] * self.rod_il[2] - self.rod_drag[2] * dth2;
-            let cd2 = ct1 * ct2 + st1 * st2;
-            let sd2 = st2 * ct1 - ct2 * st1;
-            let off2 = -cd2 * self.rod_im[1];
-            let [st3, ct3] = trig[3];
-            let dth3 = qd[3];
-            let pull3 = torque[3] * self.rod_il[3] - self.rod_drag[3] * dth3;
-            let cd3 = ct2 * ct3 + st2 * st3;
-            let sd3 = st3 * ct2 - ct3 * st2;
-            let off3 = -cd3 * self.rod_im[2];
-            let [st4, ct4] = trig[4];
-            let dth4 = qd[4];
-            let pull4 = torque[4] * self.rod_il[4] - self.rod_drag[4] * dth4;
-            let cd4 = ct3 * ct4 + st3 * st4;
-            let sd4 = st4 * ct3 - ct4 * st3;
-            let off4 = -cd4 * self.rod_im[3];
-            let [st5, ct5] = trig[5];
-            let dth5 = qd[5];
-            let pull5 = torque[5] * self.rod_il[5] - self.rod_drag[5] * dth5;
-            let cd5 = ct4 * ct5 + st4 * st5;
-            let sd5 = st5 * ct4 - ct5 * st4;
-            let off5 = -cd5 * self.rod_im[4];
-            let [st6, ct6] = trig[6];
-            let dth6 = qd[6];
-            let pull6 = torque[6] * self.rod_il[6] - self.rod_drag[6] * dth6;
-            let cd6 = ct5 * ct6 + st5 * st6;
-            let sd6 = st6 * ct5 - ct6 * st5;
-            let off6 = -cd6 * self.rod_im[5];
-            let [st7, ct7] = trig[7];
-            let dth7 = qd[7];
-            let pull7 = torque[7] * self.rod_il[7] - self.rod_drag[7] * dth7;
-            let cd7 = ct6 * ct7 + st6 * st7;
-            let sd7 = st7 * ct6 - ct7 * st6;
-            let off7 = -cd7 * self.rod_im[6];
-            let [st8, ct8] = trig[8];
-            let dth8 = qd[8];
-            let pull8 = torque[8] * self.rod_il[8] - self.rod_drag[8] * dth8;
-            let cd8 = ct7 * ct8 + st7 * st8;
-            let sd8 = st8 * ct7 - ct8 * st7;
-            let off8 = -cd8 * self.rod_im[7];
-            let [st9, ct9] = trig[9];
-            let dth9 = qd[9];
-            let pull9 = torque[9] * self.rod_il[9] - self.rod_drag[9] * dth9;
-            let cd9 = ct8 * ct9 + st8 * st9;
-            let sd9 = st9 * ct8 - ct9 * st8;
-            let off9 = -cd9 * self.rod_im[8];
-            let [st10, ct10] = trig[10];
-            let dth10 = qd[10];
-            let pull10 = torque[10] * self.rod_il[10] - self.rod_drag[10] * dth10;
-            let cd10 = ct9 * ct10 + st9 * st10;
-            let sd10 = st10 * ct9 - ct10 * st9;
-            let off10 = -cd10 * self.rod_im[9];
-            let [st11, ct11] = trig[11];
-            let dth11 = qd[11];
-            let pull11 = torque[11] * self.rod_il[11] - self.rod_drag[11] * dth11;
-            let cd11 = ct10 * ct11 + st10 * st11;
-            let sd11 = st11 * ct10 - ct11 * st10;
-            let off11 = -cd11 * self.rod_im[10];
-            let b0 =
-                self.rod_l[0] * dth0 * dth0 + ct0 * (g + pa_y) - st0 * pa_x + pull1 * sd1 * self.rod_im[0];
-            let b1 =
-                self.rod_l[1] * dth1 * dth1 + -pull0 * sd1 * self.rod_im[0] + pull2 * sd2 * self.rod_im[1];
-            let b2 =
-                self.rod_l[2] * dth2 * dth2 + -pull1 * sd2 * self.rod_im[1] + pull3 * sd3 * self.rod_im[2];
-            let b3 =
-                self.rod_l[3] * dth3 * dth3 + -pull2 * sd3 * self.rod_im[2] + pull4 * sd4 * self.rod_im[3];
-            let b4 =
-                self.rod_l[4] * dth4 * dth4 + -pull3 * sd4 * self.rod_im[3] + pull5 * sd5 * self.rod_im[4];
-            let b5 =
-                self.rod_l[5] * dth5 * dth5 + -pull4 * sd5 * self.rod_im[4] + pull6 * sd6 * self.rod_im[5];
-            let b6 =
-                self.rod_l[6] * dth6 * dth6 + -pull5 * sd6 * self.rod_im[5] + pull7 * sd7 * self.rod_im[6];
-            let b7 =
-                self.rod_l[7] * dth7 * dth7 + -pull6 * sd7 * self.rod_im[6] + pull8 * sd8 * self.rod_im[7];
-            let b8 =
-                self.rod_l[8] * dth8 * dth8 + -pull7 * sd8 * self.rod_im[7] + pull9 * sd9 * self.rod_im[8];
-            let b9 =
-                self.rod_l[9] * dth9 * dth9 + -pull8 * sd9 * self.rod_im[8] + pull10 * sd10 * self.rod_im[9];
-            let b10 = self.rod_l[10] * dth10 * dth10
-                + -pull9 * sd10 * self.rod_im[9]
-                + pull11 * sd11 * self.rod_im[10];
-            let b11 = self.rod_l[11] * dth11 * dth11 + -pull10 * sd11 * self.rod_im[10];
-            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
-            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
-            #[cold]
-            #[inline(never)]
-            fn pivots(diagonal: [f64; 12], off: [f64; 12], rhs: [f64; 12]) -> [f64; 12] {
-                let ip0 = 1.0 / diagonal[0];
-                let e0 = rhs[0];
-                let s0 = e0 * ip0;
-                let fac1 = off[1] * ip0;
-                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
-                let e1 = rhs[1] - fac1 * e0;
-                let s1 = e1 * ip1;
-                let fac2 = off[2] * ip1;
-                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
-                let e2 = rhs[2] - fac2 * e1;
-                let s2 = e2 * ip2;
-                let fac3 = off[3] * ip2;
-                let ip3 = 1.0 / (diagonal[3] - fac3 * off[3]);
-                let e3 = rhs[3] - fac3 * e2;
-                let s3 = e3 * ip3;
-                let fac4 = off[4] * ip3;
-                let ip4 = 1.0 / (diagonal[4] - fac4 * off[4]);
-                let e4 = rhs[4] - fac4 * e3;
-                let s4 = e4 * ip4;
-                let fac5 = off[5] * ip4;
-                let ip5 = 1.0 / (diagonal[5] - fac5 * off[5]);
-                let e5 = rhs[5] - fac5 * e4;
-                let s5 = e5 * ip5;
-                let fac6 = off[6] * ip5;
-                let ip6 = 1.0 / (diagonal[6] - fac6 * off[6]);
-                let e6 = rhs[6] - fac6 * e5;
-                let s6 = e6 * ip6;
-                let fac7 = off[7] * ip6;
-                let ip7 = 1.0 / (diagonal[7] - fac7 * off[7]);
-                let e7 = rhs[7] - fac7 * e6;
-                let s7 = e7 * ip7;
-                let fac8 = off[8] * ip7;
-                let ip8 = 1.0 / (diagonal[8] - fac8 * off[8]);
-                let e8 = rhs[8] - fac8 * e7;
-                let s8 = e8 * ip8;
-                let fac9 = off[9] * ip8;
-                let ip9 = 1.0 / (diagonal[9] - fac9 * off[9]);
-                let e9 = rhs[9] - fac9 * e8;
-                let s9 = e9 * ip9;
-                let fac10 = off[10] * ip9;
-                let ip10 = 1.0 / (diagonal[10] - fac10 * off[10]);
-                let e10 = rhs[10] - fac10 * e9;
-                let s10 = e10 * ip10;
-                let fac11 = off[11] * ip10;
-                let ip11 = 1.0 / (diagonal[11] - fac11 * off[11]);
-                let e11 = rhs[11] - fac11 * e10;
-                let s11 = e11 * ip11;
-                let t11 = s11;
-                let t10 = s10 - fac11 * t11;
-                let t9 = s9 - fac10 * t10;
-                let t8 = s8 - fac9 * t9;
-                let t7 = s7 - fac8 * t8;
-                let t6 = s6 - fac7 * t7;
-                let t5 = s5 - fac6 * t6;
-                let t4 = s4 - fac5 * t5;
-                let t3 = s3 - fac4 * t4;
-                let t2 = s2 - fac3 * t3;
-                let t1 = s1 - fac2 * t2;
-                let t0 = s0 - fac1 * t1;
-                [t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11]
-            }
-            let (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11) = {
-                let p0 = self.rod_diag[0];
-                let yt0 = b0;
-                let q11 = self.rod_diag[11];
-                let zb11 = b11;
-                let p1 = self.rod_diag[1] * p0 - off1 * off1;
-                let yt1 = b1 * p0 - off1 * yt0;
-                let q10 = self.rod_diag[10] * q11 - off11 * off11;
-                let zb10 = b10 * q11 - off11 * zb11;
-                let p2 = self.rod_diag[2] * p1 - (off2 * off2) * p0;
-                let yt2 = b2 * p1 - off2 * yt1;
-                let q9 = self.rod_diag[9] * q10 - (off10 * off10) * q11;
-                let zb9 = b9 * q10 - off10 * zb10;
-                let p3 = self.rod_diag[3] * p2 - (off3 * off3) * p1;
-                let yt3 = b3 * p2 - off3 * yt2;
-                let q8 = self.rod_diag[8] * q9 - (off9 * off9) * q10;
-                let zb8 = b8 * q9 - off9 * zb9;
-                let p4 = self.rod_diag[4] * p3 - (off4 * off4) * p2;
-                let yt4 = b4 * p3 - off4 * yt3;
-                let q7 = self.rod_diag[7] * q8 - (off8 * off8) * q9;
-                let zb7 = b7 * q8 - off8 * zb8;
-                let p5 = self.rod_diag[5] * p4 - (off5 * off5) * p3;
-                let yt5 = b5 * p4 - off5 * yt4;
-                let rp0 = 1.0 / p0;
-                let rp1 = 1.0 / p1;
-                let rp2 = 1.0 / p2;
-                let rp3 = 1.0 / p3;
-                let rp4 = 1.0 / p4;
-                let rp5 = 1.0 / p5;
-                let rq11 = 1.0 / q11;
-                let rq10 = 1.0 / q10;
-                let rq9 = 1.0 / q9;
-                let rq8 = 1.0 / q8;
-                let rq7 = 1.0 / q7;
-                let t6 = (b6 - off6 * yt5 * rp5 - off7 * zb7 * rq7)
-                    / (self.rod_diag[6] - (off6 * off6) * p4 * rp5 - (off7 * off7) * q8 * rq7);
-                let t5 = yt5 * rp5 - off6 * p4 * rp5 * t6;
-                let t7 = zb7 * rq7 - off7 * q8 * rq7 * t6;
-                let t4 = yt4 * rp4 - off5 * p3 * rp4 * t5;
-                let t8 = zb8 * rq8 - off8 * q9 * rq8 * t7;
-                let t3 = yt3 * rp3 - off4 * p2 * rp3 * t4;
-                let t9 = zb9 * rq9 - off9 * q10 * rq9 * t8;
-                let t2 = yt2 * rp2 - off3 * p1 * rp2 * t3;
-                let t10 = zb10 * rq10 - off10 * q11 * rq10 * t9;
-                let t1 = yt1 * rp1 - off2 * p0 * rp1 * t2;
-                let t11 = zb11 * rq11 - off11 * rq11 * t10;
-                let t0 = yt0 * rp0 - off1 * rp0 * t1;
-                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-                if false
-                    | (p0.to_bits().wrapping_sub(low) > span)
-                    | (p1.to_bits().wrapping_sub(low) > span)
-                    | (p2.to_bits().wrapping_sub(low) > span)
-                    | (p3.to_bits().wrapping_sub(low) > span)
-                    | (p4.to_bits().wrapping_sub(low) > span)
-                    | (p5.to_bits().wrapping_sub(low) > span)
-                    | (q11.to_bits().wrapping_sub(low) > span)
-                    | (q10.to_bits().wrapping_sub(low) > span)
-                    | (q9.to_bits().wrapping_sub(low) > span)
-                    | (q8.to_bits().wrapping_sub(low) > span)
-                    | (q7.to_bits().wrapping_sub(low) > span)
-                {
-                    let t = pivots(
-                        [
-                            self.rod_diag[0],
-                            self.rod_diag[1],
-                            self.rod_diag[2],
-                            self.rod_diag[3],
-                            self.rod_diag[4],
-                            self.rod_diag[5],
-                            self.rod_diag[6],
-                            self.rod_diag[7],
-                            self.rod_diag[8],
-                            self.rod_diag[9],
-                            self.rod_diag[10],
-                            self.rod_diag[11],
-                        ],
-                        [0.0, off1, off2, off3, off4, off5, off6, off7, off8, off9, off10, off11],
-                        [b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, b11],
-                    );
-                    (t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8], t[9], t[10], t[11])
-                } else {
-                    (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11)
-                }
-            };
-            let x_th0 = ((pull0 - pull1 * cd1 + t1 * sd1) * self.rod_im[0] - (ct0 * pa_x + st0 * (pa_y + g)))
-                * self.rod_il[0];
-            let x_th1 = ((pull1 - pull2 * cd2 + t2 * sd2) * self.rod_im[1]
-                - (pull0 * cd1 - pull1 + t0 * sd1) * self.rod_im[0])
-                * self.rod_il[1];
-            let x_th2 = ((pull2 - pull3 * cd3 + t3 * sd3) * self.rod_im[2]
-                - (pull1 * cd2 - pull2 + t1 * sd2) * self.rod_im[1])
-                * self.rod_il[2];
-            let x_th3 = ((pull3 - pull4 * cd4 + t4 * sd4) * self.rod_im[3]
-                - (pull2 * cd3 - pull3 + t2 * sd3) * self.rod_im[2])
-                * self.rod_il[3];
-            let x_th4 = ((pull4 - pull5 * cd5 + t5 * sd5) * self.rod_im[4]
-                - (pull3 * cd4 - pull4 + t3 * sd4) * self.rod_im[3])
-                * self.rod_il[4];
-            let x_th5 = ((pull5 - pull6 * cd6 + t6 * sd6) * self.rod_im[5]
-                - (pull4 * cd5 - pull5 + t4 * sd5) * self.rod_im[4])
-                * self.rod_il[5];
-            let x_th6 = ((pull6 - pull7 * cd7 + t7 * sd7) * self.rod_im[6]
-                - (pull5 * cd6 - pull6 + t5 * sd6) * self.rod_im[5])
-                * self.rod_il[6];
-            let x_th7 = ((pull7 - pull8 * cd8 + t8 * sd8) * self.rod_im[7]
-                - (pull6 * cd7 - pull7 + t6 * sd7) * self.rod_im[6])
-                * self.rod_il[7];
-            let x_th8 = ((pull8 - pull9 * cd9 + t9 * sd9) * self.rod_im[8]
-                - (pull7 * cd8 - pull8 + t7 * sd8) * self.rod_im[7])
-                * self.rod_il[8];
-            let x_th9 = ((pull9 - pull10 * cd10 + t10 * sd10) * self.rod_im[9]
-                - (pull8 * cd9 - pull9 + t8 * sd9) * self.rod_im[8])
-                * self.rod_il[9];
-            let x_th10 = ((pull10 - pull11 * cd11 + t11 * sd11) * self.rod_im[10]
-                - (pull9 * cd10 - pull10 + t9 * sd10) * self.rod_im[9])
-                * self.rod_il[10];
-            let x_th11 = (pull11 * self.rod_im[11] - (pull10 * cd11 - pull11 + t10 * sd11) * self.rod_im[10])
-                * self.rod_il[11];
+            let trig: [[f64; 2]; 12] = ::core::array::from_fn(|i| trig[i]);
+            let [x_th0, x_th1, x_th2, x_th3, x_th4, x_th5, x_th6, x_th7, x_th8, x_th9, x_th10, x_th11] =
+                <Self as ::pendulum_core::batch::PlanarKernel<12>>::kernel::<f64>(
+                    &self.rods,
+                    &trig,
+                    &qd.data.0[0],
+                    &torque.data.0[0],
+                    [pivot[0], pivot[1]],
+                );
             if ((((x_th0 - x_th0) + ((x_th1 - x_th1) + (x_th2 - x_th2)))
                 + ((x_th3 - x_th3) + ((x_th4 - x_th4) + (x_th5 - x_th5))))
                 + (((x_th6 - x_th6) + ((x_th7 - x_th7) + (x_th8 - x_th8)))
@@ -3277,10 +2996,10 @@ const _: () = {
             ::pendulum_core::__private::planar_tension_jacobians(
                 self,
                 ::pendulum_core::__private::RodConstants {
-                    inverse_mass: &self.rod_im,
-                    length: &self.rod_l,
-                    inverse_length: &self.rod_il,
-                    drag: &self.rod_drag,
+                    inverse_mass: &self.rods.inverse_mass,
+                    length: &self.rods.length,
+                    inverse_length: &self.rods.inverse_length,
+                    drag: &self.rods.drag,
                 },
                 q,
                 qd,
@@ -3300,10 +3019,10 @@ const _: () = {
             ::pendulum_core::__private::planar_tension_jacobians(
                 self,
                 ::pendulum_core::__private::RodConstants {
-                    inverse_mass: &self.rod_im,
-                    length: &self.rod_l,
-                    inverse_length: &self.rod_il,
-                    drag: &self.rod_drag,
+                    inverse_mass: &self.rods.inverse_mass,
+                    length: &self.rods.length,
+                    inverse_length: &self.rods.inverse_length,
+                    drag: &self.rods.drag,
                 },
                 q,
                 qd,
@@ -3311,6 +3030,348 @@ const _: () = {
                 out,
                 ::pendulum_core::Parts::State,
             )
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl ::pendulum_core::batch::PlanarKernel<12> for Planar12 {
+        fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, 12> {
+            &self.rods
+        }
+        #[inline(always)]
+        fn kernel<V: ::pendulum_core::lanes::Lane>(
+            c: &::pendulum_core::batch::LinkConstants<V, 12>,
+            trig: &[[V; 2]; 12],
+            rates: &[V; 12],
+            torque: &[V; 12],
+            pivot: [V; 2],
+        ) -> [V; 12] {
+            let rod_im = &c.inverse_mass;
+            let rod_l = &c.length;
+            let rod_il = &c.inverse_length;
+            let rod_drag = &c.drag;
+            let rod_diag = &c.diagonal;
+            let g = c.gravity;
+            let one = <V as ::pendulum_core::lanes::Lane>::splat(1.0);
+            let zero = <V as ::pendulum_core::lanes::Lane>::splat(0.0);
+            let [pa_x, pa_y] = pivot;
+            let [st0, ct0] = trig[0];
+            let dth0 = rates[0];
+            let pull0 = torque[0] * rod_il[0] - rod_drag[0] * dth0;
+            let [st1, ct1] = trig[1];
+            let dth1 = rates[1];
+            let pull1 = torque[1] * rod_il[1] - rod_drag[1] * dth1;
+            let cd1 = ct0 * ct1 + st0 * st1;
+            let sd1 = st1 * ct0 - ct1 * st0;
+            let off1 = -cd1 * rod_im[0];
+            let [st2, ct2] = trig[2];
+            let dth2 = rates[2];
+            let pull2 = torque[2] * rod_il[2] - rod_drag[2] * dth2;
+            let cd2 = ct1 * ct2 + st1 * st2;
+            let sd2 = st2 * ct1 - ct2 * st1;
+            let off2 = -cd2 * rod_im[1];
+            let [st3, ct3] = trig[3];
+            let dth3 = rates[3];
+            let pull3 = torque[3] * rod_il[3] - rod_drag[3] * dth3;
+            let cd3 = ct2 * ct3 + st2 * st3;
+            let sd3 = st3 * ct2 - ct3 * st2;
+            let off3 = -cd3 * rod_im[2];
+            let [st4, ct4] = trig[4];
+            let dth4 = rates[4];
+            let pull4 = torque[4] * rod_il[4] - rod_drag[4] * dth4;
+            let cd4 = ct3 * ct4 + st3 * st4;
+            let sd4 = st4 * ct3 - ct4 * st3;
+            let off4 = -cd4 * rod_im[3];
+            let [st5, ct5] = trig[5];
+            let dth5 = rates[5];
+            let pull5 = torque[5] * rod_il[5] - rod_drag[5] * dth5;
+            let cd5 = ct4 * ct5 + st4 * st5;
+            let sd5 = st5 * ct4 - ct5 * st4;
+            let off5 = -cd5 * rod_im[4];
+            let [st6, ct6] = trig[6];
+            let dth6 = rates[6];
+            let pull6 = torque[6] * rod_il[6] - rod_drag[6] * dth6;
+            let cd6 = ct5 * ct6 + st5 * st6;
+            let sd6 = st6 * ct5 - ct6 * st5;
+            let off6 = -cd6 * rod_im[5];
+            let [st7, ct7] = trig[7];
+            let dth7 = rates[7];
+            let pull7 = torque[7] * rod_il[7] - rod_drag[7] * dth7;
+            let cd7 = ct6 * ct7 + st6 * st7;
+            let sd7 = st7 * ct6 - ct7 * st6;
+            let off7 = -cd7 * rod_im[6];
+            let [st8, ct8] = trig[8];
+            let dth8 = rates[8];
+            let pull8 = torque[8] * rod_il[8] - rod_drag[8] * dth8;
+            let cd8 = ct7 * ct8 + st7 * st8;
+            let sd8 = st8 * ct7 - ct8 * st7;
+            let off8 = -cd8 * rod_im[7];
+            let [st9, ct9] = trig[9];
+            let dth9 = rates[9];
+            let pull9 = torque[9] * rod_il[9] - rod_drag[9] * dth9;
+            let cd9 = ct8 * ct9 + st8 * st9;
+            let sd9 = st9 * ct8 - ct9 * st8;
+            let off9 = -cd9 * rod_im[8];
+            let [st10, ct10] = trig[10];
+            let dth10 = rates[10];
+            let pull10 = torque[10] * rod_il[10] - rod_drag[10] * dth10;
+            let cd10 = ct9 * ct10 + st9 * st10;
+            let sd10 = st10 * ct9 - ct10 * st9;
+            let off10 = -cd10 * rod_im[9];
+            let [st11, ct11] = trig[11];
+            let dth11 = rates[11];
+            let pull11 = torque[11] * rod_il[11] - rod_drag[11] * dth11;
+            let cd11 = ct10 * ct11 + st10 * st11;
+            let sd11 = st11 * ct10 - ct11 * st10;
+            let off11 = -cd11 * rod_im[10];
+            let b0 = rod_l[0] * dth0 * dth0 + ct0 * (g + pa_y) - st0 * pa_x + pull1 * sd1 * rod_im[0];
+            let b1 = rod_l[1] * dth1 * dth1 + -pull0 * sd1 * rod_im[0] + pull2 * sd2 * rod_im[1];
+            let b2 = rod_l[2] * dth2 * dth2 + -pull1 * sd2 * rod_im[1] + pull3 * sd3 * rod_im[2];
+            let b3 = rod_l[3] * dth3 * dth3 + -pull2 * sd3 * rod_im[2] + pull4 * sd4 * rod_im[3];
+            let b4 = rod_l[4] * dth4 * dth4 + -pull3 * sd4 * rod_im[3] + pull5 * sd5 * rod_im[4];
+            let b5 = rod_l[5] * dth5 * dth5 + -pull4 * sd5 * rod_im[4] + pull6 * sd6 * rod_im[5];
+            let b6 = rod_l[6] * dth6 * dth6 + -pull5 * sd6 * rod_im[5] + pull7 * sd7 * rod_im[6];
+            let b7 = rod_l[7] * dth7 * dth7 + -pull6 * sd7 * rod_im[6] + pull8 * sd8 * rod_im[7];
+            let b8 = rod_l[8] * dth8 * dth8 + -pull7 * sd8 * rod_im[7] + pull9 * sd9 * rod_im[8];
+            let b9 = rod_l[9] * dth9 * dth9 + -pull8 * sd9 * rod_im[8] + pull10 * sd10 * rod_im[9];
+            let b10 = rod_l[10] * dth10 * dth10 + -pull9 * sd10 * rod_im[9] + pull11 * sd11 * rod_im[10];
+            let b11 = rod_l[11] * dth11 * dth11 + -pull10 * sd11 * rod_im[10];
+            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
+            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
+            #[cold]
+            #[inline(never)]
+            fn pivots<V: ::pendulum_core::lanes::Lane>(
+                diagonal: [V; 12],
+                off: [V; 12],
+                rhs: [V; 12],
+            ) -> [V; 12] {
+                let one = V::splat(1.0);
+                let ip0 = one / diagonal[0];
+                let e0 = rhs[0];
+                let s0 = e0 * ip0;
+                let fac1 = off[1] * ip0;
+                let ip1 = one / (diagonal[1] - fac1 * off[1]);
+                let e1 = rhs[1] - fac1 * e0;
+                let s1 = e1 * ip1;
+                let fac2 = off[2] * ip1;
+                let ip2 = one / (diagonal[2] - fac2 * off[2]);
+                let e2 = rhs[2] - fac2 * e1;
+                let s2 = e2 * ip2;
+                let fac3 = off[3] * ip2;
+                let ip3 = one / (diagonal[3] - fac3 * off[3]);
+                let e3 = rhs[3] - fac3 * e2;
+                let s3 = e3 * ip3;
+                let fac4 = off[4] * ip3;
+                let ip4 = one / (diagonal[4] - fac4 * off[4]);
+                let e4 = rhs[4] - fac4 * e3;
+                let s4 = e4 * ip4;
+                let fac5 = off[5] * ip4;
+                let ip5 = one / (diagonal[5] - fac5 * off[5]);
+                let e5 = rhs[5] - fac5 * e4;
+                let s5 = e5 * ip5;
+                let fac6 = off[6] * ip5;
+                let ip6 = one / (diagonal[6] - fac6 * off[6]);
+                let e6 = rhs[6] - fac6 * e5;
+                let s6 = e6 * ip6;
+                let fac7 = off[7] * ip6;
+                let ip7 = one / (diagonal[7] - fac7 * off[7]);
+                let e7 = rhs[7] - fac7 * e6;
+                let s7 = e7 * ip7;
+                let fac8 = off[8] * ip7;
+                let ip8 = one / (diagonal[8] - fac8 * off[8]);
+                let e8 = rhs[8] - fac8 * e7;
+                let s8 = e8 * ip8;
+                let fac9 = off[9] * ip8;
+                let ip9 = one / (diagonal[9] - fac9 * off[9]);
+                let e9 = rhs[9] - fac9 * e8;
+                let s9 = e9 * ip9;
+                let fac10 = off[10] * ip9;
+                let ip10 = one / (diagonal[10] - fac10 * off[10]);
+                let e10 = rhs[10] - fac10 * e9;
+                let s10 = e10 * ip10;
+                let fac11 = off[11] * ip10;
+                let ip11 = one / (diagonal[11] - fac11 * off[11]);
+                let e11 = rhs[11] - fac11 * e10;
+                let s11 = e11 * ip11;
+                let t11 = s11;
+                let t10 = s10 - fac11 * t11;
+                let t9 = s9 - fac10 * t10;
+                let t8 = s8 - fac9 * t9;
+                let t7 = s7 - fac8 * t8;
+                let t6 = s6 - fac7 * t7;
+                let t5 = s5 - fac6 * t6;
+                let t4 = s4 - fac5 * t5;
+                let t3 = s3 - fac4 * t4;
+                let t2 = s2 - fac3 * t3;
+                let t1 = s1 - fac2 * t2;
+                let t0 = s0 - fac1 * t1;
+                [t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11]
+            }
+            let (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11) = {
+                let p0 = rod_diag[0];
+                let yt0 = b0;
+                let q11 = rod_diag[11];
+                let zb11 = b11;
+                let p1 = rod_diag[1] * p0 - off1 * off1;
+                let yt1 = b1 * p0 - off1 * yt0;
+                let q10 = rod_diag[10] * q11 - off11 * off11;
+                let zb10 = b10 * q11 - off11 * zb11;
+                let p2 = rod_diag[2] * p1 - (off2 * off2) * p0;
+                let yt2 = b2 * p1 - off2 * yt1;
+                let q9 = rod_diag[9] * q10 - (off10 * off10) * q11;
+                let zb9 = b9 * q10 - off10 * zb10;
+                let p3 = rod_diag[3] * p2 - (off3 * off3) * p1;
+                let yt3 = b3 * p2 - off3 * yt2;
+                let q8 = rod_diag[8] * q9 - (off9 * off9) * q10;
+                let zb8 = b8 * q9 - off9 * zb9;
+                let p4 = rod_diag[4] * p3 - (off4 * off4) * p2;
+                let yt4 = b4 * p3 - off4 * yt3;
+                let q7 = rod_diag[7] * q8 - (off8 * off8) * q9;
+                let zb7 = b7 * q8 - off8 * zb8;
+                let p5 = rod_diag[5] * p4 - (off5 * off5) * p3;
+                let yt5 = b5 * p4 - off5 * yt4;
+                let rp0 = one / p0;
+                let rp1 = one / p1;
+                let rp2 = one / p2;
+                let rp3 = one / p3;
+                let rp4 = one / p4;
+                let rp5 = one / p5;
+                let rq11 = one / q11;
+                let rq10 = one / q10;
+                let rq9 = one / q9;
+                let rq8 = one / q8;
+                let rq7 = one / q7;
+                let t6 = (b6 - off6 * yt5 * rp5 - off7 * zb7 * rq7)
+                    / (rod_diag[6] - (off6 * off6) * p4 * rp5 - (off7 * off7) * q8 * rq7);
+                let t5 = yt5 * rp5 - off6 * p4 * rp5 * t6;
+                let t7 = zb7 * rq7 - off7 * q8 * rq7 * t6;
+                let t4 = yt4 * rp4 - off5 * p3 * rp4 * t5;
+                let t8 = zb8 * rq8 - off8 * q9 * rq8 * t7;
+                let t3 = yt3 * rp3 - off4 * p2 * rp3 * t4;
+                let t9 = zb9 * rq9 - off9 * q10 * rq9 * t8;
+                let t2 = yt2 * rp2 - off3 * p1 * rp2 * t3;
+                let t10 = zb10 * rq10 - off10 * q11 * rq10 * t9;
+                let t1 = yt1 * rp1 - off2 * p0 * rp1 * t2;
+                let t11 = zb11 * rq11 - off11 * rq11 * t10;
+                let t0 = yt0 * rp0 - off1 * rp0 * t1;
+                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
+                let outside = <V as ::pendulum_core::lanes::Lane>::none();
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p0, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p1, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p2, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p3, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p4, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p5, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q11, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q10, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q9, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q8, low, span),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q7, low, span),
+                );
+                if <V as ::pendulum_core::lanes::Lane>::any(outside) {
+                    let t = pivots(
+                        [
+                            rod_diag[0],
+                            rod_diag[1],
+                            rod_diag[2],
+                            rod_diag[3],
+                            rod_diag[4],
+                            rod_diag[5],
+                            rod_diag[6],
+                            rod_diag[7],
+                            rod_diag[8],
+                            rod_diag[9],
+                            rod_diag[10],
+                            rod_diag[11],
+                        ],
+                        [zero, off1, off2, off3, off4, off5, off6, off7, off8, off9, off10, off11],
+                        [b0, b1, b2, b3, b4, b5, b6, b7, b8, b9, b10, b11],
+                    );
+                    (
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[0], t0),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[1], t1),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[2], t2),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[3], t3),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[4], t4),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[5], t5),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[6], t6),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[7], t7),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[8], t8),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[9], t9),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[10], t10),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[11], t11),
+                    )
+                } else {
+                    (t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11)
+                }
+            };
+            let x_th0 =
+                ((pull0 - pull1 * cd1 + t1 * sd1) * rod_im[0] - (ct0 * pa_x + st0 * (pa_y + g))) * rod_il[0];
+            let x_th1 = ((pull1 - pull2 * cd2 + t2 * sd2) * rod_im[1]
+                - (pull0 * cd1 - pull1 + t0 * sd1) * rod_im[0])
+                * rod_il[1];
+            let x_th2 = ((pull2 - pull3 * cd3 + t3 * sd3) * rod_im[2]
+                - (pull1 * cd2 - pull2 + t1 * sd2) * rod_im[1])
+                * rod_il[2];
+            let x_th3 = ((pull3 - pull4 * cd4 + t4 * sd4) * rod_im[3]
+                - (pull2 * cd3 - pull3 + t2 * sd3) * rod_im[2])
+                * rod_il[3];
+            let x_th4 = ((pull4 - pull5 * cd5 + t5 * sd5) * rod_im[4]
+                - (pull3 * cd4 - pull4 + t3 * sd4) * rod_im[3])
+                * rod_il[4];
+            let x_th5 = ((pull5 - pull6 * cd6 + t6 * sd6) * rod_im[5]
+                - (pull4 * cd5 - pull5 + t4 * sd5) * rod_im[4])
+                * rod_il[5];
+            let x_th6 = ((pull6 - pull7 * cd7 + t7 * sd7) * rod_im[6]
+                - (pull5 * cd6 - pull6 + t5 * sd6) * rod_im[5])
+                * rod_il[6];
+            let x_th7 = ((pull7 - pull8 * cd8 + t8 * sd8) * rod_im[7]
+                - (pull6 * cd7 - pull7 + t6 * sd7) * rod_im[6])
+                * rod_il[7];
+            let x_th8 = ((pull8 - pull9 * cd9 + t9 * sd9) * rod_im[8]
+                - (pull7 * cd8 - pull8 + t7 * sd8) * rod_im[7])
+                * rod_il[8];
+            let x_th9 = ((pull9 - pull10 * cd10 + t10 * sd10) * rod_im[9]
+                - (pull8 * cd9 - pull9 + t8 * sd9) * rod_im[8])
+                * rod_il[9];
+            let x_th10 = ((pull10 - pull11 * cd11 + t11 * sd11) * rod_im[10]
+                - (pull9 * cd10 - pull10 + t9 * sd10) * rod_im[9])
+                * rod_il[10];
+            let x_th11 =
+                (pull11 * rod_im[11] - (pull10 * cd11 - pull11 + t10 * sd11) * rod_im[10]) * rod_il[11];
+            [x_th0, x_th1, x_th2, x_th3, x_th4, x_th5, x_th6, x_th7, x_th8, x_th9, x_th10, x_th11]
         }
     }
 };

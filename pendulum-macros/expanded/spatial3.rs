@@ -25,16 +25,9 @@ pub struct Spatial3 {
     ml1: ::core::primitive::f64,
     #[doc = " `M_2 l_2` (0-based), kg·m."]
     ml2: ::core::primitive::f64,
-    #[doc = " `1/m_i` per link (0-based), 1/kg."]
-    rod_im: [::core::primitive::f64; 3],
-    #[doc = " `l_i` per link, m."]
-    rod_l: [::core::primitive::f64; 3],
-    #[doc = " `1/l_i` per link, 1/m."]
-    rod_il: [::core::primitive::f64; 3],
-    #[doc = " `λ_i/l_i` per link, N·s."]
-    rod_drag: [::core::primitive::f64; 3],
-    #[doc = " `1/m_i + 1/m_{i−1}` per link (`1/m_0` for the first), 1/kg: the tension system's diagonal."]
-    rod_diag: [::core::primitive::f64; 3],
+    #[doc = r" The tension solve's per-link constants (`1/m_i`, `l_i`, `1/l_i`, `λ_i/l_i`,"]
+    #[doc = r" the system's diagonal) and `g`."]
+    rods: ::pendulum_core::batch::LinkConstants<::core::primitive::f64, 3>,
 }
 const _: () = {
     use ::core::primitive::f64;
@@ -65,7 +58,7 @@ const _: () = {
             let ml0 = mt0 * l0;
             let ml1 = mt1 * l1;
             let ml2 = mt2 * l2;
-            let (rod_im, rod_l, rod_il, rod_drag, rod_diag) = {
+            let rods = {
                 let masses = chain.masses();
                 let lengths = chain.lengths();
                 let damping = chain.damping();
@@ -78,31 +71,16 @@ const _: () = {
                 let lam0 = damping[0];
                 let lam1 = damping[1];
                 let lam2 = damping[2];
-                (
-                    [1.0 / m0, 1.0 / m1, 1.0 / m2],
-                    [l0, l1, l2],
-                    [1.0 / l0, 1.0 / l1, 1.0 / l2],
-                    [lam0 / l0, lam1 / l1, lam2 / l2],
-                    [1.0 / m0, 1.0 / m1 + 1.0 / m0, 1.0 / m2 + 1.0 / m1],
-                )
+                ::pendulum_core::batch::LinkConstants {
+                    inverse_mass: [1.0 / m0, 1.0 / m1, 1.0 / m2],
+                    length: [l0, l1, l2],
+                    inverse_length: [1.0 / l0, 1.0 / l1, 1.0 / l2],
+                    drag: [lam0 / l0, lam1 / l1, lam2 / l2],
+                    diagonal: [1.0 / m0, 1.0 / m1 + 1.0 / m0, 1.0 / m2 + 1.0 / m1],
+                    gravity: chain.gravity(),
+                }
             };
-            Self {
-                chain,
-                w0_0,
-                w0_1,
-                w0_2,
-                w1_1,
-                w1_2,
-                w2_2,
-                ml0,
-                ml1,
-                ml2,
-                rod_im,
-                rod_l,
-                rod_il,
-                rod_drag,
-                rod_diag,
-            }
+            Self { chain, w0_0, w0_1, w0_2, w1_1, w1_2, w2_2, ml0, ml1, ml2, rods }
         }
     }
     #[automatically_derived]
@@ -488,9 +466,16 @@ const _: () = {
                     Ok(()) => error,
                 }
             }
+            let rod_im = &self.rods.inverse_mass;
+            let rod_l = &self.rods.length;
+            let rod_il = &self.rods.inverse_length;
+            let rod_drag = &self.rods.drag;
+            let rod_diag = &self.rods.diagonal;
+            let g = self.rods.gravity;
+            let one = <f64 as ::pendulum_core::lanes::Lane>::splat(1.0);
+            let zero = <f64 as ::pendulum_core::lanes::Lane>::splat(0.0);
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
-            let g = self.chain.gravity();
             let mut trig = [[0.0f64; 2]; 8];
             let mut angles = [0.0f64; 8];
             angles[..6].copy_from_slice(q.as_slice());
@@ -505,15 +490,15 @@ const _: () = {
             let [sp0, cp0] = trig[3];
             let dth0 = qd[0];
             let dph0 = qd[3];
-            let is0 = 1.0 / st0;
+            let is0 = one / st0;
             let ux0 = st0 * cp0;
             let uy0 = st0 * sp0;
             let uz0 = -ct0;
             let etx0 = ct0 * cp0;
             let ety0 = ct0 * sp0;
             let rate2_0 = dth0 * dth0 + st0 * st0 * dph0 * dph0;
-            let pull_th0 = torque[0] * self.rod_il[0] - self.rod_drag[0] * dth0;
-            let pull_ph0 = torque[3] * self.rod_il[0] * is0 - self.rod_drag[0] * st0 * dph0;
+            let pull_th0 = torque[0] * rod_il[0] - rod_drag[0] * dth0;
+            let pull_ph0 = torque[3] * rod_il[0] * is0 - rod_drag[0] * st0 * dph0;
             let fx0 = pull_th0 * etx0 - pull_ph0 * sp0;
             let fy0 = pull_th0 * ety0 + pull_ph0 * cp0;
             let fz0 = pull_th0 * st0;
@@ -524,15 +509,15 @@ const _: () = {
             let [sp1, cp1] = trig[4];
             let dth1 = qd[1];
             let dph1 = qd[4];
-            let is1 = 1.0 / st1;
+            let is1 = one / st1;
             let ux1 = st1 * cp1;
             let uy1 = st1 * sp1;
             let uz1 = -ct1;
             let etx1 = ct1 * cp1;
             let ety1 = ct1 * sp1;
             let rate2_1 = dth1 * dth1 + st1 * st1 * dph1 * dph1;
-            let pull_th1 = torque[1] * self.rod_il[1] - self.rod_drag[1] * dth1;
-            let pull_ph1 = torque[4] * self.rod_il[1] * is1 - self.rod_drag[1] * st1 * dph1;
+            let pull_th1 = torque[1] * rod_il[1] - rod_drag[1] * dth1;
+            let pull_ph1 = torque[4] * rod_il[1] * is1 - rod_drag[1] * st1 * dph1;
             let fx1 = pull_th1 * etx1 - pull_ph1 * sp1;
             let fy1 = pull_th1 * ety1 + pull_ph1 * cp1;
             let fz1 = pull_th1 * st1;
@@ -543,55 +528,54 @@ const _: () = {
             let [sp2, cp2] = trig[5];
             let dth2 = qd[2];
             let dph2 = qd[5];
-            let is2 = 1.0 / st2;
+            let is2 = one / st2;
             let ux2 = st2 * cp2;
             let uy2 = st2 * sp2;
             let uz2 = -ct2;
             let etx2 = ct2 * cp2;
             let ety2 = ct2 * sp2;
             let rate2_2 = dth2 * dth2 + st2 * st2 * dph2 * dph2;
-            let pull_th2 = torque[2] * self.rod_il[2] - self.rod_drag[2] * dth2;
-            let pull_ph2 = torque[5] * self.rod_il[2] * is2 - self.rod_drag[2] * st2 * dph2;
+            let pull_th2 = torque[2] * rod_il[2] - rod_drag[2] * dth2;
+            let pull_ph2 = torque[5] * rod_il[2] * is2 - rod_drag[2] * st2 * dph2;
             let fx2 = pull_th2 * etx2 - pull_ph2 * sp2;
             let fy2 = pull_th2 * ety2 + pull_ph2 * cp2;
             let fz2 = pull_th2 * st2;
-            let free_x0 = (fx0 - fx1) * self.rod_im[0];
-            let free_y0 = (fy0 - fy1) * self.rod_im[0];
-            let free_z0 = -g + (fz0 - fz1) * self.rod_im[0];
-            let b0 = self.rod_l[0] * rate2_0
-                + ux0 * (free_x0 - pa_x)
-                + uy0 * (free_y0 - pa_y)
-                + uz0 * (free_z0 - pa_z);
-            let free_x1 = (fx1 - fx2) * self.rod_im[1];
-            let free_y1 = (fy1 - fy2) * self.rod_im[1];
-            let free_z1 = -g + (fz1 - fz2) * self.rod_im[1];
-            let b1 = self.rod_l[1] * rate2_1
+            let free_x0 = (fx0 - fx1) * rod_im[0];
+            let free_y0 = (fy0 - fy1) * rod_im[0];
+            let free_z0 = -g + (fz0 - fz1) * rod_im[0];
+            let b0 =
+                rod_l[0] * rate2_0 + ux0 * (free_x0 - pa_x) + uy0 * (free_y0 - pa_y) + uz0 * (free_z0 - pa_z);
+            let free_x1 = (fx1 - fx2) * rod_im[1];
+            let free_y1 = (fy1 - fy2) * rod_im[1];
+            let free_z1 = -g + (fz1 - fz2) * rod_im[1];
+            let b1 = rod_l[1] * rate2_1
                 + ux1 * (free_x1 - free_x0)
                 + uy1 * (free_y1 - free_y0)
                 + uz1 * (free_z1 - free_z0);
-            let free_x2 = fx2 * self.rod_im[2];
-            let free_y2 = fy2 * self.rod_im[2];
-            let free_z2 = -g + fz2 * self.rod_im[2];
-            let b2 = self.rod_l[2] * rate2_2
+            let free_x2 = fx2 * rod_im[2];
+            let free_y2 = fy2 * rod_im[2];
+            let free_z2 = -g + fz2 * rod_im[2];
+            let b2 = rod_l[2] * rate2_2
                 + ux2 * (free_x2 - free_x1)
                 + uy2 * (free_y2 - free_y1)
                 + uz2 * (free_z2 - free_z1);
-            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * self.rod_im[0];
-            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * self.rod_im[1];
+            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * rod_im[0];
+            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * rod_im[1];
             #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
             #[doc = r" continuants leave `CONTINUANT_RANGE`."]
             #[cold]
             #[inline(never)]
-            fn pivots(diagonal: [f64; 3], off: [f64; 3], rhs: [f64; 3]) -> [f64; 3] {
-                let ip0 = 1.0 / diagonal[0];
+            fn pivots<V: ::pendulum_core::lanes::Lane>(diagonal: [V; 3], off: [V; 3], rhs: [V; 3]) -> [V; 3] {
+                let one = V::splat(1.0);
+                let ip0 = one / diagonal[0];
                 let e0 = rhs[0];
                 let s0 = e0 * ip0;
                 let fac1 = off[1] * ip0;
-                let ip1 = 1.0 / (diagonal[1] - fac1 * off[1]);
+                let ip1 = one / (diagonal[1] - fac1 * off[1]);
                 let e1 = rhs[1] - fac1 * e0;
                 let s1 = e1 * ip1;
                 let fac2 = off[2] * ip1;
-                let ip2 = 1.0 / (diagonal[2] - fac2 * off[2]);
+                let ip2 = one / (diagonal[2] - fac2 * off[2]);
                 let e2 = rhs[2] - fac2 * e1;
                 let s2 = e2 * ip2;
                 let t2 = s2;
@@ -600,50 +584,59 @@ const _: () = {
                 [t0, t1, t2]
             }
             let (t0, t1, t2) = {
-                let p0 = self.rod_diag[0];
+                let p0 = rod_diag[0];
                 let yt0 = b0;
-                let q2 = self.rod_diag[2];
+                let q2 = rod_diag[2];
                 let zb2 = b2;
-                let rp0 = 1.0 / p0;
-                let rq2 = 1.0 / q2;
+                let rp0 = one / p0;
+                let rq2 = one / q2;
                 let t1 = (b1 - off1 * yt0 * rp0 - off2 * zb2 * rq2)
-                    / (self.rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
+                    / (rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
                 let t0 = yt0 * rp0 - off1 * rp0 * t1;
                 let t2 = zb2 * rq2 - off2 * rq2 * t1;
                 let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-                if false | (p0.to_bits().wrapping_sub(low) > span) | (q2.to_bits().wrapping_sub(low) > span) {
-                    let t = pivots(
-                        [self.rod_diag[0], self.rod_diag[1], self.rod_diag[2]],
-                        [0.0, off1, off2],
-                        [b0, b1, b2],
-                    );
-                    (t[0], t[1], t[2])
+                let outside = <f64 as ::pendulum_core::lanes::Lane>::none();
+                let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(p0, low, span),
+                );
+                let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::outside(q2, low, span),
+                );
+                if <f64 as ::pendulum_core::lanes::Lane>::any(outside) {
+                    let t = pivots([rod_diag[0], rod_diag[1], rod_diag[2]], [zero, off1, off2], [b0, b1, b2]);
+                    (
+                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[0], t0),
+                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[1], t1),
+                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[2], t2),
+                    )
                 } else {
                     (t0, t1, t2)
                 }
             };
-            let a_x2 = free_x2 + (-t2 * ux2) * self.rod_im[2];
-            let a_y2 = free_y2 + (-t2 * uy2) * self.rod_im[2];
-            let a_z2 = free_z2 + (-t2 * uz2) * self.rod_im[2];
-            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * self.rod_im[1];
-            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * self.rod_im[1];
-            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * self.rod_im[1];
-            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * self.rod_im[0];
-            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * self.rod_im[0];
-            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * self.rod_im[0];
-            let udd_x0 = (a_x0 - pa_x) * self.rod_il[0];
-            let udd_y0 = (a_y0 - pa_y) * self.rod_il[0];
-            let udd_z0 = (a_z0 - pa_z) * self.rod_il[0];
+            let a_x2 = free_x2 + (-t2 * ux2) * rod_im[2];
+            let a_y2 = free_y2 + (-t2 * uy2) * rod_im[2];
+            let a_z2 = free_z2 + (-t2 * uz2) * rod_im[2];
+            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * rod_im[1];
+            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * rod_im[1];
+            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * rod_im[1];
+            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * rod_im[0];
+            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * rod_im[0];
+            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * rod_im[0];
+            let udd_x0 = (a_x0 - pa_x) * rod_il[0];
+            let udd_y0 = (a_y0 - pa_y) * rod_il[0];
+            let udd_z0 = (a_z0 - pa_z) * rod_il[0];
             let x_th0 = etx0 * udd_x0 + ety0 * udd_y0 + st0 * udd_z0 + dph0 * dph0 * st0 * ct0;
             let x_ph0 = (cp0 * udd_y0 - sp0 * udd_x0 - 2.0 * dth0 * dph0 * ct0) * is0;
-            let udd_x1 = (a_x1 - a_x0) * self.rod_il[1];
-            let udd_y1 = (a_y1 - a_y0) * self.rod_il[1];
-            let udd_z1 = (a_z1 - a_z0) * self.rod_il[1];
+            let udd_x1 = (a_x1 - a_x0) * rod_il[1];
+            let udd_y1 = (a_y1 - a_y0) * rod_il[1];
+            let udd_z1 = (a_z1 - a_z0) * rod_il[1];
             let x_th1 = etx1 * udd_x1 + ety1 * udd_y1 + st1 * udd_z1 + dph1 * dph1 * st1 * ct1;
             let x_ph1 = (cp1 * udd_y1 - sp1 * udd_x1 - 2.0 * dth1 * dph1 * ct1) * is1;
-            let udd_x2 = (a_x2 - a_x1) * self.rod_il[2];
-            let udd_y2 = (a_y2 - a_y1) * self.rod_il[2];
-            let udd_z2 = (a_z2 - a_z1) * self.rod_il[2];
+            let udd_x2 = (a_x2 - a_x1) * rod_il[2];
+            let udd_y2 = (a_y2 - a_y1) * rod_il[2];
+            let udd_z2 = (a_z2 - a_z1) * rod_il[2];
             let x_th2 = etx2 * udd_x2 + ety2 * udd_y2 + st2 * udd_z2 + dph2 * dph2 * st2 * ct2;
             let x_ph2 = (cp2 * udd_y2 - sp2 * udd_x2 - 2.0 * dth2 * dph2 * ct2) * is2;
             if (((x_th0 - x_th0) + ((x_th1 - x_th1) + (x_th2 - x_th2)))

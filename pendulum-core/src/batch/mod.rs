@@ -33,9 +33,11 @@ mod directions;
 mod planar;
 mod rk4;
 mod run;
+mod unrolled;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
+pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;
@@ -122,12 +124,13 @@ pub(crate) fn for_blocks<T: Send, S, F: Send>(
     if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up
         // costs more than a short batch).
+        // A plain loop: a `flat_map` over the blocks cost 6–9% of a short block's time.
         let mut scratch = init();
-        return out
-            .chunks_mut(WIDTH * m)
-            .enumerate()
-            .flat_map(|(b, rows)| block(&mut scratch, b, rows))
-            .collect();
+        let mut failures = Vec::new();
+        for (b, rows) in out.chunks_mut(WIDTH * m).enumerate() {
+            failures.extend(block(&mut scratch, b, rows));
+        }
+        return failures;
     }
     out.par_chunks_mut(WIDTH * m)
         .enumerate()

@@ -42,11 +42,11 @@ pub(super) fn struct_item(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
             /// `accelerations` fail as not positive definite.
             inv0: ::core::primitive::f64,
         },
-        Algorithm::Tension => {
-            let (fields, docs): (Vec<Ident>, Vec<String>) =
-                rod_constants::stored(plan).into_iter().map(|(f, _, d)| (f, d)).unzip();
-            quote!(#(#[doc = #docs] #fields: [::core::primitive::f64; #n],)*)
-        }
+        Algorithm::Tension => quote! {
+            /// The tension solve's per-link constants (`1/m_i`, `l_i`, `1/l_i`, `λ_i/l_i`,
+            /// the system's diagonal) and `g`.
+            rods: ::pendulum_core::batch::LinkConstants<::core::primitive::f64, #n>,
+        },
     };
     quote! {
         #(#attrs)*
@@ -116,11 +116,9 @@ pub(super) fn constructor(def: &ModelDef, plan: &Plan, stored: &[Sym], algorithm
         }
         Algorithm::Tension => {
             let inputs = rod_constants::constructor_lets(plan);
-            let (fields, values): (Vec<Ident>, Vec<Vec<TokenStream>>) =
-                rod_constants::stored(plan).into_iter().map(|(f, v, _)| (f, v)).unzip();
-            let arrays = values.iter().map(|v| quote!([#(#v),*]));
+            let value = rod_constants::constructor_value(plan);
             // In a block of its own: its lets may share names with the stored symbols'.
-            (quote!(let (#(#fields,)*) = { #inputs (#(#arrays,)*) };), quote!(#(#fields),*))
+            (quote!(let rods = { #inputs #value };), quote!(rods))
         }
     };
     let algorithm_name = match algorithm {

@@ -27,7 +27,7 @@ use quote::quote;
 
 use self::names::{chart, index, space};
 use crate::parse::{Input, ModelDef};
-use crate::plan::{Algorithm, Plan};
+use crate::plan::{Algorithm, Kind, Plan};
 
 /// Everything `model!` emits for its input.
 pub fn expand(input: &Input) -> TokenStream {
@@ -46,7 +46,7 @@ fn model(def: &ModelDef) -> TokenStream {
     let imports = imports(&plan);
     // Every impl, in the order emitted: another trait impl is one more entry (its trait
     // imported in `imports`).
-    let impls = [
+    let mut impls = vec![
         items::constructor(def, &plan, &stored, algorithm),
         items::debug_impl(name),
         items::partial_eq_impl(name),
@@ -54,6 +54,10 @@ fn model(def: &ModelDef) -> TokenStream {
         model_impl(name, &plan, algorithm),
         derivatives::derivatives_impl(name, &plan, algorithm),
     ];
+    if (plan.kind, algorithm) == (Kind::Planar, Algorithm::Tension) {
+        // The accelerations' kernel, which `pendulum_core::batch::UnrolledBatch` runs in lanes.
+        impls.push(tension::kernel_impl(name, &plan));
+    }
     quote! {
         #struct_item
 

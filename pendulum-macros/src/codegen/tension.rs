@@ -20,13 +20,13 @@ use quote::{format_ident, quote};
 
 use super::guards::{failure, finite_probe};
 use super::names::{index, space};
-use super::rod_constants::id;
+use super::rod_constants::{self, id};
 use crate::plan::{Kind, Plan};
 
-/// The first lets of `accelerations`: the inputs, gravity, and the sines and cosines of
-/// every angle from one call of the vectorised kernel (`trig[a] = [sin q_a, cos q_a]`),
-/// its input padded to a multiple of four angles (the kernel's width with AVX2: no
-/// scalar tail).
+/// The first lets of `accelerations`: the inputs, and the sines and cosines of every
+/// angle from one call of the vectorised kernel (`trig[a] = [sin q_a, cos q_a]`), its
+/// input padded to a multiple of four angles (the kernel's width with AVX2: no scalar
+/// tail).
 fn prelude(plan: &Plan) -> TokenStream {
     let padded = plan.dof().div_ceil(4) * 4;
     let trig_call = if padded == plan.dof() {
@@ -43,7 +43,6 @@ fn prelude(plan: &Plan) -> TokenStream {
     quote! {
         let torque = &inputs.torque;
         let pivot = &inputs.pivot_acceleration;
-        let g = self.chain.gravity();
         let mut trig = [[0.0f64; 2]; #trig_len];
         #trig_call
     }
@@ -87,12 +86,16 @@ fn wrap(plan: &Plan, body: TokenStream, outputs: &[TokenStream]) -> TokenStream 
 /// θ̈_0 = ((f_0 − f_1 C_1 + T_1 S_1)/m_0 − n_0·(p̈ − g⃗)) / l_0
 /// ```
 /// (gravity cancels from every row but the first): no Cartesian accelerations at all.
-fn planar(plan: &Plan) -> TokenStream {
+///
+/// Written once, as the body of `PlanarKernel::kernel` over any lane type `V`
+/// (`pendulum_core::batch`): `accelerations` runs it on `f64` ([`planar_accelerations`]),
+/// `UnrolledBatch` on four chains at once.
+fn planar_kernel(plan: &Plan) -> TokenStream {
     let n = plan.links;
-    let mut body = prelude(plan);
+    let lane = quote!(V);
+    let mut body = rod_constants::locals(plan, &quote!(c), &lane);
     body.extend(quote! {
-        let pa_x = pivot[0];
-        let pa_y = pivot[1];
+        let [pa_x, pa_y] = pivot;
     });
     for i in 0..n {
         let (st, ct, dth, pull) = (id("st", i), id("ct", i), id("dth", i), id("pull", i));
@@ -100,7 +103,7 @@ fn planar(plan: &Plan) -> TokenStream {
         let (il, drag) = (field("rod_il", i), field("rod_drag", i));
         body.extend(quote! {
             let [#st, #ct] = trig[#ii];
-            let #dth = qd[#ii];
+            let #dth = rates[#ii];
             let #pull = torque[#ii] * #il - #drag * #dth;
         });
         if i >= 1 {
@@ -130,7 +133,7 @@ fn planar(plan: &Plan) -> TokenStream {
         }
         body.extend(quote!(let #b = #(#terms)+*;));
     }
-    body.extend(twisted_solve(n));
+    body.extend(twisted_solve(n, &lane));
     let mut outputs = Vec::new();
     for i in 0..n {
         let (x, pull, im, il) = (id("x_th", i), id("pull", i), field("rod_im", i), field("rod_il", i));
@@ -152,23 +155,72 @@ fn planar(plan: &Plan) -> TokenStream {
             quote!((#pull_above * #cd - #pull + #t_above * #sd) * #im_above)
         };
         body.extend(quote!(let #x = (#own - #above) * #il;));
-        outputs.push(quote!(#x));
+        outputs.push(x);
     }
+    quote!({ #body [#(#outputs),*] })
+}
+
+/// `impl PlanarKernel<n>` ([`planar_kernel`]) for a planar tension model.
+pub(super) fn kernel_impl(name: &Ident, plan: &Plan) -> TokenStream {
+    let n = index(plan.links);
+    let body = planar_kernel(plan);
+    quote! {
+        #[automatically_derived]
+        #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+        impl ::pendulum_core::batch::PlanarKernel<#n> for #name {
+            fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, #n> {
+                &self.rods
+            }
+
+            #[inline(always)]
+            fn kernel<V: ::pendulum_core::lanes::Lane>(
+                c: &::pendulum_core::batch::LinkConstants<V, #n>,
+                trig: &[[V; 2]; #n],
+                rates: &[V; #n],
+                torque: &[V; #n],
+                pivot: [V; 2],
+            ) -> [V; #n]
+            #body
+        }
+    }
+}
+
+/// The planar `fn accelerations`: the sines and cosines, then [`planar_kernel`] on `f64`.
+fn planar_accelerations(plan: &Plan) -> TokenStream {
+    let n = index(plan.links);
+    let mut body = prelude(plan);
+    let outputs: Vec<TokenStream> = (0..plan.links)
+        .map(|i| {
+            let x = id("x_th", i);
+            quote!(#x)
+        })
+        .collect();
+    body.extend(quote! {
+        let trig: [[f64; 2]; #n] = ::core::array::from_fn(|i| trig[i]);
+        let [#(#outputs),*] = <Self as ::pendulum_core::batch::PlanarKernel<#n>>::kernel::<f64>(
+            &self.rods,
+            &trig,
+            &qd.data.0[0],
+            &torque.data.0[0],
+            [pivot[0], pivot[1]],
+        );
+    });
     wrap(plan, body, &outputs)
 }
 
 /// `fn accelerations` by the rod tensions (module docs): [`planar`] or [`spatial`].
 pub(super) fn accelerations(plan: &Plan) -> TokenStream {
     match plan.kind {
-        Kind::Planar => planar(plan),
+        Kind::Planar => planar_accelerations(plan),
         Kind::Spatial => spatial(plan),
     }
 }
 
-/// `self.<name>[i]`: a per-link constant stored by `new` ([`rod_constants`](super::rod_constants)).
+/// `<name>[i]`: a per-link constant stored by `new`, by its local name
+/// ([`rod_constants::locals`]).
 fn field(name: &str, i: usize) -> TokenStream {
     let (f, i) = (format_ident!("{name}"), index(i));
-    quote!(self.#f[#i])
+    quote!(#f[#i])
 }
 
 /// The spatial route in Cartesian components (module docs): directions, force pairs and
@@ -183,7 +235,8 @@ fn spatial(plan: &Plan) -> TokenStream {
     let pivot_names: Vec<Ident> = XYZ.iter().map(|c| format_ident!("pa_{c}")).collect();
     // Sines and cosines of every angle at once (a vectorised kernel), then the links'
     // directions, rates and force pairs.
-    let mut body = prelude(plan);
+    let mut body = rod_constants::locals(plan, &quote!(self.rods), &quote!(f64));
+    body.extend(prelude(plan));
     for (k, p) in pivot_names.iter().enumerate() {
         let k = index(k);
         body.extend(quote!(let #p = pivot[#k];));
@@ -205,7 +258,7 @@ fn spatial(plan: &Plan) -> TokenStream {
             let [#sp, #cp] = trig[#phi];
             let #dth = qd[#th];
             let #dph = qd[#phi];
-            let #is = 1.0 / #st;
+            let #is = one / #st;
             let #ux = #st * #cp;
             let #uy = #st * #sp;
             let #uz = -#ct;
@@ -249,7 +302,7 @@ fn spatial(plan: &Plan) -> TokenStream {
         });
         body.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
     }
-    body.extend(twisted_solve(n));
+    body.extend(twisted_solve(n, &quote!(f64)));
 
     // Mass accelerations a_i, link accelerations ü_i, angle accelerations.
     for i in (0..n).rev() {
@@ -311,8 +364,9 @@ fn spatial(plan: &Plan) -> TokenStream {
 /// T_i = (Z_i − c_i Q_{i+1} T_{i−1}) / Q_i       (i > k, downwards)
 /// ```
 /// No division on a serial chain. Should a continuant leave `CONTINUANT_RANGE`, the
-/// tensions come from the classical elimination instead ([`pivots`]).
-fn twisted_solve(n: usize) -> TokenStream {
+/// tensions come from the classical elimination instead ([`pivots`]), in the lanes whose
+/// continuants do (`lane`: the number type, `f64` or the kernel's `V`).
+fn twisted_solve(n: usize, lane: &TokenStream) -> TokenStream {
     let mut out = TokenStream::new();
     let off = |i: usize| id("off", i);
     let k = n / 2;
@@ -373,11 +427,11 @@ fn twisted_solve(n: usize) -> TokenStream {
     }
     for &i in &top {
         let (r, pi) = (rp(i), p(i));
-        hot.extend(quote!(let #r = 1.0 / #pi;));
+        hot.extend(quote!(let #r = one / #pi;));
     }
     for &i in &bottom {
         let (r, qi) = (rq(i), q(i));
-        hot.extend(quote!(let #r = 1.0 / #qi;));
+        hot.extend(quote!(let #r = one / #qi;));
     }
     // The twist row.
     let (dk, bk, tk) = (field("rod_diag", k), b(k), id("t", k));
@@ -438,7 +492,7 @@ fn twisted_solve(n: usize) -> TokenStream {
     let offs: Vec<TokenStream> = (0..n)
         .map(|i| {
             if i == 0 {
-                quote!(0.0)
+                quote!(zero)
             } else {
                 let c = off(i);
                 quote!(#c)
@@ -453,9 +507,14 @@ fn twisted_solve(n: usize) -> TokenStream {
         let (#(#ts,)*) = {
             #hot
             let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
-            if false #(| (#continuants.to_bits().wrapping_sub(low) > span))* {
+            let outside = <#lane as ::pendulum_core::lanes::Lane>::none();
+            #(let outside = <#lane as ::pendulum_core::lanes::Lane>::or(
+                outside,
+                ::pendulum_core::lanes::Lane::outside(#continuants, low, span),
+            );)*
+            if <#lane as ::pendulum_core::lanes::Lane>::any(outside) {
                 let t = pivots([#(#diags),*], [#(#offs),*], [#(#bs),*]);
-                (#(t[#t_index],)*)
+                (#(<#lane as ::pendulum_core::lanes::Lane>::select(outside, t[#t_index], #ts),)*)
             } else {
                 (#(#ts,)*)
             }
@@ -466,8 +525,8 @@ fn twisted_solve(n: usize) -> TokenStream {
 
 /// `fn pivots` inside `accelerations`: the tensions by classical pivots
 /// `D_i = A_ii − c_i² / D_{i−1}` and back substitution (divisions on the serial chain, but
-/// no continuant to leave its range), for the chains whose continuants do; straight-line
-/// like the rest.
+/// no continuant to leave its range), for the chains (lanes) whose continuants do;
+/// straight-line like the rest.
 fn pivots(n: usize) -> TokenStream {
     let links = index(n);
     let mut body = TokenStream::new();
@@ -476,14 +535,14 @@ fn pivots(n: usize) -> TokenStream {
         let (ip, e, s) = (id("ip", i), id("e", i), id("s", i));
         if i == 0 {
             body.extend(quote! {
-                let #ip = 1.0 / diagonal[0];
+                let #ip = one / diagonal[0];
                 let #e = rhs[0];
             });
         } else {
             let (fac, ip_above, e_above) = (id("fac", i), id("ip", i - 1), id("e", i - 1));
             body.extend(quote! {
                 let #fac = off[#ii] * #ip_above;
-                let #ip = 1.0 / (diagonal[#ii] - #fac * off[#ii]);
+                let #ip = one / (diagonal[#ii] - #fac * off[#ii]);
                 let #e = rhs[#ii] - #fac * #e_above;
             });
         }
@@ -504,7 +563,12 @@ fn pivots(n: usize) -> TokenStream {
         /// continuants leave `CONTINUANT_RANGE`.
         #[cold]
         #[inline(never)]
-        fn pivots(diagonal: [f64; #links], off: [f64; #links], rhs: [f64; #links]) -> [f64; #links] {
+        fn pivots<V: ::pendulum_core::lanes::Lane>(
+            diagonal: [V; #links],
+            off: [V; #links],
+            rhs: [V; #links],
+        ) -> [V; #links] {
+            let one = V::splat(1.0);
             #body
             [#(#ts),*]
         }

@@ -1,0 +1,241 @@
+//! `model!`'s planar models in lanes: the generated straight-line tension solve run for
+//! [`WIDTH`] chains at once, one chain per lane.
+//!
+//! A planar model generated with `algorithm: tension` (the default from four links) writes
+//! its accelerations once, as a kernel generic over [`Lane`] ([`PlanarKernel::kernel`]).
+//! Its own `Model::accelerations` runs the kernel on `f64`; [`UnrolledBatch`] runs it on
+//! [`Lanes`] of four chains, compiled for AVX2 where the CPU has it. The operations are
+//! the same, lane by lane, with the same sine kernel, so every chain of a batch gets its
+//! single model's `θ̈` bit for bit.
+
+mod rk4;
+
+use nalgebra::{Const, SVector, U2, Vector2};
+
+use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, simd_kernel};
+use crate::error::{Error, Result};
+use crate::kinematics::trig::sin_cos_split;
+use crate::lanes::{Lane, Lanes};
+use crate::model::{Inputs, Model};
+
+/// A chain's per-link constants as a generated tension model reads them, `N` of each: one
+/// number per link (`V = f64`), or one per chain of a block (`V = Lanes<W>`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkConstants<V, const N: usize> {
+    /// `1/m_i`, 1/kg.
+    pub inverse_mass: [V; N],
+    /// `l_i`, m.
+    pub length: [V; N],
+    /// `1/l_i`, 1/m.
+    pub inverse_length: [V; N],
+    /// `λ_i/l_i`, N·s.
+    pub drag: [V; N],
+    /// `1/m_i + 1/m_{i−1}` (`1/m_0` for the first), 1/kg: the tension system's diagonal.
+    pub diagonal: [V; N],
+    /// `g`, m/s².
+    pub gravity: V,
+}
+
+impl<const N: usize> LinkConstants<f64, N> {
+    /// The constants of `chains` side by side: lane `k` holds `chains[k]`'s.
+    pub fn interleave<const W: usize>(chains: [&Self; W]) -> LinkConstants<Lanes<W>, N> {
+        let lanes =
+            |of: fn(&Self) -> &[f64; N]| std::array::from_fn(|i| Lanes::from_fn(|k| of(chains[k])[i]));
+        LinkConstants {
+            inverse_mass: lanes(|c| &c.inverse_mass),
+            length: lanes(|c| &c.length),
+            inverse_length: lanes(|c| &c.inverse_length),
+            drag: lanes(|c| &c.drag),
+            diagonal: lanes(|c| &c.diagonal),
+            gravity: Lanes::from_fn(|k| chains[k].gravity),
+        }
+    }
+}
+
+/// A planar model of `N` links whose `θ̈` is one straight-line kernel over [`Lane`]s: what
+/// `pendulum_macros::model!` emits for `kind: planar` with `algorithm: tension`. Its
+/// `Model::accelerations` is `kernel::<f64>` (after the sines and cosines, before the
+/// finiteness check); [`UnrolledBatch`] runs `kernel::<Lanes<4>>`.
+pub trait PlanarKernel<const N: usize>:
+    Model<Links = Const<N>, Dof = Const<N>, Space = U2> + Send + Sync
+{
+    /// The constants `new` stored.
+    fn constants(&self) -> &LinkConstants<f64, N>;
+
+    /// `θ̈_i` (rad/s²), lane by lane, from `trig[i] = [sin θ_i, cos θ_i]`, the rates `θ̇_i`
+    /// (rad/s), the joint torques `σ_i` (N·m) and the pivot's acceleration `p̈ = (ẍ, ÿ)`
+    /// (m/s²): the rods' tension system solved in the links' own frames. A lane whose
+    /// result is not finite is the caller's to report.
+    fn kernel<V: Lane>(
+        c: &LinkConstants<V, N>,
+        trig: &[[V; 2]; N],
+        rates: &[V; N],
+        torque: &[V; N],
+        pivot: [V; 2],
+    ) -> [V; N];
+}
+
+/// `B` chains of one generated planar model type `M` (`N` links each, each its own masses,
+/// lengths, damping and gravity), evaluated four per instruction stream.
+///
+/// ```
+/// use pendulum_core::batch::UnrolledBatch;
+/// use pendulum_core::Chain;
+///
+/// pendulum_macros::model! { struct Planar4 { kind: planar, links: 4 } }
+///
+/// let models = (0..8).map(|k| Planar4::new(Chain::uniform(4, 0.1 + 0.01 * k as f64, 0.2, 9.81).unwrap()));
+/// let batch = UnrolledBatch::new(models.collect())?;
+/// let (q, qd) = (vec![0.3; 8 * 4], vec![0.0; 8 * 4]);
+/// let mut qdd = vec![0.0; 8 * 4];
+/// let failures = batch.accelerations(&q, &qd, None, None, &mut qdd)?;
+/// assert!(failures.is_empty());
+/// # Ok::<(), pendulum_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct UnrolledBatch<M, const N: usize> {
+    models: Vec<M>,
+    /// Per block of [`WIDTH`] chains, their constants side by side.
+    blocks: Vec<LinkConstants<F64x4, N>>,
+}
+
+impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
+    /// The batch of `models`, chain `k` being `models[k]`.
+    ///
+    /// Errors: [`Error::EmptyBatch`].
+    pub fn new(models: Vec<M>) -> Result<Self> {
+        if models.is_empty() {
+            return Err(Error::EmptyBatch);
+        }
+        let blocks = (0..models.len().div_ceil(WIDTH))
+            .map(|b| LinkConstants::interleave(block_chains(b, models.len()).map(|c| models[c].constants())))
+            .collect();
+        Ok(Self { models, blocks })
+    }
+
+    /// Number of chains `B`.
+    pub fn len(&self) -> usize {
+        self.models.len()
+    }
+
+    /// Never: a batch has at least one chain.
+    pub fn is_empty(&self) -> bool {
+        self.models.is_empty()
+    }
+
+    /// Chain `k`'s model.
+    pub fn model(&self, k: usize) -> &M {
+        &self.models[k]
+    }
+
+    /// The angle accelerations `θ̈` (rad/s²) of every chain, written into `out` as `B` rows of
+    /// `N`, at angles `q` (rad) and rates `qd` (rad/s) given the same way, with each chain's
+    /// joint torques from `torque` (`B` rows of `N`, N·m; `None`: none) and pivot acceleration
+    /// `p̈ = (ẍ, ÿ)` from `pivot` (`B` rows of 2, m/s²; `None`: pivots at rest). Row `k`
+    /// equals `model(k).accelerations(..)` bit for bit; the blocks of four chains go over
+    /// the current rayon pool.
+    ///
+    /// Returns the chains that failed, in order, each with its single model's error; their
+    /// rows of `out` are NaN. Errors: [`Error::LengthMismatch`] when an array does not hold
+    /// `B` rows.
+    pub fn accelerations(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        torque: Option<&[f64]>,
+        pivot: Option<&[f64]>,
+        out: &mut [f64],
+    ) -> Result<Vec<Failure>> {
+        let chains = self.len();
+        check_len("q", q, chains, N)?;
+        check_len("qd", qd, chains, N)?;
+        check_len("out", out, chains, N)?;
+        if let Some(t) = torque {
+            check_len("torque", t, chains, N)?;
+        }
+        if let Some(p) = pivot {
+            check_len("pivot", p, chains, 2)?;
+        }
+        let failures = for_blocks(
+            out,
+            N,
+            N,
+            || (),
+            |_, b, out| {
+                let lanes = block_chains(b, chains);
+                self.block_simd(b, lanes, q, qd, torque, pivot, out);
+                let mut failures = Vec::new();
+                for (k, row) in out.chunks_exact_mut(N).enumerate() {
+                    if row.iter().all(|v| v.is_finite()) {
+                        continue;
+                    }
+                    let chain = lanes[k];
+                    failures.push(Failure { chain, error: self.error_of(chain, q, qd, torque, pivot) });
+                    row.fill(f64::NAN);
+                }
+                failures
+            },
+        );
+        Ok(failures)
+    }
+
+    /// Chain `chain`'s single model's error at its row of the inputs (out of the hot path).
+    #[cold]
+    fn error_of(
+        &self,
+        chain: usize,
+        q: &[f64],
+        qd: &[f64],
+        torque: Option<&[f64]>,
+        pivot: Option<&[f64]>,
+    ) -> Error {
+        let row = |v: &[f64]| SVector::<f64, N>::from_column_slice(&v[chain * N..(chain + 1) * N]);
+        let inputs = Inputs {
+            torque: torque.map_or_else(SVector::zeros, row),
+            pivot_acceleration: pivot
+                .map_or_else(Vector2::zeros, |p| Vector2::new(p[2 * chain], p[2 * chain + 1])),
+        };
+        let mut out = SVector::zeros();
+        match self.models[chain].accelerations(&row(q), &row(qd), &inputs, &mut out) {
+            Err(error) => error,
+            // The kernel's lanes are the single model's: unreachable unless they differ.
+            Ok(()) => Error::NotPositiveDefinite,
+        }
+    }
+
+    simd_kernel! {
+        /// One block: gather into lanes, the sines and cosines of all its angles at once, the
+        /// kernel, scatter into `out` (the block's rows).
+        fn block(
+            &self,
+            b: usize,
+            lanes: [usize; WIDTH],
+            q: &[f64],
+            qd: &[f64],
+            torque: Option<&[f64]>,
+            pivot: Option<&[f64]>,
+            out: &mut [f64],
+        ) {
+            let gather = |v: &[f64]| -> [F64x4; N] {
+                std::array::from_fn(|i| Lanes::from_fn(|k| v[lanes[k] * N + i]))
+            };
+            let zero = Lanes([0.0; WIDTH]);
+            let angles = gather(q);
+            let (mut sin, mut cos) = ([zero; N], [zero; N]);
+            sin_cos_split(Lanes::flatten(&angles), Lanes::flatten_mut(&mut sin), Lanes::flatten_mut(&mut cos));
+            let trig = std::array::from_fn(|i| [sin[i], cos[i]]);
+            let torque = torque.map_or([zero; N], gather);
+            let pivot = match pivot {
+                Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
+                None => [zero; 2],
+            };
+            let accelerations = M::kernel(&self.blocks[b], &trig, &gather(qd), &torque, pivot);
+            for (k, row) in out.chunks_exact_mut(N).enumerate() {
+                for (o, a) in row.iter_mut().zip(&accelerations) {
+                    *o = a.0[k];
+                }
+            }
+        }
+        dispatch fn block_simd, block_avx2
+    }
+}

@@ -1,0 +1,174 @@
+//! Runs of RK4 for a batch of generated planar models, in lanes: each chain's
+//! [`Rk4`](crate::integrate::Rk4) on [`FirstOrder::new`](crate::FirstOrder::new) of its
+//! model (pivot at rest, no torques), the states in lanes from the first step to the last.
+
+use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
+
+use super::{PlanarKernel, UnrolledBatch};
+use crate::batch::{F64x4, Failure, WIDTH, for_blocks, simd_kernel};
+use crate::error::{Error, Result};
+use crate::integrate::{State, kahan_add};
+use crate::kinematics::trig::sin_cos_split;
+use crate::lanes::{Lane, Lanes};
+
+/// A block's states in lanes: `θ`, `θ̇` and their compensations, `t` and its compensation.
+struct Block<const N: usize> {
+    q: [F64x4; N],
+    qd: [F64x4; N],
+    q_carry: [F64x4; N],
+    qd_carry: [F64x4; N],
+    t: F64x4,
+    t_carry: F64x4,
+}
+
+/// The increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` of one step of
+/// [`Rk4`](crate::integrate::Rk4) from `(θ, θ̇)`, for the first-order system
+/// `(θ, θ̇)' = (θ̇, θ̈)` with `θ̈ = accelerations(θ, θ̇)`, rounded as `Rk4` rounds it: lane by
+/// lane (`V = Lanes`) or for one chain (`V = f64`).
+#[inline(always)]
+fn increment<V: Lane, const N: usize>(
+    q: &[V; N],
+    qd: &[V; N],
+    h: f64,
+    mut accelerations: impl FnMut(&[V; N], &[V; N]) -> [V; N],
+) -> ([V; N], [V; N]) {
+    let (half, whole, sixth, two) = (V::splat(0.5 * h), V::splat(h), V::splat(h / 6.0), V::splat(2.0));
+    // `y = x + a k` as `Rk4`'s `axpy` rounds it.
+    let axpy = |x: &[V; N], a: V, k: &[V; N]| -> [V; N] { std::array::from_fn(|i| a * k[i] + x[i]) };
+    // k_s = (θ̇_s, θ̈_s), the stages of `Rk4::stages`.
+    let a1 = accelerations(q, qd);
+    let (q2, qd2) = (axpy(q, half, qd), axpy(qd, half, &a1));
+    let a2 = accelerations(&q2, &qd2);
+    let (q3, qd3) = (axpy(q, half, &qd2), axpy(qd, half, &a2));
+    let a3 = accelerations(&q3, &qd3);
+    let (q4, qd4) = (axpy(q, whole, &qd3), axpy(qd, whole, &a3));
+    let a4 = accelerations(&q4, &qd4);
+    let sum = |k1: &[V; N], k2: &[V; N], k3: &[V; N], k4: &[V; N]| -> [V; N] {
+        std::array::from_fn(|i| sixth * (k1[i] + two * (k2[i] + k3[i]) + k4[i]))
+    };
+    (sum(qd, &qd2, &qd3, &qd4), sum(&a1, &a2, &a3, &a4))
+}
+
+impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
+    /// `steps` steps of RK4 of size `h` (s) for every chain, each from its own state
+    /// `x = (θ, θ̇)` (`2N` entries: rad, rad/s) and time: exactly what `steps` calls of
+    /// [`Rk4::step`] on `FirstOrder::new(model)` give for each chain alone, bit for bit
+    /// (compensated time and state included), with the states kept in lanes from the
+    /// first step to the last.
+    ///
+    /// Returns the chains that failed, in order, each with the error its own step gave (a
+    /// non-finite state or acceleration); a failed chain is left at the start of the step
+    /// that failed and the others go on. Errors: [`Error::InvalidStepSize`] for a zero or
+    /// non-finite `h`, [`Error::LengthMismatch`] for a number of states other than `B` or a
+    /// state of the wrong length.
+    pub fn integrate_rk4<D: Dim>(&self, states: &mut [State<D>], h: f64, steps: usize) -> Result<Vec<Failure>>
+    where
+        DefaultAllocator: Allocator<D>,
+        State<D>: Send,
+    {
+        if !h.is_finite() || h == 0.0 {
+            return Err(Error::InvalidStepSize { h });
+        }
+        if states.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
+        }
+        if let Some(s) = states.iter().find(|s| s.x().len() != 2 * N) {
+            return Err(Error::LengthMismatch { what: "x", expected: 2 * N, got: s.x().len() });
+        }
+        let solves = (4 * N).saturating_mul(steps);
+        let failures = for_blocks(
+            states,
+            1,
+            solves,
+            || (),
+            |_, b, block| {
+                let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
+                let entries = |j: usize, carry: bool| {
+                    Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
+                };
+                let mut s = Block {
+                    q: std::array::from_fn(|i| entries(i, false)),
+                    qd: std::array::from_fn(|i| entries(N + i, false)),
+                    q_carry: std::array::from_fn(|i| entries(i, true)),
+                    qd_carry: std::array::from_fn(|i| entries(N + i, true)),
+                    t: Lanes::from_fn(|k| parts[k].0),
+                    t_carry: Lanes::from_fn(|k| parts[k].1),
+                };
+                let alive = self.rk4_run_simd(b, h, steps, &mut s);
+                let mut failures = Vec::new();
+                for (k, state) in block.iter_mut().enumerate() {
+                    let x = (s.q.iter().zip(&s.q_carry)).chain(s.qd.iter().zip(&s.qd_carry));
+                    state.set_parts(s.t.0[k], s.t_carry.0[k], x.map(|(x, carry)| (x.0[k], carry.0[k])));
+                    if alive[k] == 0 {
+                        let chain = WIDTH * b + k;
+                        failures.push(Failure {
+                            chain,
+                            error: self.step_error(chain, state.t(), state.x().as_slice(), h),
+                        });
+                    }
+                }
+                failures
+            },
+        );
+        Ok(failures)
+    }
+
+    /// The error of chain `chain`'s own RK4 step from `state` (out of the hot path): the
+    /// first stage's whose accelerations fail, else a non-finite increment.
+    #[cold]
+    fn step_error(&self, chain: usize, t: f64, x: &[f64], h: f64) -> Error {
+        let model = &self.models[chain];
+        let inputs = model.zero_inputs();
+        let mut first = None;
+        increment::<f64, N>(x[..N].try_into().expect("N"), x[N..].try_into().expect("N"), h, |q, qd| {
+            let mut out = SVector::<f64, N>::zeros();
+            let (q, qd) = (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
+            match model.accelerations(&q, &qd, &inputs, &mut out) {
+                Ok(()) => out.data.0[0],
+                Err(error) => {
+                    first.get_or_insert(error);
+                    [f64::NAN; N]
+                }
+            }
+        });
+        first.unwrap_or(Error::NonFiniteState { t, h })
+    }
+
+    simd_kernel! {
+        /// `steps` RK4 steps of block `b` in lanes; a lane whose increment is not finite
+        /// stops at the start of that step. Returns the lanes that ran to the end.
+        fn rk4_run(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [u64; WIDTH] {
+            let c = &self.blocks[b];
+            let zero = Lanes([0.0; WIDTH]);
+            let accelerations = |q: &[F64x4; N], qd: &[F64x4; N]| {
+                let (mut sin, mut cos) = ([zero; N], [zero; N]);
+                sin_cos_split(Lanes::flatten(q), Lanes::flatten_mut(&mut sin), Lanes::flatten_mut(&mut cos));
+                let trig = std::array::from_fn(|i| [sin[i], cos[i]]);
+                M::kernel(c, &trig, qd, &[zero; N], [zero; 2])
+            };
+            let mut alive = [1u64; WIDTH];
+            for _ in 0..steps {
+                let (dq, dqd) = increment(&s.q, &s.qd, h, accelerations);
+                // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
+                #[allow(clippy::eq_op)]
+                let probe = dq.iter().chain(&dqd).fold(zero, |p, d| p + (*d - *d));
+                let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !probe.outside(0, 0)[k]);
+                let advance = |x: &mut F64x4, carry: &mut F64x4, delta: F64x4| {
+                    let (new, new_carry) = kahan_add(*x, *carry, delta);
+                    (*x, *carry) = (F64x4::select(keep, new, *x), F64x4::select(keep, new_carry, *carry));
+                };
+                advance(&mut s.t, &mut s.t_carry, F64x4::splat(h));
+                for i in 0..N {
+                    advance(&mut s.q[i], &mut s.q_carry[i], dq[i]);
+                    advance(&mut s.qd[i], &mut s.qd_carry[i], dqd[i]);
+                }
+                alive = keep;
+                if alive == [0; WIDTH] {
+                    break;
+                }
+            }
+            alive
+        }
+        dispatch fn rk4_run_simd, rk4_run_avx2
+    }
+}

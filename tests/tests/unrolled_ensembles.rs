@@ -1,0 +1,308 @@
+//! `model!`'s planar models in lanes (`pendulum_core::batch::UnrolledBatch`): every chain of
+//! a batch gets exactly its generated model's `θ̈`, whatever the thread count and however
+//! the chains are split into calls, the chains whose tension continuants leave their range
+//! included, and a failing chain is reported by its index while the others finish.
+
+use nalgebra::{Const, SVector, Vector2};
+use pendulum_core::batch::{PlanarKernel, UnrolledBatch};
+use pendulum_core::integrate::{Integrator, Rk4, State};
+use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+pendulum_macros::model! {
+    struct Planar2 { kind: planar, links: 2, algorithm: tension }
+    struct Planar4 { kind: planar, links: 4 }
+    struct Planar5 { kind: planar, links: 5 }
+    struct Planar8 { kind: planar, links: 8 }
+    struct Planar16 { kind: planar, links: 16 }
+}
+
+/// `N` links with masses, lengths and damping log-uniform over two decades, gravity
+/// between 1 and 20 m/s².
+fn random_chain<const N: usize>(r: &mut ChaCha8Rng) -> Chain<Const<N>> {
+    let mut decades = |lo: f64| (0..N).map(|_| 10f64.powf(lo + 2.0 * r.random::<f64>())).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (decades(-2.0), decades(-2.0), decades(-5.0));
+    let g = r.random_range(1.0..20.0);
+    Chain::new(&masses, &lengths, g).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// Random states of `chains` chains: angles over several turns (one in 17 beyond the sine
+/// kernel's range), rates, torques and pivot accelerations, as `(B, N)` and `(B, 2)` rows.
+fn random_inputs(chains: usize, n: usize, r: &mut ChaCha8Rng) -> [Vec<f64>; 4] {
+    let q = (0..chains * n)
+        .map(|i| if i % 17 == 5 { r.random_range(-1e5..1e5) } else { r.random_range(-20.0..20.0) })
+        .collect();
+    let mut uniform =
+        |len: usize, span: f64| (0..len).map(|_| r.random_range(-span..span)).collect::<Vec<_>>();
+    [q, uniform(chains * n, 10.0), uniform(chains * n, 1e-3), uniform(chains * 2, 30.0)]
+}
+
+/// Each chain's generated model alone: its `θ̈` rows, or its error.
+fn each_alone<M: PlanarKernel<N>, const N: usize>(
+    models: &[M],
+    [q, qd, torque, pivot]: &[Vec<f64>; 4],
+) -> Vec<Result<Vec<f64>, Error>> {
+    let row = |v: &[f64], k: usize| SVector::<f64, N>::from_column_slice(&v[k * N..(k + 1) * N]);
+    models
+        .iter()
+        .enumerate()
+        .map(|(k, model)| {
+            let inputs = Inputs {
+                torque: row(torque, k),
+                pivot_acceleration: Vector2::new(pivot[2 * k], pivot[2 * k + 1]),
+            };
+            let mut out = SVector::zeros();
+            model.accelerations(&row(q, k), &row(qd, k), &inputs, &mut out).map(|()| out.as_slice().to_vec())
+        })
+        .collect()
+}
+
+/// Every entry equal bit for bit.
+fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
+    for (i, (a, b)) in batch.iter().zip(single).enumerate() {
+        assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
+    }
+}
+
+fn pools() -> [rayon::ThreadPool; 2] {
+    [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
+}
+
+/// The batch of `models` at `inputs`, with 1 and 2 threads and split in two calls, equals
+/// each model alone bit for bit, and fails exactly where they fail, with their errors.
+fn check<M: PlanarKernel<N> + Clone, const N: usize>(models: Vec<M>, inputs: &[Vec<f64>; 4]) {
+    let chains = models.len();
+    let single = each_alone(&models, inputs);
+    let [q, qd, torque, pivot] = inputs;
+    let run = |batch: &UnrolledBatch<M, N>, rows: std::ops::Range<usize>, out: &mut [f64]| {
+        let (a, b) = (rows.start * N, rows.end * N);
+        batch
+            .accelerations(
+                &q[a..b],
+                &qd[a..b],
+                Some(&torque[a..b]),
+                Some(&pivot[2 * rows.start..2 * rows.end]),
+                out,
+            )
+            .expect("batch")
+    };
+    let batch = UnrolledBatch::new(models.clone()).expect("batch");
+    for pool in pools() {
+        let mut out = vec![0.0; chains * N];
+        let failures = pool.install(|| run(&batch, 0..chains, &mut out));
+        let what = format!("{chains} chains of {N}, {} threads", pool.current_num_threads());
+        let mut failed = failures.iter();
+        for (k, alone) in single.iter().enumerate() {
+            let row = &out[k * N..(k + 1) * N];
+            match alone {
+                Ok(expected) => assert_bits(row, expected, &format!("{what}, chain {k}")),
+                Err(error) => {
+                    let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
+                    // As text: the errors carry the NaN they found.
+                    assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
+                    assert!(row.iter().all(|x| x.is_nan()), "{what}: chain {k}'s row is NaN");
+                }
+            }
+        }
+        assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+    }
+    // Split into two calls off a block boundary: the same numbers.
+    let cut = chains / 2 + 1;
+    if cut < chains {
+        let mut whole = vec![0.0; chains * N];
+        run(&batch, 0..chains, &mut whole);
+        let mut out = vec![0.0; chains * N];
+        let (low, high) = out.split_at_mut(cut * N);
+        run(&UnrolledBatch::new(models[..cut].to_vec()).expect("batch"), 0..cut, low);
+        let (a, b) = (cut * N, chains * N);
+        UnrolledBatch::new(models[cut..].to_vec())
+            .expect("batch")
+            .accelerations(&q[a..b], &qd[a..b], Some(&torque[a..b]), Some(&pivot[2 * cut..]), high)
+            .expect("batch");
+        assert_bits(&out, &whole, &format!("{chains} chains of {N} split at {cut}"));
+    }
+}
+
+fn random_models<M: From<Chain<Const<N>>>, const N: usize>(chains: usize, r: &mut ChaCha8Rng) -> Vec<M> {
+    (0..chains).map(|_| M::from(random_chain::<N>(r))).collect()
+}
+
+#[test]
+fn each_chain_of_a_batch_is_its_generated_model_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(47);
+    for chains in [1, 3, 9, 64] {
+        let inputs = random_inputs(chains, 2, &mut r);
+        check::<Planar2, 2>(random_models(chains, &mut r), &inputs);
+        let inputs = random_inputs(chains, 4, &mut r);
+        check::<Planar4, 4>(random_models(chains, &mut r), &inputs);
+        let inputs = random_inputs(chains, 5, &mut r);
+        check::<Planar5, 5>(random_models(chains, &mut r), &inputs);
+        let inputs = random_inputs(chains, 8, &mut r);
+        check::<Planar8, 8>(random_models(chains, &mut r), &inputs);
+        let inputs = random_inputs(chains, 16, &mut r);
+        check::<Planar16, 16>(random_models(chains, &mut r), &inputs);
+    }
+}
+
+#[test]
+fn a_chain_whose_continuants_leave_their_range_falls_back_in_its_lane_alone() {
+    // Masses of 1e-250 kg make the tension system's diagonal ~1e250 and its continuants
+    // overflow 2⁸⁰⁰: that chain takes the classical pivots, its neighbours in the block do
+    // not.
+    let mut r = ChaCha8Rng::seed_from_u64(5);
+    let mut models: Vec<Planar8> = random_models(7, &mut r);
+    let tiny = Chain::new(&[1e-250; 8], &[0.1; 8], 9.81).expect("chain");
+    models[1] = Planar8::new(tiny.clone());
+    models[6] = Planar8::new(tiny);
+    let inputs = random_inputs(7, 8, &mut r);
+    let single = each_alone(&models, &inputs);
+    assert!(single.iter().all(Result::is_ok), "{single:?}");
+    check::<Planar8, 8>(models, &inputs);
+}
+
+#[test]
+fn a_failing_chain_is_named_with_its_models_error_and_the_others_finish() {
+    let mut r = ChaCha8Rng::seed_from_u64(9);
+    let models: Vec<Planar4> = random_models(10, &mut r);
+    let mut inputs = random_inputs(10, 4, &mut r);
+    inputs[0][4 * 2 + 1] = f64::NAN; // chain 2: q[1]
+    inputs[1][4 * 7 + 3] = f64::INFINITY; // chain 7: qd[3]
+    let single = each_alone(&models, &inputs);
+    assert!(matches!(single[2], Err(Error::NonFinite { index: 1, .. })), "{:?}", single[2]);
+    assert!(single[7].is_err() && single.iter().filter(|s| s.is_err()).count() == 2);
+    check::<Planar4, 4>(models, &inputs);
+}
+
+#[test]
+fn bad_batches_and_arrays_are_one_line_errors() {
+    assert_eq!(UnrolledBatch::<Planar4, 4>::new(Vec::new()).unwrap_err(), Error::EmptyBatch);
+    let mut r = ChaCha8Rng::seed_from_u64(1);
+    let batch = UnrolledBatch::new(random_models::<Planar4, 4>(3, &mut r)).expect("batch");
+    let mut out = vec![0.0; 12];
+    let error = batch.accelerations(&[0.0; 11], &[0.0; 12], None, None, &mut out).unwrap_err();
+    assert_eq!(error.to_string(), "q has 11 entries, expected 12");
+    let error = batch.accelerations(&[0.0; 12], &[0.0; 12], None, Some(&[0.0; 5]), &mut out).unwrap_err();
+    assert_eq!(error.to_string(), "pivot has 5 entries, expected 6");
+}
+
+/// Each chain's state after `steps` steps of `Rk4` on `FirstOrder::new(model)`, alone, or
+/// its error (the state left where it failed).
+fn stepped_alone<M, const N: usize, const D: usize>(
+    models: &[M],
+    states: &[State<Const<D>>],
+    h: f64,
+    steps: usize,
+) -> Vec<(State<Const<D>>, Option<Error>)>
+where
+    M: Model<Links = Const<N>, Dof = Const<N>, Space = nalgebra::U2> + Clone,
+    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
+{
+    models
+        .iter()
+        .zip(states)
+        .map(|(model, state)| {
+            let system = FirstOrder::new(model.clone());
+            let mut rk4 = Rk4::new(&system);
+            let mut state = state.clone();
+            let error = (0..steps).find_map(|_| rk4.step(&system, &mut state, h).err());
+            (state, error)
+        })
+        .collect()
+}
+
+/// `chains` random states `(θ, θ̇)` at random times.
+fn random_states<const D: usize>(chains: usize, r: &mut ChaCha8Rng) -> Vec<State<Const<D>>> {
+    (0..chains)
+        .map(|_| {
+            let x = SVector::<f64, D>::from_fn(|i, _| {
+                if i < D / 2 { r.random_range(-3.0..3.0) } else { r.random_range(-5.0..5.0) }
+            });
+            State::new(r.random_range(0.0..10.0), x)
+        })
+        .collect()
+}
+
+/// The batch's RK4 runs equal each chain's alone in time, state and compensation: with 1
+/// and 2 threads, and in two calls of half the steps each.
+fn check_rk4<M, const N: usize, const D: usize>(
+    models: Vec<M>,
+    states: Vec<State<Const<D>>>,
+    h: f64,
+    steps: usize,
+) where
+    M: PlanarKernel<N> + Clone,
+    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
+{
+    let alone = stepped_alone(&models, &states, h, steps);
+    let batch = UnrolledBatch::new(models).expect("batch");
+    let compare = |batched: &[State<Const<D>>], failures: &[pendulum_core::batch::Failure], what: &str| {
+        let mut failed = failures.iter();
+        for (k, (state, (single, error))) in batched.iter().zip(&alone).enumerate() {
+            assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
+            assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
+            assert_bits(
+                state.compensation().as_slice(),
+                single.compensation().as_slice(),
+                &format!("{what}: chain {k}'s compensation"),
+            );
+            if let Some(error) = error {
+                let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
+                assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
+            }
+        }
+        assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+    };
+    for pool in pools() {
+        let mut batched = states.clone();
+        let failures = pool.install(|| batch.integrate_rk4(&mut batched, h, steps)).expect("batch");
+        compare(
+            &batched,
+            &failures,
+            &format!("{} chains of {N}, {} threads", states.len(), pool.current_num_threads()),
+        );
+    }
+    let mut batched = states.clone();
+    let first = batch.integrate_rk4(&mut batched, h, steps / 2).expect("batch");
+    let mut failures = batch.integrate_rk4(&mut batched, h, steps - steps / 2).expect("batch");
+    failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
+    failures.extend(first);
+    failures.sort_by_key(|f| f.chain);
+    compare(&batched, &failures, &format!("{} chains of {N} in two calls", states.len()));
+}
+
+#[test]
+fn rk4_runs_of_a_batch_equal_each_chain_stepped_alone_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(61);
+    for chains in [1, 6, 13] {
+        let states = random_states::<8>(chains, &mut r);
+        check_rk4::<Planar4, 4, 8>(random_models(chains, &mut r), states, 1e-3, 20);
+        let states = random_states::<16>(chains, &mut r);
+        check_rk4::<Planar8, 8, 16>(random_models(chains, &mut r), states, 3e-4, 20);
+    }
+}
+
+#[test]
+fn a_chain_that_fails_in_a_run_stops_where_it_failed_with_its_own_error() {
+    let mut r = ChaCha8Rng::seed_from_u64(3);
+    let models: Vec<Planar4> = random_models(7, &mut r);
+    let mut states = random_states::<8>(7, &mut r);
+    // Chain 2 starts with a NaN angle; chain 5 spins so fast that θ̇² overflows on the way.
+    let mut x = *states[2].x();
+    x[1] = f64::NAN;
+    states[2] = State::new(states[2].t(), x);
+    let mut x = *states[5].x();
+    x[4 + 3] = 1e153;
+    states[5] = State::new(states[5].t(), x);
+    let alone = stepped_alone::<Planar4, 4, 8>(&models, &states, 1e-3, 10);
+    assert!(matches!(alone[2].1, Some(Error::NonFinite { .. })), "{:?}", alone[2].1);
+    assert!(alone[5].1.is_some() && alone.iter().filter(|a| a.1.is_some()).count() == 2, "{alone:?}");
+    check_rk4::<Planar4, 4, 8>(models, states, 1e-3, 10);
+    let batch = UnrolledBatch::new(random_models::<Planar4, 4>(2, &mut r)).expect("batch");
+    let mut two = random_states::<8>(2, &mut r);
+    assert_eq!(batch.integrate_rk4(&mut two, 0.0, 1).unwrap_err(), Error::InvalidStepSize { h: 0.0 });
+    assert_eq!(
+        batch.integrate_rk4(&mut two[..1], 1e-3, 1).unwrap_err().to_string(),
+        "states has 1 entries, expected 2"
+    );
+}
