@@ -9,7 +9,8 @@
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
 //!   (throughput in chain-steps per second);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
-//!   the same models in lanes (`UnrolledBatch`), on one thread and on two;
+//!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
+//!   precision (eight lanes) on one;
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps).
 //!
@@ -230,6 +231,14 @@ fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
             })
         });
     }
+    let (q32, qd32): (Vec<f32>, Vec<f32>) = q.iter().zip(&qd).map(|(&a, &b)| (a as f32, b as f32)).unzip();
+    let mut out32 = vec![0.0f32; CHAINS * N];
+    let pool = pool(1);
+    group.bench_with_input(BenchmarkId::new("planar/batch_f32_1_thread", N), &N, |b, _| {
+        in_pool(b, &pool, || {
+            batch.accelerations_f32(&q32, &qd32, None, None, &mut out32).expect("batch");
+        })
+    });
 }
 
 /// 100 RK4 steps of each of the `CHAINS` models alone against the batch's run.

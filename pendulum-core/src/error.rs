@@ -92,6 +92,10 @@ pub enum Error {
     /// through round-off in extreme parameter ranges).
     #[error("the mass matrix is not numerically positive definite at this state")]
     NotPositiveDefinite,
+    /// A single-precision evaluation gave a non-finite result from finite inputs: the
+    /// chain's numbers leave `f32`'s range (or its tension solve's) where `f64`'s do not.
+    #[error("the accelerations are not finite in single precision at this state (use f64)")]
+    SinglePrecisionOverflow,
     /// The implicit stage equations of an integrator step did not converge: the
     /// iterations (Newton, simplified then full, or fixed-point sweeps) diverged, stalled
     /// above round-off, or ran out. The state is left as it was before the step.

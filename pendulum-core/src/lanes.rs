@@ -1,6 +1,7 @@
 //! Numbers that are one `f64` or `W` of them side by side: the scalar type of the tension
 //! solve, so that one algorithm serves a single chain (`f64`) and `W` chains at once in SIMD
-//! lanes ([`Lanes`]).
+//! lanes ([`Lanes`]), or `W` chains in single precision ([`Lanes32`], eight to an AVX2
+//! register; not bit for bit anything, its accuracy is measured in `docs/ensembles.md`).
 //!
 //! [`Lanes`] does every operation lane by lane, the same IEEE operation in each, with no
 //! fused multiply-add: a lane's result is bit for bit what `f64` gives for that lane alone.
@@ -46,6 +47,14 @@ pub trait Lane:
     /// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`, lane by lane: the exact power of two that
     /// brings a positive normal `x` into `[1, 2)`.
     fn normalizer(self) -> Self;
+    /// The lanes whose continuant `self` is outside the range where the tension solve trusts
+    /// it: [`CONTINUANT_RANGE`](crate::rods::CONTINUANT_RANGE) in double precision,
+    /// `[2⁻⁸⁰, 2⁸⁰]` in single ([`Lanes32`]).
+    #[inline(always)]
+    fn continuant_outside(self) -> Self::Mask {
+        let (low, span) = crate::rods::CONTINUANT_RANGE;
+        self.outside(low, span)
+    }
 }
 
 impl Lane for f64 {
@@ -136,8 +145,8 @@ impl<const W: usize> Lanes<W> {
 }
 
 macro_rules! lane_op {
-    ($trait:ident, $method:ident, $assign:ident, $assign_method:ident, $op:tt) => {
-        impl<const W: usize> $trait for Lanes<W> {
+    ($lanes:ident, $trait:ident, $method:ident, $assign:ident, $assign_method:ident, $op:tt) => {
+        impl<const W: usize> $trait for $lanes<W> {
             type Output = Self;
             #[inline(always)]
             fn $method(self, other: Self) -> Self {
@@ -148,7 +157,7 @@ macro_rules! lane_op {
                 Self(out)
             }
         }
-        impl<const W: usize> $assign for Lanes<W> {
+        impl<const W: usize> $assign for $lanes<W> {
             #[inline(always)]
             fn $assign_method(&mut self, other: Self) {
                 *self = *self $op other;
@@ -165,10 +174,139 @@ impl<const W: usize> Neg for Lanes<W> {
     }
 }
 
-lane_op!(Add, add, AddAssign, add_assign, +);
-lane_op!(Sub, sub, SubAssign, sub_assign, -);
-lane_op!(Mul, mul, MulAssign, mul_assign, *);
-lane_op!(Div, div, DivAssign, div_assign, /);
+impl<const W: usize> Neg for Lanes32<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self.map(|x| -x)
+    }
+}
+
+lane_op!(Lanes, Add, add, AddAssign, add_assign, +);
+lane_op!(Lanes, Sub, sub, SubAssign, sub_assign, -);
+lane_op!(Lanes, Mul, mul, MulAssign, mul_assign, *);
+lane_op!(Lanes, Div, div, DivAssign, div_assign, /);
+lane_op!(Lanes32, Add, add, AddAssign, add_assign, +);
+lane_op!(Lanes32, Sub, sub, SubAssign, sub_assign, -);
+lane_op!(Lanes32, Mul, mul, MulAssign, mul_assign, *);
+lane_op!(Lanes32, Div, div, DivAssign, div_assign, /);
+
+/// `W` single-precision numbers, one per chain of a batch, operated on lane by lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(transparent)]
+pub struct Lanes32<const W: usize>(pub [f32; W]);
+
+// Loops into arrays rather than `array::map` and `array::from_fn`: those left most of a
+// generated kernel's single-precision lanes scalar.
+impl<const W: usize> Lanes32<W> {
+    /// `f(k)` in lane `k`.
+    #[inline(always)]
+    pub fn from_fn(f: impl Fn(usize) -> f32) -> Self {
+        let mut out = [0.0; W];
+        for (k, x) in out.iter_mut().enumerate() {
+            *x = f(k);
+        }
+        Self(out)
+    }
+
+    /// `f(lane)` for each lane.
+    #[inline(always)]
+    pub fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        let mut out = self.0;
+        for x in &mut out {
+            *x = f(*x);
+        }
+        Self(out)
+    }
+
+    /// The lanes of `v` one after another, as [`Lanes::flatten`].
+    #[inline(always)]
+    pub fn flatten(v: &[Self]) -> &[f32] {
+        // SAFETY: `Lanes32<W>` is `repr(transparent)` over `[f32; W]`.
+        unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), W * v.len()) }
+    }
+
+    /// [`flatten`](Self::flatten), mutably.
+    #[inline(always)]
+    pub fn flatten_mut(v: &mut [Self]) -> &mut [f32] {
+        // SAFETY: as in `flatten`; the borrow of `v` is moved into the result.
+        unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast(), W * v.len()) }
+    }
+}
+
+/// `2⁻⁸⁰` and `2⁸⁰` as `f32` bit patterns: the continuants' range in single precision, wide
+/// enough for the chains of a few dozen links of grams and centimetres in SI units and far
+/// enough from `f32`'s overflow (`2¹²⁸`) for the products the solve forms with them.
+const CONTINUANT_RANGE_32: (u32, u32) = {
+    let low = (127 - 80) << 23;
+    let high = (127 + 80) << 23;
+    (low, high - low)
+};
+
+impl<const W: usize> Lane for Lanes32<W> {
+    type Mask = [u32; W];
+    const WIDTH: usize = W;
+
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Self([x as f32; W])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.map(f32::sqrt)
+    }
+    /// `(low, span)` as `f64` bit patterns: each lane widened to `f64` (exact) and checked.
+    #[inline(always)]
+    fn outside(self, low: u64, span: u64) -> [u32; W] {
+        let mut out = [0; W];
+        for (o, x) in out.iter_mut().zip(self.0) {
+            *o = f64::from(x).outside(low, span) as u32;
+        }
+        out
+    }
+    #[inline(always)]
+    fn none() -> [u32; W] {
+        [0; W]
+    }
+    #[inline(always)]
+    fn or(a: [u32; W], b: [u32; W]) -> [u32; W] {
+        let mut out = a;
+        for k in 0..W {
+            out[k] |= b[k];
+        }
+        out
+    }
+    #[inline(always)]
+    fn any(mask: [u32; W]) -> bool {
+        mask.iter().fold(0, |any, m| any | m) != 0
+    }
+    #[inline(always)]
+    fn select(mask: [u32; W], a: Self, b: Self) -> Self {
+        let mut out = b.0;
+        for k in 0..W {
+            if mask[k] != 0 {
+                out[k] = a.0[k];
+            }
+        }
+        Self(out)
+    }
+    #[inline(always)]
+    fn normalizer(self) -> Self {
+        self.map(|x| {
+            let biased = (x.to_bits() >> 23) & 0xff;
+            f32::from_bits(((254 - biased as i32) as u32 & 0xff) << 23)
+        })
+    }
+    #[inline(always)]
+    fn continuant_outside(self) -> [u32; W] {
+        let (low, span) = CONTINUANT_RANGE_32;
+        let mut out = [0; W];
+        for (o, x) in out.iter_mut().zip(self.0) {
+            *o = (x.to_bits().wrapping_sub(low) > span) as u32;
+        }
+        out
+    }
+}
 
 impl<const W: usize> Lane for Lanes<W> {
     /// 1 in the flagged lanes, 0 in the others (integers, so that the flags stay in a

@@ -3254,51 +3254,50 @@ const _: () = {
                 let t1 = yt1 * rp1 - off2 * p0 * rp1 * t2;
                 let t11 = zb11 * rq11 - off11 * rq11 * t10;
                 let t0 = yt0 * rp0 - off1 * rp0 * t1;
-                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
                 let outside = <V as ::pendulum_core::lanes::Lane>::none();
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p0, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p0),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p1, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p1),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p2, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p2),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p3, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p3),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p4, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p4),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p5, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p5),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q11, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q11),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q10, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q10),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q9, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q9),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q8, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q8),
                 );
                 let outside = <V as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q7, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q7),
                 );
                 if <V as ::pendulum_core::lanes::Lane>::any(outside) {
                     let t = pivots(

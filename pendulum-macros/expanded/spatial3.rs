@@ -594,15 +594,14 @@ const _: () = {
                     / (rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
                 let t0 = yt0 * rp0 - off1 * rp0 * t1;
                 let t2 = zb2 * rq2 - off2 * rq2 * t1;
-                let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
                 let outside = <f64 as ::pendulum_core::lanes::Lane>::none();
                 let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(p0, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(p0),
                 );
                 let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
                     outside,
-                    ::pendulum_core::lanes::Lane::outside(q2, low, span),
+                    ::pendulum_core::lanes::Lane::continuant_outside(q2),
                 );
                 if <f64 as ::pendulum_core::lanes::Lane>::any(outside) {
                     let t = pivots([rod_diag[0], rod_diag[1], rod_diag[2]], [zero, off1, off2], [b0, b1, b2]);

@@ -8,6 +8,8 @@
 //! detected at run time like the sine kernel's; a portable loop otherwise). Blocks of
 //! `WIDTH` chains go to the cores through rayon (the current pool: wrap a call in
 //! `ThreadPool::install` to choose the threads).
+//! [`UnrolledBatch`] does the same for the straight-line kernels `model!` generates for
+//! planar chains of a fixed number of links.
 //!
 //! **Bit for bit.** A lane does the same IEEE operations in the same order as the
 //! single-chain call (no fused multiply-add, the same sine kernel), so every chain of a
@@ -37,7 +39,7 @@ mod unrolled;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
-pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
+pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch, WIDTH_F32};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;
@@ -75,7 +77,7 @@ pub(crate) fn check_links(links: impl ExactSizeIterator<Item = usize>) -> Result
 }
 
 /// Checks that `v` holds `chains` rows of `per_chain` numbers.
-pub(crate) fn check_len(what: &'static str, v: &[f64], chains: usize, per_chain: usize) -> Result<()> {
+pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain: usize) -> Result<()> {
     if v.len() == chains * per_chain {
         Ok(())
     } else {
@@ -86,7 +88,12 @@ pub(crate) fn check_len(what: &'static str, v: &[f64], chains: usize, per_chain:
 /// The chains of block `b` of a batch of `chains`: lane `k` holds chain `WIDTH·b + k`, and
 /// the lanes past the last chain repeat it (their results are dropped).
 pub(crate) fn block_chains(b: usize, chains: usize) -> [usize; WIDTH] {
-    std::array::from_fn(|k| (WIDTH * b + k).min(chains - 1))
+    block_chains_of::<WIDTH>(b, chains)
+}
+
+/// [`block_chains`] for blocks of `W` chains.
+pub(crate) fn block_chains_of<const W: usize>(b: usize, chains: usize) -> [usize; W] {
+    std::array::from_fn(|k| (W * b + k).min(chains - 1))
 }
 
 /// Lane `k` of each of the `m` numbers of the rows `rows` of `v` (`m` per row).
@@ -102,11 +109,10 @@ pub(crate) fn non_finite(what: &'static str, v: &[f64]) -> Option<Error> {
     v.iter().position(|x| !x.is_finite()).map(|index| Error::NonFinite { what, index, value: v[index] })
 }
 
-/// Blocks of [`WIDTH`] chains a rayon task takes at least, for blocks of `solves` rods'
-/// solves each: about 2000 rods' solves a task, so that short work does not drown in
-/// scheduling.
-pub(crate) fn blocks_per_task(solves: usize) -> usize {
-    (2048 / (WIDTH * solves).max(1)).max(1)
+/// Blocks of `W` chains a rayon task takes at least, for blocks of `solves` rods' solves
+/// each: about 2000 rods' solves a task, so that short work does not drown in scheduling.
+pub(crate) fn blocks_per_task<const W: usize>(solves: usize) -> usize {
+    (2048 / (W * solves).max(1)).max(1)
 }
 
 /// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
@@ -120,19 +126,30 @@ pub(crate) fn for_blocks<T: Send, S, F: Send>(
     init: impl Fn() -> S + Sync + Send,
     block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
 ) -> Vec<F> {
-    let per_task = blocks_per_task(solves);
-    if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
+    for_blocks_of::<WIDTH, T, S, F>(out, m, solves, init, block)
+}
+
+/// [`for_blocks`] for blocks of `W` rows.
+pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
+    out: &mut [T],
+    m: usize,
+    solves: usize,
+    init: impl Fn() -> S + Sync + Send,
+    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
+) -> Vec<F> {
+    let per_task = blocks_per_task::<W>(solves);
+    if out.len() <= per_task * W * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up
         // costs more than a short batch).
         // A plain loop: a `flat_map` over the blocks cost 6–9% of a short block's time.
         let mut scratch = init();
         let mut failures = Vec::new();
-        for (b, rows) in out.chunks_mut(WIDTH * m).enumerate() {
+        for (b, rows) in out.chunks_mut(W * m).enumerate() {
             failures.extend(block(&mut scratch, b, rows));
         }
         return failures;
     }
-    out.par_chunks_mut(WIDTH * m)
+    out.par_chunks_mut(W * m)
         .enumerate()
         .with_min_len(per_task)
         .map_init(init, |scratch, (b, rows)| block(scratch, b, rows))

@@ -14,6 +14,7 @@ mod planar;
 mod spherical;
 pub(crate) mod tilt;
 pub(crate) mod trig;
+pub(crate) mod trig32;
 mod turning;
 
 use nalgebra::{DefaultAllocator, Dim, DimName, OVector, allocator::Allocator};

@@ -506,11 +506,10 @@ fn twisted_solve(n: usize, lane: &TokenStream) -> TokenStream {
         #fallback
         let (#(#ts,)*) = {
             #hot
-            let (low, span) = ::pendulum_core::__private::CONTINUANT_RANGE;
             let outside = <#lane as ::pendulum_core::lanes::Lane>::none();
             #(let outside = <#lane as ::pendulum_core::lanes::Lane>::or(
                 outside,
-                ::pendulum_core::lanes::Lane::outside(#continuants, low, span),
+                ::pendulum_core::lanes::Lane::continuant_outside(#continuants),
             );)*
             if <#lane as ::pendulum_core::lanes::Lane>::any(outside) {
                 let t = pivots([#(#diags),*], [#(#offs),*], [#(#bs),*]);

@@ -9,13 +9,16 @@
 //! single model's `θ̈` bit for bit.
 
 mod rk4;
+mod single;
+
+pub use single::WIDTH_F32;
 
 use nalgebra::{Const, SVector, U2, Vector2};
 
-use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, simd_kernel};
+use super::{F64x4, Failure, WIDTH, block_chains, block_chains_of, check_len, for_blocks, simd_kernel};
 use crate::error::{Error, Result};
 use crate::kinematics::trig::sin_cos_split;
-use crate::lanes::{Lane, Lanes};
+use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
 
 /// A chain's per-link constants as a generated tension model reads them, `N` of each: one
@@ -39,15 +42,27 @@ pub struct LinkConstants<V, const N: usize> {
 impl<const N: usize> LinkConstants<f64, N> {
     /// The constants of `chains` side by side: lane `k` holds `chains[k]`'s.
     pub fn interleave<const W: usize>(chains: [&Self; W]) -> LinkConstants<Lanes<W>, N> {
-        let lanes =
-            |of: fn(&Self) -> &[f64; N]| std::array::from_fn(|i| Lanes::from_fn(|k| of(chains[k])[i]));
+        Self::side_by_side(chains, Lanes)
+    }
+
+    /// [`interleave`](Self::interleave) rounded to single precision.
+    pub fn interleave_f32<const W: usize>(chains: [&Self; W]) -> LinkConstants<Lanes32<W>, N> {
+        Self::side_by_side(chains, |lanes| Lanes32(lanes.map(|x| x as f32)))
+    }
+
+    /// Each constant of `chains`, lane `k` holding `chains[k]`'s, made a lane type by `lanes`.
+    fn side_by_side<const W: usize, L>(
+        chains: [&Self; W],
+        lanes: impl Fn([f64; W]) -> L,
+    ) -> LinkConstants<L, N> {
+        let each = |of: fn(&Self) -> &[f64; N]| std::array::from_fn(|i| lanes(chains.map(|c| of(c)[i])));
         LinkConstants {
-            inverse_mass: lanes(|c| &c.inverse_mass),
-            length: lanes(|c| &c.length),
-            inverse_length: lanes(|c| &c.inverse_length),
-            drag: lanes(|c| &c.drag),
-            diagonal: lanes(|c| &c.diagonal),
-            gravity: Lanes::from_fn(|k| chains[k].gravity),
+            inverse_mass: each(|c| &c.inverse_mass),
+            length: each(|c| &c.length),
+            inverse_length: each(|c| &c.inverse_length),
+            drag: each(|c| &c.drag),
+            diagonal: each(|c| &c.diagonal),
+            gravity: lanes(chains.map(|c| c.gravity)),
         }
     }
 }
@@ -97,6 +112,8 @@ pub struct UnrolledBatch<M, const N: usize> {
     models: Vec<M>,
     /// Per block of [`WIDTH`] chains, their constants side by side.
     blocks: Vec<LinkConstants<F64x4, N>>,
+    /// The same per block of [`WIDTH_F32`] chains, in single precision.
+    blocks_f32: Vec<LinkConstants<single::F32x8, N>>,
 }
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
@@ -110,7 +127,13 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         let blocks = (0..models.len().div_ceil(WIDTH))
             .map(|b| LinkConstants::interleave(block_chains(b, models.len()).map(|c| models[c].constants())))
             .collect();
-        Ok(Self { models, blocks })
+        let blocks_f32 = (0..models.len().div_ceil(WIDTH_F32))
+            .map(|b| {
+                let chains = block_chains_of::<WIDTH_F32>(b, models.len());
+                LinkConstants::interleave_f32(chains.map(|c| models[c].constants()))
+            })
+            .collect();
+        Ok(Self { models, blocks, blocks_f32 })
     }
 
     /// Number of chains `B`.

@@ -52,9 +52,9 @@ fn increment<V: Lane, const N: usize>(
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     /// `steps` steps of RK4 of size `h` (s) for every chain, each from its own state
     /// `x = (θ, θ̇)` (`2N` entries: rad, rad/s) and time: exactly what `steps` calls of
-    /// [`Rk4::step`] on `FirstOrder::new(model)` give for each chain alone, bit for bit
-    /// (compensated time and state included), with the states kept in lanes from the
-    /// first step to the last.
+    /// [`Rk4`](crate::integrate::Rk4)'s `step` on `FirstOrder::new(model)` give for each
+    /// chain alone, bit for bit (compensated time and state included), with the states
+    /// kept in lanes from the first step to the last.
     ///
     /// Returns the chains that failed, in order, each with the error its own step gave (a
     /// non-finite state or acceleration); a failed chain is left at the start of the step
