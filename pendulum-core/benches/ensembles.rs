@@ -12,7 +12,9 @@
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
 //!   precision (eight lanes) on one;
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
-//!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps).
+//!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps);
+//! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time
+//!   against `PlanarBatch::state_jacobians` on one thread and on two.
 //!
 //! `cargo bench -p pendulum-core --bench ensembles`
 
@@ -23,7 +25,9 @@ use criterion::{Bencher, BenchmarkId, Criterion, Throughput, criterion_group, cr
 use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Chain, Circle, Directions, FirstOrder, Inputs, Model, PlanarTension};
+use pendulum_core::{
+    Chain, Circle, Derivatives, Directions, FirstOrder, Inputs, Jacobians, Model, PlanarTension,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -309,5 +313,43 @@ fn generated(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, accelerations, rk4, generated);
+/// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` of 64 planar chains of 20 links: one chain at a time against the
+/// batch on one thread and on two (the chains over the cores, not in lanes).
+fn jacobians(c: &mut Criterion) {
+    const N: usize = 20;
+    let mut group = c.benchmark_group("jacobians");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(30);
+    group.throughput(Throughput::Elements(CHAINS as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(41);
+    let chains: Vec<_> = (0..CHAINS).map(|_| random_chain(N, 2.0, &mut r)).collect();
+    let q: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let qd: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
+    let inputs = Inputs::<Dyn, U2>::zeros(Dyn(N));
+    let mut out = Jacobians::zeros(&singles[0]);
+    group.bench_with_input(BenchmarkId::new("planar/single", N), &N, |b, _| {
+        b.iter(|| {
+            for (k, model) in singles.iter().enumerate() {
+                let row = k * N..(k + 1) * N;
+                let (q, qd) =
+                    (DVector::from_column_slice(&q[row.clone()]), DVector::from_column_slice(&qd[row]));
+                model.state_jacobians(&q, &qd, &inputs, &mut out).expect("single");
+                black_box(&out);
+            }
+        })
+    });
+    let batch = PlanarBatch::new(chains).expect("batch");
+    let (mut dq, mut dqd) = (vec![0.0; CHAINS * N * N], vec![0.0; CHAINS * N * N]);
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        group.bench_with_input(BenchmarkId::new(format!("planar/batch_{threads}_threads"), N), &N, |b, _| {
+            in_pool(b, &pool, || {
+                batch.state_jacobians(&q, &qd, None, &mut dq, &mut dqd).expect("batch");
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, accelerations, rk4, generated, jacobians);
 criterion_main!(benches);

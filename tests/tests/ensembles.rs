@@ -7,7 +7,10 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, Dyn, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Accounted, Chain, Circle, Directions, Error, Inputs, Model, PlanarTension, trajectory};
+use pendulum_core::{
+    Accounted, Chain, Circle, Derivatives, Directions, Error, Inputs, Jacobians, Model, PlanarTension,
+    trajectory,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -348,5 +351,58 @@ fn a_chain_that_blows_up_mid_run_stops_at_its_last_good_state() {
     assert_bits(states[2].x().as_slice(), alone.x().as_slice(), "the blown chain");
     for k in [0, 1, 3, 4] {
         assert!((states[k].t() - 0.05).abs() < 1e-12, "chain {k} ran all 50 steps");
+    }
+}
+
+#[test]
+fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_chain() {
+    let mut r = ChaCha8Rng::seed_from_u64(77);
+    for (chains, n) in [(1, 1), (5, 8), (37, 20)] {
+        let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+        let batch = PlanarBatch::new(chain.clone()).expect("batch");
+        let mut q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-20.0..20.0)).collect();
+        let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-10.0..10.0)).collect();
+        let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+        let bad = chains / 2;
+        q[bad * n] = f64::NAN;
+        let (mut single_q, mut single_qd) = (vec![0.0; chains * n * n], vec![0.0; chains * n * n]);
+        for (k, c) in chain.iter().enumerate() {
+            let model = PlanarTension::new(c.clone());
+            let rows = k * n..(k + 1) * n;
+            let mut inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
+            inputs.pivot_acceleration = nalgebra::Vector2::new(pivot[2 * k], pivot[2 * k + 1]);
+            let mut out = Jacobians::zeros(&model);
+            let result = model.state_jacobians(
+                &DVector::from_column_slice(&q[rows.clone()]),
+                &DVector::from_column_slice(&qd[rows]),
+                &inputs,
+                &mut out,
+            );
+            assert_eq!(result.is_err(), k == bad, "chain {k}");
+            let block = k * n * n..(k + 1) * n * n;
+            if k == bad {
+                single_q[block.clone()].fill(f64::NAN);
+                single_qd[block].fill(f64::NAN);
+                continue;
+            }
+            for a in 0..n {
+                for b in 0..n {
+                    single_q[block.start + a * n + b] = out.q[(a, b)];
+                    single_qd[block.start + a * n + b] = out.qd[(a, b)];
+                }
+            }
+        }
+        for pool in pools() {
+            let (mut dq, mut dqd) = (vec![0.0; chains * n * n], vec![0.0; chains * n * n]);
+            let failures = pool
+                .install(|| batch.state_jacobians(&q, &qd, Some(&pivot), &mut dq, &mut dqd))
+                .expect("batch");
+            let what = format!("{chains} chains of {n}, {} threads", pool.current_num_threads());
+            assert_eq!(failures.len(), 1, "{what}");
+            assert_eq!(failures[0].chain, bad, "{what}");
+            assert_eq!(failures[0].error.to_string(), "q[0] must be finite, got NaN", "{what}");
+            assert_bits(&dq, &single_q, &format!("{what}: ∂θ̈/∂θ"));
+            assert_bits(&dqd, &single_qd, &format!("{what}: ∂θ̈/∂θ̇"));
+        }
     }
 }

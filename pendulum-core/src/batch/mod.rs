@@ -32,6 +32,7 @@ use crate::error::{Error, Result};
 use crate::lanes::Lanes;
 
 mod directions;
+mod jacobians;
 mod planar;
 mod rk4;
 mod run;
