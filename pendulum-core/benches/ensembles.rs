@@ -7,7 +7,8 @@
 //!   (`PlanarTension`, `Directions<U3>`) against the batch on one thread and on two;
 //! - `rk4/whirl_100`: one projected RK4 step of 1 ms of 64 whirls (3D, n = 100, each pivot on
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
-//!   (throughput in chain-steps per second);
+//!   (throughput in chain-steps per second), and 10 steps of the implicit rod midpoint
+//!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
 //!   precision (eight lanes) on one;
@@ -26,7 +27,7 @@ use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Chain, Circle, Derivatives, Directions, FirstOrder, Inputs, Jacobians, Model, PlanarTension,
+    Chain, Circle, Derivatives, Directions, FirstOrder, Inputs, Jacobians, Model, PlanarTension, RodMidpoint,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -195,6 +196,29 @@ fn rk4(c: &mut Criterion) {
         group.bench_function(format!("whirl_100/batch_{threads}_threads_100_steps"), |b| {
             in_pool(b, &pool, || {
                 batch.integrate_rk4(&mut states, 1e-3, 100).expect("batch");
+            })
+        });
+    }
+    // The implicit rod midpoint, 10 steps per call: each chain on its own, over the cores.
+    group.throughput(Throughput::Elements(10 * CHAINS as u64));
+    let mut states = start.clone();
+    group.bench_function("whirl_100/rod_midpoint_single_10_steps", |b| {
+        b.iter(|| {
+            for (k, state) in states.iter_mut().enumerate() {
+                let model = batch.model(k);
+                let mut step = RodMidpoint::new();
+                for _ in 0..10 {
+                    step.step(model, state, 1e-3).expect("single");
+                }
+            }
+        })
+    });
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let mut states = start.clone();
+        group.bench_function(format!("whirl_100/rod_midpoint_batch_{threads}_threads_10_steps"), |b| {
+            in_pool(b, &pool, || {
+                batch.integrate_rod_midpoint(&mut states, 1e-3, 10).expect("batch");
             })
         });
     }

@@ -5,6 +5,7 @@
 use std::ops::ControlFlow;
 
 use nalgebra::{DVector, Dyn, U2, U3};
+use pendulum_core::RodMidpoint;
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
@@ -403,6 +404,60 @@ fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_
             assert_eq!(failures[0].error.to_string(), "q[0] must be finite, got NaN", "{what}");
             assert_bits(&dq, &single_q, &format!("{what}: ∂θ̈/∂θ"));
             assert_bits(&dqd, &single_qd, &format!("{what}: ∂θ̈/∂θ̇"));
+        }
+    }
+}
+
+#[test]
+fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_chain() {
+    let mut r = ChaCha8Rng::seed_from_u64(19);
+    let (chains, n, h, steps) = (6, 12, 1e-3, 10);
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+    for accounted in [false, true] {
+        let batch = if accounted {
+            DirectionsBatch::accounted(models.clone())
+        } else {
+            DirectionsBatch::new(models.clone())
+        }
+        .expect("batch");
+        let mut start = if accounted {
+            accounted_states(&models, &x)
+        } else {
+            x.iter().map(|x| State::new(0.0, x.clone())).collect()
+        };
+        // Chain 4 starts from a NaN.
+        let mut bad = start[4].x().clone();
+        bad[0] = f64::NAN;
+        start[4] = State::new(0.0, bad);
+        let mut single = start.clone();
+        let errors: Vec<Option<Error>> = models
+            .iter()
+            .zip(&mut single)
+            .map(|(model, state)| {
+                let mut step = RodMidpoint::new();
+                if accounted {
+                    let system = Accounted::of(model.clone());
+                    (0..steps).find_map(|_| step.step(&system, state, h).err())
+                } else {
+                    (0..steps).find_map(|_| step.step(model, state, h).err())
+                }
+            })
+            .collect();
+        assert!(errors[4].is_some() && errors.iter().filter(|e| e.is_some()).count() == 1, "{errors:?}");
+        for pool in pools() {
+            let mut states = start.clone();
+            let failures =
+                pool.install(|| batch.integrate_rod_midpoint(&mut states, h, steps)).expect("batch");
+            let what = format!("accounted {accounted}, {} threads", pool.current_num_threads());
+            assert_eq!(failures.len(), 1, "{what}");
+            // As text: the errors carry the NaN they found.
+            let expected = errors[4].as_ref().map(ToString::to_string);
+            assert_eq!((failures[0].chain, Some(failures[0].error.to_string())), (4, expected), "{what}");
+            for (k, (a, b)) in states.iter().zip(&single).enumerate() {
+                assert_eq!(a.t().to_bits(), b.t().to_bits(), "{what}: chain {k}'s t");
+                assert_bits(a.x().as_slice(), b.x().as_slice(), &format!("{what}: chain {k}"));
+                assert_bits(a.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+            }
         }
     }
 }

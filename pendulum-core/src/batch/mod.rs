@@ -35,6 +35,7 @@ mod directions;
 mod jacobians;
 mod planar;
 mod rk4;
+mod rod_midpoint;
 mod run;
 mod unrolled;
 
