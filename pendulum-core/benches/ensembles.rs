@@ -11,7 +11,7 @@
 //!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
-//!   precision (eight lanes) on one;
+//!   precision on one;
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps);
 //! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time

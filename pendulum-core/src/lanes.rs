@@ -1,7 +1,7 @@
 //! Numbers that are one `f64` or `W` of them side by side: the scalar type of the tension
 //! solve, so that one algorithm serves a single chain (`f64`) and `W` chains at once in SIMD
-//! lanes ([`Lanes`]), or `W` chains in single precision ([`Lanes32`], eight to an AVX2
-//! register; not bit for bit anything, its accuracy is measured in `docs/ensembles.md`).
+//! lanes ([`Lanes`]), or `W` chains in single precision ([`Lanes32`]; not bit for bit
+//! anything, its accuracy is measured in `docs/ensembles.md`).
 //!
 //! [`Lanes`] does every operation lane by lane, the same IEEE operation in each, with no
 //! fused multiply-add: a lane's result is bit for bit what `f64` gives for that lane alone.

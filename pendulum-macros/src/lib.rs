@@ -67,8 +67,8 @@ use proc_macro::TokenStream;
 /// A planar model with `algorithm: tension` also implements
 /// `pendulum_core::batch::PlanarKernel<n>`: its accelerations are written once, as a
 /// kernel over any lane type, which `accelerations` runs on `f64` and
-/// `pendulum_core::batch::UnrolledBatch` on four chains at once (bit for bit) or eight in
-/// single precision.
+/// `pendulum_core::batch::UnrolledBatch` on four chains at once (bit for bit, or in
+/// single precision).
 ///
 /// Mistakes in the input are compile errors pointing at the offending token, all
 /// reported at once.

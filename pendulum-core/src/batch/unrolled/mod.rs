@@ -113,7 +113,7 @@ pub struct UnrolledBatch<M, const N: usize> {
     /// Per block of [`WIDTH`] chains, their constants side by side.
     blocks: Vec<LinkConstants<F64x4, N>>,
     /// The same per block of [`WIDTH_F32`] chains, in single precision.
-    blocks_f32: Vec<LinkConstants<single::F32x8, N>>,
+    blocks_f32: Vec<LinkConstants<single::F32Lanes, N>>,
 }
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {

@@ -1,5 +1,5 @@
-//! The batch in single precision: eight chains per AVX2 register, the same generated
-//! kernel on [`Lanes32`], the sines from the single-precision kernel. Not bit for bit the
+//! The batch in single precision: the same generated kernel on four `f32` lanes
+//! ([`Lanes32`]), the sines from the single-precision kernel, eight per AVX2 instruction. Not bit for bit the
 //! `f64` model: its accuracy against it is measured in `docs/ensembles.md` and checked in
 //! the tests.
 
@@ -9,14 +9,16 @@ use crate::error::{Error, Result};
 use crate::kinematics::trig32::sin_cos_split_f32;
 use crate::lanes::Lanes32;
 
-/// Chains per block in single precision: eight `f32` lanes, one AVX2 register.
-pub const WIDTH_F32: usize = 8;
+/// Chains per block in single precision: four `f32` lanes. Eight (one AVX2 register) were
+/// measured slower from n = 8 on: the compiler split most of the eight-lane kernel into
+/// four-lane and scalar instructions (`docs/ensembles.md`).
+pub const WIDTH_F32: usize = 4;
 
-/// Eight chains' numbers in single precision, one per lane.
-pub(super) type F32x8 = Lanes32<WIDTH_F32>;
+/// A block's numbers in single precision, one per lane.
+pub(super) type F32Lanes = Lanes32<WIDTH_F32>;
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
-    /// [`accelerations`](Self::accelerations) in single precision: the same solve on eight
+    /// [`accelerations`](Self::accelerations) in single precision: the same solve on four
     /// chains at once, from `f32` arrays laid out the same way (`B` rows of `N`; torques and
     /// pivot accelerations optional). Not bit for bit the `f64` model: about 10⁻⁶ of the
     /// largest `|θ̈|` for chains whose masses and lengths stay within a decade of each
@@ -74,7 +76,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     }
 
     simd_kernel! {
-        /// One block of eight chains: gather into lanes, the sines and cosines, the kernel,
+        /// One block of [`WIDTH_F32`] chains: gather into lanes, the sines and cosines, the kernel,
         /// scatter into `out` (the block's rows).
         fn block_f32(
             &self,
@@ -87,7 +89,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             out: &mut [f32],
         ) {
             let gather_one = |v: &[f32], i: usize| Lanes32::from_fn(|k| v[lanes[k] * N + i]);
-            let gather = |v: &[f32]| -> [F32x8; N] { std::array::from_fn(|i| gather_one(v, i)) };
+            let gather = |v: &[f32]| -> [F32Lanes; N] { std::array::from_fn(|i| gather_one(v, i)) };
             let zero = Lanes32([0.0; WIDTH_F32]);
             let angles = gather(q);
             let (mut sin, mut cos) = ([zero; N], [zero; N]);
