@@ -101,47 +101,74 @@ impl Lane for f64 {
 #[repr(transparent)]
 pub struct Lanes<const W: usize>(pub [f64; W]);
 
+/// `W` single-precision numbers, one per chain of a batch, operated on lane by lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(transparent)]
+pub struct Lanes32<const W: usize>(pub [f32; W]);
+
 impl<const W: usize> Lanes<W> {
     /// The lanes as an array.
     #[inline(always)]
     pub fn to_array(self) -> [f64; W] {
         self.0
     }
+}
 
-    /// `f(lane)` for each lane.
-    #[inline(always)]
-    pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        let mut out = self.0;
-        for x in &mut out {
-            *x = f(*x);
+/// The constructors, views and arithmetic of a lane type `$lanes` over `[$t; W]`. Loops into
+/// arrays rather than `array::map` and `array::from_fn`: those left most of a generated
+/// kernel's single-precision lanes scalar.
+macro_rules! lane_array {
+    ($lanes:ident, $t:ty) => {
+        impl<const W: usize> $lanes<W> {
+            /// `f(lane)` for each lane.
+            #[inline(always)]
+            pub fn map(self, f: impl Fn($t) -> $t) -> Self {
+                let mut out = self.0;
+                for x in &mut out {
+                    *x = f(*x);
+                }
+                Self(out)
+            }
+
+            /// `f(k)` in lane `k`.
+            #[inline(always)]
+            pub fn from_fn(f: impl Fn(usize) -> $t) -> Self {
+                let mut out = [0.0; W];
+                for (k, x) in out.iter_mut().enumerate() {
+                    *x = f(k);
+                }
+                Self(out)
+            }
+
+            /// The lanes of `v` one after another: `v[i].0[k]` at `W·i + k`.
+            #[inline(always)]
+            pub fn flatten(v: &[Self]) -> &[$t] {
+                // SAFETY: the type is `repr(transparent)` over `[$t; W]`, so a slice of `m` of
+                // them is `W·m` contiguous numbers with the same alignment.
+                unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), W * v.len()) }
+            }
+
+            /// [`flatten`](Self::flatten), mutably.
+            #[inline(always)]
+            pub fn flatten_mut(v: &mut [Self]) -> &mut [$t] {
+                // SAFETY: as in `flatten`; the borrow of `v` is moved into the result.
+                unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast(), W * v.len()) }
+            }
         }
-        Self(out)
-    }
 
-    /// The lanes of `v` one after another: `v[i].0[k]` at `W·i + k`.
-    #[inline(always)]
-    pub fn flatten(v: &[Self]) -> &[f64] {
-        // SAFETY: `Lanes<W>` is `repr(transparent)` over `[f64; W]`, so a slice of `m` of them
-        // is `W·m` contiguous `f64`s with the same alignment.
-        unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), W * v.len()) }
-    }
-
-    /// [`flatten`](Self::flatten), mutably.
-    #[inline(always)]
-    pub fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
-        // SAFETY: as in `flatten`; the borrow of `v` is moved into the result.
-        unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast(), W * v.len()) }
-    }
-
-    /// `f(k)` in lane `k`.
-    #[inline(always)]
-    pub fn from_fn(f: impl Fn(usize) -> f64) -> Self {
-        let mut out = [0.0; W];
-        for (k, x) in out.iter_mut().enumerate() {
-            *x = f(k);
+        impl<const W: usize> Neg for $lanes<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                self.map(|x| -x)
+            }
         }
-        Self(out)
-    }
+
+        lane_op!($lanes, Add, add, AddAssign, add_assign, +);
+        lane_op!($lanes, Sub, sub, SubAssign, sub_assign, -);
+        lane_op!($lanes, Mul, mul, MulAssign, mul_assign, *);
+        lane_op!($lanes, Div, div, DivAssign, div_assign, /);
+    };
 }
 
 macro_rules! lane_op {
@@ -166,72 +193,41 @@ macro_rules! lane_op {
     };
 }
 
-impl<const W: usize> Neg for Lanes<W> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self.map(|x| -x)
+lane_array!(Lanes, f64);
+lane_array!(Lanes32, f32);
+
+/// The flags of either mask, lane by lane.
+#[inline(always)]
+fn or_masks<M: Copy + std::ops::BitOrAssign, const W: usize>(a: [M; W], b: [M; W]) -> [M; W] {
+    let mut out = a;
+    for k in 0..W {
+        out[k] |= b[k];
     }
+    out
 }
 
-impl<const W: usize> Neg for Lanes32<W> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self.map(|x| -x)
-    }
+/// Whether any lane of `mask` is flagged (non-zero).
+#[inline(always)]
+fn any_mask<M: Copy + Default + PartialEq + std::ops::BitOr<Output = M>, const W: usize>(
+    mask: [M; W],
+) -> bool {
+    mask.iter().fold(M::default(), |any, &m| any | m) != M::default()
 }
 
-lane_op!(Lanes, Add, add, AddAssign, add_assign, +);
-lane_op!(Lanes, Sub, sub, SubAssign, sub_assign, -);
-lane_op!(Lanes, Mul, mul, MulAssign, mul_assign, *);
-lane_op!(Lanes, Div, div, DivAssign, div_assign, /);
-lane_op!(Lanes32, Add, add, AddAssign, add_assign, +);
-lane_op!(Lanes32, Sub, sub, SubAssign, sub_assign, -);
-lane_op!(Lanes32, Mul, mul, MulAssign, mul_assign, *);
-lane_op!(Lanes32, Div, div, DivAssign, div_assign, /);
-
-/// `W` single-precision numbers, one per chain of a batch, operated on lane by lane.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(transparent)]
-pub struct Lanes32<const W: usize>(pub [f32; W]);
-
-// Loops into arrays rather than `array::map` and `array::from_fn`: those left most of a
-// generated kernel's single-precision lanes scalar.
-impl<const W: usize> Lanes32<W> {
-    /// `f(k)` in lane `k`.
-    #[inline(always)]
-    pub fn from_fn(f: impl Fn(usize) -> f32) -> Self {
-        let mut out = [0.0; W];
-        for (k, x) in out.iter_mut().enumerate() {
-            *x = f(k);
+/// `a` in the flagged lanes, `b` in the others.
+#[inline(always)]
+fn select_lanes<M: Copy + Default + PartialEq, T: Copy, const W: usize>(
+    mask: [M; W],
+    a: [T; W],
+    b: [T; W],
+) -> [T; W] {
+    let mut out = b;
+    for k in 0..W {
+        if mask[k] != M::default() {
+            out[k] = a[k];
         }
-        Self(out)
     }
-
-    /// `f(lane)` for each lane.
-    #[inline(always)]
-    pub fn map(self, f: impl Fn(f32) -> f32) -> Self {
-        let mut out = self.0;
-        for x in &mut out {
-            *x = f(*x);
-        }
-        Self(out)
-    }
-
-    /// The lanes of `v` one after another, as [`Lanes::flatten`].
-    #[inline(always)]
-    pub fn flatten(v: &[Self]) -> &[f32] {
-        // SAFETY: `Lanes32<W>` is `repr(transparent)` over `[f32; W]`.
-        unsafe { std::slice::from_raw_parts(v.as_ptr().cast(), W * v.len()) }
-    }
-
-    /// [`flatten`](Self::flatten), mutably.
-    #[inline(always)]
-    pub fn flatten_mut(v: &mut [Self]) -> &mut [f32] {
-        // SAFETY: as in `flatten`; the borrow of `v` is moved into the result.
-        unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast(), W * v.len()) }
-    }
+    out
 }
 
 /// `2⁻⁸⁰` and `2⁸⁰` as `f32` bit patterns: the continuants' range in single precision, wide
@@ -270,25 +266,15 @@ impl<const W: usize> Lane for Lanes32<W> {
     }
     #[inline(always)]
     fn or(a: [u32; W], b: [u32; W]) -> [u32; W] {
-        let mut out = a;
-        for k in 0..W {
-            out[k] |= b[k];
-        }
-        out
+        or_masks(a, b)
     }
     #[inline(always)]
     fn any(mask: [u32; W]) -> bool {
-        mask.iter().fold(0, |any, m| any | m) != 0
+        any_mask(mask)
     }
     #[inline(always)]
     fn select(mask: [u32; W], a: Self, b: Self) -> Self {
-        let mut out = b.0;
-        for k in 0..W {
-            if mask[k] != 0 {
-                out[k] = a.0[k];
-            }
-        }
-        Self(out)
+        Self(select_lanes(mask, a.0, b.0))
     }
     #[inline(always)]
     fn normalizer(self) -> Self {
@@ -336,25 +322,15 @@ impl<const W: usize> Lane for Lanes<W> {
     }
     #[inline(always)]
     fn or(a: [u64; W], b: [u64; W]) -> [u64; W] {
-        let mut out = a;
-        for k in 0..W {
-            out[k] |= b[k];
-        }
-        out
+        or_masks(a, b)
     }
     #[inline(always)]
     fn any(mask: [u64; W]) -> bool {
-        mask.iter().fold(0, |any, m| any | m) != 0
+        any_mask(mask)
     }
     #[inline(always)]
     fn select(mask: [u64; W], a: Self, b: Self) -> Self {
-        let mut out = b.0;
-        for k in 0..W {
-            if mask[k] != 0 {
-                out[k] = a.0[k];
-            }
-        }
-        Self(out)
+        Self(select_lanes(mask, a.0, b.0))
     }
     #[inline(always)]
     fn normalizer(self) -> Self {

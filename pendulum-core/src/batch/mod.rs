@@ -41,7 +41,7 @@ mod unrolled;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
-pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch, WIDTH_F32};
+pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;
@@ -90,12 +90,7 @@ pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain
 /// The chains of block `b` of a batch of `chains`: lane `k` holds chain `WIDTH·b + k`, and
 /// the lanes past the last chain repeat it (their results are dropped).
 pub(crate) fn block_chains(b: usize, chains: usize) -> [usize; WIDTH] {
-    block_chains_of::<WIDTH>(b, chains)
-}
-
-/// [`block_chains`] for blocks of `W` chains.
-pub(crate) fn block_chains_of<const W: usize>(b: usize, chains: usize) -> [usize; W] {
-    std::array::from_fn(|k| (W * b + k).min(chains - 1))
+    std::array::from_fn(|k| (WIDTH * b + k).min(chains - 1))
 }
 
 /// Lane `k` of each of the `m` numbers of the rows `rows` of `v` (`m` per row).
@@ -107,14 +102,20 @@ pub(crate) fn gather(v: &[f64], rows: [usize; WIDTH], m: usize, out: &mut [F64x4
 }
 
 /// The first non-finite entry of `v` as the single-chain error.
-pub(crate) fn non_finite(what: &'static str, v: &[f64]) -> Option<Error> {
-    v.iter().position(|x| !x.is_finite()).map(|index| Error::NonFinite { what, index, value: v[index] })
+pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Option<Error> {
+    let value = |index: usize| v[index].into();
+    (0..v.len()).find(|&i| !value(i).is_finite()).map(|index| Error::NonFinite {
+        what,
+        index,
+        value: value(index),
+    })
 }
 
-/// Blocks of `W` chains a rayon task takes at least, for blocks of `solves` rods' solves
-/// each: about 2000 rods' solves a task, so that short work does not drown in scheduling.
-pub(crate) fn blocks_per_task<const W: usize>(solves: usize) -> usize {
-    (2048 / (W * solves).max(1)).max(1)
+/// Blocks of [`WIDTH`] chains a rayon task takes at least, for blocks of `solves` rods'
+/// solves each: about 2000 rods' solves a task, so that short work does not drown in
+/// scheduling.
+pub(crate) fn blocks_per_task(solves: usize) -> usize {
+    (2048 / (WIDTH * solves).max(1)).max(1)
 }
 
 /// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
@@ -128,30 +129,19 @@ pub(crate) fn for_blocks<T: Send, S, F: Send>(
     init: impl Fn() -> S + Sync + Send,
     block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
 ) -> Vec<F> {
-    for_blocks_of::<WIDTH, T, S, F>(out, m, solves, init, block)
-}
-
-/// [`for_blocks`] for blocks of `W` rows.
-pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
-    out: &mut [T],
-    m: usize,
-    solves: usize,
-    init: impl Fn() -> S + Sync + Send,
-    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
-) -> Vec<F> {
-    let per_task = blocks_per_task::<W>(solves);
-    if out.len() <= per_task * W * m || rayon::current_num_threads() == 1 {
+    let per_task = blocks_per_task(solves);
+    if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up
         // costs more than a short batch).
         // A plain loop: a `flat_map` over the blocks cost 6–9% of a short block's time.
         let mut scratch = init();
         let mut failures = Vec::new();
-        for (b, rows) in out.chunks_mut(W * m).enumerate() {
+        for (b, rows) in out.chunks_mut(WIDTH * m).enumerate() {
             failures.extend(block(&mut scratch, b, rows));
         }
         return failures;
     }
-    out.par_chunks_mut(W * m)
+    out.par_chunks_mut(WIDTH * m)
         .enumerate()
         .with_min_len(per_task)
         .map_init(init, |scratch, (b, rows)| block(scratch, b, rows))
@@ -169,8 +159,9 @@ pub(crate) fn has_avx2() -> bool {
     return false;
 }
 
-/// A kernel written once, in three methods: `fn kernel(&self, args…)` as given (inlined
-/// wherever it is called), `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
+/// A kernel written once, in three methods (with at most one generic parameter, a const
+/// or a type): `fn kernel(&self, args…)` as given (inlined wherever it is called),
+/// `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
 /// `#[inline(always)]` all the way down for its lanes to become registers), and
 /// `fn dispatch(&self, args…)`, which runs the AVX2 one when the CPU has AVX2 and the
 /// kernel as it is otherwise:
@@ -182,33 +173,53 @@ pub(crate) fn has_avx2() -> bool {
 /// }
 /// ```
 macro_rules! simd_kernel {
+    // One generic parameter at most, a const or a type: normalised, then emitted.
     (
         $(#[$meta:meta])*
-        $vis:vis fn $kernel:ident $(<const $c:ident: usize>)? (&$this:ident, $($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
+        $vis:vis fn $kernel:ident <const $c:ident: usize> $($rest:tt)*
+    ) => {
+        $crate::batch::simd_kernel!(@emit [const $c: usize] [$c] $(#[$meta])* $vis fn $kernel $($rest)*);
+    };
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident <$t:ident: $bound:path> $($rest:tt)*
+    ) => {
+        $crate::batch::simd_kernel!(@emit [$t: $bound] [$t] $(#[$meta])* $vis fn $kernel $($rest)*);
+    };
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident ($($args:tt)*) $($rest:tt)*
+    ) => {
+        $crate::batch::simd_kernel!(@emit [] [] $(#[$meta])* $vis fn $kernel ($($args)*) $($rest)*);
+    };
+    (
+        @emit [$($decl:tt)*] [$($name:tt)*]
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident (&$this:ident, $($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
         $body:block
         dispatch $dvis:vis fn $dispatch:ident, $avx2:ident
     ) => {
         $(#[$meta])*
         #[inline(always)]
         #[allow(clippy::too_many_arguments)]
-        $vis fn $kernel $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? $body
+        $vis fn $kernel <$($decl)*> (&$this, $($arg: $ty),*) $(-> $ret)? $body
 
         /// [`Self::$kernel`] with AVX2 when the CPU has it.
         #[allow(clippy::too_many_arguments)]
-        $dvis fn $dispatch $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? {
+        $dvis fn $dispatch <$($decl)*> (&$this, $($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             if $crate::batch::has_avx2() {
                 // SAFETY: the CPU has AVX2, checked just above.
-                return unsafe { $this.$avx2 $(::<$c>)? ($($arg),*) };
+                return unsafe { $this.$avx2::<$($name)*>($($arg),*) };
             }
-            $this.$kernel $(::<$c>)? ($($arg),*)
+            $this.$kernel::<$($name)*>($($arg),*)
         }
 
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]
         #[allow(clippy::too_many_arguments)]
-        fn $avx2 $(<const $c: usize>)? (&$this, $($arg: $ty),*) $(-> $ret)? {
-            $this.$kernel $(::<$c>)? ($($arg),*)
+        fn $avx2 <$($decl)*> (&$this, $($arg: $ty),*) $(-> $ret)? {
+            $this.$kernel::<$($name)*>($($arg),*)
         }
     };
 }

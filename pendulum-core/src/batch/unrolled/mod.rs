@@ -8,16 +8,15 @@
 //! the same, lane by lane, with the same sine kernel, so every chain of a batch gets its
 //! single model's `θ̈` bit for bit.
 
+mod precision;
 mod rk4;
 mod single;
 
-pub use single::WIDTH_F32;
-
 use nalgebra::{Const, SVector, U2, Vector2};
 
-use super::{F64x4, Failure, WIDTH, block_chains, block_chains_of, check_len, for_blocks, simd_kernel};
+use self::precision::Precision;
+use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, simd_kernel};
 use crate::error::{Error, Result};
-use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
 
@@ -70,7 +69,7 @@ impl<const N: usize> LinkConstants<f64, N> {
 /// A planar model of `N` links whose `θ̈` is one straight-line kernel over [`Lane`]s: what
 /// `pendulum_macros::model!` emits for `kind: planar` with `algorithm: tension`. Its
 /// `Model::accelerations` is `kernel::<f64>` (after the sines and cosines, before the
-/// finiteness check); [`UnrolledBatch`] runs `kernel::<Lanes<4>>`.
+/// finiteness check); [`UnrolledBatch`] runs `kernel::<Lanes<4>>` (and `Lanes32<4>`).
 pub trait PlanarKernel<const N: usize>:
     Model<Links = Const<N>, Dof = Const<N>, Space = U2> + Send + Sync
 {
@@ -112,8 +111,8 @@ pub struct UnrolledBatch<M, const N: usize> {
     models: Vec<M>,
     /// Per block of [`WIDTH`] chains, their constants side by side.
     blocks: Vec<LinkConstants<F64x4, N>>,
-    /// The same per block of [`WIDTH_F32`] chains, in single precision.
-    blocks_f32: Vec<LinkConstants<single::F32Lanes, N>>,
+    /// The same in single precision.
+    blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
 }
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
@@ -124,15 +123,10 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         if models.is_empty() {
             return Err(Error::EmptyBatch);
         }
-        let blocks = (0..models.len().div_ceil(WIDTH))
-            .map(|b| LinkConstants::interleave(block_chains(b, models.len()).map(|c| models[c].constants())))
-            .collect();
-        let blocks_f32 = (0..models.len().div_ceil(WIDTH_F32))
-            .map(|b| {
-                let chains = block_chains_of::<WIDTH_F32>(b, models.len());
-                LinkConstants::interleave_f32(chains.map(|c| models[c].constants()))
-            })
-            .collect();
+        let block = |b: usize| block_chains(b, models.len()).map(|c| models[c].constants());
+        let count = models.len().div_ceil(WIDTH);
+        let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
+        let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
         Ok(Self { models, blocks, blocks_f32 })
     }
 
@@ -169,37 +163,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         pivot: Option<&[f64]>,
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        let chains = self.len();
-        check_len("q", q, chains, N)?;
-        check_len("qd", qd, chains, N)?;
-        check_len("out", out, chains, N)?;
-        if let Some(t) = torque {
-            check_len("torque", t, chains, N)?;
-        }
-        if let Some(p) = pivot {
-            check_len("pivot", p, chains, 2)?;
-        }
-        let failures = for_blocks(
-            out,
-            N,
-            N,
-            || (),
-            |_, b, out| {
-                let lanes = block_chains(b, chains);
-                self.block_simd(b, lanes, q, qd, torque, pivot, out);
-                let mut failures = Vec::new();
-                for (k, row) in out.chunks_exact_mut(N).enumerate() {
-                    if row.iter().all(|v| v.is_finite()) {
-                        continue;
-                    }
-                    let chain = lanes[k];
-                    failures.push(Failure { chain, error: self.error_of(chain, q, qd, torque, pivot) });
-                    row.fill(f64::NAN);
-                }
-                failures
-            },
-        );
-        Ok(failures)
+        self.evaluate(&self.blocks, [q, qd], torque, pivot, out, |chain| {
+            self.error_of(chain, q, qd, torque, pivot)
+        })
     }
 
     /// Chain `chain`'s single model's error at its row of the inputs (out of the hot path).
@@ -226,36 +192,77 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         }
     }
 
+    /// `θ̈` of every chain in precision `P`, from the blocks' constants in `P` (the arrays as
+    /// [`accelerations`](Self::accelerations) takes them, `[q, qd]` first); a chain whose
+    /// row is not finite fails with `error(chain)`, its row NaN.
+    fn evaluate<P: Precision>(
+        &self,
+        blocks: &[LinkConstants<P::Lanes, N>],
+        [q, qd]: [&[P]; 2],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+        error: impl Fn(usize) -> Error + Sync + Send,
+    ) -> Result<Vec<Failure>> {
+        let chains = self.len();
+        check_len("q", q, chains, N)?;
+        check_len("qd", qd, chains, N)?;
+        check_len("out", out, chains, N)?;
+        if let Some(t) = torque {
+            check_len("torque", t, chains, N)?;
+        }
+        if let Some(p) = pivot {
+            check_len("pivot", p, chains, 2)?;
+        }
+        let failures = for_blocks(
+            out,
+            N,
+            N,
+            || (),
+            |_, b, out| {
+                let lanes = block_chains(b, chains);
+                self.block_simd::<P>(&blocks[b], lanes, q, qd, torque, pivot, out);
+                let mut failures = Vec::new();
+                for (k, row) in out.chunks_exact_mut(N).enumerate() {
+                    if row.iter().all(|&v| v.into().is_finite()) {
+                        continue;
+                    }
+                    failures.push(Failure { chain: lanes[k], error: error(lanes[k]) });
+                    row.fill(P::NAN);
+                }
+                failures
+            },
+        );
+        Ok(failures)
+    }
+
     simd_kernel! {
-        /// One block: gather into lanes, the sines and cosines of all its angles at once, the
-        /// kernel, scatter into `out` (the block's rows).
-        fn block(
+        /// One block, constants `c`: gather into lanes, the sines and cosines of all its
+        /// angles at once, the kernel, scatter into `out` (the block's rows).
+        fn block<P: Precision>(
             &self,
-            b: usize,
+            c: &LinkConstants<P::Lanes, N>,
             lanes: [usize; WIDTH],
-            q: &[f64],
-            qd: &[f64],
-            torque: Option<&[f64]>,
-            pivot: Option<&[f64]>,
-            out: &mut [f64],
+            q: &[P],
+            qd: &[P],
+            torque: Option<&[P]>,
+            pivot: Option<&[P]>,
+            out: &mut [P],
         ) {
-            let gather = |v: &[f64]| -> [F64x4; N] {
-                std::array::from_fn(|i| Lanes::from_fn(|k| v[lanes[k] * N + i]))
+            let gather = |v: &[P]| -> [P::Lanes; N] {
+                std::array::from_fn(|i| P::lanes(|k| v[lanes[k] * N + i]))
             };
-            let zero = Lanes([0.0; WIDTH]);
-            let angles = gather(q);
-            let (mut sin, mut cos) = ([zero; N], [zero; N]);
-            sin_cos_split(Lanes::flatten(&angles), Lanes::flatten_mut(&mut sin), Lanes::flatten_mut(&mut cos));
-            let trig = std::array::from_fn(|i| [sin[i], cos[i]]);
+            let zero = P::Lanes::splat(0.0);
+            let trig = P::sin_cos(&gather(q));
             let torque = torque.map_or([zero; N], gather);
             let pivot = match pivot {
-                Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
+                Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
                 None => [zero; 2],
             };
-            let accelerations = M::kernel(&self.blocks[b], &trig, &gather(qd), &torque, pivot);
+            let accelerations = M::kernel(c, &trig, &gather(qd), &torque, pivot);
             for (k, row) in out.chunks_exact_mut(N).enumerate() {
                 for (o, a) in row.iter_mut().zip(&accelerations) {
-                    *o = a.0[k];
+                    *o = P::lane(a, k);
                 }
             }
         }
