@@ -33,8 +33,8 @@ pub trait Lane:
     /// The square root, correctly rounded, lane by lane.
     fn sqrt(self) -> Self;
     /// The flags of the lanes whose bit pattern `b` has `b − low > span` (wrapping): with
-    /// `(low, span)` = [`CONTINUANT_RANGE`](crate::rods::CONTINUANT_RANGE), the lanes
-    /// outside `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (negative, zero, infinite and NaN included).
+    /// `(low, span)` = [`CONTINUANT_RANGE`], the lanes outside `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (negative,
+    /// zero, infinite and NaN included).
     fn outside(self, low: u64, span: u64) -> Self::Mask;
     /// No lane flagged.
     fn none() -> Self::Mask;
@@ -48,11 +48,11 @@ pub trait Lane:
     /// brings a positive normal `x` into `[1, 2)`.
     fn normalizer(self) -> Self;
     /// The lanes whose continuant `self` is outside the range where the tension solve trusts
-    /// it: [`CONTINUANT_RANGE`](crate::rods::CONTINUANT_RANGE) in double precision,
+    /// it: [`CONTINUANT_RANGE`] in double precision,
     /// `[2⁻⁸⁰, 2⁸⁰]` in single ([`Lanes32`]).
     #[inline(always)]
     fn continuant_outside(self) -> Self::Mask {
-        let (low, span) = crate::rods::CONTINUANT_RANGE;
+        let (low, span) = CONTINUANT_RANGE;
         self.outside(low, span)
     }
 }
@@ -230,6 +230,16 @@ fn select_lanes<M: Copy + Default + PartialEq, T: Copy, const W: usize>(
     out
 }
 
+/// The continuants `P_i` of the fast down pass must stay in `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (as bit
+/// patterns: `low ≤ bits(P_i) ≤ low + span`), far from overflow and from the subnormals
+/// where they would lose digits; otherwise the pivots are redone by
+/// `rods::Rods::eliminate_by_pivots`. Negative, zero, infinite and NaN values fall outside too.
+pub const CONTINUANT_RANGE: (u64, u64) = {
+    let low = (1023 - 800) << 52; // 2⁻⁸⁰⁰
+    let high = (1023 + 800) << 52; // 2⁸⁰⁰
+    (low, high - low)
+};
+
 /// `2⁻⁸⁰` and `2⁸⁰` as `f32` bit patterns: the continuants' range in single precision, wide
 /// enough for the chains of a few dozen links of grams and centimetres in SI units and far
 /// enough from `f32`'s overflow (`2¹²⁸`) for the products the solve forms with them.
@@ -353,8 +363,8 @@ mod tests {
             assert_eq!((a / b).0[k].to_bits(), (a.0[k] / b.0[k]).to_bits());
             assert_eq!(a.normalizer().0[k], a.0[k].normalizer());
         }
-        let mask = Lanes([1.0, 0.0, f64::NAN, 2f64.powi(900)])
-            .outside(crate::rods::CONTINUANT_RANGE.0, crate::rods::CONTINUANT_RANGE.1);
+        let mask =
+            Lanes([1.0, 0.0, f64::NAN, 2f64.powi(900)]).outside(CONTINUANT_RANGE.0, CONTINUANT_RANGE.1);
         assert_eq!(mask, [0, 1, 1, 1]);
         assert!(Lanes::<4>::any(mask) && !Lanes::<4>::any(Lanes::<4>::none()));
         assert_eq!(Lanes::select(mask, a, b).0[..2], [0.1f64, -2.0][..]);

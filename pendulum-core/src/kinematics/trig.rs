@@ -130,16 +130,32 @@ fn sin_cos_loop(angles: &[f64], out: &mut [[f64; 2]]) {
 /// caller's target features.
 #[inline(always)]
 pub(crate) fn sin_cos_split(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    split_with(angles, sin, cos, sin_cos_reduced, in_range, f64::sin_cos)
+}
+
+/// The two passes of a sine kernel over `angles` into `sin` and `cos`: `reduced(θ)` for
+/// every angle (branch-free, vectorised), then `outside(θ)` for the angles not
+/// `in_range`, should there be any. Inlined, so that it runs with its caller's target
+/// features.
+#[inline(always)]
+pub(crate) fn split_with<T: Copy>(
+    angles: &[T],
+    sin: &mut [T],
+    cos: &mut [T],
+    reduced: impl Fn(T) -> (T, T),
+    in_range: impl Fn(T) -> bool,
+    outside: impl Fn(T) -> (T, T),
+) {
     let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
-    let mut outside = false;
+    let mut any_outside = false;
     for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
-        (*s, *c) = sin_cos_reduced(theta);
-        outside |= !in_range(theta);
+        (*s, *c) = reduced(theta);
+        any_outside |= !in_range(theta);
     }
-    if outside {
+    if any_outside {
         for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
             if !in_range(theta) {
-                (*s, *c) = theta.sin_cos();
+                (*s, *c) = outside(theta);
             }
         }
     }

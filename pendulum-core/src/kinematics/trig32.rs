@@ -12,6 +12,8 @@
 //! values for `|θ| ≤ 8192` (module tests); beyond, and for non-finite θ, `f64::sin_cos`
 //! rounded to `f32`.
 
+use super::trig::split_with;
+
 /// Beyond this `|θ|` (rad) the reduction loses digits: `f64::sin_cos` instead.
 const LIMIT: f32 = 8192.0;
 
@@ -61,20 +63,10 @@ fn sin_cos_reduced(theta: f32) -> (f32, f32) {
 /// caller's target features.
 #[inline(always)]
 pub(crate) fn sin_cos_split_f32(angles: &[f32], sin: &mut [f32], cos: &mut [f32]) {
-    let (sin, cos) = (&mut sin[..angles.len()], &mut cos[..angles.len()]);
-    let mut outside = false;
-    for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
-        (*s, *c) = sin_cos_reduced(theta);
-        outside |= !in_range(theta);
-    }
-    if outside {
-        for ((s, c), &theta) in sin.iter_mut().zip(cos.iter_mut()).zip(angles) {
-            if !in_range(theta) {
-                let (sin, cos) = f64::from(theta).sin_cos();
-                (*s, *c) = (sin as f32, cos as f32);
-            }
-        }
-    }
+    split_with(angles, sin, cos, sin_cos_reduced, in_range, |theta| {
+        let (sin, cos) = f64::from(theta).sin_cos();
+        (sin as f32, cos as f32)
+    })
 }
 
 #[cfg(test)]

@@ -211,15 +211,7 @@ fn entries<const S: usize, V: Lane>(
 /// [`CONTINUANT_RANGE`].
 const BLOCK: usize = 16;
 
-/// The continuants `P_i` of the fast down pass must stay in `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (as bit
-/// patterns: `low ≤ bits(P_i) ≤ low + span`), far from overflow and from the subnormals
-/// where they would lose digits; otherwise the pivots are redone by
-/// `Rods::eliminate_by_pivots`. Negative, zero, infinite and NaN values fall outside too.
-pub const CONTINUANT_RANGE: (u64, u64) = {
-    let low = (1023 - 800) << 52; // 2⁻⁸⁰⁰
-    let high = (1023 + 800) << 52; // 2⁸⁰⁰
-    (low, high - low)
-};
+pub use crate::lanes::CONTINUANT_RANGE;
 
 /// The pivots `1/D_i` of a tridiagonal elimination as ratios of continuants (module docs),
 /// row by row: one multiply and one subtraction per row on the serial chain, the division
