@@ -352,8 +352,9 @@ fn f32_error<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
 fn single_precision_is_within_its_documented_bound_of_the_f64_model() {
     let mut r = ChaCha8Rng::seed_from_u64(32);
     // Measured (`--nocapture`): 5.7e-6, 1.4e-6, 2.1e-6 within a factor 2; 2.0e-5, 8.4e-6,
-    // 1.1e-5 within a factor 10; the bounds in `docs/ensembles.md` are 3× those.
-    for (spread, bound) in [(2.0, 2e-5), (10.0, 1e-4), (100.0, f64::INFINITY)] {
+    // 1.1e-5 within a factor 10; 4.4e-5, 1.5e-4, 6.3e-5 within a factor 100; the bounds in
+    // `docs/ensembles.md` are about 3× those.
+    for (spread, bound) in [(2.0, 2e-5), (10.0, 1e-4), (100.0, 5e-4)] {
         let errors = [
             f32_error::<Planar4, 4>(1000, spread, &mut r),
             f32_error::<Planar8, 8>(1000, spread, &mut r),

@@ -101,6 +101,22 @@ pub(crate) fn gather(v: &[f64], rows: [usize; WIDTH], m: usize, out: &mut [F64x4
     }
 }
 
+/// The first non-finite input of chain `chain` as the single-chain check names it: its row
+/// of `n` in `q`, `qd` and `torque`, then its row of 2 in `pivot`.
+pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
+    chain: usize,
+    n: usize,
+    [q, qd]: [&[T]; 2],
+    torque: Option<&[T]>,
+    pivot: Option<&[T]>,
+) -> Option<Error> {
+    let row = |what, v: &[T], m: usize| non_finite(what, &v[chain * m..(chain + 1) * m]);
+    row("q", q, n)
+        .or_else(|| row("qd", qd, n))
+        .or_else(|| torque.and_then(|t| row("torque", t, n)))
+        .or_else(|| pivot.and_then(|p| row("pivot_acceleration", p, 2)))
+}
+
 /// The first non-finite entry of `v` as the single-chain error.
 pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Option<Error> {
     let value = |index: usize| v[index].into();

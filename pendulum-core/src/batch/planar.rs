@@ -4,7 +4,8 @@
 use nalgebra::Dyn;
 
 use super::{
-    F64x4, Failure, WIDTH, block_chains, check_len, check_links, for_blocks, gather, non_finite, simd_kernel,
+    F64x4, Failure, WIDTH, block_chains, check_len, check_links, first_bad_input, for_blocks, gather,
+    simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
@@ -145,11 +146,8 @@ impl PlanarBatch {
                 if row.iter().all(|v| v.is_finite()) {
                     continue;
                 }
-                let at = |v: &'_ [f64], m: usize| v[chain * m..(chain + 1) * m].to_vec();
-                let error = non_finite("q", &at(q, n))
-                    .or_else(|| non_finite("qd", &at(qd, n)))
-                    .or_else(|| pivot.and_then(|p| non_finite("pivot_acceleration", &at(p, 2))))
-                    .unwrap_or(Error::NotPositiveDefinite);
+                let error =
+                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite);
                 row.fill(f64::NAN);
                 failures.push(Failure { chain, error });
             }

@@ -4,11 +4,11 @@
 
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
+use super::precision::Precision;
 use super::{PlanarKernel, UnrolledBatch};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks, simd_kernel};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Lane, Lanes};
 
 /// A block's states in lanes: `θ`, `θ̇` and their compensations, `t` and its compensation.
@@ -140,12 +140,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         fn rk4_run(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [u64; WIDTH] {
             let c = &self.blocks[b];
             let zero = Lanes([0.0; WIDTH]);
-            let accelerations = |q: &[F64x4; N], qd: &[F64x4; N]| {
-                let (mut sin, mut cos) = ([zero; N], [zero; N]);
-                sin_cos_split(Lanes::flatten(q), Lanes::flatten_mut(&mut sin), Lanes::flatten_mut(&mut cos));
-                let trig = std::array::from_fn(|i| [sin[i], cos[i]]);
-                M::kernel(c, &trig, qd, &[zero; N], [zero; 2])
-            };
+            let accelerations =
+                |q: &[F64x4; N], qd: &[F64x4; N]| M::kernel(c, &<f64 as Precision>::sin_cos(q), qd, &[zero; N], [zero; 2]);
             let mut alive = [1u64; WIDTH];
             for _ in 0..steps {
                 let (dq, dqd) = increment(&s.q, &s.qd, h, accelerations);

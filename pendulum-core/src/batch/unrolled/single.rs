@@ -7,7 +7,7 @@
 //! the tests.
 
 use super::{PlanarKernel, UnrolledBatch};
-use crate::batch::{Failure, non_finite};
+use crate::batch::{Failure, first_bad_input};
 use crate::error::{Error, Result};
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
@@ -30,12 +30,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
         self.evaluate(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
-            let input = |what, v: &[f32], m: usize| non_finite(what, &v[chain * m..(chain + 1) * m]);
-            input("q", q, N)
-                .or_else(|| input("qd", qd, N))
-                .or_else(|| torque.and_then(|t| input("torque", t, N)))
-                .or_else(|| pivot.and_then(|p| input("pivot_acceleration", p, 2)))
-                .unwrap_or(Error::SinglePrecisionOverflow)
+            first_bad_input(chain, N, [q, qd], torque, pivot).unwrap_or(Error::SinglePrecisionOverflow)
         })
     }
 }
