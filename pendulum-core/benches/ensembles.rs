@@ -141,6 +141,13 @@ fn accelerations(c: &mut Criterion) {
                 },
             );
         }
+        let (flat, mut out) = (flat.iter().map(|&v| v as f32).collect::<Vec<_>>(), vec![0.0f32; out.len()]);
+        let pool = pool(1);
+        group.bench_with_input(BenchmarkId::new("spatial/batch_f32_1_thread", n), &n, |b, _| {
+            in_pool(b, &pool, || {
+                batch.accelerations_f32(0.0, &flat, &mut out).expect("batch");
+            })
+        });
     }
     group.finish();
 }

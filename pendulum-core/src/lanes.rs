@@ -27,6 +27,11 @@ pub trait Lane:
     type Mask: Copy + std::fmt::Debug;
     /// Lanes.
     const WIDTH: usize;
+    /// Rows of a tension solve between two rescalings of its continuants (`rods`'
+    /// `Continuants`). Each row multiplies a continuant by its pivot `D_i`: 16 rows of
+    /// pivots between 2⁻⁴⁸ and 2⁴⁸ keep it inside [`CONTINUANT_RANGE`] in double precision,
+    /// 4 rows of pivots between 2⁻²⁰ and 2²⁰ (1/kg) inside `[2⁻⁸⁰, 2⁸⁰]` in single.
+    const RESCALE_ROWS: usize = 16;
 
     /// Every lane `x`.
     fn splat(x: f64) -> Self;
@@ -105,6 +110,14 @@ pub struct Lanes<const W: usize>(pub [f64; W]);
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[repr(transparent)]
 pub struct Lanes32<const W: usize>(pub [f32; W]);
+
+impl<const W: usize> Lanes32<W> {
+    /// `v` rounded to single precision, lane by lane.
+    #[inline(always)]
+    pub fn rounded(v: [f64; W]) -> Self {
+        Self(v.map(|x| x as f32))
+    }
+}
 
 impl<const W: usize> Lanes<W> {
     /// The lanes as an array.
@@ -252,6 +265,7 @@ const CONTINUANT_RANGE_32: (u32, u32) = {
 impl<const W: usize> Lane for Lanes32<W> {
     type Mask = [u32; W];
     const WIDTH: usize = W;
+    const RESCALE_ROWS: usize = 4;
 
     #[inline(always)]
     fn splat(x: f64) -> Self {

@@ -461,3 +461,98 @@ fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_c
         }
     }
 }
+
+/// `max |ü₃₂ − ü₆₄| / max |ü₆₄|` of each chain of whirls of `n` links whose masses, lengths
+/// and damping span `decades` decades, the worst of `chains`, and the batch's failures.
+fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8Rng) -> f64 {
+    let models: Vec<_> = (0..chains)
+        .map(|_| {
+            let mut spread =
+                |lo: f64| (0..n).map(|_| 10f64.powf(lo + decades * r.random::<f64>())).collect::<Vec<_>>();
+            let (masses, lengths, damping) = (spread(-2.0), spread(-2.0), spread(-4.0));
+            let chain =
+                Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain");
+            let drive = Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
+            Directions::<U3>::new(chain).with_drive(drive)
+        })
+        .collect();
+    let x: Vec<f64> = models
+        .iter()
+        .flat_map(|m| {
+            let q: Vec<f64> = (0..2 * n)
+                .map(|i| if i < n { r.random_range(0.1..3.0) } else { r.random_range(0.0..6.3) })
+                .collect();
+            let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-5.0..5.0)).collect();
+            m.from_spherical(&q, &qd).expect("state").as_slice().to_vec()
+        })
+        .collect();
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let t = r.random_range(0.0..10.0);
+    let (mut out64, mut out32) = (vec![0.0; chains * 3 * n], vec![0.0f32; chains * 3 * n]);
+    assert!(batch.accelerations(t, &x, &mut out64).expect("f64").is_empty());
+    let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+    assert!(batch.accelerations_f32(t, &x32, &mut out32).expect("f32").is_empty());
+    out64
+        .chunks_exact(3 * n)
+        .zip(out32.chunks_exact(3 * n))
+        .map(|(a, b)| {
+            let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            a.iter().zip(b).fold(0.0f64, |m, (a, &b)| m.max((a - f64::from(b)).abs())) / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn single_precision_directions_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors.
+    let mut r = ChaCha8Rng::seed_from_u64(47);
+    for (decades, bound) in [(0.3, 5e-6), (1.0, 5e-6), (2.0, 1e-5), (3.0, 1e-4)] {
+        for n in [8, 20, 100] {
+            let error = single_precision_error(n, decades, 200, &mut r);
+            println!("spread 10^{decades}, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_directions_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(48);
+    let (n, chains) = (12, 19);
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+    let mut x: Vec<f32> = x.iter().flat_map(|x| x.iter().map(|&v| v as f32)).collect();
+    let m = 6 * n;
+    x[3 * m + 5] = f32::NAN;
+    // A rate whose square leaves f32: finite input, overflow in the solve.
+    x[11 * m + 3 * n + 1] = 3e19;
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let mut out = vec![0.0f32; chains * 3 * n];
+        let failures = pool.install(|| batch.accelerations_f32(1.5, &x, &mut out)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11]);
+        // NaN is not equal to itself: the error named by its fields.
+        assert!(matches!(failures[0].error, Error::NonFinite { what: "x", index: 5, .. }));
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, row) in out.chunks_exact(3 * n).enumerate() {
+            assert_eq!(row.iter().all(|v| v.is_nan()), k == 3 || k == 11, "chain {k}");
+        }
+        runs.push(out);
+    }
+    assert_eq!(
+        runs[0].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        runs[1].iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    // Each chain alone in a batch of its own: the same bits.
+    for k in [0, 7, 18] {
+        let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+        let mut out = vec![0.0f32; 3 * n];
+        assert!(alone.accelerations_f32(1.5, &x[k * m..(k + 1) * m], &mut out).expect("f32").is_empty());
+        let row = &runs[0][k * 3 * n..(k + 1) * 3 * n];
+        assert_eq!(
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            row.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "chain {k}"
+        );
+    }
+}

@@ -1,16 +1,17 @@
 //! A batch of chains in unit link directions ([`Directions`]), planar or spatial, each with
 //! its own drive: accelerations, and whole steps of projected RK4, for many chains per call.
 
-use nalgebra::{DefaultAllocator, DimName, Dyn, allocator::Allocator};
+use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::{
-    F64x4, Failure, WIDTH, block_chains, check_len, check_links, for_blocks, gather, non_finite, simd_kernel,
+    F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows, for_blocks,
+    for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
 use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::error::{Error, Result};
-use crate::lanes::Lanes;
+use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::models::Directions;
 use crate::models::directions::rate_load;
 use crate::rods::{Load, Rods, Rows};
@@ -27,6 +28,8 @@ use crate::rods::{Load, Rods, Rows};
 pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     models: Vec<Directions<S, Dr>>,
     blocks: Vec<Block>,
+    /// Per block of [`WIDTH_F32`] chains, their rods and `−g` in single precision.
+    blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
     links: usize,
     /// Whether the states carry the energy ledger of [`Accounted`].
     accounted: bool,
@@ -45,6 +48,9 @@ struct Block {
     damping: Vec<F64x4>,
 }
 
+/// Eight chains' numbers in single precision, one per lane: one AVX2 register.
+type F32x8 = Lanes32<WIDTH_F32>;
+
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
 pub(super) struct Scratch<const C: usize> {
     pub solve: Solve<C>,
@@ -58,16 +64,48 @@ pub(super) struct Scratch<const C: usize> {
 }
 
 /// The loads and rows of one solve in lanes.
-pub(super) struct Solve<const C: usize> {
-    rows: Rows<C, F64x4>,
-    loads: Vec<Load<C, F64x4>>,
+pub(super) struct Solve<const C: usize, V: Lane = F64x4> {
+    rows: Rows<C, V>,
+    loads: Vec<Load<C, V>>,
+}
+
+impl<const C: usize, V: Lane> Solve<C, V> {
+    fn new(links: usize) -> Self {
+        Self { rows: Rows::with_len(links), loads: vec![Load::zero(); links] }
+    }
+
+    /// The direction accelerations `ü` (1/s²) into `out` (its first `C·n`) of chains with rods `rods`
+    /// at directions and rates `x = (u, w)` (`2·C·n`), under gravity `g⃗` and pivot
+    /// accelerations `p̈` (m/s²): [`Directions`]' tension solve, in lanes of any precision.
+    #[inline(always)]
+    fn accelerations(&mut self, rods: &Rods<V>, gravity: [V; C], pivot: [V; C], x: &[V], out: &mut [V]) {
+        let half = C * self.loads.len();
+        let (directions, rates) = (&x[..half], &x[half..2 * half]);
+        // The loads in a pass of their own: built inside the solve, the builder is not
+        // inlined.
+        let rods_rates = directions.chunks_exact(C).zip(rates.chunks_exact(C)).zip(rods.drag());
+        for (load, ((u, w), &drag)) in self.loads.iter_mut().zip(rods_rates) {
+            let (u, w) = (u.try_into().expect("C numbers"), w.try_into().expect("C numbers"));
+            *load = rate_load(u, w, drag);
+        }
+        let loads = &self.loads;
+        rods.solve(
+            gravity,
+            pivot,
+            &mut self.rows,
+            |i| loads[i],
+            |i, a, _, _| {
+                out[i * C..(i + 1) * C].copy_from_slice(&a);
+            },
+        );
+    }
 }
 
 impl<const C: usize> Scratch<C> {
     pub fn new(links: usize, state_len: usize) -> Self {
         let lanes = || vec![Lanes([0.0; WIDTH]); state_len];
         Self {
-            solve: Solve { rows: Rows::with_len(links), loads: vec![Load::zero(); links] },
+            solve: Solve::new(links),
             t: [Lanes([0.0; WIDTH]); 2],
             carry: lanes(),
             x: lanes(),
@@ -91,6 +129,13 @@ where
             return Err(Error::LengthMismatch { what: "space", expected: 3, got: S::DIM });
         }
         let links = check_links(models.iter().map(Directions::links))?;
+        let blocks_f32 = (0..models.len().div_ceil(WIDTH_F32))
+            .map(|b| {
+                let lanes = block_chains::<WIDTH_F32>(b, models.len());
+                let down = Lanes32::rounded(lanes.map(|c| -models[c].chain().gravity()));
+                (Rods::interleave_f32(lanes.map(|c| models[c].rods())), down)
+            })
+            .collect();
         let blocks = (0..models.len().div_ceil(WIDTH))
             .map(|b| {
                 let lanes = block_chains(b, models.len());
@@ -106,7 +151,7 @@ where
                 }
             })
             .collect();
-        Ok(Self { models, blocks, links, accounted: false })
+        Ok(Self { models, blocks, blocks_f32, links, accounted: false })
     }
 
     /// The batch of `models` with their energy ledgers: states as
@@ -178,64 +223,129 @@ where
             || Scratch::<C>::new(n, self.state_len()),
             |s, b, out| {
                 let lanes = block_chains(b, chains);
-                gather(x, lanes, m, &mut s.x);
-                let [k1, ..] = &mut s.k;
-                self.flow_simd::<C>(b, lanes, [t; WIDTH], &s.x, &mut s.solve, k1);
-                let mut failures = Vec::new();
-                for (k, row) in out.chunks_exact_mut(half).enumerate() {
-                    for (i, v) in row.iter_mut().enumerate() {
-                        *v = s.k[0][half + i].0[k];
-                    }
-                    if !row.iter().all(|v| v.is_finite()) {
-                        let chain = lanes[k];
-                        let error = non_finite("x", &x[chain * m..(chain + 1) * m])
-                            .unwrap_or(Error::NotPositiveDefinite);
-                        row.fill(f64::NAN);
-                        failures.push(Failure { chain, error });
-                    }
-                }
-                failures
+                self.evaluate_simd::<C>(b, lanes, t, x, s, out);
+                failed_rows(out, half, lanes, f64::NAN, |chain| {
+                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or(Error::NotPositiveDefinite)
+                })
             },
         )
     }
 
+    /// [`accelerations`](Self::accelerations) in single precision: states and results in
+    /// `f32`, the solve on eight chains per AVX2 register, each chain's constants rounded to
+    /// `f32` and its pivot acceleration computed in `f64` and then rounded. Not bit for bit
+    /// anything: its error against the `f64` call is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, in order: a non-finite state as the `f64` call names
+    /// it, otherwise [`Error::SinglePrecisionOverflow`]; their rows of `out` are NaN. Errors:
+    /// [`Error::LengthMismatch`] when an array does not hold `B` rows.
+    pub fn accelerations_f32(&self, t: f64, x: &[f32], out: &mut [f32]) -> Result<Vec<Failure>> {
+        let (chains, half) = (self.len(), S::DIM * self.links);
+        check_len("x", x, chains, 2 * half)?;
+        check_len("out", out, chains, half)?;
+        Ok(match S::DIM {
+            2 => self.accelerations_f32_in::<2>(t, x, out),
+            _ => self.accelerations_f32_in::<3>(t, x, out),
+        })
+    }
+
+    fn accelerations_f32_in<const C: usize>(&self, t: f64, x: &[f32], out: &mut [f32]) -> Vec<Failure> {
+        let (chains, n) = (self.len(), self.links);
+        let (half, m) = (C * n, 2 * C * n);
+        let lanes = || vec![Lanes32([0.0; WIDTH_F32]); m];
+        for_blocks_of::<WIDTH_F32, _, _, _>(
+            out,
+            half,
+            n,
+            || (Solve::<C, F32x8>::new(n), lanes(), lanes()),
+            |(solve, x_lanes, a_lanes), b, out| {
+                let chains = block_chains::<WIDTH_F32>(b, chains);
+                self.flow_f32_simd::<C>(b, chains, t, x, x_lanes, solve, a_lanes, out);
+                failed_rows(out, half, chains, f32::NAN, |chain| {
+                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or(Error::SinglePrecisionOverflow)
+                })
+            },
+        )
+    }
+
+    /// `of(drive, t_k)` (the pivot's acceleration or velocity) of each lane's chain, as
+    /// numbers of a lane type made by `lanes`.
+    #[inline(always)]
+    fn pivot_lanes<const C: usize, const W: usize, V>(
+        &self,
+        chains: [usize; W],
+        t: [f64; W],
+        of: impl Fn(&Dr, f64) -> OVector<f64, S>,
+        lanes: impl Fn([f64; W]) -> V,
+    ) -> [V; C] {
+        let each: [_; W] = std::array::from_fn(|k| of(self.models[chains[k]].drive(), t[k]));
+        std::array::from_fn(|c| lanes(std::array::from_fn(|k| each[k][c])))
+    }
+
     simd_kernel! {
-        /// `out = (w, ü(t, x))` for the block's chains in lanes: [`Directions`]' right-hand side,
-        /// one tension solve, with each chain's pivot acceleration at its own time.
-        pub(super) fn flow<const C: usize>(
+        /// `ü(t, x)` for the single-precision block `b` (chains `chains`) into its rows of
+        /// `out`: gathered into the lanes `x_lanes`, the solve, into `a_lanes`, scattered.
+        fn flow_f32<const C: usize>(
+            &self,
+            b: usize,
+            chains: [usize; WIDTH_F32],
+            t: f64,
+            x: &[f32],
+            x_lanes: &mut [F32x8],
+            solve: &mut Solve<C, F32x8>,
+            a_lanes: &mut [F32x8],
+            out: &mut [f32],
+        ) {
+            let (rods, down) = &self.blocks_f32[b];
+            let half = C * self.links;
+            gather(x, chains, 2 * half, Lanes32::flatten_mut(x_lanes));
+            let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
+            solve.accelerations(rods, gravity(*down), pivot, x_lanes, &mut a_lanes[..half]);
+            scatter::<_, WIDTH_F32>(Lanes32::flatten(&a_lanes[..half]), half, out);
+        }
+        dispatch fn flow_f32_simd, flow_f32_avx2
+    }
+
+    simd_kernel! {
+        /// `ü(t, x)` for block `b` (chains `chains`) into its rows of `out`: gathered into
+        /// lanes, [`flow`](Self::flow), scattered.
+        fn evaluate<const C: usize>(
             &self,
             b: usize,
             chains: [usize; WIDTH],
-            t: [f64; WIDTH],
-            x: &[F64x4],
-            solve: &mut Solve<C>,
-            out: &mut [F64x4],
-        ) -> [F64x4; C] {
+            t: f64,
+            x: &[f64],
+            s: &mut Scratch<C>,
+            out: &mut [f64],
+        ) {
             let half = C * self.links;
-            let block = &self.blocks[b];
-            let zero = Lanes([0.0; WIDTH]);
-            let pivots: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().acceleration(t[k]));
-            let pivot: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| pivots[k][c]));
-            let mut gravity = [zero; C];
-            gravity[C - 1] = block.down;
-            let (directions, rates) = (&x[..half], &x[half..2 * half]);
-            let (velocity, acceleration) = out.split_at_mut(half);
-            velocity.copy_from_slice(rates);
-            // The loads in a pass of their own: built inside the solve, the builder is not
-            // inlined.
-            let drag = block.rods.drag();
-            for (i, load) in solve.loads.iter_mut().enumerate() {
-                let at = |v: &[F64x4]| -> [F64x4; C] { std::array::from_fn(|c| v[i * C + c]) };
-                *load = rate_load(at(directions), at(rates), drag[i]);
-            }
-            let loads = &solve.loads;
-            let load = |i: usize| loads[i];
-            block.rods.solve(gravity, pivot, &mut solve.rows, load, |i, a, _, _| {
-                acceleration[i * C..(i + 1) * C].copy_from_slice(&a);
-            });
-            pivot
+            gather(x, chains, 2 * half, Lanes::flatten_mut(&mut s.x));
+            let [k1, ..] = &mut s.k;
+            self.flow::<C>(b, chains, [t; WIDTH], &s.x, &mut s.solve, k1);
+            scatter::<_, WIDTH>(Lanes::flatten(&k1[half..2 * half]), half, out);
         }
-        dispatch pub(super) fn flow_simd, flow_avx2
+        dispatch fn evaluate_simd, evaluate_avx2
+    }
+
+    /// `out = (w, ü(t, x))` for the block's chains in lanes: [`Directions`]' right-hand side,
+    /// one tension solve, with each chain's pivot acceleration at its own time.
+    #[inline(always)]
+    pub(super) fn flow<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        x: &[F64x4],
+        solve: &mut Solve<C>,
+        out: &mut [F64x4],
+    ) -> [F64x4; C] {
+        let half = C * self.links;
+        let block = &self.blocks[b];
+        let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::acceleration, Lanes);
+        let (velocity, acceleration) = out.split_at_mut(half);
+        velocity.copy_from_slice(&x[half..2 * half]);
+        solve.accelerations(&block.rods, gravity(block.down), pivot, x, acceleration);
+        pivot
     }
 
     /// The ledger's rates `(P_drive, 0, P_damping)` (W) into `out[2·S·n..]` after [`flow`](Self::flow)
@@ -253,11 +363,18 @@ where
     ) {
         let half = C * self.links;
         let block = &self.blocks[b];
-        let velocities: [_; WIDTH] = std::array::from_fn(|k| self.models[chains[k]].drive().velocity(t[k]));
-        let velocity: [F64x4; C] = std::array::from_fn(|c| Lanes::from_fn(|k| velocities[k][c]));
+        let velocity = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::velocity, Lanes);
         let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
         let (rates, accelerations) = (&x[half..2 * half], &out[half..2 * half]);
         let (drive, damping) = direction_powers(chain, velocity, pivot, rates, accelerations);
         out[2 * half..2 * half + LEDGER_LEN].copy_from_slice(&[drive, Lanes([0.0; WIDTH]), damping]);
     }
+}
+
+/// Gravity `g⃗ = −g e_up` (m/s²) per lane, from `−g`: along the last axis.
+#[inline(always)]
+fn gravity<const C: usize, V: Lane>(down: V) -> [V; C] {
+    let mut g = [V::splat(0.0); C];
+    g[C - 1] = down;
+    g
 }

@@ -37,14 +37,19 @@ mod planar;
 mod rk4;
 mod rod_midpoint;
 mod run;
+mod transpose;
 mod unrolled;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
+pub(crate) use transpose::{gather, scatter};
 pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;
+
+/// Chains per block in single precision: eight `f32` lanes, one AVX2 register.
+pub const WIDTH_F32: usize = 8;
 
 /// Four chains' numbers, one per lane.
 pub(crate) type F64x4 = Lanes<WIDTH>;
@@ -87,18 +92,10 @@ pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain
     }
 }
 
-/// The chains of block `b` of a batch of `chains`: lane `k` holds chain `WIDTH·b + k`, and
-/// the lanes past the last chain repeat it (their results are dropped).
-pub(crate) fn block_chains(b: usize, chains: usize) -> [usize; WIDTH] {
-    std::array::from_fn(|k| (WIDTH * b + k).min(chains - 1))
-}
-
-/// Lane `k` of each of the `m` numbers of the rows `rows` of `v` (`m` per row).
-#[inline(always)]
-pub(crate) fn gather(v: &[f64], rows: [usize; WIDTH], m: usize, out: &mut [F64x4]) {
-    for (j, o) in out[..m].iter_mut().enumerate() {
-        *o = Lanes::from_fn(|k| v[rows[k] * m + j]);
-    }
+/// The chains of block `b` of a batch of `chains`, in blocks of `W`: lane `k` holds chain
+/// `W·b + k`, and the lanes past the last chain repeat it (their results are dropped).
+pub(crate) fn block_chains<const W: usize>(b: usize, chains: usize) -> [usize; W] {
+    std::array::from_fn(|k| (W * b + k).min(chains - 1))
 }
 
 /// The first non-finite input of chain `chain` as the single-chain check names it: its row
@@ -117,6 +114,31 @@ pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
         .or_else(|| pivot.and_then(|p| row("pivot_acceleration", p, 2)))
 }
 
+/// Whether every entry of `v` is finite (a loop without early exit, so that it vectorises).
+#[inline(always)]
+fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
+    v.iter().fold(true, |finite, &x| finite & x.into().is_finite())
+}
+
+/// The chains of a block whose rows of `out` (`m` each, row `k` for chain `chains[k]`) are
+/// not all finite, each with `error(chain)`; their rows set to `nan`.
+pub(crate) fn failed_rows<T: Copy + Into<f64>, const W: usize>(
+    out: &mut [T],
+    m: usize,
+    chains: [usize; W],
+    nan: T,
+    error: impl Fn(usize) -> Error,
+) -> Vec<Failure> {
+    let mut failures = Vec::new();
+    for (k, row) in out.chunks_exact_mut(m).enumerate() {
+        if !all_finite(row) {
+            row.fill(nan);
+            failures.push(Failure { chain: chains[k], error: error(chains[k]) });
+        }
+    }
+    failures
+}
+
 /// The first non-finite entry of `v` as the single-chain error.
 pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Option<Error> {
     let value = |index: usize| v[index].into();
@@ -127,17 +149,14 @@ pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Op
     })
 }
 
-/// Blocks of [`WIDTH`] chains a rayon task takes at least, for blocks of `solves` rods'
+/// Blocks of `width` chains a rayon task takes at least, for blocks of `solves` rods'
 /// solves each: about 2000 rods' solves a task, so that short work does not drown in
 /// scheduling.
-pub(crate) fn blocks_per_task(solves: usize) -> usize {
-    (2048 / (WIDTH * solves).max(1)).max(1)
+pub(crate) fn blocks_per_task(width: usize, solves: usize) -> usize {
+    (2048 / (width * solves).max(1)).max(1)
 }
 
-/// Runs `block(scratch, b, rows)` for every block `b` of `out` (`WIDTH` rows of `m`
-/// numbers each, the last one shorter) across the current rayon pool, with a `scratch` from
-/// `init` per task, and collects the failures (or what `block` reports) in block order.
-/// `solves`: rods' solves per chain of a block (links × evaluations), for the task size.
+/// [`for_blocks_of`] in blocks of [`WIDTH`] chains.
 pub(crate) fn for_blocks<T: Send, S, F: Send>(
     out: &mut [T],
     m: usize,
@@ -145,19 +164,33 @@ pub(crate) fn for_blocks<T: Send, S, F: Send>(
     init: impl Fn() -> S + Sync + Send,
     block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
 ) -> Vec<F> {
-    let per_task = blocks_per_task(solves);
-    if out.len() <= per_task * WIDTH * m || rayon::current_num_threads() == 1 {
+    for_blocks_of::<WIDTH, _, _, _>(out, m, solves, init, block)
+}
+
+/// Runs `block(scratch, b, rows)` for every block `b` of `out` (`W` rows of `m` numbers
+/// each, the last one shorter) across the current rayon pool, with a `scratch` from `init`
+/// per task, and collects the failures (or what `block` reports) in block order.
+/// `solves`: rods' solves per chain of a block (links × evaluations), for the task size.
+pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
+    out: &mut [T],
+    m: usize,
+    solves: usize,
+    init: impl Fn() -> S + Sync + Send,
+    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
+) -> Vec<F> {
+    let per_task = blocks_per_task(W, solves);
+    if out.len() <= per_task * W * m || rayon::current_num_threads() == 1 {
         // One task's work, or one thread: no handing over to the pool (a thread's wake-up
         // costs more than a short batch).
         // A plain loop: a `flat_map` over the blocks cost 6–9% of a short block's time.
         let mut scratch = init();
         let mut failures = Vec::new();
-        for (b, rows) in out.chunks_mut(WIDTH * m).enumerate() {
+        for (b, rows) in out.chunks_mut(W * m).enumerate() {
             failures.extend(block(&mut scratch, b, rows));
         }
         return failures;
     }
-    out.par_chunks_mut(WIDTH * m)
+    out.par_chunks_mut(W * m)
         .enumerate()
         .with_min_len(per_task)
         .map_init(init, |scratch, (b, rows)| block(scratch, b, rows))
@@ -261,7 +294,7 @@ mod tests {
 
     #[test]
     fn the_last_block_repeats_the_last_chain() {
-        assert_eq!(block_chains(0, 6), [0, 1, 2, 3]);
+        assert_eq!(block_chains::<4>(0, 6), [0, 1, 2, 3]);
         assert_eq!(block_chains(1, 6), [4, 5, 5, 5]);
         assert_eq!(block_chains(0, 1), [0, 0, 0, 0]);
     }

@@ -4,8 +4,8 @@
 use nalgebra::Dyn;
 
 use super::{
-    F64x4, Failure, WIDTH, block_chains, check_len, check_links, first_bad_input, for_blocks, gather,
-    simd_kernel,
+    F64x4, Failure, WIDTH, block_chains, check_len, check_links, failed_rows, first_bad_input, for_blocks,
+    gather, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
@@ -140,18 +140,9 @@ impl PlanarBatch {
         let failures = for_blocks(out, n, n, scratch, |scratch, b, out| {
             let lanes = block_chains(b, chains);
             self.block_simd(b, lanes, q, qd, pivot, scratch, out);
-            let mut failures = Vec::new();
-            for (k, row) in out.chunks_exact_mut(n).enumerate() {
-                let chain = lanes[k];
-                if row.iter().all(|v| v.is_finite()) {
-                    continue;
-                }
-                let error =
-                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite);
-                row.fill(f64::NAN);
-                failures.push(Failure { chain, error });
-            }
-            failures
+            failed_rows(out, n, lanes, f64::NAN, |chain| {
+                first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite)
+            })
         });
         Ok(failures)
     }
@@ -171,13 +162,13 @@ impl PlanarBatch {
         ) {
             let n = self.links;
             let block = &self.blocks[b.min(self.blocks.len() - 1)];
-            gather(q, lanes, n, &mut s.angles);
+            gather(q, lanes, n, Lanes::flatten_mut(&mut s.angles));
             sin_cos_split(
                 Lanes::flatten(&s.angles),
                 Lanes::flatten_mut(&mut s.sin),
                 Lanes::flatten_mut(&mut s.cos),
             );
-            gather(qd, lanes, n, &mut s.rates);
+            gather(qd, lanes, n, Lanes::flatten_mut(&mut s.rates));
             let zero = Lanes([0.0; WIDTH]);
             let pivot = match pivot {
                 Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],

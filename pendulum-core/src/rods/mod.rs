@@ -206,16 +206,11 @@ fn entries<const S: usize, V: Lane>(
     ((inverse_mass + inverse_mass_above) * dot(u, u), -dot(u_above, u) * inverse_mass_above)
 }
 
-/// Rows between two rescalings of the continuants in [`Rods::solve`]. Each row multiplies
-/// `P` by its pivot `D_i`; 16 rows of pivots between 2⁻⁴⁸ and 2⁴⁸ keep `P` inside
-/// [`CONTINUANT_RANGE`].
-const BLOCK: usize = 16;
-
 pub use crate::lanes::CONTINUANT_RANGE;
 
 /// The pivots `1/D_i` of a tridiagonal elimination as ratios of continuants (module docs),
 /// row by row: one multiply and one subtraction per row on the serial chain, the division
-/// off it; both continuants multiplied every [`BLOCK`] rows by the power of two that brings
+/// off it; both continuants multiplied every [`Lane::RESCALE_ROWS`] rows by the power of two that brings
 /// `P_{i−1}` into `[1, 2)`. The pivots are valid while [`in_range`](Self::in_range) (in the
 /// lanes not flagged by [`outside`](Self::outside)).
 #[derive(Debug, Clone, Copy)]
@@ -234,25 +229,25 @@ impl<V: Lane> Continuants<V> {
     /// `1/D_i` of row `i` (rows in order from 0) with `A_ii = diagonal`, `A_{i,i−1} = off`.
     #[inline(always)]
     pub fn inverse_pivot(&mut self, i: usize, diagonal: V, off: V) -> V {
-        if i.is_multiple_of(BLOCK) {
+        if i.is_multiple_of(V::RESCALE_ROWS) {
             let scale = self.above.normalizer();
             self.above = self.above * scale;
             self.above2 = self.above2 * scale;
         }
         let p = diagonal * self.above - (off * off) * self.above2;
-        let (low, span) = CONTINUANT_RANGE;
-        self.out_of_range = V::or(self.out_of_range, p.outside(low, span));
+        self.out_of_range = V::or(self.out_of_range, p.continuant_outside());
         let inverse_pivot = self.above / p;
         (self.above2, self.above) = (self.above, p);
         inverse_pivot
     }
 
-    /// The lanes whose continuants left [`CONTINUANT_RANGE`] at some row so far.
+    /// The lanes whose continuants left their precision's range ([`Lane::continuant_outside`])
+    /// at some row so far.
     pub fn outside(&self) -> V::Mask {
         self.out_of_range
     }
 
-    /// Whether every continuant so far stayed inside [`CONTINUANT_RANGE`] (in every lane).
+    /// Whether every continuant so far stayed inside its precision's range (in every lane).
     pub fn in_range(&self) -> bool {
         !V::any(self.out_of_range)
     }

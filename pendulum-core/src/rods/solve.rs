@@ -3,7 +3,7 @@
 //! of `A T = b`, module docs of [`rods`](super)) and one up pass, O(n).
 
 use super::*;
-use crate::lanes::Lanes;
+use crate::lanes::{Lanes, Lanes32};
 
 impl Rods {
     /// The constants of a chain with these masses (kg) and lengths (m), both positive, and
@@ -33,18 +33,27 @@ impl Rods {
     }
 }
 
-impl<const W: usize> Rods<Lanes<W>> {
+impl Rods {
     /// The constants of `W` chains with the same number of rods, chain `k` in lane `k`.
-    pub fn interleave(chains: [&Rods; W]) -> Self {
+    pub fn interleave<const W: usize>(chains: [&Rods; W]) -> Rods<Lanes<W>> {
+        Self::side_by_side(chains, Lanes)
+    }
+
+    /// [`interleave`](Self::interleave) rounded to single precision.
+    pub fn interleave_f32<const W: usize>(chains: [&Rods; W]) -> Rods<Lanes32<W>> {
+        Self::side_by_side(chains, Lanes32::rounded)
+    }
+
+    /// Each constant of `chains`, lane `k` holding `chains[k]`'s, made a lane type by `lanes`.
+    fn side_by_side<const W: usize, V: Lane>(chains: [&Rods; W], lanes: impl Fn([f64; W]) -> V) -> Rods<V> {
         let n = chains[0].len();
-        let lanes = |of: fn(&Rods) -> &[f64]| -> Vec<Lanes<W>> {
-            (0..n).map(|i| Lanes(chains.map(|c| of(c)[i]))).collect()
-        };
-        Self {
-            inverse_mass: lanes(|c| &c.inverse_mass),
-            inverse_length: lanes(|c| &c.inverse_length),
-            length: lanes(|c| &c.length),
-            drag: lanes(|c| &c.drag),
+        let each =
+            |of: fn(&Rods) -> &[f64]| -> Vec<V> { (0..n).map(|i| lanes(chains.map(|c| of(c)[i]))).collect() };
+        Rods {
+            inverse_mass: each(|c| &c.inverse_mass),
+            inverse_length: each(|c| &c.inverse_length),
+            length: each(|c| &c.length),
+            drag: each(|c| &c.drag),
         }
     }
 }
@@ -86,7 +95,7 @@ impl<V: Lane> Rods<V> {
     }
 
     /// The down pass: free accelerations, right-hand sides and the elimination by
-    /// continuants (module docs), rescaled by a power of two every [`BLOCK`] rows. Returns the
+    /// continuants (module docs), rescaled by a power of two every [`Lane::RESCALE_ROWS`] rows. Returns the
     /// lanes where a continuant left [`CONTINUANT_RANGE`]; their rows then hold `b_i` and the
     /// directions but not yet valid `f_i` and `h_i`.
     #[inline(always)]
@@ -379,7 +388,7 @@ mod tests {
             assert_eq!(in_range, k != 2, "chain {k}");
             scalar.push(solution);
         }
-        let lanes = Rods::<Lanes<4>>::interleave([&chains[0].0, &chains[1].0, &chains[2].0, &chains[3].0]);
+        let lanes = Rods::interleave([&chains[0].0, &chains[1].0, &chains[2].0, &chains[3].0]);
         let load = |i: usize| {
             let of = |k: usize| chains[k].1[i];
             let lane = |f: &dyn Fn(Load<2>) -> f64| Lanes([f(of(0)), f(of(1)), f(of(2)), f(of(3))]);

@@ -46,7 +46,7 @@ impl<const N: usize> LinkConstants<f64, N> {
 
     /// [`interleave`](Self::interleave) rounded to single precision.
     pub fn interleave_f32<const W: usize>(chains: [&Self; W]) -> LinkConstants<Lanes32<W>, N> {
-        Self::side_by_side(chains, |lanes| Lanes32(lanes.map(|x| x as f32)))
+        Self::side_by_side(chains, Lanes32::rounded)
     }
 
     /// Each constant of `chains`, lane `k` holding `chains[k]`'s, made a lane type by `lanes`.
