@@ -204,13 +204,18 @@ where
     /// of `out` are NaN. Errors: [`Error::LengthMismatch`] when an array does not hold `B`
     /// rows.
     pub fn accelerations(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<Vec<Failure>> {
-        let (chains, half) = (self.len(), S::DIM * self.links);
-        check_len("x", x, chains, 2 * half)?;
-        check_len("out", out, chains, half)?;
+        self.check_rows(x, out)?;
         Ok(match S::DIM {
             2 => self.accelerations_in::<2>(t, x, out),
             _ => self.accelerations_in::<3>(t, x, out),
         })
+    }
+
+    /// Checks that `x` holds `B` states of `(u, w)` (`2·S·n` each) and `out` `B` rows of `S·n`.
+    fn check_rows<T>(&self, x: &[T], out: &[T]) -> Result<()> {
+        let (chains, half) = (self.len(), S::DIM * self.links);
+        check_len("x", x, chains, 2 * half)?;
+        check_len("out", out, chains, half)
     }
 
     fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
@@ -240,9 +245,7 @@ where
     /// it, otherwise [`Error::SinglePrecisionOverflow`]; their rows of `out` are NaN. Errors:
     /// [`Error::LengthMismatch`] when an array does not hold `B` rows.
     pub fn accelerations_f32(&self, t: f64, x: &[f32], out: &mut [f32]) -> Result<Vec<Failure>> {
-        let (chains, half) = (self.len(), S::DIM * self.links);
-        check_len("x", x, chains, 2 * half)?;
-        check_len("out", out, chains, half)?;
+        self.check_rows(x, out)?;
         Ok(match S::DIM {
             2 => self.accelerations_f32_in::<2>(t, x, out),
             _ => self.accelerations_f32_in::<3>(t, x, out),

@@ -9,47 +9,51 @@ use std::arch::x86_64::*;
 
 use super::has_avx2;
 
-/// A number the batch transposes.
+/// A number the batch transposes: with AVX2 shuffles where its width has them.
 pub(crate) trait Transpose: Copy {
-    /// `out[i][k] = rows[k][i]`: a `W × W` tile transposed.
+    /// `out[i][k] = rows[k][i]` with AVX2 shuffles, when the CPU has AVX2 and `W` is this
+    /// number's width in one register; whether it did.
     #[inline(always)]
-    fn transpose<const W: usize>(rows: [&[Self; W]; W], out: [&mut [Self; W]; W]) {
-        for (k, row) in rows.iter().enumerate() {
-            for (i, &v) in row.iter().enumerate() {
-                out[i][k] = v;
-            }
-        }
+    fn transpose_simd<const W: usize>(_rows: &[&[Self; W]; W], _out: &mut [&mut [Self; W]; W]) -> bool {
+        false
     }
 }
 
 impl Transpose for f64 {
     #[inline(always)]
-    fn transpose<const W: usize>(rows: [&[f64; W]; W], out: [&mut [f64; W]; W]) {
+    fn transpose_simd<const W: usize>(rows: &[&[f64; W]; W], out: &mut [&mut [f64; W]; W]) -> bool {
         #[cfg(target_arch = "x86_64")]
         if W == 4 && has_avx2() {
             // SAFETY: the CPU has AVX2; W = 4, so the pointers address four numbers each.
-            return unsafe { transpose_4x4(rows.map(|r| r.as_ptr()), out.map(|o| o.as_mut_ptr())) };
+            unsafe { transpose_4x4(rows.map(|r| r.as_ptr()), out.each_mut().map(|o| o.as_mut_ptr())) };
+            return true;
         }
-        for (k, row) in rows.iter().enumerate() {
-            for (i, &v) in row.iter().enumerate() {
-                out[i][k] = v;
-            }
-        }
+        false
     }
 }
 
 impl Transpose for f32 {
     #[inline(always)]
-    fn transpose<const W: usize>(rows: [&[f32; W]; W], out: [&mut [f32; W]; W]) {
+    fn transpose_simd<const W: usize>(rows: &[&[f32; W]; W], out: &mut [&mut [f32; W]; W]) -> bool {
         #[cfg(target_arch = "x86_64")]
         if W == 8 && has_avx2() {
             // SAFETY: the CPU has AVX2; W = 8, so the pointers address eight numbers each.
-            return unsafe { transpose_8x8(rows.map(|r| r.as_ptr()), out.map(|o| o.as_mut_ptr())) };
+            unsafe { transpose_8x8(rows.map(|r| r.as_ptr()), out.each_mut().map(|o| o.as_mut_ptr())) };
+            return true;
         }
-        for (k, row) in rows.iter().enumerate() {
-            for (i, &v) in row.iter().enumerate() {
-                out[i][k] = v;
-            }
+        false
+    }
+}
+
+/// `out[i][k] = rows[k][i]`: a `W × W` tile transposed.
+#[inline(always)]
+fn transpose<T: Transpose, const W: usize>(rows: [&[T; W]; W], mut out: [&mut [T; W]; W]) {
+    if T::transpose_simd(&rows, &mut out) {
+        return;
+    }
+    for (k, row) in rows.iter().enumerate() {
+        for (i, &v) in row.iter().enumerate() {
+            out[i][k] = v;
         }
     }
 }
@@ -110,7 +114,7 @@ pub(crate) fn gather<T: Transpose, const W: usize>(v: &[T], rows: [usize; W], m:
     let rows: [&[T]; W] = rows.map(|r| &v[m * r..m * (r + 1)]);
     let mut tiles = out[..W * m].chunks_exact_mut(W * W);
     for (t, tile) in tiles.by_ref().enumerate() {
-        T::transpose(rows.map(|row| as_array(&row[W * t..])), split(tile));
+        transpose(rows.map(|row| as_array(&row[W * t..])), split(tile));
     }
     let done = m / W * W;
     for (j, out) in tiles.into_remainder().chunks_exact_mut(W).enumerate() {
@@ -138,7 +142,7 @@ pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: 
     for (t, tile) in tiles.by_ref().enumerate() {
         let tile: [&[T; W]; W] = std::array::from_fn(|i| as_array(&tile[W * i..]));
         let out = rows.each_mut().map(|row| as_array_mut(&mut row[W * t..]));
-        T::transpose(tile, out);
+        transpose(tile, out);
     }
     let done = m / W * W;
     for (j, lanes) in tiles.remainder().chunks_exact(W).enumerate() {
