@@ -106,6 +106,14 @@ fn accelerations(c: &mut Criterion) {
                 },
             );
         }
+        let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+        let (q32, qd32, mut out32) = (narrow(&q), narrow(&qd), vec![0.0f32; out.len()]);
+        let pool1 = pool(1);
+        group.bench_with_input(BenchmarkId::new("planar/batch_f32_1_thread", n), &n, |b, _| {
+            in_pool(b, &pool1, || {
+                batch.accelerations_f32(&q32, &qd32, None, &mut out32).expect("batch");
+            })
+        });
 
         let models: Vec<_> = chains.iter().cloned().map(Directions::<U3>::new).collect();
         let x: Vec<DVector<f64>> = models

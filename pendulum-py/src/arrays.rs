@@ -85,12 +85,12 @@ impl Rows {
 }
 
 /// `data` as an array of shape `lead + tail`.
-pub fn array<'py>(
+pub fn array<'py, T: numpy::Element>(
     py: Python<'py>,
-    data: Vec<f64>,
+    data: Vec<T>,
     lead: &[usize],
     tail: &[usize],
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let shape: Vec<usize> = lead.iter().chain(tail).copied().collect();
     let flat = PyArray1::from_vec(py, data);
     if shape.len() == 1 {

@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
-use pendulum_core::batch::PlanarBatch;
+use pendulum_core::batch::{Failure, PlanarBatch};
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -64,6 +64,40 @@ struct Batch {
 }
 
 impl Chain {
+    /// `Chain.accelerations(..., precision="float32")`: the planar model without torques in
+    /// single precision ([`planar_batch_f32`]).
+    fn accelerations_f32<'py>(
+        &self,
+        py: Python<'py>,
+        kind: Kind,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if kind != Kind::Planar {
+            return Err(invalid("precision: 'float32' serves model='planar' only"));
+        }
+        if torque.is_none() && pivot_acceleration.is_none() {
+            let single = |b: &PlanarBatch, q: &[f32], qd: &[f32], out: &mut [f32]| {
+                b.accelerations_f32(q, qd, None, out)
+            };
+            if let Some(out) = planar_in_place(py, &self.inner, q, qd, single)? {
+                return Ok(out);
+            }
+            if let Some(out) = planar_table_f32(py, &self.inner, q, qd)? {
+                return Ok(out);
+            }
+        }
+        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
+        if b.torque.data.iter().any(|t| *t != 0.0) {
+            return Err(invalid("precision: 'float32' takes no torques"));
+        }
+        let out =
+            maybe_detached(py, b.q.data.len(), || planar_batch_f32(&self.inner, &b)).map_err(core_error)?;
+        Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
+    }
+
     fn batch(
         &self,
         kind: Kind,
@@ -184,18 +218,85 @@ fn planar_batch(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::
     }
 }
 
-/// `θ̈` of many planar states given as one C-contiguous float64 array `q` of shape
-/// `(B, n)`, `qd` the same or absent, without torques or pivot acceleration: read where
-/// numpy holds them and written into the result array, no copies ([`planar_batch`]'s
-/// numbers). `None`: not this case (the general path takes it, and its errors).
-fn planar_in_place<'py>(
+/// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states
+/// and pivot accelerations rounded to `f32`, the result in `f32`.
+fn planar_batch_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<Vec<f32>> {
+    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+    let batch = PlanarBatch::repeated(chain.clone(), b.q.count())?;
+    let mut out = vec![0.0f32; b.q.data.len()];
+    let (q, qd, pivot) = (narrow(&b.q.data), narrow(&b.qd.data), narrow(&b.pivot.data));
+    let failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out)?;
+    // The inputs were checked finite in f64: a failure is single precision's range (an
+    // input past f32's, or the solve's numbers).
+    match failures.is_empty() {
+        true => Ok(out),
+        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
+    }
+}
+
+/// A C-contiguous `(B, n)` float64 array as its `B` and its numbers rounded to `f32`;
+/// `None` for any other array, or one with a number that is infinite in `f32`.
+fn table_f32(a: &Bound<'_, PyAny>, n: usize) -> Option<(usize, Vec<f32>)> {
+    let a = a.cast::<PyArray2<f64>>().ok()?.readonly();
+    let [count, width] = [a.shape()[0], a.shape()[1]];
+    // C order only: `as_slice` of a Fortran-ordered array is contiguous too.
+    (width == n && a.is_c_contiguous()).then_some(())?;
+    let numbers: Vec<f32> = a.as_slice().ok()?.iter().map(|&x| x as f32).collect();
+    // An infinite number (given, or past f32's range) is the general path's to name.
+    numbers.iter().all(|x| !x.is_infinite()).then_some((count, numbers))
+}
+
+/// `θ̈` in single precision of the states of a C-contiguous `(B, n)` float64 table `q`,
+/// `qd` the same or absent, without torques or pivot acceleration, rounded to `f32` in one
+/// pass over each array (float32 tables are read in place by [`planar_in_place`]). `None`:
+/// not this case.
+fn planar_table_f32<'py>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     q: &Bound<'py, PyAny>,
     qd: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     let n = chain.links();
-    let Ok(q) = q.cast::<PyArray2<f64>>() else { return Ok(None) };
+    let Some((count, qs)) = table_f32(q, n) else { return Ok(None) };
+    let qds = match qd.map(|qd| table_f32(qd, n)) {
+        None => vec![0.0; qs.len()],
+        Some(Some((c, qds))) if c == count => qds,
+        Some(_) => return Ok(None),
+    };
+    if count == 0 {
+        return Ok(None);
+    }
+    let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
+    let mut out = vec![0.0f32; qs.len()];
+    let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(&qs, &qds, None, &mut out))
+        .map_err(core_error)?;
+    if !failures.is_empty() {
+        // The general path's message for a non-finite input ([`Rows::read`]'s).
+        for (what, values) in [("q", &qs), ("qd", &qds)] {
+            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                return Err(invalid(format!("{what}: {v} is not finite")));
+            }
+        }
+        return Err(core_error(pendulum_core::Error::SinglePrecisionOverflow));
+    }
+    Ok(Some(PyArray1::from_vec(py, out).reshape([count, n])?.into_any()))
+}
+
+/// `θ̈` of many planar states given as one C-contiguous array `q` of `T` (float64, or
+/// float32 for single precision) of shape `(B, n)`, `qd` the same or absent, without
+/// torques or pivot acceleration: read where numpy holds them and written into the result
+/// array, no copies, by `run` (`PlanarBatch::accelerations` or `accelerations_f32`: then
+/// [`planar_batch`]'s numbers). `None`: not this case (the general path takes it, and its
+/// errors).
+fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync + Default>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+    run: impl Fn(&PlanarBatch, &[T], &[T], &mut [T]) -> pendulum_core::Result<Vec<Failure>> + Send + Sync,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let n = chain.links();
+    let Ok(q) = q.cast::<PyArray2<T>>() else { return Ok(None) };
     let q = q.readonly();
     let [count, width] = [q.shape()[0], q.shape()[1]];
     // C order only: `as_slice` of a Fortran-ordered array is contiguous too, column-major.
@@ -206,7 +307,7 @@ fn planar_in_place<'py>(
     let given = match qd {
         None => None,
         Some(qd) => {
-            let Ok(qd) = qd.cast::<PyArray2<f64>>() else { return Ok(None) };
+            let Ok(qd) = qd.cast::<PyArray2<T>>() else { return Ok(None) };
             if qd.shape() != [count, n] || !qd.is_c_contiguous() {
                 return Ok(None);
             }
@@ -214,27 +315,26 @@ fn planar_in_place<'py>(
         }
     };
     let zeros;
-    let qds: &[f64] = match &given {
+    let qds: &[T] = match &given {
         Some(qd) => match qd.as_slice() {
             Ok(slice) => slice,
             Err(_) => return Ok(None),
         },
         None => {
-            zeros = vec![0.0; qs.len()];
+            zeros = vec![T::default(); qs.len()];
             &zeros
         }
     };
-    let out = PyArray2::<f64>::zeros(py, [count, n], false);
+    let out = PyArray2::<T>::zeros(py, [count, n], false);
     {
         let mut written = out.readwrite();
         let os = written.as_slice_mut().map_err(|e| invalid(e.to_string()))?;
         let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
-        let failures =
-            maybe_detached(py, qs.len(), || batch.accelerations(qs, qds, None, os)).map_err(core_error)?;
+        let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
         if let Some(failure) = failures.into_iter().next() {
             // The general path's message for a non-finite input ([`Rows::read`]'s).
             for (what, values) in [("q", qs), ("qd", qds)] {
-                if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                if let Some(v) = values.iter().map(|&v| v.into()).find(|v: &f64| !v.is_finite()) {
                     return Err(invalid(format!("{what}: {v} is not finite")));
                 }
             }
@@ -441,7 +541,11 @@ impl Chain {
     /// by `model` ("planar" or "spatial"). `q` may hold many states along leading axes,
     /// shape `(..., dof)`; `qd`, `torque` (default zeros) are one row for all or one per
     /// state, likewise `pivot_acceleration`. Returns an array shaped like `q`.
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
+    /// `precision="float32"` (planar, no torques) computes in single precision, eight
+    /// states per SIMD register, and returns float32: within about 1e-5 of the largest
+    /// acceleration (docs/ensembles.md).
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", precision = "float64"))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn accelerations<'py>(
         &self,
         py: Python<'py>,
@@ -450,12 +554,20 @@ impl Chain {
         torque: Option<&Bound<'py, PyAny>>,
         pivot_acceleration: Option<&Bound<'py, PyAny>>,
         model: &str,
+        precision: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let kind = Kind::of(model)?;
+        match precision {
+            "float64" => {}
+            "float32" => return self.accelerations_f32(py, kind, q, qd, torque, pivot_acceleration),
+            _ => return Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+        }
         if kind == Kind::Planar
             && torque.is_none()
             && pivot_acceleration.is_none()
-            && let Some(out) = planar_in_place(py, &self.inner, q, qd)?
+            && let Some(out) = planar_in_place(py, &self.inner, q, qd, |b, q: &[f64], qd, out| {
+                b.accelerations(q, qd, None, out)
+            })?
         {
             return Ok(out);
         }

@@ -91,6 +91,38 @@ def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
     assert str(many.value) == str(one.value) == "q: NaN is not finite"
 
 
+def test_single_precision_is_the_double_precision_batch_to_its_documented_error():
+    # precision="float32": eight states per SIMD register in f32, within 1e-5 of the largest
+    # acceleration of each state (docs/ensembles.md), shaped like q, float32.
+    rng = np.random.default_rng(11)
+    n = 12
+    chain = pendulum.Chain(rng.uniform(0.01, 0.1, n), rng.uniform(0.01, 0.1, n), damping=rng.uniform(1e-4, 1e-3, n))
+    q, qd = rng.uniform(-3, 3, (4, 25, n)), rng.uniform(-5, 5, (4, 25, n))
+    pivot = rng.uniform(-30, 30, (4, 25, 2))
+    double = chain.accelerations(q, qd, pivot_acceleration=pivot)
+    single = chain.accelerations(q, qd, pivot_acceleration=pivot, precision="float32")
+    assert single.dtype == np.float32 and single.shape == double.shape == (4, 25, n)
+    error = np.max(np.abs(single - double), axis=-1) / np.max(np.abs(double), axis=-1)
+    assert 0 < error.max() < 1e-5
+    one = chain.accelerations(q[1, 2], qd[1, 2], pivot_acceleration=pivot[1, 2], precision="float32")
+    assert one.dtype == np.float32 and np.array_equal(one, single[1, 2])
+    # A (B, n) table, float32 or float64, is read in one pass: the same numbers.
+    table = chain.accelerations(q[0], qd[0], precision="float32")
+    narrow = chain.accelerations(q[0].astype(np.float32), qd[0].astype(np.float32), precision="float32")
+    general = chain.accelerations(q[0], qd[0], pivot_acceleration=np.zeros(2), precision="float32")
+    assert table.dtype == np.float32 and np.array_equal(table, narrow) and np.array_equal(table, general)
+    for call, message in [
+        (lambda: chain.accelerations(q, qd, precision="float16"), "precision: 'float16' is neither"),
+        (lambda: chain.accelerations(np.zeros(2 * n), precision="float32", model="spatial"), "model='planar' only"),
+        (lambda: chain.accelerations(q[0], qd[0], np.ones(n), precision="float32"), "takes no torques"),
+        (lambda: chain.accelerations(q[0], qd[0] * 1e20, precision="float32"), "not finite in single precision"),
+        (lambda: chain.accelerations(q[0] * 1e40, precision="float32"), "not finite in single precision"),
+        (lambda: chain.accelerations(np.full((3, n), np.inf, np.float32), precision="float32"), "q: inf is not finite"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            call()
+
+
 def test_a_contiguous_table_of_planar_states_is_read_in_place_with_the_same_numbers():
     # A (B, n) C-contiguous float64 table without torques or pivot acceleration is read
     # where numpy holds it; any other layout takes the general path: the same numbers.

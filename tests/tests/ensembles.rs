@@ -463,15 +463,11 @@ fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_c
 }
 
 /// `max |ü₃₂ − ü₆₄| / max |ü₆₄|` of each chain of whirls of `n` links whose masses, lengths
-/// and damping span `decades` decades, the worst of `chains`, and the batch's failures.
+/// and damping span `decades` decades, at random states: the worst of `chains`.
 fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8Rng) -> f64 {
     let models: Vec<_> = (0..chains)
         .map(|_| {
-            let mut spread =
-                |lo: f64| (0..n).map(|_| 10f64.powf(lo + decades * r.random::<f64>())).collect::<Vec<_>>();
-            let (masses, lengths, damping) = (spread(-2.0), spread(-2.0), spread(-4.0));
-            let chain =
-                Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain");
+            let chain = spread_chain(n, decades, r);
             let drive = Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
             Directions::<U3>::new(chain).with_drive(drive)
         })
@@ -492,14 +488,7 @@ fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8
     assert!(batch.accelerations(t, &x, &mut out64).expect("f64").is_empty());
     let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
     assert!(batch.accelerations_f32(t, &x32, &mut out32).expect("f32").is_empty());
-    out64
-        .chunks_exact(3 * n)
-        .zip(out32.chunks_exact(3 * n))
-        .map(|(a, b)| {
-            let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            a.iter().zip(b).fold(0.0f64, |m, (a, &b)| m.max((a - f64::from(b)).abs())) / scale
-        })
-        .fold(0.0, f64::max)
+    worst_relative_error(&out64, &out32, 3 * n)
 }
 
 #[test]
@@ -552,6 +541,86 @@ fn single_precision_directions_fail_by_chain_and_change_with_no_thread_count_or_
         assert_eq!(
             out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             row.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "chain {k}"
+        );
+    }
+}
+
+/// Chains of `n` links whose masses, lengths and damping are spread over `decades`
+/// decades around 10 g, 1 cm and 1e-4 N·m·s, with gravity 9.81 m/s².
+fn spread_chain(n: usize, decades: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {
+    let mut spread =
+        |lo: f64| (0..n).map(|_| 10f64.powf(lo + decades * r.random::<f64>())).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (spread(-2.0), spread(-2.0), spread(-4.0));
+    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// The worst over rows of `max |a₃₂ − a₆₄| / max |a₆₄|` (rows of `m`).
+fn worst_relative_error(f64s: &[f64], f32s: &[f32], m: usize) -> f64 {
+    f64s.chunks_exact(m)
+        .zip(f32s.chunks_exact(m))
+        .map(|(a, b)| {
+            let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            a.iter().zip(b).fold(0.0f64, |e, (a, &b)| e.max((a - f64::from(b)).abs())) / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn single_precision_planar_chains_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors.
+    let mut r = ChaCha8Rng::seed_from_u64(49);
+    let chains = 200;
+    for (decades, bound) in [(0.3, 1e-5), (1.0, 1e-5), (2.0, 5e-5)] {
+        for n in [8, 20, 100] {
+            let batch = PlanarBatch::new((0..chains).map(|_| spread_chain(n, decades, &mut r)).collect())
+                .expect("batch");
+            let q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+            let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+            let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+            let (mut out64, mut out32) = (vec![0.0; chains * n], vec![0.0f32; chains * n]);
+            assert!(batch.accelerations(&q, &qd, Some(&pivot), &mut out64).expect("f64").is_empty());
+            let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+            let (q, qd, pivot) = (narrow(&q), narrow(&qd), narrow(&pivot));
+            assert!(batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out32).expect("f32").is_empty());
+            let error = worst_relative_error(&out64, &out32, n);
+            println!("planar, spread 10^{decades}, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(50);
+    let (n, chains) = (10, 21);
+    let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 1.0, &mut r)).collect();
+    let mut q: Vec<f32> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+    let mut qd: Vec<f32> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+    q[4 * n + 2] = f32::INFINITY;
+    qd[13 * n + 7] = 3e19;
+    let batch = PlanarBatch::new(list.clone()).expect("batch");
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let mut out = vec![0.0f32; chains * n];
+        let failures = pool.install(|| batch.accelerations_f32(&q, &qd, None, &mut out)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [4, 13]);
+        assert_eq!(failures[0].error, Error::NonFinite { what: "q", index: 2, value: f64::INFINITY });
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, row) in out.chunks_exact(n).enumerate() {
+            assert_eq!(row.iter().all(|v| v.is_nan()), k == 4 || k == 13, "chain {k}");
+        }
+        runs.push(out.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    }
+    assert_eq!(runs[0], runs[1]);
+    for k in [0, 9, 20] {
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let mut out = vec![0.0f32; n];
+        let row = |v: &[f32]| v[k * n..(k + 1) * n].to_vec();
+        assert!(alone.accelerations_f32(&row(&q), &row(&qd), None, &mut out).expect("f32").is_empty());
+        assert_eq!(
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            runs[0][k * n..(k + 1) * n],
             "chain {k}"
         );
     }

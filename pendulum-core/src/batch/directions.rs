@@ -4,7 +4,7 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::{
-    F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows, for_blocks,
+    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows, for_blocks,
     for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
@@ -47,9 +47,6 @@ struct Block {
     lengths: Vec<F64x4>,
     damping: Vec<F64x4>,
 }
-
-/// Eight chains' numbers in single precision, one per lane: one AVX2 register.
-type F32x8 = Lanes32<WIDTH_F32>;
 
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
 pub(super) struct Scratch<const C: usize> {

@@ -29,7 +29,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::lanes::Lanes;
+use crate::lanes::{Lanes, Lanes32};
 
 mod directions;
 mod jacobians;
@@ -53,6 +53,9 @@ pub const WIDTH_F32: usize = 8;
 
 /// Four chains' numbers, one per lane.
 pub(crate) type F64x4 = Lanes<WIDTH>;
+
+/// Eight chains' numbers in single precision, one per lane: one AVX2 register.
+pub(crate) type F32x8 = Lanes32<WIDTH_F32>;
 
 /// A chain of a batch that failed, and why; the other chains finished.
 #[derive(Debug, Clone, PartialEq)]

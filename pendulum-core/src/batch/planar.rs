@@ -4,13 +4,13 @@
 use nalgebra::Dyn;
 
 use super::{
-    F64x4, Failure, WIDTH, block_chains, check_len, check_links, failed_rows, first_bad_input, for_blocks,
-    gather, simd_kernel,
+    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
+    first_bad_input, for_blocks, for_blocks_of, gather, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
-use crate::kinematics::trig::sin_cos_split;
-use crate::lanes::Lanes;
+use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
+use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
@@ -30,27 +30,70 @@ pub struct PlanarBatch {
     /// Per block of [`WIDTH`] chains, their constants side by side (one block for all when
     /// the chains are one chain repeated).
     blocks: Vec<Block>,
+    /// The same in single precision, per block of [`WIDTH_F32`] chains.
+    blocks_f32: Vec<Block<F32x8>>,
     count: usize,
     links: usize,
 }
 
-/// What the solve needs of one block's chains.
+/// What the solve needs of one block's chains, in lanes `V`.
 #[derive(Debug, Clone)]
-struct Block {
-    rods: Rods<F64x4>,
+struct Block<V: Lane = F64x4> {
+    rods: Rods<V>,
     /// `−g` (m/s²) per lane.
-    down: F64x4,
+    down: V,
 }
 
 /// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates, and the rows.
-struct Scratch {
-    angles: Vec<F64x4>,
-    sin: Vec<F64x4>,
-    cos: Vec<F64x4>,
-    rates: Vec<F64x4>,
-    loads: Vec<Load<2, F64x4>>,
-    rows: Rows<2, F64x4>,
-    accelerations: Vec<F64x4>,
+struct Scratch<V: Lane = F64x4> {
+    angles: Vec<V>,
+    sin: Vec<V>,
+    cos: Vec<V>,
+    rates: Vec<V>,
+    loads: Vec<Load<2, V>>,
+    rows: Rows<2, V>,
+    accelerations: Vec<V>,
+}
+
+impl<V: Lane> Scratch<V> {
+    fn new(links: usize) -> Self {
+        let lanes = || vec![V::splat(0.0); links];
+        Self {
+            angles: lanes(),
+            sin: lanes(),
+            cos: lanes(),
+            rates: lanes(),
+            loads: vec![Load::zero(); links],
+            rows: Rows::with_len(links),
+            accelerations: lanes(),
+        }
+    }
+}
+
+impl<V: Lane> Block<V> {
+    /// `θ̈` (rad/s²) of the block's chains into `s.accelerations`, from `s.sin`, `s.cos`,
+    /// `s.rates` (rad/s) and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s
+    /// tension solve, in lanes of any precision.
+    #[inline(always)]
+    fn accelerations(&self, pivot: [V; 2], s: &mut Scratch<V>) {
+        // The loads in a pass of their own: built inside the solve, the builder is not
+        // inlined (as in the single-chain model).
+        let drag = self.rods.drag();
+        for (i, load) in s.loads.iter_mut().enumerate() {
+            *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
+        }
+        let loads = &s.loads;
+        let accelerations = &mut s.accelerations;
+        self.rods.solve(
+            [V::splat(0.0), self.down],
+            pivot,
+            &mut s.rows,
+            |i| loads[i],
+            |i, a, u, _| {
+                accelerations[i] = angle_acceleration(a, u);
+            },
+        );
+    }
 }
 
 impl PlanarBatch {
@@ -70,7 +113,16 @@ impl PlanarBatch {
                 }
             })
             .collect();
-        Ok(Self { count: chains.len(), chains, blocks, links })
+        let blocks_f32 = (0..chains.len().div_ceil(WIDTH_F32))
+            .map(|b| {
+                let lanes = block_chains::<WIDTH_F32>(b, chains.len());
+                Block {
+                    rods: Rods::interleave_f32(lanes.map(|c| chains[c].rods())),
+                    down: Lanes32::rounded(lanes.map(|c| -Model::chain(chains[c].dense()).gravity())),
+                }
+            })
+            .collect();
+        Ok(Self { count: chains.len(), chains, blocks, blocks_f32, links })
     }
 
     /// `count` copies of `chain`: one model at `count` states per call. The lanes' constants
@@ -121,30 +173,94 @@ impl PlanarBatch {
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
         let (chains, n) = (self.len(), self.links);
+        self.check_rows(q, qd, pivot, out)?;
+        let failures = for_blocks(
+            out,
+            n,
+            n,
+            || Scratch::new(n),
+            |scratch, b, out| {
+                let lanes = block_chains(b, chains);
+                self.block_simd(b, lanes, q, qd, pivot, scratch, out);
+                failed_rows(out, n, lanes, f64::NAN, |chain| {
+                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite)
+                })
+            },
+        );
+        Ok(failures)
+    }
+
+    /// [`accelerations`](Self::accelerations) in single precision: arrays in `f32`, eight
+    /// chains per AVX2 register, each chain's constants rounded to `f32`, the sines from
+    /// the single-precision kernel (Cephes' `sinf`). Not bit for bit anything: its error
+    /// against the `f64` call is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, in order: a non-finite input as the `f64` call names
+    /// it, otherwise [`Error::SinglePrecisionOverflow`]; their rows of `out` are NaN.
+    /// Errors: [`Error::LengthMismatch`] when an array does not hold `B` rows.
+    pub fn accelerations_f32(
+        &self,
+        q: &[f32],
+        qd: &[f32],
+        pivot: Option<&[f32]>,
+        out: &mut [f32],
+    ) -> Result<Vec<Failure>> {
+        let (chains, n) = (self.len(), self.links);
+        self.check_rows(q, qd, pivot, out)?;
+        let failures = for_blocks_of::<WIDTH_F32, _, _, _>(
+            out,
+            n,
+            n,
+            || Scratch::new(n),
+            |scratch, b, out| {
+                let lanes = block_chains::<WIDTH_F32>(b, chains);
+                self.block_f32_simd(b, lanes, q, qd, pivot, scratch, out);
+                failed_rows(out, n, lanes, f32::NAN, |chain| {
+                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::SinglePrecisionOverflow)
+                })
+            },
+        );
+        Ok(failures)
+    }
+
+    /// Checks that `q`, `qd` and `out` hold `B` rows of `n` and `pivot` `B` rows of 2.
+    fn check_rows<T>(&self, q: &[T], qd: &[T], pivot: Option<&[T]>, out: &[T]) -> Result<()> {
+        let (chains, n) = (self.len(), self.links);
         check_len("q", q, chains, n)?;
         check_len("qd", qd, chains, n)?;
         check_len("out", out, chains, n)?;
-        if let Some(p) = pivot {
-            check_len("pivot", p, chains, 2)?;
+        pivot.map_or(Ok(()), |p| check_len("pivot", p, chains, 2))
+    }
+
+    simd_kernel! {
+        /// [`block`](Self::block) in single precision, eight chains.
+        fn block_f32(
+            &self,
+            b: usize,
+            lanes: [usize; WIDTH_F32],
+            q: &[f32],
+            qd: &[f32],
+            pivot: Option<&[f32]>,
+            s: &mut Scratch<F32x8>,
+            out: &mut [f32],
+        ) {
+            let n = self.links;
+            let block = &self.blocks_f32[b.min(self.blocks_f32.len() - 1)];
+            gather(q, lanes, n, Lanes32::flatten_mut(&mut s.angles));
+            sin_cos_split_f32(
+                Lanes32::flatten(&s.angles),
+                Lanes32::flatten_mut(&mut s.sin),
+                Lanes32::flatten_mut(&mut s.cos),
+            );
+            gather(qd, lanes, n, Lanes32::flatten_mut(&mut s.rates));
+            let pivot = match pivot {
+                Some(p) => [Lanes32::from_fn(|k| p[2 * lanes[k]]), Lanes32::from_fn(|k| p[2 * lanes[k] + 1])],
+                None => [Lanes32::splat(0.0); 2],
+            };
+            block.accelerations(pivot, s);
+            scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
         }
-        let lanes = || vec![Lanes([0.0; WIDTH]); n];
-        let scratch = || Scratch {
-            angles: lanes(),
-            sin: lanes(),
-            cos: lanes(),
-            rates: lanes(),
-            loads: vec![Load::zero(); n],
-            rows: Rows::with_len(n),
-            accelerations: lanes(),
-        };
-        let failures = for_blocks(out, n, n, scratch, |scratch, b, out| {
-            let lanes = block_chains(b, chains);
-            self.block_simd(b, lanes, q, qd, pivot, scratch, out);
-            failed_rows(out, n, lanes, f64::NAN, |chain| {
-                first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite)
-            })
-        });
-        Ok(failures)
+        dispatch fn block_f32_simd, block_f32_avx2
     }
 
     simd_kernel! {
@@ -174,23 +290,8 @@ impl PlanarBatch {
                 Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [zero; 2],
             };
-            // The loads in a pass of their own: built inside the solve, the builder is not
-            // inlined (as in the single-chain model).
-            let drag = block.rods.drag();
-            for (i, load) in s.loads.iter_mut().enumerate() {
-                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
-            }
-            let loads = &s.loads;
-            let load = |i: usize| loads[i];
-            let accelerations = &mut s.accelerations;
-            block.rods.solve([zero, block.down], pivot, &mut s.rows, load, |i, a, u, _| {
-                accelerations[i] = angle_acceleration(a, u);
-            });
-            for (k, row) in out.chunks_exact_mut(n).enumerate() {
-                for (o, a) in row.iter_mut().zip(accelerations.iter()) {
-                    *o = a.0[k];
-                }
-            }
+            block.accelerations(pivot, s);
+            scatter::<_, WIDTH>(Lanes::flatten(&s.accelerations), n, out);
         }
         dispatch fn block_simd, block_avx2
     }

@@ -117,6 +117,7 @@ class Chain:
         pivot_acceleration: Optional[npt.ArrayLike] = None,
         *,
         model: str = "planar",
+        precision: str = "float64",
     ) -> _Array: ...
     def jacobians(
         self,
