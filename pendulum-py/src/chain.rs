@@ -3,15 +3,17 @@
 //! for one state or a leading batch of them; its normal modes and linearisation.
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
-use pendulum_core::batch::{Failure, PlanarBatch};
+use numpy::PyArray1;
+use pendulum_core::batch::PlanarBatch;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 
 use crate::arrays::{Rows, array, per_link};
+use crate::detach::{PARALLEL_FROM, maybe_detached};
 use crate::errors::{core_error, invalid, run_error};
+use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use pendulum_experiment::options::{expand, links};
 
 /// A chain of point masses on massless rigid rods, hung from a pivot.
@@ -93,8 +95,10 @@ impl Chain {
         if b.torque.data.iter().any(|t| *t != 0.0) {
             return Err(invalid("precision: 'float32' takes no torques"));
         }
-        let out =
-            maybe_detached(py, b.q.data.len(), || planar_batch_f32(&self.inner, &b)).map_err(core_error)?;
+        let out = maybe_detached(py, b.q.data.len(), || {
+            planar_batch_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
+        })
+        .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 
@@ -144,10 +148,6 @@ where
     }
 }
 
-/// Rows at least this many numbers in all are computed on every core, with the GIL
-/// released; smaller batches in the calling thread.
-const PARALLEL_FROM: usize = 4096;
-
 /// `count` rows of `width` numbers, row `i` written by `f(scratch, i, row)` with a
 /// scratch from `init` per thread: on every core for a large batch (each row the same
 /// computation whatever the thread, so the same bits), and the first failing row's error,
@@ -178,11 +178,6 @@ where
     Ok(out)
 }
 
-/// Runs `f` without the GIL when the batch is large enough to be worth it.
-fn maybe_detached<T: Send>(py: Python<'_>, numbers: usize, f: impl FnOnce() -> T + Send) -> T {
-    if numbers < PARALLEL_FROM { f() } else { py.detach(f) }
-}
-
 /// `q̈` of every state, row after row.
 fn accelerations<M: Model<Links = Dyn, Dof = Dyn> + Sync>(
     model: &M,
@@ -203,145 +198,6 @@ where
             Ok(())
         },
     )
-}
-
-/// `θ̈` of every planar state without torques by the batch of chains
-/// ([`PlanarBatch::repeated`]): the same numbers as [`accelerations`] row by row, and the
-/// first failing row's error.
-fn planar_batch(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<Vec<f64>> {
-    let batch = PlanarBatch::repeated(chain.clone(), b.q.count())?;
-    let mut out = vec![0.0; b.q.data.len()];
-    let failures = batch.accelerations(&b.q.data, &b.qd.data, Some(&b.pivot.data), &mut out)?;
-    match failures.into_iter().next() {
-        Some(failure) => Err(failure.error),
-        None => Ok(out),
-    }
-}
-
-/// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states
-/// and pivot accelerations rounded to `f32`, the result in `f32`.
-fn planar_batch_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<Vec<f32>> {
-    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
-    let batch = PlanarBatch::repeated(chain.clone(), b.q.count())?;
-    let mut out = vec![0.0f32; b.q.data.len()];
-    let (q, qd, pivot) = (narrow(&b.q.data), narrow(&b.qd.data), narrow(&b.pivot.data));
-    let failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out)?;
-    // The inputs were checked finite in f64: a failure is single precision's range (an
-    // input past f32's, or the solve's numbers).
-    match failures.is_empty() {
-        true => Ok(out),
-        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
-    }
-}
-
-/// A C-contiguous `(B, n)` float64 array as its `B` and its numbers rounded to `f32`;
-/// `None` for any other array, or one with a number that is infinite in `f32`.
-fn table_f32(a: &Bound<'_, PyAny>, n: usize) -> Option<(usize, Vec<f32>)> {
-    let a = a.cast::<PyArray2<f64>>().ok()?.readonly();
-    let [count, width] = [a.shape()[0], a.shape()[1]];
-    // C order only: `as_slice` of a Fortran-ordered array is contiguous too.
-    (width == n && a.is_c_contiguous()).then_some(())?;
-    let numbers: Vec<f32> = a.as_slice().ok()?.iter().map(|&x| x as f32).collect();
-    // An infinite number (given, or past f32's range) is the general path's to name.
-    numbers.iter().all(|x| !x.is_infinite()).then_some((count, numbers))
-}
-
-/// `θ̈` in single precision of the states of a C-contiguous `(B, n)` float64 table `q`,
-/// `qd` the same or absent, without torques or pivot acceleration, rounded to `f32` in one
-/// pass over each array (float32 tables are read in place by [`planar_in_place`]). `None`:
-/// not this case.
-fn planar_table_f32<'py>(
-    py: Python<'py>,
-    chain: &pendulum_core::Chain<Dyn>,
-    q: &Bound<'py, PyAny>,
-    qd: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Option<Bound<'py, PyAny>>> {
-    let n = chain.links();
-    let Some((count, qs)) = table_f32(q, n) else { return Ok(None) };
-    let qds = match qd.map(|qd| table_f32(qd, n)) {
-        None => vec![0.0; qs.len()],
-        Some(Some((c, qds))) if c == count => qds,
-        Some(_) => return Ok(None),
-    };
-    if count == 0 {
-        return Ok(None);
-    }
-    let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
-    let mut out = vec![0.0f32; qs.len()];
-    let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(&qs, &qds, None, &mut out))
-        .map_err(core_error)?;
-    if !failures.is_empty() {
-        // The general path's message for a non-finite input ([`Rows::read`]'s).
-        for (what, values) in [("q", &qs), ("qd", &qds)] {
-            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-                return Err(invalid(format!("{what}: {v} is not finite")));
-            }
-        }
-        return Err(core_error(pendulum_core::Error::SinglePrecisionOverflow));
-    }
-    Ok(Some(PyArray1::from_vec(py, out).reshape([count, n])?.into_any()))
-}
-
-/// `θ̈` of many planar states given as one C-contiguous array `q` of `T` (float64, or
-/// float32 for single precision) of shape `(B, n)`, `qd` the same or absent, without
-/// torques or pivot acceleration: read where numpy holds them and written into the result
-/// array, no copies, by `run` (`PlanarBatch::accelerations` or `accelerations_f32`: then
-/// [`planar_batch`]'s numbers). `None`: not this case (the general path takes it, and its
-/// errors).
-fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync + Default>(
-    py: Python<'py>,
-    chain: &pendulum_core::Chain<Dyn>,
-    q: &Bound<'py, PyAny>,
-    qd: Option<&Bound<'py, PyAny>>,
-    run: impl Fn(&PlanarBatch, &[T], &[T], &mut [T]) -> pendulum_core::Result<Vec<Failure>> + Send + Sync,
-) -> PyResult<Option<Bound<'py, PyAny>>> {
-    let n = chain.links();
-    let Ok(q) = q.cast::<PyArray2<T>>() else { return Ok(None) };
-    let q = q.readonly();
-    let [count, width] = [q.shape()[0], q.shape()[1]];
-    // C order only: `as_slice` of a Fortran-ordered array is contiguous too, column-major.
-    let Ok(qs) = q.as_slice() else { return Ok(None) };
-    if width != n || count < 2 || !q.is_c_contiguous() {
-        return Ok(None);
-    }
-    let given = match qd {
-        None => None,
-        Some(qd) => {
-            let Ok(qd) = qd.cast::<PyArray2<T>>() else { return Ok(None) };
-            if qd.shape() != [count, n] || !qd.is_c_contiguous() {
-                return Ok(None);
-            }
-            Some(qd.readonly())
-        }
-    };
-    let zeros;
-    let qds: &[T] = match &given {
-        Some(qd) => match qd.as_slice() {
-            Ok(slice) => slice,
-            Err(_) => return Ok(None),
-        },
-        None => {
-            zeros = vec![T::default(); qs.len()];
-            &zeros
-        }
-    };
-    let out = PyArray2::<T>::zeros(py, [count, n], false);
-    {
-        let mut written = out.readwrite();
-        let os = written.as_slice_mut().map_err(|e| invalid(e.to_string()))?;
-        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
-        let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        if let Some(failure) = failures.into_iter().next() {
-            // The general path's message for a non-finite input ([`Rows::read`]'s).
-            for (what, values) in [("q", qs), ("qd", qds)] {
-                if let Some(v) = values.iter().map(|&v| v.into()).find(|v: &f64| !v.is_finite()) {
-                    return Err(invalid(format!("{what}: {v} is not finite")));
-                }
-            }
-            return Err(core_error(failure.error));
-        }
-    }
-    Ok(Some(out.into_any()))
 }
 
 /// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
@@ -576,7 +432,7 @@ impl Chain {
         let out = maybe_detached(py, numbers, || match kind {
             // Many planar states without torques: the SIMD batch, four states per lane group.
             Kind::Planar if b.q.count() > 1 && b.torque.data.iter().all(|t| *t == 0.0) => {
-                planar_batch(&self.inner, &b)
+                planar_batch(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
             }
             _ => with_model!(self, kind, |m| accelerations(m, &b)),
         })

@@ -1,0 +1,159 @@
+//! `Chain.accelerations`' routes for many planar states without torques: the batch of
+//! chains (`PlanarBatch`), in double or single precision, with C-ordered `(B, n)` tables
+//! read where numpy holds them.
+
+use nalgebra::Dyn;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pendulum_core::batch::{Failure, PlanarBatch};
+use pyo3::prelude::*;
+
+use crate::detach::maybe_detached;
+use crate::errors::{core_error, invalid};
+
+/// `θ̈` of every planar state without torques by the batch of chains
+/// ([`PlanarBatch::repeated`]) at the `count` states `q`, `qd` and pivot accelerations
+/// `pivot`, rows of `n`, `n`, 2: the same numbers as the model's row by row, and the
+/// first failing row's error.
+pub fn planar_batch(
+    chain: &pendulum_core::Chain<Dyn>,
+    count: usize,
+    [q, qd, pivot]: [&[f64]; 3],
+) -> pendulum_core::Result<Vec<f64>> {
+    let batch = PlanarBatch::repeated(chain.clone(), count)?;
+    let mut out = vec![0.0; q.len()];
+    let failures = batch.accelerations(q, qd, Some(pivot), &mut out)?;
+    match failures.into_iter().next() {
+        Some(failure) => Err(failure.error),
+        None => Ok(out),
+    }
+}
+
+/// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states
+/// and pivot accelerations rounded to `f32`, the result in `f32`.
+pub fn planar_batch_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    count: usize,
+    [q, qd, pivot]: [&[f64]; 3],
+) -> pendulum_core::Result<Vec<f32>> {
+    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+    let batch = PlanarBatch::repeated(chain.clone(), count)?;
+    let mut out = vec![0.0f32; q.len()];
+    let (q, qd, pivot) = (narrow(q), narrow(qd), narrow(pivot));
+    let failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out)?;
+    // The inputs were checked finite in f64: a failure is single precision's range (an
+    // input past f32's, or the solve's numbers).
+    match failures.is_empty() {
+        true => Ok(out),
+        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
+    }
+}
+
+/// A C-contiguous `(B, n)` float64 array as its `B` and its numbers rounded to `f32`;
+/// `None` for any other array, or one with a number that is infinite in `f32`.
+fn table_f32(a: &Bound<'_, PyAny>, n: usize) -> Option<(usize, Vec<f32>)> {
+    let a = a.cast::<PyArray2<f64>>().ok()?.readonly();
+    let [count, width] = [a.shape()[0], a.shape()[1]];
+    // C order only: `as_slice` of a Fortran-ordered array is contiguous too.
+    (width == n && a.is_c_contiguous()).then_some(())?;
+    let numbers: Vec<f32> = a.as_slice().ok()?.iter().map(|&x| x as f32).collect();
+    // An infinite number (given, or past f32's range) is the general path's to name.
+    numbers.iter().all(|x| !x.is_infinite()).then_some((count, numbers))
+}
+
+/// `θ̈` in single precision of the states of a C-contiguous `(B, n)` float64 table `q`,
+/// `qd` the same or absent, without torques or pivot acceleration, rounded to `f32` in one
+/// pass over each array (float32 tables are read in place by [`planar_in_place`]). `None`:
+/// not this case.
+pub fn planar_table_f32<'py>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let n = chain.links();
+    let Some((count, qs)) = table_f32(q, n) else { return Ok(None) };
+    let qds = match qd.map(|qd| table_f32(qd, n)) {
+        None => vec![0.0; qs.len()],
+        Some(Some((c, qds))) if c == count => qds,
+        Some(_) => return Ok(None),
+    };
+    if count == 0 {
+        return Ok(None);
+    }
+    let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
+    let mut out = vec![0.0f32; qs.len()];
+    let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(&qs, &qds, None, &mut out))
+        .map_err(core_error)?;
+    if !failures.is_empty() {
+        // The general path's message for a non-finite input ([`Rows::read`]'s).
+        for (what, values) in [("q", &qs), ("qd", &qds)] {
+            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                return Err(invalid(format!("{what}: {v} is not finite")));
+            }
+        }
+        return Err(core_error(pendulum_core::Error::SinglePrecisionOverflow));
+    }
+    Ok(Some(PyArray1::from_vec(py, out).reshape([count, n])?.into_any()))
+}
+
+/// `θ̈` of many planar states given as one C-contiguous array `q` of `T` (float64, or
+/// float32 for single precision) of shape `(B, n)`, `qd` the same or absent, without
+/// torques or pivot acceleration: read where numpy holds them and written into the result
+/// array, no copies, by `run` (`PlanarBatch::accelerations` or `accelerations_f32`: then
+/// [`planar_batch`]'s numbers). `None`: not this case (the general path takes it, and its
+/// errors).
+pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync + Default>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+    run: impl Fn(&PlanarBatch, &[T], &[T], &mut [T]) -> pendulum_core::Result<Vec<Failure>> + Send + Sync,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let n = chain.links();
+    let Ok(q) = q.cast::<PyArray2<T>>() else { return Ok(None) };
+    let q = q.readonly();
+    let [count, width] = [q.shape()[0], q.shape()[1]];
+    // C order only: `as_slice` of a Fortran-ordered array is contiguous too, column-major.
+    let Ok(qs) = q.as_slice() else { return Ok(None) };
+    if width != n || count < 2 || !q.is_c_contiguous() {
+        return Ok(None);
+    }
+    let given = match qd {
+        None => None,
+        Some(qd) => {
+            let Ok(qd) = qd.cast::<PyArray2<T>>() else { return Ok(None) };
+            if qd.shape() != [count, n] || !qd.is_c_contiguous() {
+                return Ok(None);
+            }
+            Some(qd.readonly())
+        }
+    };
+    let zeros;
+    let qds: &[T] = match &given {
+        Some(qd) => match qd.as_slice() {
+            Ok(slice) => slice,
+            Err(_) => return Ok(None),
+        },
+        None => {
+            zeros = vec![T::default(); qs.len()];
+            &zeros
+        }
+    };
+    let out = PyArray2::<T>::zeros(py, [count, n], false);
+    {
+        let mut written = out.readwrite();
+        let os = written.as_slice_mut().map_err(|e| invalid(e.to_string()))?;
+        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
+        let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
+        if let Some(failure) = failures.into_iter().next() {
+            // The general path's message for a non-finite input ([`Rows::read`]'s).
+            for (what, values) in [("q", qs), ("qd", qds)] {
+                if let Some(v) = values.iter().map(|&v| v.into()).find(|v: &f64| !v.is_finite()) {
+                    return Err(invalid(format!("{what}: {v} is not finite")));
+                }
+            }
+            return Err(core_error(failure.error));
+        }
+    }
+    Ok(Some(out.into_any()))
+}
