@@ -40,9 +40,13 @@ fn in_range(theta: f32) -> bool {
 /// `(sin θ, cos θ)` for `|θ| ≤ LIMIT`; meaningless outside.
 #[inline(always)]
 fn sin_cos_reduced(theta: f32) -> (f32, f32) {
-    let x = theta.abs();
+    // Clamped, so that the conversion below is in range: the angles past LIMIT (NaN
+    // included) are redone by the caller. A saturating `as i32` instead was left scalar
+    // by the compiler, a third of the batch's time.
+    let x = theta.abs().min(LIMIT);
     // ⌊x 4/π⌋ rounded up to even: the nearest multiple of π/2 in units of π/4.
-    let j = ((x * FOUR_OVER_PI) as i32).wrapping_add(1) & !1;
+    // SAFETY: 0 ≤ x·4/π ≤ 10431 (x ≤ LIMIT, and never NaN after `min`): finite and within i32.
+    let j = unsafe { (x * FOUR_OVER_PI).to_int_unchecked::<i32>() }.wrapping_add(1) & !1;
     let y = j as f32;
     let r = ((x - y * D1) - y * D2) - y * D3;
     let z = r * r;
