@@ -30,7 +30,8 @@ pub trait Lane:
     /// Rows of a tension solve between two rescalings of its continuants (`rods`'
     /// `Continuants`). Each row multiplies a continuant by its pivot `D_i`: 16 rows of
     /// pivots between 2⁻⁴⁸ and 2⁴⁸ keep it inside [`CONTINUANT_RANGE`] in double precision,
-    /// 4 rows of pivots between 2⁻²⁰ and 2²⁰ (1/kg) inside `[2⁻⁸⁰, 2⁸⁰]` in single.
+    /// 4 rows of pivots between 2⁻¹⁹ and 2¹⁹ (1/kg) inside `[2⁻⁸⁰, 2⁸⁰]` in single (after
+    /// each rescaling the continuant is in `[1, 2)`).
     const RESCALE_ROWS: usize = 16;
 
     /// Every lane `x`.

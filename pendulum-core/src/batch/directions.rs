@@ -252,12 +252,12 @@ where
     fn accelerations_f32_in<const C: usize>(&self, t: f64, x: &[f32], out: &mut [f32]) -> Vec<Failure> {
         let (chains, n) = (self.len(), self.links);
         let (half, m) = (C * n, 2 * C * n);
-        let lanes = || vec![Lanes32([0.0; WIDTH_F32]); m];
+        let lanes = |len: usize| vec![Lanes32([0.0; WIDTH_F32]); len];
         for_blocks_of::<WIDTH_F32, _, _, _>(
             out,
             half,
             n,
-            || (Solve::<C, F32x8>::new(n), lanes(), lanes()),
+            || (Solve::<C, F32x8>::new(n), lanes(m), lanes(half)),
             |(solve, x_lanes, a_lanes), b, out| {
                 let chains = block_chains::<WIDTH_F32>(b, chains);
                 self.flow_f32_simd::<C>(b, chains, t, x, x_lanes, solve, a_lanes, out);
@@ -300,8 +300,8 @@ where
             let half = C * self.links;
             gather(x, chains, 2 * half, Lanes32::flatten_mut(x_lanes));
             let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
-            solve.accelerations(rods, gravity(*down), pivot, x_lanes, &mut a_lanes[..half]);
-            scatter::<_, WIDTH_F32>(Lanes32::flatten(&a_lanes[..half]), half, out);
+            solve.accelerations(rods, gravity(*down), pivot, x_lanes, a_lanes);
+            scatter::<_, WIDTH_F32>(Lanes32::flatten(a_lanes), half, out);
         }
         dispatch fn flow_f32_simd, flow_f32_avx2
     }

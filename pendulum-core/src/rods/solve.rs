@@ -416,6 +416,42 @@ mod tests {
         }
     }
 
+    #[test]
+    fn in_single_precision_lanes_the_continuants_stay_in_range_and_only_tiny_masses_fall_back() {
+        // Eight chains of 40 rods in f32 lanes; lane 5 has masses of 1e-9 kg (pivots near
+        // 2³¹ kg⁻¹, past what 4 rows between rescalings keep inside 2^±80), the others
+        // masses of 3 to 30 g (pivots up to 2¹⁰ kg⁻¹: inside with a rescaling every 4 rows,
+        // not every 16 as in f64). Only lane 5 falls back to the elimination by pivots, and
+        // every lane is its chain's f64 solve to single precision.
+        let mut chains: Vec<(Rods, Vec<Load<2>>)> =
+            (0..8).map(|k| random_chain(40, (-2.5, -1.5), 50 + k)).collect();
+        let tiny: Vec<f64> = (0..40).map(|i| 1e-9 * (1.0 + (i % 3) as f64)).collect();
+        chains[5].0 = Rods::new(&tiny, &[0.5; 40], &[0.0; 40]);
+        let lanes = Rods::interleave_f32(std::array::from_fn::<_, 8, _>(|k| &chains[k].0));
+        let load = |i: usize| {
+            let lane = |f: &dyn Fn(Load<2>) -> f64| Lanes32::from_fn(|k| f(chains[k].1[i]) as f32);
+            Load {
+                direction: [lane(&|l| l.direction[0]), lane(&|l| l.direction[1])],
+                rate_squared: lane(&|l| l.rate_squared),
+                pair: [lane(&|l| l.pair[0]), lane(&|l| l.pair[1])],
+            }
+        };
+        let (zero, g) = (Lanes32::<8>::splat(0.0), Lanes32::<8>::splat(-9.81));
+        let mut rows = Rows::with_len(40);
+        let outside = lanes.eliminate([zero, g], [zero; 2], &mut rows.0[..40], load);
+        assert_eq!(outside, [0, 0, 0, 0, 0, 1, 0, 0]);
+        let mut tension = vec![zero; 40];
+        lanes.solve([zero, g], [zero; 2], &mut rows, load, |i, _, _, t| tension[i] = t);
+        for (k, (rods, loads)) in chains.iter().enumerate() {
+            let ((_, scalar), _, _) = solve_as(rods, [0.0, -9.81], loads, Route::Solve);
+            let scale = scalar.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+            for (i, t) in scalar.iter().enumerate() {
+                let error = (f64::from(tension[i].0[k]) - t).abs() / scale;
+                assert!(error < 1e-5, "lane {k}, rod {i}: {error:e}");
+            }
+        }
+    }
+
     /// The worst relative residual of Newton's law for every mass and of the rigidity of
     /// every rod, for the solution `(ü, T)` of `loads` with the pivot at rest — written
     /// from the module docs' mechanics, apart from the tridiagonal system (`entries`)
