@@ -218,14 +218,17 @@ where
     fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
         let (chains, n) = (self.len(), self.links);
         let (half, m) = (C * n, 2 * C * n);
+        // The solve's rows and the block's states and results in lanes: no room for RK4's
+        // stages (a call that allocated them faulted in fresh pages every time).
+        let lanes = |len: usize| vec![Lanes([0.0; WIDTH]); len];
         for_blocks(
             out,
             half,
             n,
-            || Scratch::<C>::new(n, self.state_len()),
-            |s, b, out| {
+            || (Solve::<C>::new(n), lanes(m), lanes(half)),
+            |(solve, x_lanes, a_lanes), b, out| {
                 let lanes = block_chains(b, chains);
-                self.evaluate_simd::<C>(b, lanes, t, x, s, out);
+                self.evaluate_simd::<C>(b, lanes, t, x, x_lanes, solve, a_lanes, out);
                 failed_rows(out, half, lanes, f64::NAN, |chain| {
                     non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or(Error::NotPositiveDefinite)
                 })
@@ -308,21 +311,24 @@ where
 
     simd_kernel! {
         /// `ü(t, x)` for block `b` (chains `chains`) into its rows of `out`: gathered into
-        /// lanes, [`flow`](Self::flow), scattered.
+        /// `x_lanes`, the solve, into `a_lanes`, scattered.
         fn evaluate<const C: usize>(
             &self,
             b: usize,
             chains: [usize; WIDTH],
             t: f64,
             x: &[f64],
-            s: &mut Scratch<C>,
+            x_lanes: &mut [F64x4],
+            solve: &mut Solve<C>,
+            a_lanes: &mut [F64x4],
             out: &mut [f64],
         ) {
+            let block = &self.blocks[b];
             let half = C * self.links;
-            gather(x, chains, 2 * half, Lanes::flatten_mut(&mut s.x));
-            let [k1, ..] = &mut s.k;
-            self.flow::<C>(b, chains, [t; WIDTH], &s.x, &mut s.solve, k1);
-            scatter::<_, WIDTH>(Lanes::flatten(&k1[half..2 * half]), half, out);
+            gather(x, chains, 2 * half, Lanes::flatten_mut(x_lanes));
+            let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, [t; WIDTH], Dr::acceleration, Lanes);
+            solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
+            scatter::<_, WIDTH>(Lanes::flatten(a_lanes), half, out);
         }
         dispatch fn evaluate_simd, evaluate_avx2
     }
