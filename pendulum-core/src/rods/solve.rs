@@ -114,12 +114,11 @@ impl<V: Lane> Rods<V> {
         let mut continuants = Continuants::new();
         // 1/D_{i−1}, e_{i−1}.
         let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
-        let mut here = load(0);
         for (i, row) in rows.iter_mut().enumerate() {
+            let here = load(i);
             // Below the last rod, no load (no `Option`: copied through one, a load of lanes
             // fell apart into scalars).
-            let below = if i + 1 < n { load(i + 1) } else { Load::zero() };
-            let pair_below = below.pair;
+            let pair_below = if i + 1 < n { load(i + 1).pair } else { [zero; S] };
             let im = self.inverse_mass[i];
             let u = here.direction;
             let mut a = gravity;
@@ -137,7 +136,6 @@ impl<V: Lane> Rods<V> {
             inverse_mass_above = im;
             u_above = u;
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
-            here = below;
         }
         continuants.outside()
     }
