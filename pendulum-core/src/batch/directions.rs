@@ -85,6 +85,56 @@ impl<const C: usize, V: Lane> Solve<C, V> {
             let (u, w) = (u.try_into().expect("C numbers"), w.try_into().expect("C numbers"));
             *load = rate_load(u, w, drag);
         }
+        self.solve_loaded(rods, gravity, pivot, out);
+    }
+
+    /// [`accelerations`](Self::accelerations) at a Runge–Kutta stage `y = x + a·k`, formed
+    /// in the loads' pass: `y` written whole (`x`, `k` and `y` alike hold a state), its
+    /// rates `w` into `out[..C·n]` (the velocities) and its `ü` into `out[C·n..2·C·n]`.
+    /// One pass over the stage's numbers instead of three (the sum, the velocities, the
+    /// loads): the lanes' states do not fit in the first-level cache.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn stage(
+        &mut self,
+        rods: &Rods<V>,
+        gravity: [V; C],
+        pivot: [V; C],
+        x: &[V],
+        a: V,
+        k: &[V],
+        y: &mut [V],
+        out: &mut [V],
+    ) {
+        let half = C * self.loads.len();
+        let (y_motion, y_rest) = y.split_at_mut(2 * half);
+        let (yu, yw) = y_motion.split_at_mut(half);
+        let (velocities, accelerations) = out[..2 * half].split_at_mut(half);
+        let links = (yu.chunks_exact_mut(C).zip(yw.chunks_exact_mut(C)))
+            .zip(x[..half].chunks_exact(C).zip(x[half..2 * half].chunks_exact(C)))
+            .zip(k[..half].chunks_exact(C).zip(k[half..2 * half].chunks_exact(C)))
+            .zip(velocities.chunks_exact_mut(C).zip(rods.drag()));
+        for (load, ((((yu, yw), (xu, xw)), (ku, kw)), (velocity, &drag))) in self.loads.iter_mut().zip(links)
+        {
+            let (mut u, mut w) = ([V::splat(0.0); C], [V::splat(0.0); C]);
+            for c in 0..C {
+                u[c] = a * ku[c] + xu[c];
+                w[c] = a * kw[c] + xw[c];
+            }
+            yu.copy_from_slice(&u);
+            yw.copy_from_slice(&w);
+            velocity.copy_from_slice(&w);
+            *load = rate_load(u, w, drag);
+        }
+        for ((y, x), k) in y_rest.iter_mut().zip(&x[2 * half..]).zip(&k[2 * half..]) {
+            *y = a * *k + *x;
+        }
+        self.solve_loaded(rods, gravity, pivot, accelerations);
+    }
+
+    /// The tension solve of the loads in `self.loads`: `ü` into `out` (`C·n`).
+    #[inline(always)]
+    fn solve_loaded(&mut self, rods: &Rods<V>, gravity: [V; C], pivot: [V; C], out: &mut [V]) {
         let loads = &self.loads;
         rods.solve(
             gravity,
@@ -351,6 +401,26 @@ where
         let (velocity, acceleration) = out.split_at_mut(half);
         velocity.copy_from_slice(&x[half..2 * half]);
         solve.accelerations(&block.rods, gravity(block.down), pivot, x, acceleration);
+        pivot
+    }
+
+    /// [`flow`](Self::flow) at the Runge–Kutta stage `y = x + a·k`, written into `y` as it
+    /// goes ([`Solve::stage`]).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn stage<const C: usize>(
+        &self,
+        b: usize,
+        chains: [usize; WIDTH],
+        t: [f64; WIDTH],
+        (x, a, k): (&[F64x4], F64x4, &[F64x4]),
+        y: &mut [F64x4],
+        solve: &mut Solve<C>,
+        out: &mut [F64x4],
+    ) -> [F64x4; C] {
+        let block = &self.blocks[b];
+        let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::acceleration, Lanes);
+        solve.stage(&block.rods, gravity(block.down), pivot, x, a, k, y, out);
         pivot
     }
 

@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
-use super::directions::{Scratch, Solve};
+use super::directions::Scratch;
 use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
@@ -260,27 +260,24 @@ where
         let (x, y, rows) = (&s.x, &mut s.y, &mut s.solve);
         let [k1, k2, k3, k4] = &mut s.k;
         let (half_lanes, h_lanes) = (Lanes([half; WIDTH]), Lanes([h; WIDTH]));
-        let axpy = |y: &mut [F64x4], a: F64x4, k: &[F64x4]| {
-            for ((y, x), k) in y.iter_mut().zip(x).zip(k) {
-                *y = a * *k + *x;
-            }
-        };
         let at = |dt: f64| -> [f64; WIDTH] { std::array::from_fn(|k| t[k] + dt) };
         // `Accounted`'s right-hand side when the states carry the ledger.
         let accounted = self.is_accounted();
-        let flow = |t: [f64; WIDTH], x: &[F64x4], rows: &mut Solve<C>, k: &mut [F64x4]| {
-            let pivot = self.flow::<C>(b, chains, t, x, rows, k);
+        let pivot = self.flow::<C>(b, chains, t, x, rows, k1);
+        if accounted {
+            self.ledger_rates::<C>(b, chains, t, x, pivot, k1);
+        }
+        // k_{j+1} = f(t + c h, y) at y = x + a k_j, y formed in the stage's pass.
+        let stages = [(at(half), half_lanes), (at(half), half_lanes), (at(h), h_lanes)];
+        let mut ks = [&mut **k1, &mut **k2, &mut **k3, &mut **k4];
+        for (j, (t, a)) in stages.into_iter().enumerate() {
+            let [.., before, next] = &mut ks[..j + 2] else { unreachable!("two stages") };
+            let pivot = self.stage::<C>(b, chains, t, (x, a, before), y, rows, next);
             if accounted {
-                self.ledger_rates::<C>(b, chains, t, x, pivot, k);
+                self.ledger_rates::<C>(b, chains, t, y, pivot, next);
             }
-        };
-        flow(t, x, rows, k1);
-        axpy(y, half_lanes, k1);
-        flow(at(half), y, rows, k2);
-        axpy(y, half_lanes, k2);
-        flow(at(half), y, rows, k3);
-        axpy(y, h_lanes, k3);
-        flow(at(h), y, rows, k4);
+        }
+        let [k1, k2, k3, k4] = ks;
         let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
         // Zipped, not indexed: four bounds checks per number were a tenth of the step.
         for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
@@ -293,6 +290,7 @@ where
 /// finite `y` and NaN otherwise, summed lane by lane in four independent sums (a per-lane
 /// loop of flags was vectorised across entries and transposed back, with spills).
 #[inline(always)]
+#[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
 fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
     let mut sums = [Lanes([0.0; WIDTH]); 4];
     let mut quads = v.chunks_exact(4);
