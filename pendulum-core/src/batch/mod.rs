@@ -37,7 +37,7 @@ mod planar;
 mod rk4;
 mod rod_midpoint;
 mod run;
-mod transpose;
+pub(crate) mod transpose;
 mod unrolled;
 
 pub use directions::DirectionsBatch;

@@ -15,7 +15,7 @@ mod single;
 use nalgebra::{Const, SVector, U2, Vector2};
 
 use self::precision::Precision;
-use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, simd_kernel};
+use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, gather, scatter, simd_kernel};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
@@ -249,10 +249,12 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             pivot: Option<&[P]>,
             out: &mut [P],
         ) {
-            let gather = |v: &[P]| -> [P::Lanes; N] {
-                std::array::from_fn(|i| P::lanes(|k| v[lanes[k] * N + i]))
-            };
             let zero = P::Lanes::splat(0.0);
+            let gather = |v: &[P]| -> [P::Lanes; N] {
+                let mut out = [zero; N];
+                gather::<P, WIDTH>(v, lanes, N, P::flatten_mut(&mut out));
+                out
+            };
             let trig = P::sin_cos(&gather(q));
             let torque = torque.map_or([zero; N], gather);
             let pivot = match pivot {
@@ -260,11 +262,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
                 None => [zero; 2],
             };
             let accelerations = M::kernel(c, &trig, &gather(qd), &torque, pivot);
-            for (k, row) in out.chunks_exact_mut(N).enumerate() {
-                for (o, a) in row.iter_mut().zip(&accelerations) {
-                    *o = P::lane(a, k);
-                }
-            }
+            scatter::<P, WIDTH>(P::flatten(&accelerations), N, out);
         }
         dispatch fn block_simd, block_avx2
     }

@@ -2,19 +2,22 @@
 //! models, and `f32`, with its own sine kernel ([`trig32`](crate::kinematics::trig32)).
 
 use crate::batch::WIDTH;
+use crate::batch::transpose::Transpose;
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
 use crate::lanes::{Lane, Lanes, Lanes32};
 
 /// A number type of the batch's arrays and its [`WIDTH`] lanes.
-pub(crate) trait Precision: Copy + Send + Sync + Into<f64> + 'static {
+pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     /// [`WIDTH`] numbers, one per chain of a block.
     type Lanes: Lane + Send + Sync;
     /// Not a number.
     const NAN: Self;
     /// `f(k)` in lane `k`.
     fn lanes(f: impl Fn(usize) -> Self) -> Self::Lanes;
-    /// Lane `k` of `v`.
-    fn lane(v: &Self::Lanes, k: usize) -> Self;
+    /// The lanes of `v` one after another (`v[i]`'s lane `k` at `WIDTH·i + k`).
+    fn flatten(v: &[Self::Lanes]) -> &[Self];
+    /// [`flatten`](Self::flatten), mutably.
+    fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self];
     /// `[sin θ_i, cos θ_i]` of every lane of every angle, by this precision's sine kernel
     /// (inlined, so that it runs with its caller's target features).
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N];
@@ -29,8 +32,12 @@ impl Precision for f64 {
         Lanes::from_fn(f)
     }
     #[inline(always)]
-    fn lane(v: &Self::Lanes, k: usize) -> Self {
-        v.0[k]
+    fn flatten(v: &[Self::Lanes]) -> &[Self] {
+        Lanes::flatten(v)
+    }
+    #[inline(always)]
+    fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self] {
+        Lanes::flatten_mut(v)
     }
     #[inline(always)]
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
@@ -49,8 +56,12 @@ impl Precision for f32 {
         Lanes32::from_fn(f)
     }
     #[inline(always)]
-    fn lane(v: &Self::Lanes, k: usize) -> Self {
-        v.0[k]
+    fn flatten(v: &[Self::Lanes]) -> &[Self] {
+        Lanes32::flatten(v)
+    }
+    #[inline(always)]
+    fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self] {
+        Lanes32::flatten_mut(v)
     }
     #[inline(always)]
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
