@@ -144,6 +144,11 @@ pub(crate) fn failed_rows<T: Copy + Into<f64>, const W: usize>(
 
 /// The first non-finite entry of `v` as the single-chain error.
 pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Option<Error> {
+    // The common case in a loop that vectorises; the search one number at a time was a
+    // tenth of a one-step RK4 call.
+    if all_finite(v) {
+        return None;
+    }
     let value = |index: usize| v[index].into();
     (0..v.len()).find(|&i| !value(i).is_finite()).map(|index| Error::NonFinite {
         what,

@@ -7,6 +7,7 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::Scratch;
+use super::transpose::{gather_rows, scatter_rows};
 use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
@@ -117,7 +118,7 @@ where
     where
         F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
     {
-        let n = self.links();
+        let (n, m) = (self.links(), self.state_len());
         let mut chains: Vec<(&mut State<Dyn>, &mut T)> =
             states.iter_mut().zip(observers.iter_mut()).collect();
         let solves = n.saturating_mul(4).saturating_mul(plan.steps.min(usize::MAX as u64) as usize);
@@ -141,10 +142,8 @@ where
                 }
                 let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].0.parts());
                 s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
-                for (j, (x, carry)) in s.x.iter_mut().zip(&mut s.carry).enumerate() {
-                    *x = Lanes::from_fn(|k| parts[k].2[j]);
-                    *carry = Lanes::from_fn(|k| parts[k].3[j]);
-                }
+                gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(&mut s.x));
+                gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(&mut s.carry));
                 let ran = alive;
                 // Chain `k` of the block out of its lane into its state, and sampled.
                 let take_sample =
@@ -189,10 +188,24 @@ where
                         }
                     }
                 }
-                for (k, (state, _)) in block.iter_mut().enumerate() {
-                    if ran[k] != 0 {
-                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
-                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                if block.len() == WIDTH && ran.iter().all(|&r| r != 0) {
+                    // A whole block that ran: out of lanes by the tiles' transposes (one
+                    // number at a time, this was a quarter of a one-step call).
+                    let (mut xs, mut carries): ([&mut [f64]; WIDTH], [&mut [f64]; WIDTH]) =
+                        Default::default();
+                    for (k, (state, _)) in block.iter_mut().enumerate() {
+                        let (t, t_carry, x, carry) = state.parts_mut();
+                        (*t, *t_carry) = (s.t[0].0[k], s.t[1].0[k]);
+                        (xs[k], carries[k]) = (x, carry);
+                    }
+                    scatter_rows(Lanes::flatten(&s.x), m, xs);
+                    scatter_rows(Lanes::flatten(&s.carry), m, carries);
+                } else {
+                    for (k, (state, _)) in block.iter_mut().enumerate() {
+                        if ran[k] != 0 {
+                            let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
+                            state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
+                        }
                     }
                 }
                 ids.into_iter().zip(ends).collect()

@@ -135,10 +135,20 @@ unsafe fn transpose_8x8<const W: usize>(rows: [*const f32; W], out: [*mut f32; W
 /// numbers `j` of each row `rows[k]` of `v` (`m` per row).
 #[inline(always)]
 pub(crate) fn gather<T: Transpose, const W: usize>(v: &[T], rows: [usize; W], m: usize, out: &mut [T]) {
+    let mut slices = [v; W];
+    for (slice, &r) in slices.iter_mut().zip(&rows) {
+        *slice = &v[m * r..m * (r + 1)];
+    }
+    gather_rows(slices, m, out);
+}
+
+/// [`gather`] from `W` rows anywhere: `out[W·j + k] = rows[k][j]` for `j < m`.
+#[inline(always)]
+pub(crate) fn gather_rows<T: Transpose, const W: usize>(rows: [&[T]; W], m: usize, out: &mut [T]) {
     let out = &mut out[..W * m];
-    let mut starts = [v.as_ptr(); W];
-    for (start, &r) in starts.iter_mut().zip(&rows) {
-        *start = v[m * r..m * (r + 1)].as_ptr();
+    let mut starts = [out.as_ptr(); W];
+    for (start, row) in starts.iter_mut().zip(&rows) {
+        *start = row[..m].as_ptr();
     }
     let (simd, tiles) = (T::has_simd::<W>(), m / W);
     for t in 0..tiles {
@@ -152,12 +162,13 @@ pub(crate) fn gather<T: Transpose, const W: usize>(v: &[T], rows: [usize; W], m:
             }
         }
         // SAFETY: `src` reads W numbers of W rows, `dst` writes the tile `W·W·t..W·W·(t + 1)`
-        // of `out`, which `v` does not overlap (one is borrowed mutably); `simd` as checked.
+        // of `out`, which the rows do not overlap (`out` is borrowed mutably); `simd` as
+        // checked.
         unsafe { transpose(simd, src, dst) };
     }
     for j in W * tiles..m {
-        for (k, &r) in rows.iter().enumerate() {
-            out[W * j + k] = v[m * r + j];
+        for (k, row) in rows.iter().enumerate() {
+            out[W * j + k] = row[j];
         }
     }
 }
@@ -166,7 +177,6 @@ pub(crate) fn gather<T: Transpose, const W: usize>(v: &[T], rows: [usize; W], m:
 /// lane `k` of the `m` groups of `W` in `lanes`.
 #[inline(always)]
 pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: &mut [T]) {
-    let lanes = &lanes[..W * m];
     if out.len() != W * m {
         for (k, row) in out.chunks_exact_mut(m).enumerate() {
             for (j, o) in row.iter_mut().enumerate() {
@@ -175,24 +185,41 @@ pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: 
         }
         return;
     }
+    let mut rest = out;
+    let rows: [&mut [T]; W] = std::array::from_fn(|_| {
+        let (row, tail) = std::mem::take(&mut rest).split_at_mut(m);
+        rest = tail;
+        row
+    });
+    scatter_rows(lanes, m, rows);
+}
+
+/// [`scatter`] into `W` rows anywhere: `rows[k][j] = lanes[W·j + k]` for `j < m`.
+#[inline(always)]
+pub(crate) fn scatter_rows<T: Transpose, const W: usize>(lanes: &[T], m: usize, mut rows: [&mut [T]; W]) {
+    let lanes = &lanes[..W * m];
+    let mut starts = [std::ptr::null_mut(); W];
+    for (start, row) in starts.iter_mut().zip(&mut rows) {
+        *start = row[..m].as_mut_ptr();
+    }
     let (simd, tiles) = (T::has_simd::<W>(), m / W);
     for t in 0..tiles {
         let mut src = [lanes.as_ptr(); W];
-        let mut dst = [out.as_mut_ptr(); W];
+        let mut dst = starts;
         for (k, (s, d)) in src.iter_mut().zip(&mut dst).enumerate() {
-            // SAFETY: `W·(t + 1) ≤ m`: `s` stays in `lanes`' `W·m`, `d` in row `k` of `out`.
+            // SAFETY: `W·(t + 1) ≤ m`: `s` stays in `lanes`' `W·m`, `d` in row `k`'s `m`.
             unsafe {
                 *s = s.add(W * W * t + W * k);
-                *d = d.add(m * k + W * t);
+                *d = d.add(W * t);
             }
         }
         // SAFETY: `src` reads the tile `W·W·t..W·W·(t + 1)` of `lanes`, `dst` writes W numbers
-        // of each of the W rows of `out` (borrowed mutably, so apart from `lanes`).
+        // of each of the W rows (each borrowed mutably, so apart from `lanes` and each other).
         unsafe { transpose(simd, src, dst) };
     }
     for j in W * tiles..m {
-        for k in 0..W {
-            out[m * k + j] = lanes[W * j + k];
+        for (k, row) in rows.iter_mut().enumerate() {
+            row[j] = lanes[W * j + k];
         }
     }
 }

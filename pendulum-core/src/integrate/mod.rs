@@ -120,6 +120,11 @@ where
         (self.t, self.t_carry, self.x.as_slice(), self.x_carry.as_slice())
     }
 
+    /// [`parts`](Self::parts), to be written.
+    pub(crate) fn parts_mut(&mut self) -> (&mut f64, &mut f64, &mut [f64], &mut [f64]) {
+        (&mut self.t, &mut self.t_carry, self.x.as_mut_slice(), self.x_carry.as_mut_slice())
+    }
+
     /// Sets what [`parts`](Self::parts) gives; `x` and `x_carry` as long as the state.
     pub(crate) fn set_parts(&mut self, t: f64, t_carry: f64, x: impl Iterator<Item = (f64, f64)>) {
         (self.t, self.t_carry) = (t, t_carry);
