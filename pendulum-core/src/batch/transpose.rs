@@ -135,21 +135,33 @@ unsafe fn transpose_8x8<const W: usize>(rows: [*const f32; W], out: [*mut f32; W
 /// numbers `j` of each row `rows[k]` of `v` (`m` per row).
 #[inline(always)]
 pub(crate) fn gather<T: Transpose, const W: usize>(v: &[T], rows: [usize; W], m: usize, out: &mut [T]) {
-    let mut slices = [v; W];
-    for (slice, &r) in slices.iter_mut().zip(&rows) {
-        *slice = &v[m * r..m * (r + 1)];
+    let mut starts = [v.as_ptr(); W];
+    for (start, &r) in starts.iter_mut().zip(&rows) {
+        *start = v[m * r..m * (r + 1)].as_ptr();
     }
-    gather_rows(slices, m, out);
+    // SAFETY: each start is a row of `m` numbers of `v`, which `out` (borrowed mutably)
+    // does not overlap.
+    unsafe { gather_from(starts, m, out) };
 }
 
 /// [`gather`] from `W` rows anywhere: `out[W·j + k] = rows[k][j]` for `j < m`.
 #[inline(always)]
 pub(crate) fn gather_rows<T: Transpose, const W: usize>(rows: [&[T]; W], m: usize, out: &mut [T]) {
-    let out = &mut out[..W * m];
     let mut starts = [out.as_ptr(); W];
     for (start, row) in starts.iter_mut().zip(&rows) {
         *start = row[..m].as_ptr();
     }
+    // SAFETY: each start is a row of `m` numbers, apart from `out` (borrowed mutably).
+    unsafe { gather_from(starts, m, out) };
+}
+
+/// `out[W·j + k] = *starts[k].add(j)` for `j < m`, in `W × W` tiles.
+///
+/// # Safety
+/// Each `starts[k]` is readable for `m` numbers, none of which are in `out`.
+#[inline(always)]
+unsafe fn gather_from<T: Transpose, const W: usize>(starts: [*const T; W], m: usize, out: &mut [T]) {
+    let out = &mut out[..W * m];
     let (simd, tiles) = (T::has_simd::<W>(), m / W);
     for t in 0..tiles {
         let mut src = starts;
@@ -162,13 +174,13 @@ pub(crate) fn gather_rows<T: Transpose, const W: usize>(rows: [&[T]; W], m: usiz
             }
         }
         // SAFETY: `src` reads W numbers of W rows, `dst` writes the tile `W·W·t..W·W·(t + 1)`
-        // of `out`, which the rows do not overlap (`out` is borrowed mutably); `simd` as
-        // checked.
+        // of `out`, apart from them (the caller's contract); `simd` as checked.
         unsafe { transpose(simd, src, dst) };
     }
     for j in W * tiles..m {
-        for (k, row) in rows.iter().enumerate() {
-            out[W * j + k] = row[j];
+        for (k, start) in starts.iter().enumerate() {
+            // SAFETY: `j < m` (the caller's contract).
+            out[W * j + k] = unsafe { *start.add(j) };
         }
     }
 }
@@ -178,6 +190,7 @@ pub(crate) fn gather_rows<T: Transpose, const W: usize>(rows: [&[T]; W], m: usiz
 #[inline(always)]
 pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: &mut [T]) {
     if out.len() != W * m {
+        let lanes = &lanes[..W * m];
         for (k, row) in out.chunks_exact_mut(m).enumerate() {
             for (j, o) in row.iter_mut().enumerate() {
                 *o = lanes[W * j + k];
@@ -185,23 +198,35 @@ pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: 
         }
         return;
     }
-    let mut rest = out;
-    let rows: [&mut [T]; W] = std::array::from_fn(|_| {
-        let (row, tail) = std::mem::take(&mut rest).split_at_mut(m);
-        rest = tail;
-        row
-    });
-    scatter_rows(lanes, m, rows);
+    let mut starts = [out.as_mut_ptr(); W];
+    for (k, start) in starts.iter_mut().enumerate() {
+        // SAFETY: `out` holds `W` rows of `m`.
+        *start = unsafe { start.add(m * k) };
+    }
+    // SAFETY: the `W` rows of `out`, each of `m` numbers, apart from `lanes` (`out` is
+    // borrowed mutably).
+    unsafe { scatter_into(lanes, m, starts) };
 }
 
 /// [`scatter`] into `W` rows anywhere: `rows[k][j] = lanes[W·j + k]` for `j < m`.
 #[inline(always)]
 pub(crate) fn scatter_rows<T: Transpose, const W: usize>(lanes: &[T], m: usize, mut rows: [&mut [T]; W]) {
-    let lanes = &lanes[..W * m];
     let mut starts = [std::ptr::null_mut(); W];
     for (start, row) in starts.iter_mut().zip(&mut rows) {
         *start = row[..m].as_mut_ptr();
     }
+    // SAFETY: each start is a row of `m` numbers, borrowed mutably (apart from `lanes` and
+    // from each other).
+    unsafe { scatter_into(lanes, m, starts) };
+}
+
+/// `*starts[k].add(j) = lanes[W·j + k]` for `j < m`, in `W × W` tiles.
+///
+/// # Safety
+/// Each `starts[k]` is writable for `m` numbers, apart from each other and from `lanes`.
+#[inline(always)]
+unsafe fn scatter_into<T: Transpose, const W: usize>(lanes: &[T], m: usize, starts: [*mut T; W]) {
+    let lanes = &lanes[..W * m];
     let (simd, tiles) = (T::has_simd::<W>(), m / W);
     for t in 0..tiles {
         let mut src = [lanes.as_ptr(); W];
@@ -214,12 +239,13 @@ pub(crate) fn scatter_rows<T: Transpose, const W: usize>(lanes: &[T], m: usize, 
             }
         }
         // SAFETY: `src` reads the tile `W·W·t..W·W·(t + 1)` of `lanes`, `dst` writes W numbers
-        // of each of the W rows (each borrowed mutably, so apart from `lanes` and each other).
+        // of each of the W rows (the caller's contract).
         unsafe { transpose(simd, src, dst) };
     }
     for j in W * tiles..m {
-        for (k, row) in rows.iter_mut().enumerate() {
-            row[j] = lanes[W * j + k];
+        for (k, start) in starts.iter().enumerate() {
+            // SAFETY: `j < m` (the caller's contract).
+            unsafe { *start.add(j) = lanes[W * j + k] };
         }
     }
 }
