@@ -11,6 +11,16 @@
 
 use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
+/// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
+/// std).
+#[inline(always)]
+pub(crate) fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    return false;
+}
+
 /// The arithmetic the tension solve needs, lane by lane.
 pub trait Lane:
     Copy

@@ -206,16 +206,6 @@ pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
         .collect()
 }
 
-/// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
-/// std).
-#[inline(always)]
-pub(crate) fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    return std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    return false;
-}
-
 /// A kernel written once, in three methods (with at most one generic parameter, a const
 /// or a type): `fn kernel(&self, args…)` as given (inlined wherever it is called),
 /// `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
@@ -265,7 +255,7 @@ macro_rules! simd_kernel {
         #[allow(clippy::too_many_arguments)]
         $dvis fn $dispatch <$($decl)*> (&$this, $($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
-            if $crate::batch::has_avx2() {
+            if $crate::lanes::has_avx2() {
                 // SAFETY: the CPU has AVX2, checked just above.
                 return unsafe { $this.$avx2::<$($name)*>($($arg),*) };
             }

@@ -10,7 +10,7 @@
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use super::has_avx2;
+use crate::lanes::has_avx2;
 
 /// A number the batch transposes: with AVX2 shuffles where its width has them.
 pub(crate) trait Transpose: Copy {
@@ -38,6 +38,7 @@ impl Transpose for f64 {
     }
 
     #[inline(always)]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     unsafe fn transpose_simd<const W: usize>(src: [*const f64; W], dst: [*mut f64; W]) {
         // SAFETY: the caller's contract: AVX2, W = 4, valid pointers.
         #[cfg(target_arch = "x86_64")]
@@ -54,6 +55,7 @@ impl Transpose for f32 {
     }
 
     #[inline(always)]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     unsafe fn transpose_simd<const W: usize>(src: [*const f32; W], dst: [*mut f32; W]) {
         // SAFETY: the caller's contract: AVX2, W = 8, valid pointers.
         #[cfg(target_arch = "x86_64")]
