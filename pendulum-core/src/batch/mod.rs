@@ -21,10 +21,10 @@
 //! rows of the output are NaN (accelerations) or its state is left as it was (steps).
 //!
 //! Layout: arrays are chain-major, `(B, m)` row after row as numpy stores a `(B, m)` array.
-//! Each block is gathered into lane order (`m` rows of `WIDTH`) and scattered back. For one
-//! evaluation these copies cost about what the lanes save (`docs/ensembles.md`); a run
-//! ([`DirectionsBatch::integrate_rk4`], [`DirectionsBatch::run_rk4`]) keeps its states in
-//! lanes from the first step to the last, and gains.
+//! Each block is gathered into lane order (`m` rows of `WIDTH`) and scattered back, in
+//! transposed tiles (`transpose`). A run ([`DirectionsBatch::integrate_rk4`],
+//! [`DirectionsBatch::run_rk4`]) keeps its states in lanes from the first step to the last
+//! and gains most (`docs/ensembles.md`).
 
 use rayon::prelude::*;
 
