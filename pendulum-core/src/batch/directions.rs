@@ -4,7 +4,7 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::{
-    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows, for_blocks,
+    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
     for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
@@ -65,6 +65,9 @@ pub(super) struct Solve<const C: usize, V: Lane = F64x4> {
     rows: Rows<C, V>,
     loads: Vec<Load<C, V>>,
 }
+
+/// A task's room for one evaluation in lanes: the solve, the block's states, its results.
+type Lanes3<const C: usize, V> = (Solve<C, V>, Vec<V>, Vec<V>);
 
 impl<const C: usize, V: Lane> Solve<C, V> {
     fn new(links: usize) -> Self {
@@ -266,21 +269,43 @@ where
     }
 
     fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
+        self.in_blocks::<C, WIDTH, _, F64x4>(
+            x,
+            out,
+            (f64::NAN, Error::NotPositiveDefinite),
+            |b, chains, s, out| self.evaluate_simd::<C>(b, chains, t, x, s, out),
+        )
+    }
+
+    /// Runs `kernel(b, chains, lanes, rows)` for every block of `W` chains (`lanes`: the
+    /// solve's rows and the block's states and results in lanes `V`, one set per task; no
+    /// room for RK4's stages, a call that allocated them faulted in fresh pages every time)
+    /// and reports the chains whose rows of `out` are not finite, their rows set to `nan`: a
+    /// non-finite state by its entry, otherwise with `otherwise`.
+    fn in_blocks<const C: usize, const W: usize, T, V>(
+        &self,
+        x: &[T],
+        out: &mut [T],
+        (nan, otherwise): (T, Error),
+        kernel: impl Fn(usize, [usize; W], &mut Lanes3<C, V>, &mut [T]) + Sync + Send,
+    ) -> Vec<Failure>
+    where
+        T: Copy + Into<f64> + Send + Sync,
+        V: Lane + Send,
+    {
         let (chains, n) = (self.len(), self.links);
         let (half, m) = (C * n, 2 * C * n);
-        // The solve's rows and the block's states and results in lanes: no room for RK4's
-        // stages (a call that allocated them faulted in fresh pages every time).
-        let lanes = |len: usize| vec![Lanes([0.0; WIDTH]); len];
-        for_blocks(
+        let lanes = |len: usize| vec![V::splat(0.0); len];
+        for_blocks_of::<W, _, _, _>(
             out,
             half,
             n,
-            || (Solve::<C>::new(n), lanes(m), lanes(half)),
-            |(solve, x_lanes, a_lanes), b, out| {
-                let lanes = block_chains(b, chains);
-                self.evaluate_simd::<C>(b, lanes, t, x, x_lanes, solve, a_lanes, out);
-                failed_rows(out, half, lanes, f64::NAN, |chain| {
-                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or(Error::NotPositiveDefinite)
+            || (Solve::<C, V>::new(n), lanes(m), lanes(half)),
+            |s, b, out| {
+                let ids = block_chains::<W>(b, chains);
+                kernel(b, ids, s, out);
+                failed_rows(out, half, ids, nan, |chain| {
+                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or_else(|| otherwise.clone())
                 })
             },
         )
@@ -303,21 +328,11 @@ where
     }
 
     fn accelerations_f32_in<const C: usize>(&self, t: f64, x: &[f32], out: &mut [f32]) -> Vec<Failure> {
-        let (chains, n) = (self.len(), self.links);
-        let (half, m) = (C * n, 2 * C * n);
-        let lanes = |len: usize| vec![Lanes32([0.0; WIDTH_F32]); len];
-        for_blocks_of::<WIDTH_F32, _, _, _>(
+        self.in_blocks::<C, WIDTH_F32, _, F32x8>(
+            x,
             out,
-            half,
-            n,
-            || (Solve::<C, F32x8>::new(n), lanes(m), lanes(half)),
-            |(solve, x_lanes, a_lanes), b, out| {
-                let chains = block_chains::<WIDTH_F32>(b, chains);
-                self.flow_f32_simd::<C>(b, chains, t, x, x_lanes, solve, a_lanes, out);
-                failed_rows(out, half, chains, f32::NAN, |chain| {
-                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or(Error::SinglePrecisionOverflow)
-                })
-            },
+            (f32::NAN, Error::SinglePrecisionOverflow),
+            |b, chains, s, out| self.flow_f32_simd::<C>(b, chains, t, x, s, out),
         )
     }
 
@@ -344,11 +359,10 @@ where
             chains: [usize; WIDTH_F32],
             t: f64,
             x: &[f32],
-            x_lanes: &mut [F32x8],
-            solve: &mut Solve<C, F32x8>,
-            a_lanes: &mut [F32x8],
+            s: &mut Lanes3<C, F32x8>,
             out: &mut [f32],
         ) {
+            let (solve, x_lanes, a_lanes) = s;
             let (rods, down) = &self.blocks_f32[b];
             let half = C * self.links;
             gather(x, chains, 2 * half, Lanes32::flatten_mut(x_lanes));
@@ -368,11 +382,10 @@ where
             chains: [usize; WIDTH],
             t: f64,
             x: &[f64],
-            x_lanes: &mut [F64x4],
-            solve: &mut Solve<C>,
-            a_lanes: &mut [F64x4],
+            s: &mut Lanes3<C, F64x4>,
             out: &mut [f64],
         ) {
+            let (solve, x_lanes, a_lanes) = s;
             let block = &self.blocks[b];
             let half = C * self.links;
             gather(x, chains, 2 * half, Lanes::flatten_mut(x_lanes));

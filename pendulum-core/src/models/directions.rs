@@ -264,6 +264,8 @@ where
         let (directions, rates) = x.split_at(C * n);
         let mut tensions = tensions;
         with_scratch::<C, _>(n, |s| {
+            // Built where the solve asks, twice per rod (`Rods::solve`): a few products,
+            // cheaper than the spills of carrying it (measured: the call got faster).
             let load = |i: usize| {
                 let (mut u, mut w) = ([0.0; C], [0.0; C]);
                 u.copy_from_slice(&directions[i * C..(i + 1) * C]);
