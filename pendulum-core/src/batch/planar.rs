@@ -5,7 +5,7 @@ use nalgebra::Dyn;
 
 use super::{
     F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
-    first_bad_input, for_blocks, for_blocks_of, gather, scatter, simd_kernel,
+    first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
@@ -172,22 +172,10 @@ impl PlanarBatch {
         pivot: Option<&[f64]>,
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        let (chains, n) = (self.len(), self.links);
         self.check_rows(q, qd, pivot, out)?;
-        let failures = for_blocks(
-            out,
-            n,
-            n,
-            || Scratch::new(n),
-            |scratch, b, out| {
-                let lanes = block_chains(b, chains);
-                self.block_simd(b, lanes, q, qd, pivot, scratch, out);
-                failed_rows(out, n, lanes, f64::NAN, |chain| {
-                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::NotPositiveDefinite)
-                })
-            },
-        );
-        Ok(failures)
+        Ok(self.in_blocks([q, qd], pivot, out, (f64::NAN, Error::NotPositiveDefinite), |b, lanes, s, out| {
+            self.block_simd(b, lanes, q, qd, pivot, s, out)
+        }))
     }
 
     /// [`accelerations`](Self::accelerations) in single precision: arrays in `f32`, eight
@@ -205,22 +193,45 @@ impl PlanarBatch {
         pivot: Option<&[f32]>,
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        let (chains, n) = (self.len(), self.links);
         self.check_rows(q, qd, pivot, out)?;
-        let failures = for_blocks_of::<WIDTH_F32, _, _, _>(
+        Ok(self.in_blocks(
+            [q, qd],
+            pivot,
+            out,
+            (f32::NAN, Error::SinglePrecisionOverflow),
+            |b, lanes, s, out| self.block_f32_simd(b, lanes, q, qd, pivot, s, out),
+        ))
+    }
+
+    /// Runs `kernel(b, chains, scratch, rows)` for every block of `W` chains (a scratch in
+    /// lanes `V` per task) and reports the chains whose rows of `out` are not finite, their
+    /// rows set to `nan`: a non-finite input by its entry, otherwise with `otherwise`.
+    fn in_blocks<const W: usize, T, V>(
+        &self,
+        [q, qd]: [&[T]; 2],
+        pivot: Option<&[T]>,
+        out: &mut [T],
+        (nan, otherwise): (T, Error),
+        kernel: impl Fn(usize, [usize; W], &mut Scratch<V>, &mut [T]) + Sync + Send,
+    ) -> Vec<Failure>
+    where
+        T: Copy + Into<f64> + Send + Sync,
+        V: Lane + Send,
+    {
+        let (chains, n) = (self.len(), self.links);
+        for_blocks_of::<W, _, _, _>(
             out,
             n,
             n,
             || Scratch::new(n),
             |scratch, b, out| {
-                let lanes = block_chains::<WIDTH_F32>(b, chains);
-                self.block_f32_simd(b, lanes, q, qd, pivot, scratch, out);
-                failed_rows(out, n, lanes, f32::NAN, |chain| {
-                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or(Error::SinglePrecisionOverflow)
+                let lanes = block_chains::<W>(b, chains);
+                kernel(b, lanes, scratch, out);
+                failed_rows(out, n, lanes, nan, |chain| {
+                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or_else(|| otherwise.clone())
                 })
             },
-        );
-        Ok(failures)
+        )
     }
 
     /// Checks that `q`, `qd` and `out` hold `B` rows of `n` and `pivot` `B` rows of 2.
