@@ -9,6 +9,9 @@
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
 //!   (throughput in chain-steps per second), and 10 steps of the implicit rod midpoint
 //!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
+//! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
+//!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
+//!   (throughput in chain-steps);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
 //!   precision on one;
@@ -240,6 +243,53 @@ fn rk4(c: &mut Criterion) {
     group.finish();
 }
 
+/// 100 RK4 steps of 0.1 ms of 64 free planar chains of `n` links swinging from random
+/// angles: `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`.
+fn planar_rk4(c: &mut Criterion) {
+    const STEPS: usize = 100;
+    let mut group = c.benchmark_group("rk4");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2)).sample_size(20);
+    group.throughput(Throughput::Elements((STEPS * CHAINS) as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(13);
+    for n in [20, 100] {
+        let chains: Vec<_> = (0..CHAINS).map(|_| random_chain(n, 1.1, &mut r)).collect();
+        let start: Vec<State<Dyn>> = (0..CHAINS)
+            .map(|_| {
+                let x = (0..2 * n).map(|i| if i < n { r.random_range(-0.5..0.5) } else { 0.0 });
+                State::new(0.0, DVector::from_iterator(2 * n, x))
+            })
+            .collect();
+        let systems: Vec<_> = chains.iter().map(|c| FirstOrder::new(PlanarTension::new(c.clone()))).collect();
+        let mut solvers: Vec<_> = systems.iter().map(Rk4::new).collect();
+        let mut states = start.clone();
+        group.bench_with_input(BenchmarkId::new("planar_100_steps/single", n), &n, |b, _| {
+            b.iter(|| {
+                for ((system, rk4), state) in systems.iter().zip(&mut solvers).zip(&mut states) {
+                    for _ in 0..STEPS {
+                        rk4.step(system, state, 1e-4).expect("single");
+                    }
+                }
+            })
+        });
+        let batch = PlanarBatch::new(chains).expect("batch");
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            let mut states = start.clone();
+            group.bench_with_input(
+                BenchmarkId::new(format!("planar_100_steps/batch_{threads}_threads"), n),
+                &n,
+                |b, _| {
+                    in_pool(b, &pool, || {
+                        let failures = batch.integrate_rk4(&mut states, 1e-4, STEPS).expect("batch");
+                        assert!(failures.is_empty(), "{failures:?}");
+                    })
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
 /// One generated model type: its `CHAINS` models one call each against the batch.
 fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -390,5 +440,5 @@ fn jacobians(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, accelerations, rk4, generated, jacobians);
+criterion_group!(benches, accelerations, rk4, planar_rk4, generated, jacobians);
 criterion_main!(benches);

@@ -2,6 +2,8 @@
 //! accelerations, the terms of `M q̈ + c + k + d = Q`, energies and the analytic Jacobians —
 //! for one state or a leading batch of them; its normal modes and linearisation.
 
+use std::sync::atomic::AtomicBool;
+
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
 use numpy::PyArray1;
 use pendulum_core::batch::PlanarBatch;
@@ -13,7 +15,10 @@ use rayon::prelude::*;
 use crate::arrays::{Rows, array, per_link};
 use crate::detach::{PARALLEL_FROM, maybe_detached};
 use crate::errors::{core_error, invalid, run_error};
-use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
+use crate::interrupt::interruptible;
+use crate::planar_states::{
+    SOLVES_PER_CHUNK, planar_batch, planar_batch_f32, planar_in_place, planar_rk4, planar_table_f32,
+};
 use pendulum_experiment::options::{expand, links};
 
 /// A chain of point masses on massless rigid rods, hung from a pivot.
@@ -438,6 +443,43 @@ impl Chain {
         })
         .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
+    }
+
+    /// `(q, qd)` after `steps` steps of classical RK4 of `h` seconds from each state, the
+    /// chain free (no torques, pivot at rest; planar model): many states at once, four per
+    /// SIMD register and on every core, each bit for bit what the chain alone would give
+    /// (docs/ensembles.md). A state whose step is not finite raises RuntimeError naming it;
+    /// Ctrl-C stops the call.
+    #[pyo3(signature = (q, qd = None, *, h, steps = 1, model = "planar"))]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        h: f64,
+        steps: usize,
+        model: &str,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        if Kind::of(model)? != Kind::Planar {
+            return Err(invalid("integrate: serves model='planar' only"));
+        }
+        if !(h.is_finite() && h > 0.0) {
+            return Err(invalid(format!("h: {h} is not a positive time step (s)")));
+        }
+        let b = self.batch(Kind::Planar, q, qd, None, None)?;
+        let (chain, lead, (q, qd)) = (self.inner.clone(), b.q.lead.clone(), (b.q.data, b.qd.data));
+        let solves = q.len().saturating_mul(4).saturating_mul(steps);
+        let (q, qd) = if q.is_empty() {
+            (q, qd)
+        } else if solves <= SOLVES_PER_CHUNK {
+            // A few milliseconds at most: here, without a thread of its own.
+            planar_rk4(&chain, &lead, [&q, &qd], h, steps, &AtomicBool::new(false)).map_err(run_error)?
+        } else {
+            interruptible(py, "integrate", move |stop| planar_rk4(&chain, &lead, [&q, &qd], h, steps, stop))?
+                .map_err(run_error)?
+        };
+        let w = b.q.width;
+        Ok((array(py, q, &b.q.lead, &[w])?.into_any(), array(py, qd, &b.q.lead, &[w])?.into_any()))
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians

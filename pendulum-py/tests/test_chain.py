@@ -184,6 +184,64 @@ def test_chains_pickle_and_compare():
     assert "n=2" in repr(chain)
 
 
+def rk4_step(chain, q, qd, h):
+    """One classical RK4 step of the free planar chain written with numpy around
+    ``Chain.accelerations``, in the order of ``x + a k`` and ``h/6 (k1 + 2 (k2 + k3) + k4)``."""
+    x = np.concatenate([q, qd], axis=-1)
+    n = chain.n
+
+    def f(x):
+        return np.concatenate([x[..., n:], chain.accelerations(x[..., :n], x[..., n:])], axis=-1)
+
+    k1 = f(x)
+    k2 = f(0.5 * h * k1 + x)
+    k3 = f(0.5 * h * k2 + x)
+    k4 = f(h * k3 + x)
+    x = x + h / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
+    return x[..., :n], x[..., n:]
+
+
+def test_integrate_steps_many_states_each_as_rk4_around_the_model_would():
+    rng = np.random.default_rng(8)
+    chain = pendulum.Chain(rng.uniform(0.1, 1.0, 7), rng.uniform(0.1, 1.0, 7), damping=0.01)
+    q, qd = rng.uniform(-2, 2, (3, 5, 7)), rng.uniform(-1, 1, (3, 5, 7))
+    q1, qd1 = chain.integrate(q, qd, h=1e-3)
+    assert q1.shape == qd1.shape == (3, 5, 7)
+    # Bit for bit: a numpy RK4 step around the model, and each state alone.
+    expected = rk4_step(chain, q, qd, 1e-3)
+    np.testing.assert_array_equal(q1, expected[0])
+    np.testing.assert_array_equal(qd1, expected[1])
+    alone = chain.integrate(q[1, 2], qd[1, 2], h=1e-3, steps=40)
+    many = chain.integrate(q, qd, h=1e-3, steps=40)
+    np.testing.assert_array_equal(many[0][1, 2], alone[0])
+    np.testing.assert_array_equal(many[1][1, 2], alone[1])
+    # Without rates: from rest.
+    np.testing.assert_array_equal(chain.integrate(q, h=1e-3)[0], chain.integrate(q, np.zeros_like(q), h=1e-3)[0])
+
+
+def test_integrate_keeps_the_energy_of_an_undamped_chain_and_the_period_of_a_small_swing():
+    chain = pendulum.Chain([0.3, 0.2, 0.5], [0.4, 0.3, 0.2])
+    q, qd = np.array([1.0, -0.5, 2.0]), np.array([0.0, 1.0, -1.0])
+    q1, qd1 = chain.integrate(q, qd, h=1e-4, steps=20_000)
+    before, after = sum(chain.energy(q, qd)), sum(chain.energy(q1, qd1))
+    assert abs(after - before) < 1e-9 * abs(before)
+    # One link, 1e-4 rad: after one period 2π √(l/g) it is back where it started.
+    one = pendulum.Chain(1.0, 0.5)
+    period = 2 * math.pi * math.sqrt(0.5 / G)
+    steps = 10_000
+    q1, qd1 = one.integrate([1e-4], [0.0], h=period / steps, steps=steps)
+    assert abs(q1[0] - 1e-4) < 1e-11 and abs(qd1[0]) < 1e-10
+
+
+def test_a_state_that_blows_up_in_integrate_is_named():
+    chain = pendulum.Chain(0.01, [0.01] * 4)
+    qd = np.zeros((2, 3, 4))
+    qd[1, 0] = 1e150
+    message = r"integrate: state \(1, 0\): the step from t = 0 s with h = 0.001 s produced a non-finite state"
+    with pytest.raises(RuntimeError, match=message):
+        chain.integrate(np.full((2, 3, 4), 0.4), qd, h=1e-3, steps=10)
+
+
 @pytest.mark.parametrize(
     "call, message",
     [
@@ -197,6 +255,10 @@ def test_chains_pickle_and_compare():
         (lambda: pendulum.Chain(1.0, 0.5).accelerations([0.0, 0.0], model="spatial"), "spherical-angle singularity"),
         (lambda: pendulum.Chain(1.0, 0.5).linearize([0.3]), "not an equilibrium"),
         (lambda: pendulum.Chain(1.0, 0.5).accelerations(["a"]), "q: not an array of numbers"),
+        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=0.0), "h: 0 is not a positive time step"),
+        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=float("nan")), "h: NaN is not a positive time step"),
+        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3, 0.1], h=1e-3, model="spatial"), "integrate: serves model='planar' only"),
+        (lambda: pendulum.Chain(1.0, [0.5, 0.5]).integrate([0.1, float("inf")], h=1e-3), "q: inf is not finite"),
     ],
 )
 def test_bad_input_is_a_value_error_naming_the_value(call, message):

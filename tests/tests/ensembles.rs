@@ -9,8 +9,8 @@ use pendulum_core::RodMidpoint;
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Accounted, Chain, Circle, Derivatives, Directions, Error, Inputs, Jacobians, Model, PlanarTension,
-    trajectory,
+    Accounted, Chain, Circle, Derivatives, Directions, Error, FirstOrder, Inputs, Jacobians, Model,
+    PlanarTension, trajectory,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -353,6 +353,114 @@ fn a_chain_that_blows_up_mid_run_stops_at_its_last_good_state() {
     for k in [0, 1, 3, 4] {
         assert!((states[k].t() - 0.05).abs() < 1e-12, "chain {k} ran all 50 steps");
     }
+}
+
+/// `steps` steps of RK4 of the free planar chain alone, from `start`: the states, and the
+/// time of the step that failed.
+fn planar_rk4_alone(
+    chain: &Chain<Dyn>,
+    start: &State<Dyn>,
+    h: f64,
+    steps: usize,
+) -> (State<Dyn>, Option<f64>) {
+    let system = FirstOrder::new(PlanarTension::new(chain.clone()));
+    let (mut state, mut rk4) = (start.clone(), Rk4::new(&system));
+    for _ in 0..steps {
+        let t = state.t();
+        if rk4.step(&system, &mut state, h).is_err() {
+            return (state, Some(t));
+        }
+    }
+    (state, None)
+}
+
+#[test]
+fn planar_rk4_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(41);
+    for (chains, n) in [(1, 1), (6, 3), (9, 20), (5, 100)] {
+        let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+        let batch = PlanarBatch::new(chain.clone()).expect("batch");
+        // Chains at different times, swinging from angles over several turns.
+        let start: Vec<State<Dyn>> = (0..chains)
+            .map(|k| {
+                let x = (0..2 * n)
+                    .map(|i| if i < n { r.random_range(-8.0..8.0) } else { r.random_range(-3.0..3.0) });
+                State::new(0.1 * k as f64, DVector::from_iterator(2 * n, x))
+            })
+            .collect();
+        let h = 1e-4;
+        let single: Vec<_> = chain.iter().zip(&start).map(|(c, s)| planar_rk4_alone(c, s, h, 30)).collect();
+        for pool in pools() {
+            // 30 steps in one call, 10 calls of 3, and the batch split in two.
+            let mut run = start.clone();
+            assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 30)).expect("batch").is_empty());
+            let mut calls = start.clone();
+            for _ in 0..10 {
+                assert!(pool.install(|| batch.integrate_rk4(&mut calls, h, 3)).expect("batch").is_empty());
+            }
+            let mut halves = start.clone();
+            let cut = chains / 2;
+            let (first, second) = halves.split_at_mut(cut);
+            for (part, states) in [(&chain[..cut], first), (&chain[cut..], second)] {
+                if !part.is_empty() {
+                    let half = PlanarBatch::new(part.to_vec()).expect("half");
+                    assert!(pool.install(|| half.integrate_rk4(states, h, 30)).expect("batch").is_empty());
+                }
+            }
+            for (k, (alone, failed)) in single.iter().enumerate() {
+                assert_eq!(*failed, None, "chain {k}");
+                for s in [&run[k], &calls[k], &halves[k]] {
+                    assert_eq!(s.t().to_bits(), alone.t().to_bits(), "chain {k}");
+                    assert_bits(
+                        s.x().as_slice(),
+                        alone.x().as_slice(),
+                        &format!("chain {k} of {chains}×{n}"),
+                    );
+                    assert_bits(s.compensation().as_slice(), alone.compensation().as_slice(), "compensation");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_planar_chain_that_fails_stops_at_its_last_good_state_and_the_others_run_on() {
+    let mut r = ChaCha8Rng::seed_from_u64(43);
+    let n = 6;
+    let chain: Vec<_> = (0..7).map(|_| random_chain(n, &mut r)).collect();
+    let batch = PlanarBatch::new(chain.clone()).expect("batch");
+    let x = |rate: f64| State::new(0.0, DVector::from_fn(2 * n, |i, _| if i < n { 0.4 } else { rate }));
+    let mut start: Vec<State<Dyn>> = (0..7).map(|_| x(0.5)).collect();
+    // Chain 1 starts with a NaN; chain 5 spins so fast that RK4 at this step diverges.
+    let mut bad = start[1].x().clone();
+    bad[n + 2] = f64::NAN;
+    start[1] = State::new(0.0, bad.clone());
+    start[5] = x(1e150);
+    let h = 1e-3;
+    let mut states = start.clone();
+    let failures = batch.integrate_rk4(&mut states, h, 40).expect("batch");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 5], "{failures:?}");
+    assert_eq!(
+        failures[0].error.to_string(),
+        Error::NonFinite { what: "x", index: n + 2, value: f64::NAN }.to_string()
+    );
+    assert_bits(states[1].x().as_slice(), bad.as_slice(), "the chain that never started");
+    let Error::NonFiniteState { t, .. } = failures[1].error else { panic!("{failures:?}") };
+    let (alone, failed) = planar_rk4_alone(&chain[5], &start[5], h, 40);
+    assert_eq!(failed.map(f64::to_bits), Some(t.to_bits()), "the same step fails alone");
+    assert_bits(states[5].x().as_slice(), alone.x().as_slice(), "the blown chain");
+    for k in [0, 2, 3, 4, 6] {
+        let (alone, _) = planar_rk4_alone(&chain[k], &start[k], h, 40);
+        assert_bits(states[k].x().as_slice(), alone.x().as_slice(), &format!("chain {k}"));
+    }
+    assert_eq!(
+        batch.integrate_rk4(&mut states, f64::NAN, 1).unwrap_err().to_string(),
+        Error::InvalidStepSize { h: f64::NAN }.to_string()
+    );
+    assert_eq!(
+        batch.integrate_rk4(&mut states[..3], h, 1).unwrap_err(),
+        Error::LengthMismatch { what: "states", expected: 7, got: 3 }
+    );
 }
 
 #[test]

@@ -23,17 +23,20 @@
 //! Layout: arrays are chain-major, `(B, m)` row after row as numpy stores a `(B, m)` array.
 //! Each block is gathered into lane order (`m` rows of `WIDTH`) and scattered back, in
 //! transposed tiles (`transpose`). A run ([`DirectionsBatch::integrate_rk4`],
-//! [`DirectionsBatch::run_rk4`]) keeps its states in lanes from the first step to the last
-//! and gains most (`docs/ensembles.md`).
+//! [`DirectionsBatch::run_rk4`], [`PlanarBatch::integrate_rk4`]) keeps its states in lanes
+//! from the first step to the last and gains most (`docs/ensembles.md`).
 
+use nalgebra::Dyn;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::integrate::State;
 use crate::lanes::{Lanes, Lanes32};
 
 mod directions;
 mod jacobians;
 mod planar;
+mod planar_rk4;
 mod rk4;
 mod rod_midpoint;
 mod run;
@@ -84,6 +87,17 @@ pub(crate) fn check_links(links: impl ExactSizeIterator<Item = usize>) -> Result
         }
     }
     expected.ok_or(Error::EmptyBatch)
+}
+
+/// Checks that there is one state per chain, each of `m` entries.
+pub(crate) fn check_states(states: &[State<Dyn>], chains: usize, m: usize) -> Result<()> {
+    if states.len() != chains {
+        return Err(Error::LengthMismatch { what: "states", expected: chains, got: states.len() });
+    }
+    match states.iter().find(|s| s.x().len() != m) {
+        Some(s) => Err(Error::LengthMismatch { what: "x", expected: m, got: s.x().len() }),
+        None => Ok(()),
+    }
 }
 
 /// Checks that `v` holds `chains` rows of `per_chain` numbers.

@@ -29,34 +29,34 @@ pub struct PlanarBatch {
     chains: Vec<PlanarTension<Dyn>>,
     /// Per block of [`WIDTH`] chains, their constants side by side (one block for all when
     /// the chains are one chain repeated).
-    blocks: Vec<Block>,
+    pub(super) blocks: Vec<Block>,
     /// The same in single precision, per block of [`WIDTH_F32`] chains.
     blocks_f32: Vec<Block<F32x8>>,
     count: usize,
-    links: usize,
+    pub(super) links: usize,
 }
 
 /// What the solve needs of one block's chains, in lanes `V`.
 #[derive(Debug, Clone)]
-struct Block<V: Lane = F64x4> {
+pub(super) struct Block<V: Lane = F64x4> {
     rods: Rods<V>,
     /// `−g` (m/s²) per lane.
     down: V,
 }
 
 /// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates, and the rows.
-struct Scratch<V: Lane = F64x4> {
+pub(super) struct Scratch<V: Lane = F64x4> {
     angles: Vec<V>,
-    sin: Vec<V>,
-    cos: Vec<V>,
-    rates: Vec<V>,
+    pub(super) sin: Vec<V>,
+    pub(super) cos: Vec<V>,
+    pub(super) rates: Vec<V>,
     loads: Vec<Load<2, V>>,
     rows: Rows<2, V>,
-    accelerations: Vec<V>,
+    pub(super) accelerations: Vec<V>,
 }
 
 impl<V: Lane> Scratch<V> {
-    fn new(links: usize) -> Self {
+    pub(super) fn new(links: usize) -> Self {
         let lanes = || vec![V::splat(0.0); links];
         Self {
             angles: lanes(),
@@ -75,7 +75,7 @@ impl<V: Lane> Block<V> {
     /// `s.rates` (rad/s) and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s
     /// tension solve, in lanes of any precision.
     #[inline(always)]
-    fn accelerations(&self, pivot: [V; 2], s: &mut Scratch<V>) {
+    pub(super) fn accelerations(&self, pivot: [V; 2], s: &mut Scratch<V>) {
         // The loads in a pass of their own: built inside the solve, the builder is not
         // inlined (as in the single-chain model).
         let drag = self.rods.drag();

@@ -77,13 +77,7 @@ where
 
     /// One state per chain, each of [`state_len`](Self::state_len) entries.
     pub(super) fn check_states(&self, states: &[State<Dyn>]) -> Result<()> {
-        if states.len() != self.len() {
-            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
-        }
-        match states.iter().find(|s| s.x().len() != self.state_len()) {
-            Some(s) => Err(Error::LengthMismatch { what: "x", expected: self.state_len(), got: s.x().len() }),
-            None => Ok(()),
-        }
+        super::check_states(states, self.len(), self.state_len())
     }
 
     /// Runs the chains `plan.steps` steps of `Projected<Rk4>` of size `plan.h` in lanes,
@@ -304,7 +298,7 @@ where
 /// loop of flags was vectorised across entries and transposed back, with spills).
 #[inline(always)]
 #[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
-fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
+pub(super) fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
     let mut sums = [Lanes([0.0; WIDTH]); 4];
     let mut quads = v.chunks_exact(4);
     for quad in quads.by_ref() {

@@ -119,6 +119,15 @@ class Chain:
         model: str = "planar",
         precision: str = "float64",
     ) -> _Array: ...
+    def integrate(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        *,
+        h: float,
+        steps: int = 1,
+        model: str = "planar",
+    ) -> tuple[_Array, _Array]: ...
     def jacobians(
         self,
         q: npt.ArrayLike,
