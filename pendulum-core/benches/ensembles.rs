@@ -104,7 +104,7 @@ fn accelerations(c: &mut Criterion) {
                 &n,
                 |b, _| {
                     in_pool(b, &pool, || {
-                        batch.accelerations(&q, &qd, None, &mut out).expect("batch");
+                        batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
                     })
                 },
             );
@@ -280,7 +280,8 @@ fn planar_rk4(c: &mut Criterion) {
                 &n,
                 |b, _| {
                     in_pool(b, &pool, || {
-                        let failures = batch.integrate_rk4(&mut states, 1e-4, STEPS).expect("batch");
+                        let failures =
+                            batch.integrate_rk4(&mut states, None, None, 1e-4, STEPS).expect("batch");
                         assert!(failures.is_empty(), "{failures:?}");
                     })
                 },

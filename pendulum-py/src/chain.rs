@@ -427,7 +427,7 @@ impl Chain {
             && torque.is_none()
             && pivot_acceleration.is_none()
             && let Some(out) = planar_in_place(py, &self.inner, q, qd, |b, q: &[f64], qd, out| {
-                b.accelerations(q, qd, None, out)
+                b.accelerations(q, qd, None, None, out)
             })?
         {
             return Ok(out);
@@ -435,9 +435,9 @@ impl Chain {
         let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
         let numbers = b.q.data.len();
         let out = maybe_detached(py, numbers, || match kind {
-            // Many planar states without torques: the SIMD batch, four states per lane group.
-            Kind::Planar if b.q.count() > 1 && b.torque.data.iter().all(|t| *t == 0.0) => {
-                planar_batch(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
+            // Many planar states: the SIMD batch, four states per lane group.
+            Kind::Planar if b.q.count() > 1 => {
+                planar_batch(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data])
             }
             _ => with_model!(self, kind, |m| accelerations(m, &b)),
         })
@@ -445,17 +445,20 @@ impl Chain {
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 
-    /// `(q, qd)` after `steps` steps of classical RK4 of `h` seconds from each state, the
-    /// chain free (no torques, pivot at rest; planar model): many states at once, four per
-    /// SIMD register and on every core, each bit for bit what the chain alone would give
-    /// (docs/ensembles.md). A state whose step is not finite raises RuntimeError naming it;
-    /// Ctrl-C stops the call.
-    #[pyo3(signature = (q, qd = None, *, h, steps = 1, model = "planar"))]
+    /// `(q, qd)` after `steps` steps of classical RK4 of `h` seconds from each state, with
+    /// its joint torques (N·m) and pivot acceleration (m/s²) held over the call (none: the
+    /// chain free; planar model): many states at once, four per SIMD register and on every
+    /// core, each bit for bit what the chain alone would give (docs/ensembles.md). A state
+    /// whose step is not finite raises RuntimeError naming it; Ctrl-C stops the call.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar"))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn integrate<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
         h: f64,
         steps: usize,
         model: &str,
@@ -466,17 +469,21 @@ impl Chain {
         if !(h.is_finite() && h > 0.0) {
             return Err(invalid(format!("h: {h} is not a positive time step (s)")));
         }
-        let b = self.batch(Kind::Planar, q, qd, None, None)?;
-        let (chain, lead, (q, qd)) = (self.inner.clone(), b.q.lead.clone(), (b.q.data, b.qd.data));
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
+        let (chain, lead) = (self.inner.clone(), b.q.lead.clone());
+        let [q, qd, torque, pivot] = [b.q.data, b.qd.data, b.torque.data, b.pivot.data];
         let solves = q.len().saturating_mul(4).saturating_mul(steps);
         let (q, qd) = if q.is_empty() {
             (q, qd)
         } else if solves <= SOLVES_PER_CHUNK {
             // A few milliseconds at most: here, without a thread of its own.
-            planar_rk4(&chain, &lead, [&q, &qd], h, steps, &AtomicBool::new(false)).map_err(run_error)?
-        } else {
-            interruptible(py, "integrate", move |stop| planar_rk4(&chain, &lead, [&q, &qd], h, steps, stop))?
+            planar_rk4(&chain, &lead, [&q, &qd, &torque, &pivot], h, steps, &AtomicBool::new(false))
                 .map_err(run_error)?
+        } else {
+            interruptible(py, "integrate", move |stop| {
+                planar_rk4(&chain, &lead, [&q, &qd, &torque, &pivot], h, steps, stop)
+            })?
+            .map_err(run_error)?
         };
         let w = b.q.width;
         Ok((array(py, q, &b.q.lead, &[w])?.into_any(), array(py, qd, &b.q.lead, &[w])?.into_any()))

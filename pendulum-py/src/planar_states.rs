@@ -14,18 +14,18 @@ use pyo3::prelude::*;
 use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
 
-/// `θ̈` of every planar state without torques by the batch of chains
-/// ([`PlanarBatch::repeated`]) at the `count` states `q`, `qd` and pivot accelerations
-/// `pivot`, rows of `n`, `n`, 2: the same numbers as the model's row by row, and the
-/// first failing row's error.
+/// `θ̈` of every planar state by the batch of chains ([`PlanarBatch::repeated`]) at the
+/// `count` states `q`, `qd`, joint torques `torque` and pivot accelerations `pivot`, rows of
+/// `n`, `n`, `n`, 2: the same numbers as the model's row by row, and the first failing
+/// row's error.
 pub fn planar_batch(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
-    [q, qd, pivot]: [&[f64]; 3],
+    [q, qd, torque, pivot]: [&[f64]; 4],
 ) -> pendulum_core::Result<Vec<f64>> {
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0; q.len()];
-    let failures = batch.accelerations(q, qd, Some(pivot), &mut out)?;
+    let failures = batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?;
     match failures.into_iter().next() {
         Some(failure) => Err(failure.error),
         None => Ok(out),
@@ -166,14 +166,15 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
 /// (a few milliseconds each).
 pub const SOLVES_PER_CHUNK: usize = 1 << 20;
 
-/// `steps` RK4 steps of `h` (s) of the free planar chain from each of the `count` states
-/// `(q, q̇)` (rows of `n`): [`PlanarBatch::integrate_rk4`] on every core, in chunks of
-/// steps between which `stop` is looked at (the same bits as one call). The new `(q, q̇)`;
-/// a failed state is an error naming its index in the leading shape `lead`.
+/// `steps` RK4 steps of `h` (s) of the planar chain from each state `(q, q̇)` with its
+/// joint torques and pivot acceleration held (rows of `n`, `n`, `n`, 2):
+/// [`PlanarBatch::integrate_rk4`] on every core, in chunks of steps between which `stop`
+/// is looked at (the same bits as one call). The new `(q, q̇)`; a failed state is an error
+/// naming its index in the leading shape `lead`.
 pub fn planar_rk4(
     chain: &pendulum_core::Chain<Dyn>,
     lead: &[usize],
-    [q, qd]: [&[f64]; 2],
+    [q, qd, torque, pivot]: [&[f64]; 4],
     h: f64,
     steps: usize,
     stop: &AtomicBool,
@@ -194,7 +195,7 @@ pub fn planar_rk4(
             return Err(pendulum_experiment::Error::interrupted("integrate: interrupted"));
         }
         let now = chunk.min(steps - done);
-        let failures = batch.integrate_rk4(&mut states, h, now).map_err(core)?;
+        let failures = batch.integrate_rk4(&mut states, Some(torque), Some(pivot), h, now).map_err(core)?;
         if let Some(first) = failures.first() {
             let more = match failures.len() {
                 1 => String::new(),

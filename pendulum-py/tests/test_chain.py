@@ -64,19 +64,20 @@ def test_the_equation_of_motion_holds_with_the_terms_it_returns(n, seed):
 
 def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
     rng = np.random.default_rng(1)
-    chain = pendulum.Chain(0.1, 0.1, damping=0.01)
     chain = pendulum.Chain([0.1] * 8, [0.1] * 8, damping=0.01)
     q, qd = rng.uniform(-2, 2, (3, 5, 8)), rng.normal(size=(3, 5, 8))
-    torque = rng.normal(size=8)
+    # Many states go through the batch of chains (four per SIMD lane group): still the
+    # states one at a time, bit for bit, torques on some and none on others.
+    torque = rng.normal(size=(3, 5, 8))
+    torque[1] = 0.0
     batch = chain.accelerations(q, qd, torque)
     assert batch.shape == (3, 5, 8)
     for i in range(3):
         for j in range(5):
-            assert np.array_equal(batch[i, j], chain.accelerations(q[i, j], qd[i, j], torque))
+            assert np.array_equal(batch[i, j], chain.accelerations(q[i, j], qd[i, j], torque[i, j]))
     qdd, dq, dqd = chain.jacobians(q, qd)
     assert (qdd.shape, dq.shape, dqd.shape) == ((3, 5, 8), (3, 5, 8, 8), (3, 5, 8, 8))
-    # Without torques many states go through the batch of chains (four per SIMD lane
-    # group): still the states one at a time, bit for bit, and the same error for a bad one.
+    # Pivots accelerating, and the same error for a bad state.
     pivot = rng.normal(size=(3, 5, 2))
     batch = chain.accelerations(q, qd, pivot_acceleration=pivot)
     for i in range(3):
@@ -217,6 +218,37 @@ def test_integrate_steps_many_states_each_as_rk4_around_the_model_would():
     np.testing.assert_array_equal(many[1][1, 2], alone[1])
     # Without rates: from rest.
     np.testing.assert_array_equal(chain.integrate(q, h=1e-3)[0], chain.integrate(q, np.zeros_like(q), h=1e-3)[0])
+
+
+def test_integrate_holds_torques_and_pivot_accelerations_over_the_call():
+    rng = np.random.default_rng(9)
+    chain = pendulum.Chain(rng.uniform(0.1, 1.0, 5), rng.uniform(0.1, 1.0, 5), damping=0.02)
+    q, qd = rng.uniform(-2, 2, (6, 5)), rng.uniform(-1, 1, (6, 5))
+    torque, pivot = rng.normal(size=(6, 5)), rng.normal(size=(6, 2))
+    torque[2] = 0.0
+
+    def f(x):
+        n = chain.n
+        return np.concatenate([x[:, n:], chain.accelerations(x[:, :n], x[:, n:], torque, pivot)], axis=-1)
+
+    x = np.concatenate([q, qd], axis=-1)
+    h = 2e-3
+    k1 = f(x)
+    k2 = f(0.5 * h * k1 + x)
+    k3 = f(0.5 * h * k2 + x)
+    k4 = f(h * k3 + x)
+    x = x + h / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
+    q1, qd1 = chain.integrate(q, qd, torque, pivot, h=h)
+    np.testing.assert_array_equal(q1, x[:, :5])
+    np.testing.assert_array_equal(qd1, x[:, 5:])
+    # One link: a torque m g l sin θ0 holds it at θ0; a pivot accelerating sideways at a
+    # holds it at rest at tan θ = −a/g. Both stay put.
+    one = pendulum.Chain(0.3, 0.5)
+    held, _ = one.integrate([0.7], [0.0], [0.3 * G * 0.5 * math.sin(0.7)], h=1e-3, steps=1000)
+    assert abs(held[0] - 0.7) < 1e-12
+    lag = math.atan(-2.0 / G)
+    tilted, _ = one.integrate([lag], [0.0], pivot_acceleration=[2.0, 0.0], h=1e-3, steps=1000)
+    assert abs(tilted[0] - lag) < 1e-12
 
 
 def test_integrate_keeps_the_energy_of_an_undamped_chain_and_the_period_of_a_small_swing():

@@ -68,7 +68,7 @@ fn planar_batch_equals_each_chain_alone_bit_for_bit() {
         for pool in pools() {
             let mut out = vec![0.0; chains * n];
             let failures =
-                pool.install(|| batch.accelerations(&q, &qd, Some(&pivot), &mut out)).expect("batch");
+                pool.install(|| batch.accelerations(&q, &qd, None, Some(&pivot), &mut out)).expect("batch");
             assert!(failures.is_empty(), "{failures:?}");
             assert_bits(
                 &out,
@@ -83,10 +83,10 @@ fn planar_batch_equals_each_chain_alone_bit_for_bit() {
             let mut out = vec![0.0; chains * n];
             let (low, high) = out.split_at_mut(cut * n);
             a.expect("a")
-                .accelerations(&q[..cut * n], &qd[..cut * n], Some(&pivot[..2 * cut]), low)
+                .accelerations(&q[..cut * n], &qd[..cut * n], None, Some(&pivot[..2 * cut]), low)
                 .expect("a");
             b.expect("b")
-                .accelerations(&q[cut * n..], &qd[cut * n..], Some(&pivot[2 * cut..]), high)
+                .accelerations(&q[cut * n..], &qd[cut * n..], None, Some(&pivot[2 * cut..]), high)
                 .expect("b");
             assert_bits(&out, &single, "split");
         }
@@ -103,9 +103,12 @@ fn one_chain_repeated_is_that_chain_at_every_state() {
     let (mut a, mut b) = (vec![0.0; count * n], vec![0.0; count * n]);
     PlanarBatch::repeated(chain.clone(), count)
         .expect("repeated")
-        .accelerations(&q, &qd, None, &mut a)
+        .accelerations(&q, &qd, None, None, &mut a)
         .expect("a");
-    PlanarBatch::new(vec![chain; count]).expect("copies").accelerations(&q, &qd, None, &mut b).expect("b");
+    PlanarBatch::new(vec![chain; count])
+        .expect("copies")
+        .accelerations(&q, &qd, None, None, &mut b)
+        .expect("b");
     assert_bits(&a, &b, "repeated");
 }
 
@@ -117,11 +120,11 @@ fn a_failing_chain_is_named_and_the_others_finish() {
     let mut q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
     let qd = vec![0.5; chains * n];
     let mut clean = vec![0.0; chains * n];
-    assert!(batch.accelerations(&q, &qd, None, &mut clean).expect("clean").is_empty());
+    assert!(batch.accelerations(&q, &qd, None, None, &mut clean).expect("clean").is_empty());
     q[5 * n + 2] = f64::NAN;
     q[9 * n] = f64::INFINITY;
     let mut out = vec![0.0; chains * n];
-    let failures = batch.accelerations(&q, &qd, None, &mut out).expect("batch");
+    let failures = batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
     let said: Vec<_> = failures.iter().map(|f| f.to_string()).collect();
     assert_eq!(said, ["chain 5: q[2] must be finite, got NaN", "chain 9: q[0] must be finite, got inf"]);
     assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [5, 9]);
@@ -142,7 +145,7 @@ fn batches_need_chains_of_one_length_and_whole_rows() {
     assert_eq!(err.to_string(), "chain 1 of the batch has 5 links, chain 0 has 4");
     assert_eq!(PlanarBatch::new(vec![]).unwrap_err(), Error::EmptyBatch);
     let batch = PlanarBatch::new(vec![random_chain(4, &mut r); 3]).expect("batch");
-    let err = batch.accelerations(&[0.0; 11], &[0.0; 12], None, &mut [0.0; 12]).unwrap_err();
+    let err = batch.accelerations(&[0.0; 11], &[0.0; 12], None, None, &mut [0.0; 12]).unwrap_err();
     assert_eq!(err.to_string(), "q has 11 entries, expected 12");
 }
 
@@ -355,15 +358,17 @@ fn a_chain_that_blows_up_mid_run_stops_at_its_last_good_state() {
     }
 }
 
-/// `steps` steps of RK4 of the free planar chain alone, from `start`: the states, and the
-/// time of the step that failed.
+/// `steps` steps of RK4 of the planar chain alone with `inputs` held (none: free), from
+/// `start`: the state, and the time of the step that failed.
 fn planar_rk4_alone(
     chain: &Chain<Dyn>,
+    inputs: Option<Inputs<Dyn, U2>>,
     start: &State<Dyn>,
     h: f64,
     steps: usize,
 ) -> (State<Dyn>, Option<f64>) {
-    let system = FirstOrder::new(PlanarTension::new(chain.clone()));
+    let inputs = inputs.unwrap_or_else(|| Inputs::zeros(Dyn(chain.links())));
+    let system = FirstOrder::with_inputs(PlanarTension::new(chain.clone()), inputs);
     let (mut state, mut rk4) = (start.clone(), Rk4::new(&system));
     for _ in 0..steps {
         let t = state.t();
@@ -388,28 +393,66 @@ fn planar_rk4_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
                 State::new(0.1 * k as f64, DVector::from_iterator(2 * n, x))
             })
             .collect();
+        // Torques on two chains in three (both kinds in one block), pivots accelerating.
+        let torque: Vec<f64> =
+            (0..chains * n).map(|i| if (i / n) % 3 == 1 { 0.0 } else { r.random_range(-0.1..0.1) }).collect();
+        let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+        let inputs = |k: usize| {
+            let mut inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
+            inputs.torque.copy_from_slice(&torque[k * n..(k + 1) * n]);
+            inputs.pivot_acceleration = nalgebra::Vector2::new(pivot[2 * k], pivot[2 * k + 1]);
+            inputs
+        };
         let h = 1e-4;
-        let single: Vec<_> = chain.iter().zip(&start).map(|(c, s)| planar_rk4_alone(c, s, h, 30)).collect();
+        let driven: Vec<_> =
+            (0..chains).map(|k| planar_rk4_alone(&chain[k], Some(inputs(k)), &start[k], h, 30)).collect();
+        let free: Vec<_> = (0..chains).map(|k| planar_rk4_alone(&chain[k], None, &start[k], h, 30)).collect();
+        let (torque, pivot) = (Some(&torque[..]), Some(&pivot[..]));
         for pool in pools() {
-            // 30 steps in one call, 10 calls of 3, and the batch split in two.
+            // 30 steps in one call, 10 calls of 3, the batch split in two; and free chains.
             let mut run = start.clone();
-            assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 30)).expect("batch").is_empty());
+            assert!(
+                pool.install(|| batch.integrate_rk4(&mut run, torque, pivot, h, 30))
+                    .expect("batch")
+                    .is_empty()
+            );
             let mut calls = start.clone();
             for _ in 0..10 {
-                assert!(pool.install(|| batch.integrate_rk4(&mut calls, h, 3)).expect("batch").is_empty());
+                let failures =
+                    pool.install(|| batch.integrate_rk4(&mut calls, torque, pivot, h, 3)).expect("batch");
+                assert!(failures.is_empty(), "{failures:?}");
             }
             let mut halves = start.clone();
             let cut = chains / 2;
             let (first, second) = halves.split_at_mut(cut);
-            for (part, states) in [(&chain[..cut], first), (&chain[cut..], second)] {
-                if !part.is_empty() {
-                    let half = PlanarBatch::new(part.to_vec()).expect("half");
-                    assert!(pool.install(|| half.integrate_rk4(states, h, 30)).expect("batch").is_empty());
+            for (range, states) in [(0..cut, first), (cut..chains, second)] {
+                if !range.is_empty() {
+                    let half = PlanarBatch::new(chain[range.clone()].to_vec()).expect("half");
+                    let (t, p) = (
+                        &torque.unwrap()[range.start * n..range.end * n],
+                        &pivot.unwrap()[2 * range.start..2 * range.end],
+                    );
+                    assert!(
+                        pool.install(|| half.integrate_rk4(states, Some(t), Some(p), h, 30))
+                            .expect("batch")
+                            .is_empty()
+                    );
                 }
             }
-            for (k, (alone, failed)) in single.iter().enumerate() {
-                assert_eq!(*failed, None, "chain {k}");
-                for s in [&run[k], &calls[k], &halves[k]] {
+            let mut unforced = start.clone();
+            assert!(
+                pool.install(|| batch.integrate_rk4(&mut unforced, None, None, h, 30))
+                    .expect("batch")
+                    .is_empty()
+            );
+            for k in 0..chains {
+                assert_eq!((driven[k].1, free[k].1), (None, None), "chain {k}");
+                for (s, alone) in [
+                    (&run[k], &driven[k].0),
+                    (&calls[k], &driven[k].0),
+                    (&halves[k], &driven[k].0),
+                    (&unforced[k], &free[k].0),
+                ] {
                     assert_eq!(s.t().to_bits(), alone.t().to_bits(), "chain {k}");
                     assert_bits(
                         s.x().as_slice(),
@@ -431,35 +474,40 @@ fn a_planar_chain_that_fails_stops_at_its_last_good_state_and_the_others_run_on(
     let batch = PlanarBatch::new(chain.clone()).expect("batch");
     let x = |rate: f64| State::new(0.0, DVector::from_fn(2 * n, |i, _| if i < n { 0.4 } else { rate }));
     let mut start: Vec<State<Dyn>> = (0..7).map(|_| x(0.5)).collect();
-    // Chain 1 starts with a NaN; chain 5 spins so fast that RK4 at this step diverges.
+    // Chain 1 starts with a NaN, chain 3 with an infinite torque; chain 5 spins so fast that
+    // RK4 at this step diverges.
     let mut bad = start[1].x().clone();
     bad[n + 2] = f64::NAN;
     start[1] = State::new(0.0, bad.clone());
     start[5] = x(1e150);
+    let mut torque = vec![0.0; 7 * n];
+    torque[3 * n + 4] = f64::INFINITY;
     let h = 1e-3;
     let mut states = start.clone();
-    let failures = batch.integrate_rk4(&mut states, h, 40).expect("batch");
-    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 5], "{failures:?}");
-    assert_eq!(
-        failures[0].error.to_string(),
-        Error::NonFinite { what: "x", index: n + 2, value: f64::NAN }.to_string()
-    );
+    let failures = batch.integrate_rk4(&mut states, Some(&torque), None, h, 40).expect("batch");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 3, 5], "{failures:?}");
+    let said = |k: usize| failures[k].error.to_string();
+    assert_eq!(said(0), Error::NonFinite { what: "x", index: n + 2, value: f64::NAN }.to_string());
+    assert_eq!(said(1), Error::NonFinite { what: "torque", index: 4, value: f64::INFINITY }.to_string());
     assert_bits(states[1].x().as_slice(), bad.as_slice(), "the chain that never started");
-    let Error::NonFiniteState { t, .. } = failures[1].error else { panic!("{failures:?}") };
-    let (alone, failed) = planar_rk4_alone(&chain[5], &start[5], h, 40);
+    assert_bits(states[3].x().as_slice(), start[3].x().as_slice(), "the chain that never started");
+    let Error::NonFiniteState { t, .. } = failures[2].error else { panic!("{failures:?}") };
+    let (alone, failed) = planar_rk4_alone(&chain[5], None, &start[5], h, 40);
     assert_eq!(failed.map(f64::to_bits), Some(t.to_bits()), "the same step fails alone");
     assert_bits(states[5].x().as_slice(), alone.x().as_slice(), "the blown chain");
-    for k in [0, 2, 3, 4, 6] {
-        let (alone, _) = planar_rk4_alone(&chain[k], &start[k], h, 40);
+    for k in [0, 2, 4, 6] {
+        let (alone, _) = planar_rk4_alone(&chain[k], None, &start[k], h, 40);
         assert_bits(states[k].x().as_slice(), alone.x().as_slice(), &format!("chain {k}"));
     }
+    let nan = batch.integrate_rk4(&mut states, None, None, f64::NAN, 1).unwrap_err();
+    assert_eq!(nan.to_string(), Error::InvalidStepSize { h: f64::NAN }.to_string());
     assert_eq!(
-        batch.integrate_rk4(&mut states, f64::NAN, 1).unwrap_err().to_string(),
-        Error::InvalidStepSize { h: f64::NAN }.to_string()
+        batch.integrate_rk4(&mut states[..3], None, None, h, 1).unwrap_err(),
+        Error::LengthMismatch { what: "states", expected: 7, got: 3 }
     );
     assert_eq!(
-        batch.integrate_rk4(&mut states[..3], h, 1).unwrap_err(),
-        Error::LengthMismatch { what: "states", expected: 7, got: 3 }
+        batch.integrate_rk4(&mut states, Some(&torque[1..]), None, h, 1).unwrap_err(),
+        Error::LengthMismatch { what: "torque", expected: 7 * n, got: 7 * n - 1 }
     );
 }
 
@@ -687,7 +735,7 @@ fn single_precision_planar_chains_are_within_their_documented_error() {
             let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
             let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
             let (mut out64, mut out32) = (vec![0.0; chains * n], vec![0.0f32; chains * n]);
-            assert!(batch.accelerations(&q, &qd, Some(&pivot), &mut out64).expect("f64").is_empty());
+            assert!(batch.accelerations(&q, &qd, None, Some(&pivot), &mut out64).expect("f64").is_empty());
             let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
             let (q, qd, pivot) = (narrow(&q), narrow(&qd), narrow(&pivot));
             assert!(batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out32).expect("f32").is_empty());

@@ -44,12 +44,15 @@ pub(super) struct Block<V: Lane = F64x4> {
     down: V,
 }
 
-/// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates, and the rows.
+/// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates and joint
+/// torques, and the rows.
 pub(super) struct Scratch<V: Lane = F64x4> {
     angles: Vec<V>,
     pub(super) sin: Vec<V>,
     pub(super) cos: Vec<V>,
     pub(super) rates: Vec<V>,
+    /// `Q_i` (N·m), read in the lanes flagged by the solve's `torqued` only.
+    pub(super) torque: Vec<V>,
     loads: Vec<Load<2, V>>,
     rows: Rows<2, V>,
     pub(super) accelerations: Vec<V>,
@@ -63,6 +66,7 @@ impl<V: Lane> Scratch<V> {
             sin: lanes(),
             cos: lanes(),
             rates: lanes(),
+            torque: lanes(),
             loads: vec![Load::zero(); links],
             rows: Rows::with_len(links),
             accelerations: lanes(),
@@ -72,15 +76,27 @@ impl<V: Lane> Scratch<V> {
 
 impl<V: Lane> Block<V> {
     /// `θ̈` (rad/s²) of the block's chains into `s.accelerations`, from `s.sin`, `s.cos`,
-    /// `s.rates` (rad/s) and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s
-    /// tension solve, in lanes of any precision.
+    /// `s.rates` (rad/s), the joint torques `s.torque` (N·m) in the lanes flagged in
+    /// `torqued` and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s tension
+    /// solve, in lanes of any precision. The pull on rod `i` is `Q_i/l_i − λ_i θ̇_i/l_i` in a
+    /// torqued lane and `−λ_i θ̇_i/l_i` in the others, as the model forms it for a chain with
+    /// torques and one without.
     #[inline(always)]
-    pub(super) fn accelerations(&self, pivot: [V; 2], s: &mut Scratch<V>) {
+    pub(super) fn accelerations(&self, pivot: [V; 2], torqued: V::Mask, s: &mut Scratch<V>) {
         // The loads in a pass of their own: built inside the solve, the builder is not
         // inlined (as in the single-chain model).
         let drag = self.rods.drag();
-        for (i, load) in s.loads.iter_mut().enumerate() {
-            *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
+        if V::any(torqued) {
+            let inverse_length = self.rods.inverse_length();
+            for (i, load) in s.loads.iter_mut().enumerate() {
+                let damped = -drag[i] * s.rates[i];
+                let pull = s.torque[i] * inverse_length[i] - drag[i] * s.rates[i];
+                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], V::select(torqued, pull, damped));
+            }
+        } else {
+            for (i, load) in s.loads.iter_mut().enumerate() {
+                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
+            }
         }
         let loads = &s.loads;
         let accelerations = &mut s.accelerations;
@@ -160,7 +176,8 @@ impl PlanarBatch {
 
     /// The angle accelerations `θ̈` (rad/s²) of every chain, written into `out` as `B` rows of
     /// `n`, at angles `q` (rad) and rates `qd` (rad/s) given the same way, with each chain's
-    /// pivot acceleration `p̈ = (ẍ, ÿ)` (m/s²) from `pivot` (`B` rows of 2; `None`: pivots at
+    /// joint torques `Q_i` (N·m) from `torque` (`B` rows of `n`; `None`: none) and pivot
+    /// acceleration `p̈ = (ẍ, ÿ)` (m/s²) from `pivot` (`B` rows of 2; `None`: pivots at
     /// rest).
     ///
     /// Returns the chains that failed (a non-finite input or result), in order; their rows of
@@ -169,12 +186,17 @@ impl PlanarBatch {
         &self,
         q: &[f64],
         qd: &[f64],
+        torque: Option<&[f64]>,
         pivot: Option<&[f64]>,
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
         self.check_rows(q, qd, pivot, out)?;
-        Ok(self.in_blocks([q, qd], pivot, out, (f64::NAN, Error::NotPositiveDefinite), |b, lanes, s, out| {
-            self.block_simd(b, lanes, q, qd, pivot, s, out)
+        if let Some(torque) = torque {
+            check_len("torque", torque, self.len(), self.links)?;
+        }
+        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        Ok(self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
+            self.block_simd(b, lanes, q, qd, torque, pivot, s, out)
         }))
     }
 
@@ -196,6 +218,7 @@ impl PlanarBatch {
         self.check_rows(q, qd, pivot, out)?;
         Ok(self.in_blocks(
             [q, qd],
+            None,
             pivot,
             out,
             (f32::NAN, Error::SinglePrecisionOverflow),
@@ -209,6 +232,7 @@ impl PlanarBatch {
     fn in_blocks<const W: usize, T, V>(
         &self,
         [q, qd]: [&[T]; 2],
+        torque: Option<&[T]>,
         pivot: Option<&[T]>,
         out: &mut [T],
         (nan, otherwise): (T, Error),
@@ -228,7 +252,7 @@ impl PlanarBatch {
                 let lanes = block_chains::<W>(b, chains);
                 kernel(b, lanes, scratch, out);
                 failed_rows(out, n, lanes, nan, |chain| {
-                    first_bad_input(chain, n, [q, qd], None, pivot).unwrap_or_else(|| otherwise.clone())
+                    first_bad_input(chain, n, [q, qd], torque, pivot).unwrap_or_else(|| otherwise.clone())
                 })
             },
         )
@@ -268,7 +292,7 @@ impl PlanarBatch {
                 Some(p) => [Lanes32::from_fn(|k| p[2 * lanes[k]]), Lanes32::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [Lanes32::splat(0.0); 2],
             };
-            block.accelerations(pivot, s);
+            block.accelerations(pivot, F32x8::none(), s);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
         }
         dispatch fn block_f32_simd, block_f32_avx2
@@ -283,12 +307,14 @@ impl PlanarBatch {
             lanes: [usize; WIDTH],
             q: &[f64],
             qd: &[f64],
+            torque: Option<&[f64]>,
             pivot: Option<&[f64]>,
             s: &mut Scratch,
             out: &mut [f64],
         ) {
             let n = self.links;
             let block = &self.blocks[b.min(self.blocks.len() - 1)];
+            let torqued = torque.map_or(F64x4::none(), |t| gather_torques(t, lanes, n, &mut s.torque));
             gather(q, lanes, n, Lanes::flatten_mut(&mut s.angles));
             sin_cos_split(
                 Lanes::flatten(&s.angles),
@@ -301,9 +327,23 @@ impl PlanarBatch {
                 Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [zero; 2],
             };
-            block.accelerations(pivot, s);
+            block.accelerations(pivot, torqued, s);
             scatter::<_, WIDTH>(Lanes::flatten(&s.accelerations), n, out);
         }
         dispatch fn block_simd, block_avx2
     }
+}
+
+/// The joint torques of the chains `lanes` (rows of `n` of `torque`) into lane order in
+/// `out`, and the lanes whose chain has a non-zero torque (flag `1`).
+#[inline(always)]
+pub(super) fn gather_torques(
+    torque: &[f64],
+    lanes: [usize; WIDTH],
+    n: usize,
+    out: &mut [F64x4],
+) -> [u64; WIDTH] {
+    gather(torque, lanes, n, Lanes::flatten_mut(out));
+    // As the model decides per chain: any non-zero torque (no early exit, so it vectorises).
+    lanes.map(|c| u64::from(!torque[c * n..(c + 1) * n].iter().fold(true, |zero, x| zero & (*x == 0.0))))
 }

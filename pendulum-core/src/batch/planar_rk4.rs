@@ -6,21 +6,25 @@
 
 use nalgebra::Dyn;
 
-use super::planar::{Block, Scratch};
+use super::planar::{Block, Scratch, gather_torques};
 use super::rk4::non_finite_lanes;
 use super::transpose::{gather_rows, scatter_rows};
 use super::{
-    F64x4, Failure, PlanarBatch, WIDTH, block_chains, check_states, for_blocks, non_finite, simd_kernel,
+    F64x4, Failure, PlanarBatch, WIDTH, block_chains, check_len, check_states, for_blocks, non_finite,
+    simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Lane, Lanes};
 
-/// A block's run: the solve's scratch, the times and states with their compensations, the
-/// stage state `y` (then the increment) and the stages `k1 … k4`, each `2n` lanes.
+/// A block's run: the solve's scratch (with the joint torques), the pivot accelerations and
+/// the lanes with torques, the times and states with their compensations, the stage state
+/// `y` (then the increment) and the stages `k1 … k4`, each `2n` lanes.
 struct Run {
     solve: Scratch,
+    pivot: [F64x4; 2],
+    torqued: [u64; WIDTH],
     t: [F64x4; 2],
     x: Vec<F64x4>,
     carry: Vec<F64x4>,
@@ -33,6 +37,8 @@ impl Run {
         let lanes = || vec![Lanes([0.0; WIDTH]); 2 * links];
         Self {
             solve: Scratch::new(links),
+            pivot: [Lanes([0.0; WIDTH]); 2],
+            torqued: [0; WIDTH],
             t: [Lanes([0.0; WIDTH]); 2],
             x: lanes(),
             carry: lanes(),
@@ -43,25 +49,40 @@ impl Run {
 }
 
 impl PlanarBatch {
-    /// `steps` steps of RK4 of size `h` (s) for every chain, free (no torques, pivot at
-    /// rest), each from its own state `x = (θ, θ̇)` (rad, rad/s; `2n` entries) and time:
-    /// equal bit for bit to `steps` steps of [`Rk4`](crate::integrate::Rk4) on
-    /// [`FirstOrder::new`](crate::FirstOrder::new)`(`[`PlanarTension`](crate::PlanarTension)`)`
+    /// `steps` steps of RK4 of size `h` (s) for every chain, each from its own state
+    /// `x = (θ, θ̇)` (rad, rad/s; `2n` entries) and time, with its joint torques `Q_i` (N·m,
+    /// `B` rows of `n`; `None`: none) and pivot acceleration `p̈` (m/s², `B` rows of 2;
+    /// `None`: at rest) held over the call (a zero-order hold, as a controller applies its
+    /// action): equal bit for bit to `steps` steps of [`Rk4`](crate::integrate::Rk4) on
+    /// [`FirstOrder::with_inputs`](crate::FirstOrder::with_inputs)`(`[`PlanarTension`](crate::PlanarTension)`, inputs)`
     /// of that chain alone, the states kept in lanes from the first step to the last.
     ///
-    /// Returns the chains that failed, in order: a non-finite state (by its entry, before any
-    /// step), or a step whose increment is not finite ([`Error::NonFiniteState`] with the
-    /// time of that step; the single chain's RK4 fails at the same step, perhaps naming the
-    /// non-finite stage instead). A failed chain is left at its last good state and the
-    /// others go on. Errors: [`Error::LengthMismatch`] for a number of states other than
-    /// `B` or a state not of `2n` entries, [`Error::InvalidStepSize`] for a non-finite or
-    /// zero `h`.
-    pub fn integrate_rk4(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Result<Vec<Failure>> {
+    /// Returns the chains that failed, in order: a non-finite state or input (by its entry,
+    /// before any step), or a step whose increment is not finite ([`Error::NonFiniteState`]
+    /// with the time of that step; the single chain's RK4 fails at the same step, perhaps
+    /// naming the non-finite stage instead). A failed chain is left at its last good state
+    /// and the others go on. Errors: [`Error::LengthMismatch`] for a number of states other
+    /// than `B`, a state not of `2n` entries or inputs not of `B` rows,
+    /// [`Error::InvalidStepSize`] for a non-finite or zero `h`.
+    pub fn integrate_rk4(
+        &self,
+        states: &mut [State<Dyn>],
+        torque: Option<&[f64]>,
+        pivot: Option<&[f64]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
         if !h.is_finite() || h == 0.0 {
             return Err(Error::InvalidStepSize { h });
         }
         let (n, m) = (self.links, 2 * self.links);
         check_states(states, self.len(), m)?;
+        if let Some(torque) = torque {
+            check_len("torque", torque, self.len(), n)?;
+        }
+        if let Some(pivot) = pivot {
+            check_len("pivot", pivot, self.len(), 2)?;
+        }
         let solves = n.saturating_mul(4).saturating_mul(steps);
         Ok(for_blocks(
             states,
@@ -74,11 +95,22 @@ impl PlanarBatch {
                 let mut failures = Vec::new();
                 let mut alive = [0u64; WIDTH];
                 for (k, state) in block.iter().enumerate() {
-                    match non_finite("x", state.x().as_slice()) {
-                        Some(error) => failures.push(Failure { chain: ids[k], error }),
+                    let c = ids[k];
+                    let bad = non_finite("x", state.x().as_slice())
+                        .or_else(|| torque.and_then(|t| non_finite("torque", &t[c * n..(c + 1) * n])))
+                        .or_else(|| {
+                            pivot.and_then(|p| non_finite("pivot_acceleration", &p[2 * c..2 * c + 2]))
+                        });
+                    match bad {
+                        Some(error) => failures.push(Failure { chain: c, error }),
                         None => alive[k] = 1,
                     }
                 }
+                s.torqued = torque.map_or([0; WIDTH], |t| gather_torques(t, ids, n, &mut s.solve.torque));
+                s.pivot = match pivot {
+                    Some(p) => [Lanes::from_fn(|k| p[2 * ids[k]]), Lanes::from_fn(|k| p[2 * ids[k] + 1])],
+                    None => [Lanes([0.0; WIDTH]); 2],
+                };
                 let ran = alive;
                 let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].parts());
                 s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
@@ -125,25 +157,25 @@ impl PlanarBatch {
         /// lanes whose increment was not finite (left as they were).
         fn rk4_step(&self, b: usize, h: f64, alive: [u64; WIDTH], s: &mut Run) -> [u64; WIDTH] {
             let block = &self.blocks[b.min(self.blocks.len() - 1)];
-            let n = self.links;
-            let Run { solve, t: [t, t_carry], x, carry, y, k: [k1, k2, k3, k4] } = s;
+            let Run { solve, pivot, torqued, t: [t, t_carry], x, carry, y, k: [k1, k2, k3, k4] } = s;
+            let inputs = (*pivot, *torqued);
             let half = 0.5 * h;
-            rates(block, n, x, solve, k1);
+            rates(block, inputs, x, solve, k1);
             // k_{j+1} = f(y) at y = x + a k_j, as nalgebra's `axpy(a, k_j, 1.0)` forms it.
             let a_half = Lanes([half; WIDTH]);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k1) {
                 *y = a_half * *k + *x;
             }
-            rates(block, n, y, solve, k2);
+            rates(block, inputs, y, solve, k2);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k2) {
                 *y = a_half * *k + *x;
             }
-            rates(block, n, y, solve, k3);
+            rates(block, inputs, y, solve, k3);
             let a_full = Lanes([h; WIDTH]);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k3) {
                 *y = a_full * *k + *x;
             }
-            rates(block, n, y, solve, k4);
+            rates(block, inputs, y, solve, k4);
             let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
                 *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
@@ -162,14 +194,22 @@ impl PlanarBatch {
     }
 }
 
-/// `x' = (θ̇, θ̈)` of the block's free chains at `x = (θ, θ̇)` (`2n` lanes each), into
-/// `out`: [`Block::accelerations`] with the pivots at rest.
+/// `x' = (θ̇, θ̈)` of the block's chains at `x = (θ, θ̇)` (`2n` lanes each), into `out`:
+/// [`Block::accelerations`] with the pivot accelerations and torqued lanes `inputs` (the
+/// torques in `s`).
 #[inline(always)]
-fn rates(block: &Block, n: usize, x: &[F64x4], s: &mut Scratch, out: &mut [F64x4]) {
+fn rates(
+    block: &Block,
+    (pivot, torqued): ([F64x4; 2], [u64; WIDTH]),
+    x: &[F64x4],
+    s: &mut Scratch,
+    out: &mut [F64x4],
+) {
+    let n = x.len() / 2;
     let (angles, rates) = x.split_at(n);
     sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(&mut s.sin), Lanes::flatten_mut(&mut s.cos));
     s.rates.copy_from_slice(rates);
-    block.accelerations([Lanes([0.0; WIDTH]); 2], s);
+    block.accelerations(pivot, torqued, s);
     let (velocities, accelerations) = out.split_at_mut(n);
     velocities.copy_from_slice(rates);
     accelerations.copy_from_slice(&s.accelerations);

@@ -123,6 +123,8 @@ class Chain:
         self,
         q: npt.ArrayLike,
         qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
         *,
         h: float,
         steps: int = 1,
