@@ -1,7 +1,7 @@
-//! `Chain.accelerations`' routes for many planar states without torques: the batch of
-//! chains (`PlanarBatch`), in double or single precision, with C-ordered `(B, n)` tables
-//! read where numpy holds them; and `Chain.integrate`'s RK4 steps of many free planar
-//! chains in lanes.
+//! `Chain.accelerations`' routes for many planar states: the batch of chains
+//! (`PlanarBatch`), in double precision with any inputs or in single precision without
+//! torques, C-ordered `(B, n)` tables read where numpy holds them; and `Chain.integrate`'s
+//! RK4 steps of many planar chains in lanes, their inputs held.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

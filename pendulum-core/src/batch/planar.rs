@@ -18,11 +18,12 @@ use crate::rods::{Load, Rods, Rows};
 
 /// `B` planar chains with the same number of links `n`, in absolute link angles (rad) as
 /// [`PlanarTension`]: each chain's own masses, lengths, damping and gravity, and per call
-/// each chain's state and pivot acceleration. No joint torques.
+/// each chain's state, joint torques and pivot acceleration.
 ///
 /// [`accelerations`](Self::accelerations) gives every chain's `θ̈` equal bit for bit to
 /// [`PlanarTension::accelerations`](crate::model::Model::accelerations) of that chain alone
-/// (module docs of [`batch`](super)).
+/// (module docs of [`batch`](super)), and [`integrate_rk4`](Self::integrate_rk4) its RK4
+/// steps.
 #[derive(Debug, Clone)]
 pub struct PlanarBatch {
     /// One model per chain, or one for all ([`repeated`](Self::repeated)).

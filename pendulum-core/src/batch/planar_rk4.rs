@@ -1,6 +1,6 @@
-//! Runs of RK4 for a batch of planar chains in link angles, in lanes: [`Rk4`] on each free
-//! chain's first-order system `x = (θ, θ̇)`, the states in lanes from the first step to the
-//! last.
+//! Runs of RK4 for a batch of planar chains in link angles, in lanes: [`Rk4`] on each
+//! chain's first-order system `x = (θ, θ̇)` with its torques and pivot acceleration held,
+//! the states in lanes from the first step to the last.
 //!
 //! [`Rk4`]: crate::integrate::Rk4
 
