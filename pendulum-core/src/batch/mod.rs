@@ -35,6 +35,7 @@ use crate::lanes::{Lanes, Lanes32};
 
 mod directions;
 mod jacobians;
+mod lane_states;
 mod planar;
 mod planar_rk4;
 mod rk4;

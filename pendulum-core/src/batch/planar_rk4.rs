@@ -6,9 +6,8 @@
 
 use nalgebra::Dyn;
 
+use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
 use super::planar::{Block, Scratch, gather_torques};
-use super::rk4::non_finite_lanes;
-use super::transpose::{gather_rows, scatter_rows};
 use super::{
     F64x4, Failure, PlanarBatch, WIDTH, block_chains, check_len, check_states, for_blocks, non_finite,
     simd_kernel,
@@ -112,10 +111,7 @@ impl PlanarBatch {
                     None => [Lanes([0.0; WIDTH]); 2],
                 };
                 let ran = alive;
-                let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].parts());
-                s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
-                gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(&mut s.x));
-                gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(&mut s.carry));
+                into_lanes(lanes.map(|k| &block[k]), m, &mut s.t, &mut s.x, &mut s.carry);
                 for _ in 0..steps {
                     if alive == [0; WIDTH] {
                         break;
@@ -128,22 +124,7 @@ impl PlanarBatch {
                         alive[k] = 0;
                     }
                 }
-                if block.len() == WIDTH && ran == [1; WIDTH] {
-                    let (mut xs, mut carries): ([&mut [f64]; WIDTH], [&mut [f64]; WIDTH]) =
-                        Default::default();
-                    for (k, state) in block.iter_mut().enumerate() {
-                        let (t, t_carry, x, carry) = state.parts_mut();
-                        (*t, *t_carry) = (s.t[0].0[k], s.t[1].0[k]);
-                        (xs[k], carries[k]) = (x, carry);
-                    }
-                    scatter_rows(Lanes::flatten(&s.x), m, xs);
-                    scatter_rows(Lanes::flatten(&s.carry), m, carries);
-                } else {
-                    for (k, state) in block.iter_mut().enumerate().filter(|(k, _)| ran[*k] != 0) {
-                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
-                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
-                    }
-                }
+                out_of_lanes(block.iter_mut(), ran, m, (&s.t, &s.x, &s.carry));
                 failures.sort_by_key(|f| f.chain);
                 failures
             },

@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::Scratch;
-use super::transpose::{gather_rows, scatter_rows};
+use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
 use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
@@ -134,10 +134,7 @@ where
                         None => alive[k] = 1,
                     }
                 }
-                let parts: [_; WIDTH] = std::array::from_fn(|k| block[lanes[k]].0.parts());
-                s.t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
-                gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(&mut s.x));
-                gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(&mut s.carry));
+                into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, &mut s.carry);
                 let ran = alive;
                 // Chain `k` of the block out of its lane into its state, and sampled.
                 let take_sample =
@@ -182,26 +179,8 @@ where
                         }
                     }
                 }
-                if block.len() == WIDTH && ran.iter().all(|&r| r != 0) {
-                    // A whole block that ran: out of lanes by the tiles' transposes (one
-                    // number at a time, this was a quarter of a one-step call).
-                    let (mut xs, mut carries): ([&mut [f64]; WIDTH], [&mut [f64]; WIDTH]) =
-                        Default::default();
-                    for (k, (state, _)) in block.iter_mut().enumerate() {
-                        let (t, t_carry, x, carry) = state.parts_mut();
-                        (*t, *t_carry) = (s.t[0].0[k], s.t[1].0[k]);
-                        (xs[k], carries[k]) = (x, carry);
-                    }
-                    scatter_rows(Lanes::flatten(&s.x), m, xs);
-                    scatter_rows(Lanes::flatten(&s.carry), m, carries);
-                } else {
-                    for (k, (state, _)) in block.iter_mut().enumerate() {
-                        if ran[k] != 0 {
-                            let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
-                            state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
-                        }
-                    }
-                }
+                let states = block.iter_mut().map(|(state, _)| &mut **state);
+                out_of_lanes(states, ran, m, (&s.t, &s.x, &s.carry));
                 ids.into_iter().zip(ends).collect()
             },
         )
@@ -291,24 +270,4 @@ where
             *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
         }
     }
-}
-
-/// The lanes in which some entry of `v` is not finite (flag `1`): `y − y` is `0` for a
-/// finite `y` and NaN otherwise, summed lane by lane in four independent sums (a per-lane
-/// loop of flags was vectorised across entries and transposed back, with spills).
-#[inline(always)]
-#[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
-pub(super) fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
-    let mut sums = [Lanes([0.0; WIDTH]); 4];
-    let mut quads = v.chunks_exact(4);
-    for quad in quads.by_ref() {
-        for (sum, y) in sums.iter_mut().zip(quad) {
-            *sum += *y - *y;
-        }
-    }
-    for (sum, y) in sums.iter_mut().zip(quads.remainder()) {
-        *sum += *y - *y;
-    }
-    let total = (sums[0] + sums[1]) + (sums[2] + sums[3]);
-    std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
 }

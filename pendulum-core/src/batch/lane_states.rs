@@ -1,0 +1,76 @@
+//! What the RK4 runs in lanes share: a block's states ([`State`]: time, state and their
+//! rounding compensations) into lanes and back out, and the lanes whose numbers are not
+//! finite.
+
+use nalgebra::Dyn;
+
+use super::transpose::{gather_rows, scatter_rows};
+use super::{F64x4, WIDTH};
+use crate::integrate::State;
+use crate::lanes::Lanes;
+
+/// The states `states` (`m` numbers each) into lanes: the times and their compensations
+/// into `t`, the states into `x`, their compensations into `carry`.
+#[inline(always)]
+pub(super) fn into_lanes(
+    states: [&State<Dyn>; WIDTH],
+    m: usize,
+    t: &mut [F64x4; 2],
+    x: &mut [F64x4],
+    carry: &mut [F64x4],
+) {
+    let parts = states.map(State::parts);
+    *t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
+    gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(x));
+    gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
+}
+
+/// The block's states (up to [`WIDTH`], lane `k` for the `k`-th) that `ran` (flag `1`) out
+/// of the lanes [`into_lanes`] filled: a whole block that ran by the tiles' transposes
+/// (one number at a time, this was a quarter of a one-step call), otherwise chain by chain.
+#[inline(always)]
+pub(super) fn out_of_lanes<'a>(
+    states: impl IntoIterator<Item = &'a mut State<Dyn>>,
+    ran: [u64; WIDTH],
+    m: usize,
+    (t, x, carry): (&[F64x4; 2], &[F64x4], &[F64x4]),
+) {
+    let mut states = states.into_iter();
+    let mut block: [Option<&mut State<Dyn>>; WIDTH] = std::array::from_fn(|_| states.next());
+    if ran == [1; WIDTH] && block.iter().all(Option::is_some) {
+        let (mut xs, mut carries): ([&mut [f64]; WIDTH], [&mut [f64]; WIDTH]) = Default::default();
+        for (k, state) in block.iter_mut().flatten().enumerate() {
+            let (time, time_carry, x, carry) = state.parts_mut();
+            (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
+            (xs[k], carries[k]) = (x, carry);
+        }
+        scatter_rows(Lanes::flatten(x), m, xs);
+        scatter_rows(Lanes::flatten(carry), m, carries);
+    } else {
+        for (k, state) in block.iter_mut().enumerate() {
+            if let Some(state) = state.as_deref_mut().filter(|_| ran[k] != 0) {
+                state.set_parts(t[0].0[k], t[1].0[k], x.iter().zip(carry).map(|(x, c)| (x.0[k], c.0[k])));
+            }
+        }
+    }
+}
+
+/// The lanes in which some entry of `v` is not finite (flag `1`): `y − y` is `0` for a
+/// finite `y` and NaN otherwise, summed lane by lane in four independent sums (a per-lane
+/// loop of flags was vectorised across entries and transposed back, with spills).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
+pub(super) fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
+    let mut sums = [Lanes([0.0; WIDTH]); 4];
+    let mut quads = v.chunks_exact(4);
+    for quad in quads.by_ref() {
+        for (sum, y) in sums.iter_mut().zip(quad) {
+            *sum += *y - *y;
+        }
+    }
+    for (sum, y) in sums.iter_mut().zip(quads.remainder()) {
+        *sum += *y - *y;
+    }
+    let total = (sums[0] + sums[1]) + (sums[2] + sums[3]);
+    std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
+}
