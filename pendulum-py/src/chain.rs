@@ -460,9 +460,11 @@ impl Chain {
         torque: Option<&Bound<'py, PyAny>>,
         pivot_acceleration: Option<&Bound<'py, PyAny>>,
         h: f64,
-        steps: usize,
+        steps: i64,
         model: &str,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let steps = usize::try_from(steps)
+            .map_err(|_| invalid(format!("steps: {steps} is not a number of steps (0 or more)")))?;
         if Kind::of(model)? != Kind::Planar {
             return Err(invalid("integrate: serves model='planar' only"));
         }

@@ -288,6 +288,7 @@ def test_a_state_that_blows_up_in_integrate_is_named():
         (lambda: pendulum.Chain(1.0, 0.5).linearize([0.3]), "not an equilibrium"),
         (lambda: pendulum.Chain(1.0, 0.5).accelerations(["a"]), "q: not an array of numbers"),
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=0.0), "h: 0 is not a positive time step"),
+        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=1e-3, steps=-2), "steps: -2 is not a number of steps"),
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=float("nan")), "h: NaN is not a positive time step"),
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3, 0.1], h=1e-3, model="spatial"), "integrate: serves model='planar' only"),
         (lambda: pendulum.Chain(1.0, [0.5, 0.5]).integrate([0.1, float("inf")], h=1e-3), "q: inf is not finite"),
