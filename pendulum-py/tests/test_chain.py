@@ -251,6 +251,36 @@ def test_integrate_holds_torques_and_pivot_accelerations_over_the_call():
     assert abs(tilted[0] - lag) < 1e-12
 
 
+def lqr_gain(a, b):
+    """The LQR gain for Q = I, R = I from the stable invariant subspace of the Hamiltonian
+    matrix (numpy only): u = −K x."""
+    n = a.shape[0]
+    hamiltonian = np.block([[a, -b @ b.T], [-np.eye(n), -a.T]])
+    values, vectors = np.linalg.eig(hamiltonian)
+    stable = vectors[:, values.real < 0]
+    riccati = np.real(stable[n:] @ np.linalg.inv(stable[:n]))
+    return b.T @ riccati
+
+
+def test_a_controller_holds_many_inverted_double_pendulums_upright_through_integrate():
+    # docs/python.md's control loop: torques held over each 10 ms, 64 copies per call.
+    chain = pendulum.Chain([0.5, 0.4], [0.4, 0.35], damping=1e-3)
+    up = np.full(2, np.pi)
+    linear = chain.linearize(up)
+    gain = lqr_gain(linear["A"], linear["B_torque"])
+    slowest = np.linalg.eigvals(linear["A"] - linear["B_torque"] @ gain).real.max()
+    assert slowest < 0
+    rng = np.random.default_rng(0)
+    q, qd = up + rng.uniform(-0.05, 0.05, (64, 2)), rng.uniform(-0.1, 0.1, (64, 2))
+    fallen, _ = chain.integrate(q, qd, h=1e-3, steps=2000)
+    assert np.all(np.abs(fallen - up).max(axis=-1) > 0.5)
+    for _ in range(500):
+        torque = -np.concatenate([q - up, qd], axis=-1) @ gain.T
+        q, qd = chain.integrate(q, qd, torque, h=1e-3, steps=10)
+    distance = np.abs(np.concatenate([q - up, qd], axis=-1)).max()
+    assert distance < 0.5 * math.exp(slowest * 5.0), (distance, slowest)
+
+
 def test_integrate_keeps_the_energy_of_an_undamped_chain_and_the_period_of_a_small_swing():
     chain = pendulum.Chain([0.3, 0.2, 0.5], [0.4, 0.3, 0.2])
     q, qd = np.array([1.0, -0.5, 2.0]), np.array([0.0, 1.0, -1.0])
