@@ -11,7 +11,7 @@
 //!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
-//!   (throughput in chain-steps);
+//!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
 //!   precision on one;
@@ -287,6 +287,17 @@ fn planar_rk4(c: &mut Criterion) {
                 },
             );
         }
+        // Single precision, eight chains a register, the states as rows of (θ, θ̇).
+        let mut rows: Vec<f32> = start.iter().flat_map(|s| s.x().iter().map(|&v| v as f32)).collect();
+        let mut carry = vec![0.0f32; rows.len()];
+        let one = pool(1);
+        group.bench_with_input(BenchmarkId::new("planar_100_steps/batch_f32_1_thread", n), &n, |b, _| {
+            in_pool(b, &one, || {
+                let failures =
+                    batch.integrate_rk4_f32((&mut rows, &mut carry), None, None, 1e-4, STEPS).expect("batch");
+                assert!(failures.is_empty(), "{failures:?}");
+            })
+        });
     }
     group.finish();
 }

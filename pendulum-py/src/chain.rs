@@ -16,9 +16,8 @@ use crate::arrays::{Rows, array, per_link};
 use crate::detach::{PARALLEL_FROM, maybe_detached};
 use crate::errors::{core_error, invalid, run_error};
 use crate::interrupt::interruptible;
-use crate::planar_states::{
-    SOLVES_PER_CHUNK, planar_batch, planar_batch_f32, planar_in_place, planar_rk4, planar_table_f32,
-};
+use crate::planar_runs::{Rows as StateRows, SOLVES_PER_CHUNK, planar_rk4, planar_rk4_f32};
+use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use pendulum_experiment::options::{expand, links};
 
 /// A chain of point masses on massless rigid rods, hung from a pivot.
@@ -448,9 +447,11 @@ impl Chain {
     /// `(q, qd)` after `steps` steps of classical RK4 of `h` seconds from each state, with
     /// its joint torques (N·m) and pivot acceleration (m/s²) held over the call (none: the
     /// chain free; planar model): many states at once, four per SIMD register and on every
-    /// core, each bit for bit what the chain alone would give (docs/ensembles.md). A state
-    /// whose step is not finite raises RuntimeError naming it; Ctrl-C stops the call.
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar"))]
+    /// core, each bit for bit what the chain alone would give (docs/ensembles.md).
+    /// `precision="float32"` steps eight states per register in single precision and
+    /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
+    /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64"))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn integrate<'py>(
         &self,
@@ -462,6 +463,7 @@ impl Chain {
         h: f64,
         steps: i64,
         model: &str,
+        precision: &str,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let steps = usize::try_from(steps)
             .map_err(|_| invalid(format!("steps: {steps} is not a number of steps (0 or more)")))?;
@@ -472,23 +474,11 @@ impl Chain {
             return Err(invalid(format!("h: {h} is not a positive time step (s)")));
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
-        let (chain, lead) = (self.inner.clone(), b.q.lead.clone());
-        let [q, qd, torque, pivot] = [b.q.data, b.qd.data, b.torque.data, b.pivot.data];
-        let solves = q.len().saturating_mul(4).saturating_mul(steps);
-        let (q, qd) = if q.is_empty() {
-            (q, qd)
-        } else if solves <= SOLVES_PER_CHUNK {
-            // A few milliseconds at most: here, without a thread of its own.
-            planar_rk4(&chain, &lead, [&q, &qd, &torque, &pivot], h, steps, &AtomicBool::new(false))
-                .map_err(run_error)?
-        } else {
-            interruptible(py, "integrate", move |stop| {
-                planar_rk4(&chain, &lead, [&q, &qd, &torque, &pivot], h, steps, stop)
-            })?
-            .map_err(run_error)?
-        };
-        let w = b.q.width;
-        Ok((array(py, q, &b.q.lead, &[w])?.into_any(), array(py, qd, &b.q.lead, &[w])?.into_any()))
+        match precision {
+            "float64" => integrate_with(py, &self.inner, b, (h, steps), planar_rk4),
+            "float32" => integrate_with(py, &self.inner, b, (h, steps), planar_rk4_f32),
+            _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+        }
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
@@ -620,4 +610,45 @@ where
     let mut state = State::<M>::new(b.q.width);
     let s = state.load(b, 0);
     pendulum_core::linearize(model, &s.q, &s.qd, &s.inputs, tolerance)
+}
+
+/// The signature of [`planar_rk4`] and [`planar_rk4_f32`].
+type PlanarRun<T> = fn(
+    &pendulum_core::Chain<Dyn>,
+    &StateRows<'_>,
+    (f64, usize),
+    &AtomicBool,
+) -> pendulum_experiment::Result<(Vec<T>, Vec<T>)>;
+
+/// `Chain.integrate` of the states and inputs `b` by `run`: here for a few milliseconds'
+/// work, on a thread of its own that Ctrl-C can stop otherwise; `(q, qd)` shaped as `b.q`.
+fn integrate_with<'py, T: numpy::Element + Send + 'static>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    b: Batch,
+    (h, steps): (f64, usize),
+    run: PlanarRun<T>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let (lead, width) = (b.q.lead.clone(), b.q.width);
+    let (q, qd) = if b.q.data.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        let chain = chain.clone();
+        let work = move |stop: &AtomicBool| {
+            let [q, qd, torque, pivot] = [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data];
+            run(&chain, &StateRows { lead: &b.q.lead, q, qd, torque, pivot }, (h, steps), stop)
+        };
+        if b_solves(&lead, width, steps) <= SOLVES_PER_CHUNK {
+            // A few milliseconds at most: here, without a thread of its own.
+            work(&AtomicBool::new(false)).map_err(run_error)?
+        } else {
+            interruptible(py, "integrate", work)?.map_err(run_error)?
+        }
+    };
+    Ok((array(py, q, &lead, &[width])?.into_any(), array(py, qd, &lead, &[width])?.into_any()))
+}
+
+/// Rods' solves of `steps` steps of the states of leading shape `lead` (`width` links).
+fn b_solves(lead: &[usize], width: usize, steps: usize) -> usize {
+    lead.iter().product::<usize>().saturating_mul(width).saturating_mul(4).saturating_mul(steps)
 }

@@ -11,6 +11,7 @@ mod detach;
 mod errors;
 mod interrupt;
 mod page;
+mod planar_runs;
 mod planar_states;
 mod run;
 mod steady;

@@ -1,14 +1,10 @@
 //! `Chain.accelerations`' routes for many planar states: the batch of chains
 //! (`PlanarBatch`), in double precision with any inputs or in single precision without
-//! torques, C-ordered `(B, n)` tables read where numpy holds them; and `Chain.integrate`'s
-//! RK4 steps of many planar chains in lanes, their inputs held.
+//! torques, C-ordered `(B, n)` tables read where numpy holds them.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
-use nalgebra::{DVector, Dyn};
+use nalgebra::Dyn;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pendulum_core::batch::{Failure, PlanarBatch};
-use pendulum_core::integrate::State;
 use pyo3::prelude::*;
 
 use crate::detach::maybe_detached;
@@ -160,73 +156,4 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
         }
     }
     Ok(Some(out.into_any()))
-}
-
-/// Rods' solves per chunk of a batched integration: Ctrl-C is looked at between chunks
-/// (a few milliseconds each).
-pub const SOLVES_PER_CHUNK: usize = 1 << 20;
-
-/// `steps` RK4 steps of `h` (s) of the planar chain from each state `(q, q̇)` with its
-/// joint torques and pivot acceleration held (rows of `n`, `n`, `n`, 2):
-/// [`PlanarBatch::integrate_rk4`] on every core, in chunks of steps between which `stop`
-/// is looked at (the same bits as one call). The new `(q, q̇)`; a failed state is an error
-/// naming its index in the leading shape `lead`.
-pub fn planar_rk4(
-    chain: &pendulum_core::Chain<Dyn>,
-    lead: &[usize],
-    [q, qd, torque, pivot]: [&[f64]; 4],
-    h: f64,
-    steps: usize,
-    stop: &AtomicBool,
-) -> pendulum_experiment::Result<(Vec<f64>, Vec<f64>)> {
-    let n = chain.links();
-    let count = q.len() / n;
-    let core = |e: pendulum_core::Error| pendulum_experiment::Error::invalid(e.to_string());
-    let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core)?;
-    let mut states: Vec<State<Dyn>> = q
-        .chunks_exact(n)
-        .zip(qd.chunks_exact(n))
-        .map(|(q, qd)| State::new(0.0, DVector::from_iterator(2 * n, q.iter().chain(qd).copied())))
-        .collect();
-    let chunk = (SOLVES_PER_CHUNK / (4 * n * count).max(1)).max(1);
-    let mut done = 0;
-    while done < steps {
-        if stop.load(Ordering::Relaxed) {
-            return Err(pendulum_experiment::Error::interrupted("integrate: interrupted"));
-        }
-        let now = chunk.min(steps - done);
-        let failures = batch.integrate_rk4(&mut states, Some(torque), Some(pivot), h, now).map_err(core)?;
-        if let Some(first) = failures.first() {
-            let more = match failures.len() {
-                1 => String::new(),
-                k => format!(" ({} more states failed too)", k - 1),
-            };
-            let (index, error) = (numpy_index(first.chain, lead), &first.error);
-            return Err(pendulum_experiment::Error::failed(format!(
-                "integrate: state {index}: {error}{more}"
-            )));
-        }
-        done += now;
-    }
-    let (mut q, mut qd) = (Vec::with_capacity(count * n), Vec::with_capacity(count * n));
-    for state in &states {
-        let (angles, rates) = state.x().as_slice().split_at(n);
-        q.extend_from_slice(angles);
-        qd.extend_from_slice(rates);
-    }
-    Ok((q, qd))
-}
-
-/// Row `row` of a C-ordered array with leading shape `lead`, as numpy writes its index:
-/// `(1, 2)`; a single leading axis as `4`, none as `0`.
-fn numpy_index(mut row: usize, lead: &[usize]) -> String {
-    let mut index = vec![0; lead.len()];
-    for (i, &extent) in lead.iter().enumerate().rev() {
-        (index[i], row) = (row % extent.max(1), row / extent.max(1));
-    }
-    match index.as_slice() {
-        [] => "0".to_string(),
-        [i] => i.to_string(),
-        more => format!("({})", more.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")),
-    }
 }

@@ -781,3 +781,80 @@ fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_
         );
     }
 }
+
+/// States of `chains` chains of `n` links as rows of `(θ, θ̇)`: angles within ±1 rad,
+/// rates within ±1 rad/s.
+fn planar_rows(chains: usize, n: usize, r: &mut ChaCha8Rng) -> Vec<f64> {
+    (0..chains * 2 * n).map(|_| r.random_range(-1.0..1.0)).collect()
+}
+
+#[test]
+fn single_precision_planar_runs_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"): 100 and 1000 RK4 steps of
+    // 0.1 ms from the same states, the f32 run against the f64 one; `--nocapture` prints them.
+    let mut r = ChaCha8Rng::seed_from_u64(51);
+    let (chains, h) = (64, 1e-4);
+    for (decades, steps, bound) in [(0.3, 100, 5e-6), (0.3, 1000, 3e-4), (1.0, 100, 5e-6), (2.0, 100, 1e-5)] {
+        for n in [8, 20, 100] {
+            let batch = PlanarBatch::new((0..chains).map(|_| spread_chain(n, decades, &mut r)).collect())
+                .expect("batch");
+            let rows = planar_rows(chains, n, &mut r);
+            let mut states: Vec<State<Dyn>> =
+                rows.chunks_exact(2 * n).map(|x| State::new(0.0, DVector::from_column_slice(x))).collect();
+            assert!(batch.integrate_rk4(&mut states, None, None, h, steps).expect("f64").is_empty());
+            let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+            let (mut f32s, mut carry): (Vec<f32>, _) =
+                (rows.iter().map(|&v| v as f32).collect(), vec![0.0; rows.len()]);
+            let run = batch.integrate_rk4_f32((&mut f32s, &mut carry), None, None, h, steps);
+            assert!(run.expect("f32").is_empty());
+            let error = worst_relative_error(&f64s, &f32s, 2 * n);
+            println!("planar run, spread 10^{decades}, {steps} steps of {h} s, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, {steps} × {h} s, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_planar_runs_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(52);
+    let (n, chains) = (6, 19);
+    let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 1.0, &mut r)).collect();
+    let batch = PlanarBatch::new(list.clone()).expect("batch");
+    let mut start: Vec<f32> = planar_rows(chains, n, &mut r).iter().map(|&v| v as f32).collect();
+    let torque: Vec<f32> = (0..chains * n).map(|i| if (i / n) % 2 == 0 { 0.0 } else { 1e-3 }).collect();
+    start[3 * 2 * n + 1] = f32::NAN;
+    start[11 * 2 * n + n] = 1e30; // spins so fast that the first step overflows
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let (mut x, mut carry) = (start.clone(), vec![0.0; start.len()]);
+        let failures = pool
+            .install(|| batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), None, 1e-3, 20))
+            .expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11], "{failures:?}");
+        assert_eq!(failures[0].error.to_string(), "x[1] must be finite, got NaN");
+        assert_eq!(failures[1].error, Error::NonFiniteState { t: 0.0, h: 1e-3 });
+        for k in [3, 11] {
+            let row = k * 2 * n..(k + 1) * 2 * n;
+            let same = x[row.clone()].iter().zip(&start[row]).all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "chain {k} is left where it was");
+        }
+        runs.push(x.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        // Twenty calls of one step, the compensation kept: the same numbers.
+        let (mut y, mut carry) = (start.clone(), vec![0.0; start.len()]);
+        for _ in 0..20 {
+            pool.install(|| batch.integrate_rk4_f32((&mut y, &mut carry), Some(&torque), None, 1e-3, 1))
+                .expect("f32");
+        }
+        assert_eq!(y.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), runs[0], "one step per call");
+    }
+    assert_eq!(runs[0], runs[1], "one thread or two");
+    for k in [0, 8, 18] {
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let (mut x, mut carry) = (start[k * 2 * n..(k + 1) * 2 * n].to_vec(), vec![0.0; 2 * n]);
+        let t = &torque[k * n..(k + 1) * n];
+        let run = alone.integrate_rk4_f32((&mut x, &mut carry), Some(t), None, 1e-3, 20);
+        assert!(run.expect("f32").is_empty());
+        let bits: Vec<u32> = x.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(bits, runs[0][k * 2 * n..(k + 1) * 2 * n], "chain {k} alone");
+    }
+}

@@ -3,6 +3,7 @@
 
 use nalgebra::Dyn;
 
+use super::transpose::Transpose;
 use super::{
     F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
     first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
@@ -32,7 +33,7 @@ pub struct PlanarBatch {
     /// the chains are one chain repeated).
     pub(super) blocks: Vec<Block>,
     /// The same in single precision, per block of [`WIDTH_F32`] chains.
-    blocks_f32: Vec<Block<F32x8>>,
+    pub(super) blocks_f32: Vec<Block<F32x8>>,
     count: usize,
     pub(super) links: usize,
 }
@@ -315,7 +316,9 @@ impl PlanarBatch {
         ) {
             let n = self.links;
             let block = &self.blocks[b.min(self.blocks.len() - 1)];
-            let torqued = torque.map_or(F64x4::none(), |t| gather_torques(t, lanes, n, &mut s.torque));
+            let torqued = torque.map_or(F64x4::none(), |t| {
+                gather_torques(t, lanes, n, Lanes::flatten_mut(&mut s.torque)).map(u64::from)
+            });
             gather(q, lanes, n, Lanes::flatten_mut(&mut s.angles));
             sin_cos_split(
                 Lanes::flatten(&s.angles),
@@ -336,15 +339,15 @@ impl PlanarBatch {
 }
 
 /// The joint torques of the chains `lanes` (rows of `n` of `torque`) into lane order in
-/// `out`, and the lanes whose chain has a non-zero torque (flag `1`).
+/// `out` (flattened lanes), and which of them has a non-zero torque.
 #[inline(always)]
-pub(super) fn gather_torques(
-    torque: &[f64],
-    lanes: [usize; WIDTH],
+pub(super) fn gather_torques<T: Transpose + Into<f64>, const W: usize>(
+    torque: &[T],
+    lanes: [usize; W],
     n: usize,
-    out: &mut [F64x4],
-) -> [u64; WIDTH] {
-    gather(torque, lanes, n, Lanes::flatten_mut(out));
+    out: &mut [T],
+) -> [bool; W] {
+    gather(torque, lanes, n, out);
     // As the model decides per chain: any non-zero torque (no early exit, so it vectorises).
-    lanes.map(|c| u64::from(!torque[c * n..(c + 1) * n].iter().fold(true, |zero, x| zero & (*x == 0.0))))
+    lanes.map(|c| !torque[c * n..(c + 1) * n].iter().fold(true, |zero, &x| zero & (x.into() == 0.0)))
 }

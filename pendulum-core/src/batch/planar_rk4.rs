@@ -1,6 +1,7 @@
 //! Runs of RK4 for a batch of planar chains in link angles, in lanes: [`Rk4`] on each
 //! chain's first-order system `x = (θ, θ̇)` with its torques and pivot acceleration held,
-//! the states in lanes from the first step to the last.
+//! the states in lanes from the first step to the last; in `f64` (four chains a register,
+//! bit for bit the chain alone) or `f32` (eight).
 //!
 //! [`Rk4`]: crate::integrate::Rk4
 
@@ -8,37 +9,125 @@ use nalgebra::Dyn;
 
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
 use super::planar::{Block, Scratch, gather_torques};
+use super::transpose::Transpose;
+use super::transpose::{gather_rows, scatter_rows};
 use super::{
-    F64x4, Failure, PlanarBatch, WIDTH, block_chains, check_len, check_states, for_blocks, non_finite,
-    simd_kernel,
+    F32x8, F64x4, Failure, PlanarBatch, WIDTH, WIDTH_F32, block_chains, check_len, check_states, for_blocks,
+    for_blocks_of, non_finite, simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::kinematics::trig::sin_cos_split;
-use crate::lanes::{Lane, Lanes};
+use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
+use crate::lanes::{Lane, Lanes, Lanes32};
 
-/// A block's run: the solve's scratch (with the joint torques), the pivot accelerations and
-/// the lanes with torques, the times and states with their compensations, the stage state
-/// `y` (then the increment) and the stages `k1 … k4`, each `2n` lanes.
-struct Run {
-    solve: Scratch,
-    pivot: [F64x4; 2],
-    torqued: [u64; WIDTH],
-    t: [F64x4; 2],
-    x: Vec<F64x4>,
-    carry: Vec<F64x4>,
-    y: Vec<F64x4>,
-    k: [Vec<F64x4>; 4],
+/// The lanes a planar run steps in, with their precision's sine kernel: [`F64x4`] or
+/// [`F32x8`].
+pub(super) trait RunLane: Lane + Send {
+    /// The number type of one lane.
+    type Num: Transpose + Into<f64> + Send + Sync;
+    /// The lanes of `v` one after another.
+    fn flatten_mut(v: &mut [Self]) -> &mut [Self::Num];
+    /// `f(k)` in lane `k`.
+    fn from_nums(f: impl Fn(usize) -> Self::Num) -> Self;
+    /// The lanes `k` with `flag(k)`.
+    fn mask(flag: impl Fn(usize) -> bool) -> Self::Mask;
+    /// `sin`, `cos` of every lane of `angles` (inlined, so that it runs with its caller's
+    /// target features).
+    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
+    /// The lanes in which some entry of `v` is not finite.
+    fn non_finite(v: &[Self]) -> Self::Mask;
+    /// `a` and not `b`, lane by lane.
+    fn and_not(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// `a` and `b`, lane by lane.
+    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
 }
 
-impl Run {
+impl RunLane for F64x4 {
+    type Num = f64;
+    #[inline(always)]
+    fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
+        Lanes::flatten_mut(v)
+    }
+    #[inline(always)]
+    fn from_nums(f: impl Fn(usize) -> f64) -> Self {
+        Lanes::from_fn(f)
+    }
+    #[inline(always)]
+    fn mask(flag: impl Fn(usize) -> bool) -> [u64; WIDTH] {
+        std::array::from_fn(|k| u64::from(flag(k)))
+    }
+    #[inline(always)]
+    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
+        sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(sin), Lanes::flatten_mut(cos));
+    }
+    #[inline(always)]
+    fn non_finite(v: &[Self]) -> [u64; WIDTH] {
+        non_finite_lanes(v)
+    }
+    #[inline(always)]
+    fn and_not(a: [u64; WIDTH], b: [u64; WIDTH]) -> [u64; WIDTH] {
+        std::array::from_fn(|k| a[k] & !b[k])
+    }
+    #[inline(always)]
+    fn and(a: [u64; WIDTH], b: [u64; WIDTH]) -> [u64; WIDTH] {
+        std::array::from_fn(|k| a[k] & b[k])
+    }
+}
+
+impl RunLane for F32x8 {
+    type Num = f32;
+    #[inline(always)]
+    fn flatten_mut(v: &mut [Self]) -> &mut [f32] {
+        Lanes32::flatten_mut(v)
+    }
+    #[inline(always)]
+    fn from_nums(f: impl Fn(usize) -> f32) -> Self {
+        Lanes32::from_fn(f)
+    }
+    #[inline(always)]
+    fn mask(flag: impl Fn(usize) -> bool) -> [u32; WIDTH_F32] {
+        std::array::from_fn(|k| u32::from(flag(k)))
+    }
+    #[inline(always)]
+    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
+        sin_cos_split_f32(Lanes32::flatten(angles), Lanes32::flatten_mut(sin), Lanes32::flatten_mut(cos));
+    }
+    #[inline(always)]
+    #[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
+    fn non_finite(v: &[Self]) -> [u32; WIDTH_F32] {
+        let total = v.iter().fold(Lanes32([0.0; WIDTH_F32]), |sum, y| sum + (*y - *y));
+        std::array::from_fn(|k| u32::from(total.0[k].is_nan()))
+    }
+    #[inline(always)]
+    fn and_not(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
+        std::array::from_fn(|k| a[k] & !b[k])
+    }
+    #[inline(always)]
+    fn and(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
+        std::array::from_fn(|k| a[k] & b[k])
+    }
+}
+
+/// A block's run: the solve's scratch (with the joint torques), the pivot accelerations and
+/// the lanes with torques, the states and their compensations, the stage state `y` (then
+/// the increment) and the stages `k1 … k4`, each `2n` lanes.
+struct Run<V: RunLane> {
+    solve: Scratch<V>,
+    pivot: [V; 2],
+    torqued: V::Mask,
+    x: Vec<V>,
+    carry: Vec<V>,
+    y: Vec<V>,
+    k: [Vec<V>; 4],
+}
+
+impl<V: RunLane> Run<V> {
     fn new(links: usize) -> Self {
-        let lanes = || vec![Lanes([0.0; WIDTH]); 2 * links];
+        let lanes = || vec![V::splat(0.0); 2 * links];
         Self {
             solve: Scratch::new(links),
-            pivot: [Lanes([0.0; WIDTH]); 2],
-            torqued: [0; WIDTH],
-            t: [Lanes([0.0; WIDTH]); 2],
+            pivot: [V::splat(0.0); 2],
+            torqued: V::none(),
             x: lanes(),
             carry: lanes(),
             y: lanes(),
@@ -71,79 +160,140 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
         let (n, m) = (self.links, 2 * self.links);
         check_states(states, self.len(), m)?;
-        if let Some(torque) = torque {
-            check_len("torque", torque, self.len(), n)?;
-        }
-        if let Some(pivot) = pivot {
-            check_len("pivot", pivot, self.len(), 2)?;
-        }
+        self.check_run(torque, pivot, h)?;
         let solves = n.saturating_mul(4).saturating_mul(steps);
         Ok(for_blocks(
             states,
             1,
             solves,
-            || Run::new(n),
+            || Run::<F64x4>::new(n),
             |s, b, block| {
                 let ids = block_chains::<WIDTH>(b, self.len());
                 let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(block.len() - 1));
-                let mut failures = Vec::new();
-                let mut alive = [0u64; WIDTH];
-                for (k, state) in block.iter().enumerate() {
-                    let c = ids[k];
-                    let bad = non_finite("x", state.x().as_slice())
-                        .or_else(|| torque.and_then(|t| non_finite("torque", &t[c * n..(c + 1) * n])))
-                        .or_else(|| {
-                            pivot.and_then(|p| non_finite("pivot_acceleration", &p[2 * c..2 * c + 2]))
-                        });
-                    match bad {
-                        Some(error) => failures.push(Failure { chain: c, error }),
-                        None => alive[k] = 1,
-                    }
-                }
-                s.torqued = torque.map_or([0; WIDTH], |t| gather_torques(t, ids, n, &mut s.solve.torque));
-                s.pivot = match pivot {
-                    Some(p) => [Lanes::from_fn(|k| p[2 * ids[k]]), Lanes::from_fn(|k| p[2 * ids[k] + 1])],
-                    None => [Lanes([0.0; WIDTH]); 2],
-                };
-                let ran = alive;
-                into_lanes(lanes.map(|k| &block[k]), m, &mut s.t, &mut s.x, &mut s.carry);
+                let (mut failures, ran) =
+                    start(s, (ids, block.len(), n), (torque, pivot), |k| block[k].x().as_slice());
+                let mut alive = ran.map(u64::from);
+                let mut t = [Lanes([0.0; WIDTH]); 2];
+                into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
+                let lanes_h = Lanes([h; WIDTH]);
                 for _ in 0..steps {
                     if alive == [0; WIDTH] {
                         break;
                     }
-                    let t = s.t[0];
-                    let failed = self.rk4_step_simd(b, h, alive, s);
-                    for k in (0..block.len()).filter(|&k| failed[k] != 0) {
-                        let error = Error::NonFiniteState { t: t.0[k], h };
+                    let failed = self.rk4_step_simd(&self.blocks[b.min(self.blocks.len() - 1)], h, alive, s);
+                    let keep = F64x4::and_not(alive, failed);
+                    let (new_t, new_carry) = kahan_add(t[0], t[1], lanes_h);
+                    for (k, _) in failed.iter().enumerate().filter(|(_, f)| **f != 0) {
+                        let error = Error::NonFiniteState { t: t[0].0[k], h };
                         failures.push(Failure { chain: ids[k], error });
-                        alive[k] = 0;
                     }
+                    t = [F64x4::select(keep, new_t, t[0]), F64x4::select(keep, new_carry, t[1])];
+                    alive = keep;
                 }
-                out_of_lanes(block.iter_mut(), ran, m, (&s.t, &s.x, &s.carry));
+                out_of_lanes(block.iter_mut(), ran.map(u64::from), m, (&t, &s.x, &s.carry));
                 failures.sort_by_key(|f| f.chain);
                 failures
             },
         ))
     }
 
+    /// [`integrate_rk4`](Self::integrate_rk4) in single precision: the states as `B` rows
+    /// of `2n` of `x`, `(θ, θ̇)` (numpy's `(B, 2n)` in `f32`), and their rounding
+    /// compensations the same way in `carry` (zeros to start; kept from call to call, `n`
+    /// calls of one step equal one call of `n` steps), both overwritten; eight chains per
+    /// AVX2 register, each chain's constants rounded to `f32`, the sines from the
+    /// single-precision kernel. Not bit for bit anything: its error against the `f64` run
+    /// is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, in order, as [`integrate_rk4`](Self::integrate_rk4)
+    /// does (a failed step's time counted from the call's start), their rows left at the
+    /// last good state. Errors as there, and [`Error::LengthMismatch`] for a `carry` not
+    /// the size of `x`.
+    pub fn integrate_rk4_f32(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        torque: Option<&[f32]>,
+        pivot: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        let (n, m) = (self.links, 2 * self.links);
+        check_len("x", x, self.len(), m)?;
+        check_len("carry", carry, self.len(), m)?;
+        self.check_run(torque, pivot, h)?;
+        let solves = n.saturating_mul(4).saturating_mul(steps);
+        let mut chains: Vec<(&mut [f32], &mut [f32])> = x.chunks_mut(m).zip(carry.chunks_mut(m)).collect();
+        Ok(for_blocks_of::<WIDTH_F32, _, _, _>(
+            &mut chains,
+            1,
+            solves,
+            || Run::<F32x8>::new(n),
+            |s, b, block| {
+                let (ids, count) = (block_chains::<WIDTH_F32>(b, self.len()), block.len());
+                let (mut failures, ran) = start(s, (ids, count, n), (torque, pivot), |k| &*block[k].0);
+                let mut alive = ran.map(u32::from);
+                let lanes: [usize; WIDTH_F32] = std::array::from_fn(|k| k.min(count - 1));
+                gather_rows(lanes.map(|k| &*block[k].0), m, Lanes32::flatten_mut(&mut s.x));
+                gather_rows(lanes.map(|k| &*block[k].1), m, Lanes32::flatten_mut(&mut s.carry));
+                let constants = &self.blocks_f32[b.min(self.blocks_f32.len() - 1)];
+                for step in 0..steps {
+                    if alive == [0; WIDTH_F32] {
+                        break;
+                    }
+                    let failed = self.rk4_step_simd(constants, h, alive, s);
+                    for (k, _) in failed.iter().enumerate().filter(|(_, f)| **f != 0) {
+                        let error = Error::NonFiniteState { t: step as f64 * h, h };
+                        failures.push(Failure { chain: ids[k], error });
+                    }
+                    alive = F32x8::and_not(alive, failed);
+                }
+                // Every row back (lanes that did not step hold the numbers they came with).
+                if count == WIDTH_F32 {
+                    let (mut xs, mut carries): ([&mut [f32]; WIDTH_F32], [&mut [f32]; WIDTH_F32]) =
+                        Default::default();
+                    for (k, (x, carry)) in block.iter_mut().enumerate() {
+                        (xs[k], carries[k]) = (&mut **x, &mut **carry);
+                    }
+                    scatter_rows(Lanes32::flatten(&s.x), m, xs);
+                    scatter_rows(Lanes32::flatten(&s.carry), m, carries);
+                } else {
+                    for (k, (x, carry)) in block.iter_mut().enumerate() {
+                        for (j, (x, carry)) in x.iter_mut().zip(carry.iter_mut()).enumerate() {
+                            (*x, *carry) = (s.x[j].0[k], s.carry[j].0[k]);
+                        }
+                    }
+                }
+                failures.sort_by_key(|f| f.chain);
+                failures
+            },
+        ))
+    }
+
+    /// Checks a run's step and inputs: torques `B` rows of `n`, pivots `B` rows of 2.
+    fn check_run<T>(&self, torque: Option<&[T]>, pivot: Option<&[T]>, h: f64) -> Result<()> {
+        if !h.is_finite() || h == 0.0 {
+            return Err(Error::InvalidStepSize { h });
+        }
+        if let Some(torque) = torque {
+            check_len("torque", torque, self.len(), self.links)?;
+        }
+        pivot.map_or(Ok(()), |p| check_len("pivot", p, self.len(), 2))
+    }
+
     simd_kernel! {
-        /// One step of [`Rk4`](crate::integrate::Rk4) in lanes, applied only in the `alive`
-        /// lanes: the stages, the increment `h (k1 + 2 k2 + 2 k3 + k4) / 6`, then `t += h`
-        /// and `x += increment` by compensated summation ([`State`]'s). Returns the alive
-        /// lanes whose increment was not finite (left as they were).
-        fn rk4_step(&self, b: usize, h: f64, alive: [u64; WIDTH], s: &mut Run) -> [u64; WIDTH] {
-            let block = &self.blocks[b.min(self.blocks.len() - 1)];
-            let Run { solve, pivot, torqued, t: [t, t_carry], x, carry, y, k: [k1, k2, k3, k4] } = s;
+        /// One step of [`Rk4`](crate::integrate::Rk4) in lanes `V` for the chains of
+        /// `block`, applied only in the `alive` lanes: the stages, the increment
+        /// `h (k1 + 2 k2 + 2 k3 + k4) / 6`, then `x += increment` by compensated summation
+        /// ([`State`]'s). Returns the alive lanes whose increment was not finite (left as
+        /// they were).
+        fn rk4_step<V: RunLane>(&self, block: &Block<V>, h: f64, alive: V::Mask, s: &mut Run<V>) -> V::Mask {
+            let Run { solve, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
             let inputs = (*pivot, *torqued);
-            let half = 0.5 * h;
             rates(block, inputs, x, solve, k1);
             // k_{j+1} = f(y) at y = x + a k_j, as nalgebra's `axpy(a, k_j, 1.0)` forms it.
-            let a_half = Lanes([half; WIDTH]);
+            let (a_half, a_full) = (V::splat(0.5 * h), V::splat(h));
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k1) {
                 *y = a_half * *k + *x;
             }
@@ -152,43 +302,80 @@ impl PlanarBatch {
                 *y = a_half * *k + *x;
             }
             rates(block, inputs, y, solve, k3);
-            let a_full = Lanes([h; WIDTH]);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k3) {
                 *y = a_full * *k + *x;
             }
             rates(block, inputs, y, solve, k4);
-            let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
+            let (sixth, two) = (V::splat(h / 6.0), V::splat(2.0));
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
                 *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
             }
-            let bad = non_finite_lanes(y);
-            let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !bad[k]);
-            let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; WIDTH]));
-            (*t, *t_carry) = (F64x4::select(keep, new_t, *t), F64x4::select(keep, new_carry, *t_carry));
+            let bad = V::non_finite(y);
+            let keep = V::and_not(alive, bad);
             for ((x, carry), y) in x.iter_mut().zip(carry.iter_mut()).zip(&*y) {
                 let (new, new_carry) = kahan_add(*x, *carry, *y);
-                (*x, *carry) = (F64x4::select(keep, new, *x), F64x4::select(keep, new_carry, *carry));
+                (*x, *carry) = (V::select(keep, new, *x), V::select(keep, new_carry, *carry));
             }
-            std::array::from_fn(|k| alive[k] & bad[k])
+            V::and(alive, bad)
         }
         dispatch fn rk4_step_simd, rk4_step_avx2
     }
+}
+
+/// A run's joint torques and pivot accelerations, each optional.
+type Inputs<'a, T> = (Option<&'a [T]>, Option<&'a [T]>);
+
+/// A block's start: its first `count` chains `ids` (of `n` links) with a non-finite state
+/// (`x(k)` for chain `ids[k]`) or input, as failures; which ones can step; the inputs into
+/// lanes.
+fn start<'x, V: RunLane, const W: usize>(
+    s: &mut Run<V>,
+    (ids, count, n): ([usize; W], usize, usize),
+    (torque, pivot): Inputs<'_, V::Num>,
+    x: impl Fn(usize) -> &'x [V::Num],
+) -> (Vec<Failure>, [bool; W])
+where
+    V::Num: 'x,
+{
+    let mut failures = Vec::new();
+    let mut ok = [false; W];
+    for (k, &c) in ids.iter().enumerate().take(count) {
+        let bad = non_finite("x", x(k))
+            .or_else(|| torque.and_then(|t| non_finite("torque", &t[c * n..(c + 1) * n])))
+            .or_else(|| pivot.and_then(|p| non_finite("pivot_acceleration", &p[2 * c..2 * c + 2])));
+        match bad {
+            Some(error) => failures.push(Failure { chain: c, error }),
+            None => ok[k] = true,
+        }
+    }
+    s.torqued = match torque {
+        Some(t) => {
+            let flags = gather_torques(t, ids, n, V::flatten_mut(&mut s.solve.torque));
+            V::mask(|k| flags[k])
+        }
+        None => V::none(),
+    };
+    s.pivot = match pivot {
+        Some(p) => [V::from_nums(|k| p[2 * ids[k]]), V::from_nums(|k| p[2 * ids[k] + 1])],
+        None => [V::splat(0.0); 2],
+    };
+    (failures, ok)
 }
 
 /// `x' = (θ̇, θ̈)` of the block's chains at `x = (θ, θ̇)` (`2n` lanes each), into `out`:
 /// [`Block::accelerations`] with the pivot accelerations and torqued lanes `inputs` (the
 /// torques in `s`).
 #[inline(always)]
-fn rates(
-    block: &Block,
-    (pivot, torqued): ([F64x4; 2], [u64; WIDTH]),
-    x: &[F64x4],
-    s: &mut Scratch,
-    out: &mut [F64x4],
+fn rates<V: RunLane>(
+    block: &Block<V>,
+    (pivot, torqued): ([V; 2], V::Mask),
+    x: &[V],
+    s: &mut Scratch<V>,
+    out: &mut [V],
 ) {
     let n = x.len() / 2;
     let (angles, rates) = x.split_at(n);
-    sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(&mut s.sin), Lanes::flatten_mut(&mut s.cos));
+    V::sin_cos(angles, &mut s.sin, &mut s.cos);
     s.rates.copy_from_slice(rates);
     block.accelerations(pivot, torqued, s);
     let (velocities, accelerations) = out.split_at_mut(n);

@@ -129,6 +129,7 @@ class Chain:
         h: float,
         steps: int = 1,
         model: str = "planar",
+        precision: str = "float64",
     ) -> tuple[_Array, _Array]: ...
     def jacobians(
         self,
