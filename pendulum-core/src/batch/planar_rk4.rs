@@ -177,12 +177,12 @@ impl PlanarBatch {
                 let mut alive = ran.map(u64::from);
                 let mut t = [Lanes([0.0; WIDTH]); 2];
                 into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
-                let lanes_h = Lanes([h; WIDTH]);
+                let (constants, lanes_h) = (&self.blocks[b.min(self.blocks.len() - 1)], Lanes([h; WIDTH]));
                 for _ in 0..steps {
                     if alive == [0; WIDTH] {
                         break;
                     }
-                    let failed = self.rk4_step_simd(&self.blocks[b.min(self.blocks.len() - 1)], h, alive, s);
+                    let failed = self.rk4_step_simd(constants, h, alive, s);
                     let keep = F64x4::and_not(alive, failed);
                     let (new_t, new_carry) = kahan_add(t[0], t[1], lanes_h);
                     for (k, _) in failed.iter().enumerate().filter(|(_, f)| **f != 0) {
