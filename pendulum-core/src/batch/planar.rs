@@ -15,7 +15,7 @@ use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
-use crate::rods::{Load, Rods, Rows};
+use crate::rods::{Load, Rods, Rows, damping_pull, pull};
 
 /// `B` planar chains with the same number of links `n`, in absolute link angles (rad) as
 /// [`PlanarTension`]: each chain's own masses, lengths, damping and gravity, and per call
@@ -91,13 +91,13 @@ impl<V: Lane> Block<V> {
         if V::any(torqued) {
             let inverse_length = self.rods.inverse_length();
             for (i, load) in s.loads.iter_mut().enumerate() {
-                let damped = -drag[i] * s.rates[i];
-                let pull = s.torque[i] * inverse_length[i] - drag[i] * s.rates[i];
-                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], V::select(torqued, pull, damped));
+                let torqued_pull = pull(s.torque[i], inverse_length[i], drag[i], s.rates[i]);
+                let pull = V::select(torqued, torqued_pull, damping_pull(drag[i], s.rates[i]));
+                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], pull);
             }
         } else {
             for (i, load) in s.loads.iter_mut().enumerate() {
-                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], -drag[i] * s.rates[i]);
+                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], damping_pull(drag[i], s.rates[i]));
             }
         }
         let loads = &s.loads;

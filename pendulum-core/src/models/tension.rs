@@ -11,7 +11,7 @@ use crate::lanes::Lane;
 use crate::model::all_finite;
 use crate::model::{Inputs, Model, ModelAlloc, check_inputs};
 use crate::models::planar::Planar;
-use crate::rods::{Load, PlanarTangents, RodConstants, Rods, with_scratch};
+use crate::rods::{Load, PlanarTangents, RodConstants, Rods, damping_pull, pull, with_scratch};
 
 /// A planar chain in absolute link angles, exactly [`Planar`] except for
 /// [`accelerations`](Model::accelerations), which solve the rod tensions (a symmetric
@@ -113,11 +113,11 @@ where
             // Without torques (the common case) the pull is the damping's alone.
             if all_zero(torque) {
                 for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
-                    *load = build(trig, qd[i], -drag[i] * qd[i]);
+                    *load = build(trig, qd[i], damping_pull(drag[i], qd[i]));
                 }
             } else {
                 for (i, (load, &trig)) in loads.iter_mut().zip(&*sin_cos).enumerate() {
-                    *load = build(trig, qd[i], torque[i] * inverse_length[i] - drag[i] * qd[i]);
+                    *load = build(trig, qd[i], pull(torque[i], inverse_length[i], drag[i], qd[i]));
                 }
             }
             let loads = &*loads;

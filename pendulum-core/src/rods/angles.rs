@@ -31,7 +31,7 @@ use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, U2, allocator::Allocator
 
 use crate::model::Inputs;
 
-use super::{Continuants, RodConstants};
+use super::{Continuants, RodConstants, pull};
 use crate::kinematics::trig::sin_cos_into;
 
 /// The joint above link `j` (between links `j − 1` and `j`, module docs): `C_j`, `S_j` and
@@ -115,8 +115,7 @@ where
         sin_cos_into(q, trig.as_mut_slice());
         let mut links = OVector::<Link, L>::from_fn_generic(dim, U1, |i, _| {
             let [sin, cos] = trig[i];
-            let pull = torque[i] * il[i] - drag[i] * qd[i];
-            Link { sin, cos, rate: qd[i], pull, ..Link::default() }
+            Link { sin, cos, rate: qd[i], pull: pull(torque[i], il[i], drag[i], qd[i]), ..Link::default() }
         });
         let ls = links.as_mut_slice();
         for j in 1..n {
@@ -189,7 +188,7 @@ where
         let (links, work) = (self.links.as_slice(), self.work.as_mut_slice());
         let columns = Columns { links, rods: self.rods, gravity: self.gravity, pivot: self.pivot };
         let (dq, dqd, dtorque, out) = (&dq[..n], &dqd[..n], &dtorque[..n], &mut out[..n]);
-        let dpull = |i: usize| dtorque[i] * il[i] - drag[i] * dqd[i];
+        let dpull = |i: usize| pull(dtorque[i], il[i], drag[i], dqd[i]);
         let mut e_above = 0.0;
         for i in 0..n {
             let here = &links[i];

@@ -75,6 +75,21 @@ pub struct RodConstants<'a> {
     pub drag: &'a [f64],
 }
 
+/// The pull on planar rod `i` (N), `f_i = Q_i/l_i − (λ_i/l_i) θ̇_i`, from the joint torque
+/// `Q_i` (N·m), `1/l_i`, the drag `λ_i/l_i` (N·s) and the rate `θ̇_i` (rad/s); linear, so
+/// also its change along `(δQ, δθ̇)`.
+#[inline(always)]
+pub(crate) fn pull<V: Lane>(torque: V, inverse_length: V, drag: V, rate: V) -> V {
+    torque * inverse_length - drag * rate
+}
+
+/// [`pull`] of a chain without torques, as the model forms it then: `−(λ_i/l_i) θ̇_i`
+/// (the same number but for the sign of a zero).
+#[inline(always)]
+pub(crate) fn damping_pull<V: Lane>(drag: V, rate: V) -> V {
+    -drag * rate
+}
+
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
 /// force pair `F_i` (N) acting on it (on mass `i`; the opposite on mass `i−1`).
 #[derive(Debug, Clone, Copy)]
