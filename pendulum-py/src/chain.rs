@@ -1,8 +1,7 @@
 //! `pendulum.Chain`: a chain's parameters, and its models evaluated on numpy arrays —
 //! accelerations, the terms of `M q̈ + c + k + d = Q`, energies and the analytic Jacobians —
-//! for one state or a leading batch of them; its normal modes and linearisation.
-
-use std::sync::atomic::AtomicBool;
+//! for one state or a leading batch of them; their RK4 runs (`integrate`, `trajectory`, in
+//! `planar_runs`); its normal modes and linearisation.
 
 use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
 use numpy::PyArray1;
@@ -15,8 +14,7 @@ use rayon::prelude::*;
 use crate::arrays::{Rows, array, per_link};
 use crate::detach::{PARALLEL_FROM, maybe_detached};
 use crate::errors::{core_error, invalid, run_error};
-use crate::interrupt::interruptible;
-use crate::planar_runs::{Rows as StateRows, SOLVES_PER_CHUNK, planar_rk4, planar_rk4_f32};
+use crate::planar_runs::{Plan, planar_run};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use pendulum_experiment::options::{expand, links};
 
@@ -120,6 +118,27 @@ impl Chain {
         let torque = Rows::read_like("torque", torque, dof, &q)?;
         let pivot = Rows::read_like("pivot_acceleration", pivot, space, &q)?;
         Ok(Batch { q, qd, torque, pivot })
+    }
+
+    /// `integrate` and `trajectory`: the planar model's run of `plan` from the states `q`
+    /// (`qd`, torques and pivot accelerations as for `accelerations`), in `precision`.
+    fn run_planar<'py>(
+        &self,
+        py: Python<'py>,
+        [q]: [&Bound<'py, PyAny>; 1],
+        [qd, torque, pivot]: [Option<&Bound<'py, PyAny>>; 3],
+        plan: Plan,
+        model: &str,
+        precision: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if Kind::of(model)? != Kind::Planar {
+            return Err(invalid("integrate: serves model='planar' only"));
+        }
+        if !(plan.h.is_finite() && plan.h > 0.0) {
+            return Err(invalid(format!("h: {} is not a positive time step (s)", plan.h)));
+        }
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
+        planar_run(py, &self.inner, [b.q, b.qd, b.torque, b.pivot], plan, precision)
     }
 }
 
@@ -464,21 +483,35 @@ impl Chain {
         steps: i64,
         model: &str,
         precision: &str,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let steps = usize::try_from(steps)
-            .map_err(|_| invalid(format!("steps: {steps} is not a number of steps (0 or more)")))?;
-        if Kind::of(model)? != Kind::Planar {
-            return Err(invalid("integrate: serves model='planar' only"));
-        }
-        if !(h.is_finite() && h > 0.0) {
-            return Err(invalid(format!("h: {h} is not a positive time step (s)")));
-        }
-        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
-        match precision {
-            "float64" => integrate_with(py, &self.inner, b, (h, steps), planar_rk4),
-            "float32" => integrate_with(py, &self.inner, b, (h, steps), planar_rk4_f32),
-            _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
-        }
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let plan = Plan { h, steps: count("steps", steps)?, every: None };
+        self.run_planar(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
+    }
+
+    /// `(t, q, qd)`: `integrate`'s run sampled at the start, after every `every`-th step and
+    /// after the last: `t` (s) of shape `(samples,)`, `q` and `qd` of shape `(samples, ...)`
+    /// with the states' own shape after the first axis (the states' times start at 0).
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps, every = 1, model = "planar", precision = "float64"))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
+    fn trajectory<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
+        h: f64,
+        steps: i64,
+        every: i64,
+        model: &str,
+        precision: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let every = match count("every", every)? {
+            0 => return Err(invalid("every: 0 is not a number of steps (1 or more)")),
+            every => every,
+        };
+        let plan = Plan { h, steps: count("steps", steps)?, every: Some(every) };
+        self.run_planar(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
@@ -612,43 +645,8 @@ where
     pendulum_core::linearize(model, &s.q, &s.qd, &s.inputs, tolerance)
 }
 
-/// The signature of [`planar_rk4`] and [`planar_rk4_f32`].
-type PlanarRun<T> = fn(
-    &pendulum_core::Chain<Dyn>,
-    &StateRows<'_>,
-    (f64, usize),
-    &AtomicBool,
-) -> pendulum_experiment::Result<(Vec<T>, Vec<T>)>;
-
-/// `Chain.integrate` of the states and inputs `b` by `run`: here for a few milliseconds'
-/// work, on a thread of its own that Ctrl-C can stop otherwise; `(q, qd)` shaped as `b.q`.
-fn integrate_with<'py, T: numpy::Element + Send + 'static>(
-    py: Python<'py>,
-    chain: &pendulum_core::Chain<Dyn>,
-    b: Batch,
-    (h, steps): (f64, usize),
-    run: PlanarRun<T>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let (lead, width) = (b.q.lead.clone(), b.q.width);
-    let (q, qd) = if b.q.data.is_empty() {
-        (Vec::new(), Vec::new())
-    } else {
-        let chain = chain.clone();
-        let work = move |stop: &AtomicBool| {
-            let [q, qd, torque, pivot] = [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data];
-            run(&chain, &StateRows { lead: &b.q.lead, q, qd, torque, pivot }, (h, steps), stop)
-        };
-        if b_solves(&lead, width, steps) <= SOLVES_PER_CHUNK {
-            // A few milliseconds at most: here, without a thread of its own.
-            work(&AtomicBool::new(false)).map_err(run_error)?
-        } else {
-            interruptible(py, "integrate", work)?.map_err(run_error)?
-        }
-    };
-    Ok((array(py, q, &lead, &[width])?.into_any(), array(py, qd, &lead, &[width])?.into_any()))
-}
-
-/// Rods' solves of `steps` steps of the states of leading shape `lead` (`width` links).
-fn b_solves(lead: &[usize], width: usize, steps: usize) -> usize {
-    lead.iter().product::<usize>().saturating_mul(width).saturating_mul(4).saturating_mul(steps)
+/// A count of steps from Python: `what` is refused in one line when negative.
+fn count(what: &str, value: i64) -> PyResult<usize> {
+    usize::try_from(value)
+        .map_err(|_| invalid(format!("{what}: {value} is not a number of steps (0 or more)")))
 }

@@ -1,61 +1,145 @@
-//! `Chain.integrate`: RK4 steps of many planar chains in lanes, their torques and pivot
-//! accelerations held (`PlanarBatch::integrate_rk4` in double precision, bit for bit each
-//! state alone; `integrate_rk4_f32` in single), in chunks of steps between which Ctrl-C is
-//! looked at.
+//! `Chain.integrate` and `Chain.trajectory`: RK4 steps of many planar chains in lanes, their
+//! torques and pivot accelerations held (`PlanarBatch::integrate_rk4` in double precision,
+//! bit for bit each state alone; `integrate_rk4_f32` in single), in chunks of steps between
+//! which Ctrl-C is looked at, the states sampled every so many steps if asked.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::{DVector, Dyn};
+use numpy::PyArray1;
 use pendulum_core::batch::{Failure, PlanarBatch};
 use pendulum_core::integrate::State;
 use pendulum_experiment::Error;
+use pyo3::prelude::*;
+
+use crate::arrays::{Rows, array};
+use crate::errors::{invalid, run_error};
+use crate::interrupt::interruptible;
 
 /// Rods' solves per chunk of a batched integration: Ctrl-C is looked at between chunks
 /// (a few milliseconds each).
-pub const SOLVES_PER_CHUNK: usize = 1 << 20;
+const SOLVES_PER_CHUNK: usize = 1 << 20;
 
-/// The numbers of one integration: the rows of `q`, `q̇`, the torques (`n` each) and the
-/// pivot accelerations (2) of every state, with the leading shape that named them.
-pub struct Rows<'a> {
-    pub lead: &'a [usize],
-    pub q: &'a [f64],
-    pub qd: &'a [f64],
-    pub torque: &'a [f64],
-    pub pivot: &'a [f64],
+/// The steps of a run: `steps` of `h` (s), the states sampled at the start, after every
+/// `every`-th step and after the last (`None`: only after the last).
+#[derive(Debug, Clone, Copy)]
+pub struct Plan {
+    pub h: f64,
+    pub steps: usize,
+    pub every: Option<usize>,
 }
 
-/// `steps` RK4 steps of `h` (s) of the planar chain from each state with its inputs held:
-/// [`PlanarBatch::integrate_rk4`] on every core, in chunks (the same bits as one call).
-/// The new `(q, q̇)`; a failed state is an error naming its index.
-pub fn planar_rk4(
+impl Plan {
+    /// The steps after which the states are sampled (0 for the start).
+    fn samples(&self) -> Vec<usize> {
+        match self.every {
+            None => vec![self.steps],
+            Some(every) => {
+                let mut at: Vec<usize> = (0..self.steps).step_by(every).collect();
+                at.push(self.steps);
+                at
+            }
+        }
+    }
+}
+
+/// A run's states `q`, `q̇` at its samples, one block of `count × n` numbers after another.
+struct Samples<T> {
+    q: Vec<T>,
+    qd: Vec<T>,
+}
+
+/// The run of `Chain.integrate` (`plan.every` `None`: `(q, qd)` shaped as `q`) or
+/// `Chain.trajectory` (`(t, q, qd)`, the samples along a first axis) of the states and
+/// inputs `rows` (`q`, `qd`, torques, pivot accelerations) in `precision`: here for a few
+/// milliseconds' work, on a thread of its own that Ctrl-C can stop otherwise.
+pub fn planar_run<'py>(
+    py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
-    rows: &Rows<'_>,
-    (h, steps): (f64, usize),
+    rows: [Rows; 4],
+    plan: Plan,
+    precision: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    match precision {
+        "float64" => run_in(py, chain, rows, plan, planar_rk4),
+        "float32" => run_in(py, chain, rows, plan, planar_rk4_f32),
+        _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+    }
+}
+
+/// [`planar_rk4`] or [`planar_rk4_f32`].
+type PlanarRun<T> =
+    fn(&pendulum_core::Chain<Dyn>, [&Rows; 4], Plan, &AtomicBool) -> pendulum_experiment::Result<Samples<T>>;
+
+/// [`planar_run`] in one precision's `run`.
+fn run_in<'py, T: numpy::Element + Copy + Default + Send + 'static>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, torque, pivot]: [Rows; 4],
+    plan: Plan,
+    run: PlanarRun<T>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (lead, width, count) = (q.lead.clone(), q.width, q.count());
+    let times = plan.samples();
+    let samples = if count == 0 {
+        Samples { q: Vec::new(), qd: Vec::new() }
+    } else {
+        let chain = chain.clone();
+        let work = move |stop: &AtomicBool| run(&chain, [&q, &qd, &torque, &pivot], plan, stop);
+        let solves = count.saturating_mul(width).saturating_mul(4).saturating_mul(plan.steps);
+        if solves <= SOLVES_PER_CHUNK {
+            // A few milliseconds at most: here, without a thread of its own.
+            work(&AtomicBool::new(false)).map_err(run_error)?
+        } else {
+            interruptible(py, "the integration", work)?.map_err(run_error)?
+        }
+    };
+    let (q, qd) = (samples.q, samples.qd);
+    if plan.every.is_none() {
+        return Ok((array(py, q, &lead, &[width])?, array(py, qd, &lead, &[width])?)
+            .into_pyobject(py)?
+            .into_any());
+    }
+    let shape: Vec<usize> = std::iter::once(times.len()).chain(lead.iter().copied()).collect();
+    let t = PyArray1::from_vec(py, times.iter().map(|&k| k as f64 * plan.h).collect());
+    let (q, qd) = (array(py, q, &shape, &[width])?, array(py, qd, &shape, &[width])?);
+    Ok((t, q, qd).into_pyobject(py)?.into_any())
+}
+
+/// `plan` for the planar chain from each state of `q`, `qd` with its torques and pivot
+/// acceleration held: [`PlanarBatch::integrate_rk4`] on every core, in chunks (the same
+/// bits as one call). A failed state is an error naming its index.
+fn planar_rk4(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, torque, pivot]: [&Rows; 4],
+    plan: Plan,
     stop: &AtomicBool,
-) -> pendulum_experiment::Result<(Vec<f64>, Vec<f64>)> {
+) -> pendulum_experiment::Result<Samples<f64>> {
     let n = chain.links();
-    let batch = PlanarBatch::repeated(chain.clone(), rows.q.len() / n).map_err(core)?;
-    let mut states: Vec<State<Dyn>> = rows
-        .q
+    let batch = PlanarBatch::repeated(chain.clone(), q.count()).map_err(core)?;
+    let mut states: Vec<State<Dyn>> = q
+        .data
         .chunks_exact(n)
-        .zip(rows.qd.chunks_exact(n))
+        .zip(qd.data.chunks_exact(n))
         .map(|(q, qd)| State::new(0.0, DVector::from_iterator(2 * n, q.iter().chain(qd).copied())))
         .collect();
-    in_chunks(n, rows, steps, stop, |now| {
-        batch.integrate_rk4(&mut states, Some(rows.torque), Some(rows.pivot), h, now)
-    })?;
-    Ok(split(n, states.iter().map(|s| s.x().as_slice())))
+    in_chunks(
+        (&q.lead, n, plan, stop),
+        &mut states,
+        |states, now| batch.integrate_rk4(states, Some(&torque.data), Some(&pivot.data), plan.h, now),
+        |states, samples| split(n, states.iter().map(|s| s.x().as_slice()), samples),
+    )
 }
 
 /// [`planar_rk4`] in single precision ([`PlanarBatch::integrate_rk4_f32`]): the numbers
 /// rounded to `f32` (one past its range is an error), the rounding compensation kept from
 /// chunk to chunk (the same numbers as one call).
-pub fn planar_rk4_f32(
+fn planar_rk4_f32(
     chain: &pendulum_core::Chain<Dyn>,
-    rows: &Rows<'_>,
-    (h, steps): (f64, usize),
+    [q, qd, torque, pivot]: [&Rows; 4],
+    plan: Plan,
     stop: &AtomicBool,
-) -> pendulum_experiment::Result<(Vec<f32>, Vec<f32>)> {
+) -> pendulum_experiment::Result<Samples<f32>> {
     let n = chain.links();
     let narrow = |v: &[f64]| -> pendulum_experiment::Result<Vec<f32>> {
         let out: Vec<f32> = v.iter().map(|&x| x as f32).collect();
@@ -64,59 +148,64 @@ pub fn planar_rk4_f32(
             false => Err(core(pendulum_core::Error::SinglePrecisionOverflow)),
         }
     };
-    let (torque, pivot) = (narrow(rows.torque)?, narrow(rows.pivot)?);
-    let mut x = Vec::with_capacity(2 * rows.q.len());
-    for (q, qd) in rows.q.chunks_exact(n).zip(rows.qd.chunks_exact(n)) {
+    let (torque, pivot) = (narrow(&torque.data)?, narrow(&pivot.data)?);
+    let mut x = Vec::with_capacity(2 * q.data.len());
+    for (q, qd) in q.data.chunks_exact(n).zip(qd.data.chunks_exact(n)) {
         x.extend(narrow(q)?);
         x.extend(narrow(qd)?);
     }
-    let mut carry = vec![0.0f32; x.len()];
-    let batch = PlanarBatch::repeated(chain.clone(), rows.q.len() / n).map_err(core)?;
-    in_chunks(n, rows, steps, stop, |now| {
-        batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), Some(&pivot), h, now)
-    })?;
-    Ok(split(n, x.chunks_exact(2 * n)))
+    let carry = vec![0.0f32; x.len()];
+    let batch = PlanarBatch::repeated(chain.clone(), q.count()).map_err(core)?;
+    in_chunks(
+        (&q.lead, n, plan, stop),
+        &mut (x, carry),
+        |(x, carry), now| batch.integrate_rk4_f32((x, carry), Some(&torque), Some(&pivot), plan.h, now),
+        |(x, _), samples| split(n, x.chunks_exact(2 * n), samples),
+    )
 }
 
-/// `run(steps)` over the chunks of `steps` (about [`SOLVES_PER_CHUNK`] rods' solves each),
-/// `stop` looked at before each; the first failure as the error naming its state.
-fn in_chunks(
-    n: usize,
-    rows: &Rows<'_>,
-    steps: usize,
-    stop: &AtomicBool,
-    mut run: impl FnMut(usize) -> pendulum_core::Result<Vec<Failure>>,
-) -> pendulum_experiment::Result<()> {
-    let chunk = (SOLVES_PER_CHUNK / (4 * rows.q.len()).max(1)).max(1);
-    debug_assert!(n > 0);
+/// `run(states, k)` of `k` steps over the chunks of `plan` (about [`SOLVES_PER_CHUNK`] rods'
+/// solves each, ending at the samples), `stop` looked at before each, and
+/// `sample(states, samples)` at the plan's samples; the first failure as the error naming
+/// its state by its index in the leading shape `lead`.
+fn in_chunks<S, T>(
+    (lead, n, plan, stop): (&[usize], usize, Plan, &AtomicBool),
+    states: &mut S,
+    mut run: impl FnMut(&mut S, usize) -> pendulum_core::Result<Vec<Failure>>,
+    mut sample: impl FnMut(&S, &mut Samples<T>),
+) -> pendulum_experiment::Result<Samples<T>> {
+    let count: usize = lead.iter().product();
+    let chunk = (SOLVES_PER_CHUNK / (4 * n * count).max(1)).max(1);
+    let mut samples = Samples { q: Vec::new(), qd: Vec::new() };
     let mut done = 0;
-    while done < steps {
-        if stop.load(Ordering::Relaxed) {
-            return Err(Error::interrupted("integrate: interrupted"));
+    for next in plan.samples() {
+        while done < next {
+            if stop.load(Ordering::Relaxed) {
+                return Err(Error::interrupted("the integration was interrupted"));
+            }
+            let now = chunk.min(next - done);
+            let failures = run(states, now).map_err(core)?;
+            if let Some(first) = failures.first() {
+                let more = match failures.len() {
+                    1 => String::new(),
+                    k => format!(" ({} more states failed too)", k - 1),
+                };
+                let (index, error) = (numpy_index(first.chain, lead), &first.error);
+                return Err(Error::failed(format!("integrate: state {index}: {error}{more}")));
+            }
+            done += now;
         }
-        let now = chunk.min(steps - done);
-        let failures = run(now).map_err(core)?;
-        if let Some(first) = failures.first() {
-            let more = match failures.len() {
-                1 => String::new(),
-                k => format!(" ({} more states failed too)", k - 1),
-            };
-            let (index, error) = (numpy_index(first.chain, rows.lead), &first.error);
-            return Err(Error::failed(format!("integrate: state {index}: {error}{more}")));
-        }
-        done += now;
+        sample(states, &mut samples);
     }
-    Ok(())
+    Ok(samples)
 }
 
-/// Rows of `(θ, θ̇)` as the tables of `θ` and of `θ̇`.
-fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>) -> (Vec<T>, Vec<T>) {
-    let (mut q, mut qd) = (Vec::new(), Vec::new());
+/// Rows of `(θ, θ̇)` appended to the samples' `θ` and `θ̇`.
+fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, samples: &mut Samples<T>) {
     for row in rows {
-        q.extend_from_slice(&row[..n]);
-        qd.extend_from_slice(&row[n..2 * n]);
+        samples.q.extend_from_slice(&row[..n]);
+        samples.qd.extend_from_slice(&row[n..2 * n]);
     }
-    (q, qd)
 }
 
 fn core(e: pendulum_core::Error) -> Error {

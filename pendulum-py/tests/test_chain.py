@@ -314,6 +314,30 @@ def test_integrate_keeps_the_energy_of_an_undamped_chain_and_the_period_of_a_sma
     assert abs(q1[0] - 1e-4) < 1e-11 and abs(qd1[0]) < 1e-10
 
 
+def test_a_trajectory_samples_the_run_that_integrate_ends_with():
+    rng = np.random.default_rng(5)
+    chain = pendulum.Chain(rng.uniform(0.1, 1.0, 4), rng.uniform(0.1, 1.0, 4), damping=0.01)
+    q, qd = rng.uniform(-2, 2, (3, 2, 4)), rng.uniform(-1, 1, (3, 2, 4))
+    for precision in ["float64", "float32"]:
+        t, qs, qds = chain.trajectory(q, qd, h=1e-3, steps=250, every=100, precision=precision)
+        np.testing.assert_array_equal(t, [0.0, 0.1, 0.2, 0.25])
+        assert qs.shape == qds.shape == (4, 3, 2, 4)
+        np.testing.assert_array_equal(qs[0], q.astype(qs.dtype))
+        end = chain.integrate(q, qd, h=1e-3, steps=250, precision=precision)
+        np.testing.assert_array_equal(qs[-1], end[0])
+        np.testing.assert_array_equal(qds[-1], end[1])
+        # A sample is the run up to it.
+        middle = chain.integrate(q, qd, h=1e-3, steps=200, precision=precision)
+        np.testing.assert_array_equal(qs[2], middle[0])
+    # A small swing of one link: θ₀ cos ωt at every sample.
+    one = pendulum.Chain(1.0, 0.5)
+    omega = math.sqrt(G / 0.5)
+    t, qs, _ = one.trajectory([1e-4], h=1e-3, steps=3000, every=10)
+    np.testing.assert_allclose(qs[:, 0], 1e-4 * np.cos(omega * t), rtol=0, atol=1e-11)
+    with pytest.raises(ValueError, match="every: 0 is not a number of steps"):
+        one.trajectory([0.1], h=1e-3, steps=10, every=0)
+
+
 def test_a_state_that_blows_up_in_integrate_is_named():
     chain = pendulum.Chain(0.01, [0.01] * 4)
     qd = np.zeros((2, 3, 4))

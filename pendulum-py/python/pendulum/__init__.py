@@ -3,7 +3,9 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 
 - ``Chain``: a chain's parameters and its models evaluated on arrays (accelerations,
   the terms of ``M q̈ + c + k + d = Q``, energies, analytic Jacobians), many states per
-  call along leading axes; its normal modes and linearisation.
+  call along leading axes; many states stepped by RK4 per call (``integrate``, sampled by
+  ``trajectory``, torques and pivot accelerations held); its normal modes and
+  linearisation.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).

@@ -131,6 +131,19 @@ class Chain:
         model: str = "planar",
         precision: str = "float64",
     ) -> tuple[_Array, _Array]: ...
+    def trajectory(
+        self,
+        q: npt.ArrayLike,
+        qd: Optional[npt.ArrayLike] = None,
+        torque: Optional[npt.ArrayLike] = None,
+        pivot_acceleration: Optional[npt.ArrayLike] = None,
+        *,
+        h: float,
+        steps: int,
+        every: int = 1,
+        model: str = "planar",
+        precision: str = "float64",
+    ) -> tuple[_Array, _Array, _Array]: ...
     def jacobians(
         self,
         q: npt.ArrayLike,
