@@ -47,21 +47,19 @@ pub(super) struct Block<V: Lane = F64x4> {
 }
 
 /// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates and joint
-/// torques, and the rows.
-pub(super) struct Scratch<V: Lane = F64x4> {
+/// torques, the solve's room and the accelerations.
+struct Scratch<V: Lane = F64x4> {
     angles: Vec<V>,
-    pub(super) sin: Vec<V>,
-    pub(super) cos: Vec<V>,
-    pub(super) rates: Vec<V>,
-    /// `Q_i` (N·m), read in the lanes flagged by the solve's `torqued` only.
-    pub(super) torque: Vec<V>,
-    loads: Vec<Load<2, V>>,
-    rows: Rows<2, V>,
-    pub(super) accelerations: Vec<V>,
+    sin: Vec<V>,
+    cos: Vec<V>,
+    rates: Vec<V>,
+    torque: Vec<V>,
+    work: Work<V>,
+    accelerations: Vec<V>,
 }
 
 impl<V: Lane> Scratch<V> {
-    pub(super) fn new(links: usize) -> Self {
+    fn new(links: usize) -> Self {
         let lanes = || vec![V::splat(0.0); links];
         Self {
             angles: lanes(),
@@ -69,46 +67,66 @@ impl<V: Lane> Scratch<V> {
             cos: lanes(),
             rates: lanes(),
             torque: lanes(),
-            loads: vec![Load::zero(); links],
-            rows: Rows::with_len(links),
+            work: Work::new(links),
             accelerations: lanes(),
         }
     }
 }
 
+/// The solve's room: the rods' loads and the rows it leaves for its up pass.
+pub(super) struct Work<V: Lane> {
+    loads: Vec<Load<2, V>>,
+    rows: Rows<2, V>,
+}
+
+impl<V: Lane> Work<V> {
+    pub(super) fn new(links: usize) -> Self {
+        Self { loads: vec![Load::zero(); links], rows: Rows::with_len(links) }
+    }
+}
+
+/// A block's joint torques `Q_i` (N·m, lane order) and the lanes that have any: the others'
+/// torques are not read.
+pub(super) type Torques<'a, V> = (&'a [V], <V as Lane>::Mask);
+
 impl<V: Lane> Block<V> {
-    /// `θ̈` (rad/s²) of the block's chains into `s.accelerations`, from `s.sin`, `s.cos`,
-    /// `s.rates` (rad/s), the joint torques `s.torque` (N·m) in the lanes flagged in
-    /// `torqued` and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s tension
-    /// solve, in lanes of any precision. The pull on rod `i` is `Q_i/l_i − λ_i θ̇_i/l_i` in a
-    /// torqued lane and `−λ_i θ̇_i/l_i` in the others, as the model forms it for a chain with
-    /// torques and one without.
+    /// `θ̈` (rad/s²) of the block's chains into `out`, from `[sin θ, cos θ, θ̇ (rad/s)]`, the
+    /// joint torques and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s
+    /// tension solve, in lanes of any precision. The pull on rod `i` is
+    /// `Q_i/l_i − λ_i θ̇_i/l_i` in a lane with torques and `−λ_i θ̇_i/l_i` in the others, as
+    /// the model forms it for a chain with torques and one without.
     #[inline(always)]
-    pub(super) fn accelerations(&self, pivot: [V; 2], torqued: V::Mask, s: &mut Scratch<V>) {
+    pub(super) fn accelerations(
+        &self,
+        [sin, cos, rates]: [&[V]; 3],
+        (torque, torqued): Torques<'_, V>,
+        pivot: [V; 2],
+        work: &mut Work<V>,
+        out: &mut [V],
+    ) {
         // The loads in a pass of their own: built inside the solve, the builder is not
         // inlined (as in the single-chain model).
         let drag = self.rods.drag();
         if V::any(torqued) {
             let inverse_length = self.rods.inverse_length();
-            for (i, load) in s.loads.iter_mut().enumerate() {
-                let torqued_pull = pull(s.torque[i], inverse_length[i], drag[i], s.rates[i]);
-                let pull = V::select(torqued, torqued_pull, damping_pull(drag[i], s.rates[i]));
-                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], pull);
+            for (i, load) in work.loads.iter_mut().enumerate() {
+                let torqued_pull = pull(torque[i], inverse_length[i], drag[i], rates[i]);
+                let pull = V::select(torqued, torqued_pull, damping_pull(drag[i], rates[i]));
+                *load = planar_load(sin[i], cos[i], rates[i], pull);
             }
         } else {
-            for (i, load) in s.loads.iter_mut().enumerate() {
-                *load = planar_load(s.sin[i], s.cos[i], s.rates[i], damping_pull(drag[i], s.rates[i]));
+            for (i, load) in work.loads.iter_mut().enumerate() {
+                *load = planar_load(sin[i], cos[i], rates[i], damping_pull(drag[i], rates[i]));
             }
         }
-        let loads = &s.loads;
-        let accelerations = &mut s.accelerations;
+        let loads = &work.loads;
         self.rods.solve(
             [V::splat(0.0), self.down],
             pivot,
-            &mut s.rows,
+            &mut work.rows,
             |i| loads[i],
             |i, a, u, _| {
-                accelerations[i] = angle_acceleration(a, u);
+                out[i] = angle_acceleration(a, u);
             },
         );
     }
@@ -294,7 +312,8 @@ impl PlanarBatch {
                 Some(p) => [Lanes32::from_fn(|k| p[2 * lanes[k]]), Lanes32::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [Lanes32::splat(0.0); 2],
             };
-            block.accelerations(pivot, F32x8::none(), s);
+            let trig = [&s.sin[..], &s.cos, &s.rates];
+            block.accelerations(trig, (&s.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
         }
         dispatch fn block_f32_simd, block_f32_avx2
@@ -331,7 +350,8 @@ impl PlanarBatch {
                 Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [zero; 2],
             };
-            block.accelerations(pivot, torqued, s);
+            let trig = [&s.sin[..], &s.cos, &s.rates];
+            block.accelerations(trig, (&s.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH>(Lanes::flatten(&s.accelerations), n, out);
         }
         dispatch fn block_simd, block_avx2

@@ -8,7 +8,7 @@
 use nalgebra::Dyn;
 
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
-use super::planar::{Block, Scratch, gather_torques};
+use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_rows};
 use super::{
@@ -108,11 +108,15 @@ impl RunLane for F32x8 {
     }
 }
 
-/// A block's run: the solve's scratch (with the joint torques), the pivot accelerations and
-/// the lanes with torques, the states and their compensations, the stage state `y` (then
-/// the increment) and the stages `k1 … k4`, each `2n` lanes.
+/// A block's run: `sin θ`, `cos θ` of a stage and the solve's room (`n` lanes), the joint
+/// torques, the lanes with torques and the pivot accelerations, the states and their
+/// compensations, the stage state `y` (then the increment) and the stages `k1 … k4`, each
+/// `2n` lanes.
 struct Run<V: RunLane> {
-    solve: Scratch<V>,
+    sin: Vec<V>,
+    cos: Vec<V>,
+    work: Work<V>,
+    torque: Vec<V>,
     pivot: [V; 2],
     torqued: V::Mask,
     x: Vec<V>,
@@ -123,15 +127,18 @@ struct Run<V: RunLane> {
 
 impl<V: RunLane> Run<V> {
     fn new(links: usize) -> Self {
-        let lanes = || vec![V::splat(0.0); 2 * links];
+        let lanes = |len: usize| vec![V::splat(0.0); len];
         Self {
-            solve: Scratch::new(links),
+            sin: lanes(links),
+            cos: lanes(links),
+            work: Work::new(links),
+            torque: lanes(links),
             pivot: [V::splat(0.0); 2],
             torqued: V::none(),
-            x: lanes(),
-            carry: lanes(),
-            y: lanes(),
-            k: [lanes(), lanes(), lanes(), lanes()],
+            x: lanes(2 * links),
+            carry: lanes(2 * links),
+            y: lanes(2 * links),
+            k: [lanes(2 * links), lanes(2 * links), lanes(2 * links), lanes(2 * links)],
         }
     }
 }
@@ -289,23 +296,24 @@ impl PlanarBatch {
         /// ([`State`]'s). Returns the alive lanes whose increment was not finite (left as
         /// they were).
         fn rk4_step<V: RunLane>(&self, block: &Block<V>, h: f64, alive: V::Mask, s: &mut Run<V>) -> V::Mask {
-            let Run { solve, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
-            let inputs = (*pivot, *torqued);
-            rates(block, inputs, x, solve, k1);
+            let Run { sin, cos, work, torque, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
+            // Plain calls, not a closure: a closure is not compiled with the kernel's AVX2.
+            let inputs = ((&torque[..], *torqued), *pivot);
+            rates(block, inputs, x, (sin, cos, work), k1);
             // k_{j+1} = f(y) at y = x + a k_j, as nalgebra's `axpy(a, k_j, 1.0)` forms it.
             let (a_half, a_full) = (V::splat(0.5 * h), V::splat(h));
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k1) {
                 *y = a_half * *k + *x;
             }
-            rates(block, inputs, y, solve, k2);
+            rates(block, inputs, y, (sin, cos, work), k2);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k2) {
                 *y = a_half * *k + *x;
             }
-            rates(block, inputs, y, solve, k3);
+            rates(block, inputs, y, (sin, cos, work), k3);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k3) {
                 *y = a_full * *k + *x;
             }
-            rates(block, inputs, y, solve, k4);
+            rates(block, inputs, y, (sin, cos, work), k4);
             let (sixth, two) = (V::splat(h / 6.0), V::splat(2.0));
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
                 *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
@@ -350,7 +358,7 @@ where
     }
     s.torqued = match torque {
         Some(t) => {
-            let flags = gather_torques(t, ids, n, V::flatten_mut(&mut s.solve.torque));
+            let flags = gather_torques(t, ids, n, V::flatten_mut(&mut s.torque));
             V::mask(|k| flags[k])
         }
         None => V::none(),
@@ -363,22 +371,20 @@ where
 }
 
 /// `x' = (θ̇, θ̈)` of the block's chains at `x = (θ, θ̇)` (`2n` lanes each), into `out`:
-/// [`Block::accelerations`] with the pivot accelerations and torqued lanes `inputs` (the
-/// torques in `s`).
+/// [`Block::accelerations`] with the block's torques and pivot accelerations, the sines and
+/// the solve in the room given.
 #[inline(always)]
 fn rates<V: RunLane>(
     block: &Block<V>,
-    (pivot, torqued): ([V; 2], V::Mask),
+    (torques, pivot): (Torques<'_, V>, [V; 2]),
     x: &[V],
-    s: &mut Scratch<V>,
+    (sin, cos, work): (&mut [V], &mut [V], &mut Work<V>),
     out: &mut [V],
 ) {
     let n = x.len() / 2;
     let (angles, rates) = x.split_at(n);
-    V::sin_cos(angles, &mut s.sin, &mut s.cos);
-    s.rates.copy_from_slice(rates);
-    block.accelerations(pivot, torqued, s);
+    V::sin_cos(angles, sin, cos);
     let (velocities, accelerations) = out.split_at_mut(n);
     velocities.copy_from_slice(rates);
-    accelerations.copy_from_slice(&s.accelerations);
+    block.accelerations([sin, cos, rates], torques, pivot, work, accelerations);
 }
