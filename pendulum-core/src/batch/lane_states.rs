@@ -4,7 +4,7 @@
 
 use nalgebra::Dyn;
 
-use super::transpose::{gather_rows, scatter_rows};
+use super::transpose::{gather_rows, scatter_some_rows};
 use super::{F64x4, WIDTH};
 use crate::integrate::State;
 use crate::lanes::Lanes;
@@ -26,8 +26,8 @@ pub(super) fn into_lanes(
 }
 
 /// The block's states (up to [`WIDTH`], lane `k` for the `k`-th) that `ran` (flag `1`) out
-/// of the lanes [`into_lanes`] filled: a whole block that ran by the tiles' transposes
-/// (one number at a time, this was a quarter of a one-step call), otherwise chain by chain.
+/// of the lanes [`into_lanes`] filled (by the tiles' transposes for a whole block: one
+/// number at a time, this was a quarter of a one-step call).
 #[inline(always)]
 pub(super) fn out_of_lanes<'a>(
     states: impl IntoIterator<Item = &'a mut State<Dyn>>,
@@ -35,24 +35,15 @@ pub(super) fn out_of_lanes<'a>(
     m: usize,
     (t, x, carry): (&[F64x4; 2], &[F64x4], &[F64x4]),
 ) {
-    let mut states = states.into_iter();
-    let mut block: [Option<&mut State<Dyn>>; WIDTH] = std::array::from_fn(|_| states.next());
-    if ran == [1; WIDTH] && block.iter().all(Option::is_some) {
-        let (mut xs, mut carries): ([&mut [f64]; WIDTH], [&mut [f64]; WIDTH]) = Default::default();
-        for (k, state) in block.iter_mut().flatten().enumerate() {
-            let (time, time_carry, x, carry) = state.parts_mut();
-            (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
-            (xs[k], carries[k]) = (x, carry);
-        }
-        scatter_rows(Lanes::flatten(x), m, xs);
-        scatter_rows(Lanes::flatten(carry), m, carries);
-    } else {
-        for (k, state) in block.iter_mut().enumerate() {
-            if let Some(state) = state.as_deref_mut().filter(|_| ran[k] != 0) {
-                state.set_parts(t[0].0[k], t[1].0[k], x.iter().zip(carry).map(|(x, c)| (x.0[k], c.0[k])));
-            }
-        }
+    let mut xs: [Option<&mut [f64]>; WIDTH] = Default::default();
+    let mut carries: [Option<&mut [f64]>; WIDTH] = Default::default();
+    for (k, state) in states.into_iter().enumerate().filter(|(k, _)| ran[*k] != 0) {
+        let (time, time_carry, x, carry) = state.parts_mut();
+        (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
+        (xs[k], carries[k]) = (Some(x), Some(carry));
     }
+    scatter_some_rows(Lanes::flatten(x), m, xs);
+    scatter_some_rows(Lanes::flatten(carry), m, carries);
 }
 
 /// The lanes in which some entry of `v` is not finite (flag `1`): `y − y` is `0` for a

@@ -10,7 +10,7 @@ use nalgebra::Dyn;
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
-use super::transpose::{gather_rows, scatter_rows};
+use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
     F32x8, F64x4, Failure, PlanarBatch, WIDTH, WIDTH_F32, block_chains, check_len, check_states, for_blocks,
     for_blocks_of, non_finite, simd_kernel,
@@ -257,21 +257,13 @@ impl PlanarBatch {
                     alive = F32x8::and_not(alive, failed);
                 }
                 // Every row back (lanes that did not step hold the numbers they came with).
-                if count == WIDTH_F32 {
-                    let (mut xs, mut carries): ([&mut [f32]; WIDTH_F32], [&mut [f32]; WIDTH_F32]) =
-                        Default::default();
-                    for (k, (x, carry)) in block.iter_mut().enumerate() {
-                        (xs[k], carries[k]) = (&mut **x, &mut **carry);
-                    }
-                    scatter_rows(Lanes32::flatten(&s.x), m, xs);
-                    scatter_rows(Lanes32::flatten(&s.carry), m, carries);
-                } else {
-                    for (k, (x, carry)) in block.iter_mut().enumerate() {
-                        for (j, (x, carry)) in x.iter_mut().zip(carry.iter_mut()).enumerate() {
-                            (*x, *carry) = (s.x[j].0[k], s.carry[j].0[k]);
-                        }
-                    }
+                let mut xs: [Option<&mut [f32]>; WIDTH_F32] = Default::default();
+                let mut carries: [Option<&mut [f32]>; WIDTH_F32] = Default::default();
+                for (k, (x, carry)) in block.iter_mut().enumerate() {
+                    (xs[k], carries[k]) = (Some(&mut **x), Some(&mut **carry));
                 }
+                scatter_some_rows(Lanes32::flatten(&s.x), m, xs);
+                scatter_some_rows(Lanes32::flatten(&s.carry), m, carries);
                 failures.sort_by_key(|f| f.chain);
                 failures
             },

@@ -222,6 +222,25 @@ pub(crate) fn scatter_rows<T: Transpose, const W: usize>(lanes: &[T], m: usize, 
     unsafe { scatter_into(lanes, m, starts) };
 }
 
+/// [`scatter_rows`] into the rows given, `None` for a lane left out: by the tiles for a
+/// whole set of `W`, number by number otherwise.
+#[inline(always)]
+pub(crate) fn scatter_some_rows<T: Transpose, const W: usize>(
+    lanes: &[T],
+    m: usize,
+    rows: [Option<&mut [T]>; W],
+) {
+    if rows.iter().all(Option::is_some) {
+        scatter_rows(lanes, m, rows.map(|row| row.expect("every row")));
+        return;
+    }
+    for (k, row) in rows.into_iter().enumerate() {
+        for (j, o) in row.into_iter().flat_map(|row| &mut row[..m]).enumerate() {
+            *o = lanes[W * j + k];
+        }
+    }
+}
+
 /// `*starts[k].add(j) = lanes[W·j + k]` for `j < m`, in `W × W` tiles.
 ///
 /// # Safety
@@ -275,6 +294,21 @@ mod tests {
                 scatter::<T, W>(&lanes, m, &mut out);
                 for k in 0..short {
                     assert_eq!(&out[k * m..(k + 1) * m], &v[m * rows[k]..m * (rows[k] + 1)], "m {m} k {k}");
+                }
+            }
+            // Into rows anywhere: all of them, or some (the others untouched).
+            for skip in [None, Some(1)] {
+                let mut out = vec![T::from(999); W * m];
+                let mut chunks = out.chunks_exact_mut(m);
+                let some: [Option<&mut [T]>; W] =
+                    std::array::from_fn(|k| chunks.next().filter(|_| Some(k) != skip));
+                scatter_some_rows(&lanes, m, some);
+                for (k, row) in out.chunks_exact(m).enumerate() {
+                    let expected: Vec<T> = match Some(k) == skip {
+                        true => vec![T::from(999); m],
+                        false => v[m * rows[k]..m * (rows[k] + 1)].to_vec(),
+                    };
+                    assert_eq!(row, &expected[..], "m {m} k {k} skip {skip:?}");
                 }
             }
         }
