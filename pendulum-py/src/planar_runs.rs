@@ -72,7 +72,7 @@ type PlanarRun<T> =
     fn(&pendulum_core::Chain<Dyn>, [&Rows; 4], Plan, &AtomicBool) -> pendulum_experiment::Result<Samples<T>>;
 
 /// [`planar_run`] in one precision's `run`.
-fn run_in<'py, T: numpy::Element + Copy + Default + Send + 'static>(
+fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [Rows; 4],
