@@ -4,7 +4,8 @@
 //!
 //! One libm `sincos` call costs about as much as the whole tension solve of a link, and
 //! no compiler vectorises it. The loop below runs two angles per instruction with the
-//! baseline x86-64 target (SSE2) and four on CPUs with AVX2 (detected at run time). Both
+//! baseline x86-64 target (SSE2), four on CPUs with AVX2 and eight with AVX-512 (detected
+//! at run time). All
 //! do the same IEEE operations in the same order (no fused multiply-add), so the results
 //! are bit for bit the same on every machine. The kernel is fdlibm's (`k_sin.c`,
 //! `k_cos.c`: error below 1 ulp on `[−π/4, π/4]` given the tail `r_t` of the reduced
@@ -20,6 +21,9 @@
 //! θ ≈ 45.553; for `k = 0`, `r = θ` exactly). Tested against std at random angles, at the
 //! doubles nearest every multiple of π/2 in range and at their neighbours: at most 1 ulp
 //! apart (module tests). The one difference in kind: `sin(−0)` is `+0`.
+
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::{has_avx2, has_avx512};
 
 /// Beyond this `|θ|` (rad), and for non-finite `θ`, [`sin_cos_into`] calls `f64::sin_cos`.
 pub(crate) const LIMIT: f64 = 8192.0;
@@ -91,10 +95,22 @@ fn sin_cos_reduced(theta: f64) -> (f64, f64) {
 /// others (NaN for a non-finite angle, as std).
 pub fn sin_cos_into(angles: &[f64], out: &mut [[f64; 2]]) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if has_avx512() {
+        // SAFETY: the CPU has AVX-512, checked just above.
+        return unsafe { sin_cos_avx512(angles, out) };
+    }
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
         // SAFETY: the CPU has AVX2, checked just above.
         return unsafe { sin_cos_avx2(angles, out) };
     }
+    sin_cos_loop(angles, out)
+}
+
+/// [`sin_cos_loop`] compiled for AVX-512: eight lanes, the same operations.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn sin_cos_avx512(angles: &[f64], out: &mut [[f64; 2]]) {
     sin_cos_loop(angles, out)
 }
 
@@ -126,10 +142,28 @@ fn sin_cos_loop(angles: &[f64], out: &mut [[f64; 2]]) {
 }
 
 /// [`sin_cos_into`]'s values, bit for bit, into two arrays (`sin[i]`, `cos[i]` of
-/// `angles[i]`): the layout of the batch's lanes. Inlined, so that it runs with its
-/// caller's target features.
+/// `angles[i]`): the layout of the batch's lanes. With AVX-512 in its own function, else
+/// inlined, so that it runs with its caller's target features.
 #[inline(always)]
 pub(crate) fn sin_cos_split(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx512() {
+        // SAFETY: the CPU has AVX-512, checked just above.
+        return unsafe { split_avx512(angles, sin, cos) };
+    }
+    split(angles, sin, cos)
+}
+
+/// [`split`] compiled for AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn split_avx512(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    split(angles, sin, cos)
+}
+
+/// The body of [`sin_cos_split`], for whatever target features its caller has.
+#[inline(always)]
+fn split(angles: &[f64], sin: &mut [f64], cos: &mut [f64]) {
     split_with(angles, sin, cos, sin_cos_reduced, in_range, f64::sin_cos)
 }
 
@@ -237,15 +271,40 @@ mod tests {
 
     #[test]
     fn every_instruction_set_gives_the_same_bits() {
-        // sin_cos_into takes the AVX2 loop where the CPU has it; the baseline loop must
-        // agree with it to the bit (and trivially with itself elsewhere).
+        // The baseline loop, the AVX2 and the AVX-512 loops (those the CPU has) and the
+        // split form must agree to the bit, on every length (the vector loops' tails).
         let u = stream(3, 100_003);
         let angles: Vec<f64> = u.iter().map(|x| 1.1 * LIMIT * (2.0 * x - 1.0)).collect();
-        let (mut fast, mut baseline) = (vec![[0.0; 2]; angles.len()], vec![[0.0; 2]; angles.len()]);
-        sin_cos_into(&angles, &mut fast);
-        sin_cos_loop(&angles, &mut baseline);
-        for ((a, b), theta) in fast.iter().zip(&baseline).zip(&angles) {
-            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{theta:e}");
+        let bits = |v: &[[f64; 2]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for len in (0..40).chain([100_003]) {
+            let angles = &angles[..len];
+            let mut baseline = vec![[0.0; 2]; len];
+            sin_cos_loop(angles, &mut baseline);
+            let mut loops: Vec<Vec<[f64; 2]>> = Vec::new();
+            let mut run = |f: &dyn Fn(&mut [[f64; 2]])| {
+                let mut out = vec![[0.0; 2]; len];
+                f(&mut out);
+                loops.push(out);
+            };
+            run(&|out| sin_cos_into(angles, out));
+            run(&|out| {
+                let (mut sin, mut cos) = (vec![0.0; len], vec![0.0; len]);
+                sin_cos_split(angles, &mut sin, &mut cos);
+                out.iter_mut().zip(sin.iter().zip(&cos)).for_each(|(o, (&s, &c))| *o = [s, c]);
+            });
+            #[cfg(target_arch = "x86_64")]
+            if has_avx2() {
+                // SAFETY: the CPU has AVX2.
+                run(&|out| unsafe { sin_cos_avx2(angles, out) });
+            }
+            #[cfg(target_arch = "x86_64")]
+            if has_avx512() {
+                // SAFETY: the CPU has AVX-512.
+                run(&|out| unsafe { sin_cos_avx512(angles, out) });
+            }
+            for out in &loops {
+                assert_eq!(bits(out), bits(&baseline), "{len} angles");
+            }
         }
     }
 
