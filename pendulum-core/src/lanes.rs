@@ -22,13 +22,25 @@ pub(crate) fn has_avx2() -> bool {
 }
 
 /// Whether the CPU has AVX-512 (its foundation, `avx512f`; checked once, then cached by
-/// std): the sine kernels then run eight `f64` (sixteen `f32`) angles per instruction.
+/// std): the sine kernels then run eight `f64` (sixteen `f32`) angles per instruction,
+/// and the planar batch eight chains.
 #[inline(always)]
 pub(crate) fn has_avx512() -> bool {
     #[cfg(target_arch = "x86_64")]
     return std::arch::is_x86_feature_detected!("avx512f");
     #[cfg(not(target_arch = "x86_64"))]
     return false;
+}
+
+/// Ends the body of a loop over rows of lanes (one link's, one state entry's): a compiler
+/// fence, which emits no instruction but keeps LLVM's loop vectorizer from running the
+/// loop across rows, one lane per gather. It did so with eight `f64` lanes under AVX-512,
+/// and the eight-lane planar batch took 1.4× the four-lane one's time at n = 100
+/// (`docs/ensembles.md`); with the fence each operation on a row's lanes is one
+/// instruction.
+#[inline(always)]
+pub(crate) fn one_row_at_a_time() {
+    std::sync::atomic::compiler_fence(std::sync::atomic::Ordering::SeqCst);
 }
 
 /// The arithmetic the tension solve needs, lane by lane.

@@ -36,6 +36,24 @@ fn pools() -> [rayon::ThreadPool; 2] {
     [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
 }
 
+/// The planar batch as built (eight lanes where the CPU has AVX-512) and held to four
+/// lanes, each with a pool of one and of two threads.
+fn widths_and_pools(batch: &PlanarBatch) -> Vec<(PlanarBatch, rayon::ThreadPool)> {
+    [true, false]
+        .into_iter()
+        .flat_map(|avx512| pools().map(|pool| (batch.clone().with_avx512(avx512), pool)))
+        .collect()
+}
+
+#[test]
+fn the_planar_batch_runs_eight_lanes_exactly_where_the_cpu_has_avx512() {
+    let batch = PlanarBatch::new(vec![Chain::uniform(3, 0.1, 0.2, 9.81).expect("chain"); 5]).expect("batch");
+    #[cfg(target_arch = "x86_64")]
+    assert_eq!(batch.uses_avx512(), std::arch::is_x86_feature_detected!("avx512f"));
+    assert!(!batch.clone().with_avx512(false).uses_avx512());
+    assert_eq!(batch.clone().with_avx512(false).with_avx512(true).uses_avx512(), batch.uses_avx512());
+}
+
 #[test]
 fn planar_batch_equals_each_chain_alone_bit_for_bit() {
     let mut r = ChaCha8Rng::seed_from_u64(31);
@@ -65,15 +83,16 @@ fn planar_batch_equals_each_chain_alone_bit_for_bit() {
                 .expect("single");
             single[rows].copy_from_slice(out.as_slice());
         }
-        for pool in pools() {
+        for (batch, pool) in widths_and_pools(&batch) {
             let mut out = vec![0.0; chains * n];
             let failures =
                 pool.install(|| batch.accelerations(&q, &qd, None, Some(&pivot), &mut out)).expect("batch");
             assert!(failures.is_empty(), "{failures:?}");
+            let (threads, avx512) = (pool.current_num_threads(), batch.uses_avx512());
             assert_bits(
                 &out,
                 &single,
-                &format!("{chains} chains of {n}, {} threads", pool.current_num_threads()),
+                &format!("{chains} chains of {n}, {threads} threads, AVX-512 {avx512}"),
             );
         }
         // Split into two calls at every block boundary and off it: the same numbers.
@@ -119,12 +138,22 @@ fn a_failing_chain_is_named_and_the_others_finish() {
     let batch = PlanarBatch::new((0..chains).map(|_| random_chain(n, &mut r)).collect()).expect("batch");
     let mut q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
     let qd = vec![0.5; chains * n];
+    for batch in [batch.clone(), batch.with_avx512(false)] {
+        a_failing_chain_in(&batch, &mut q, &qd);
+    }
+}
+
+/// [`a_failing_chain_is_named_and_the_others_finish`] for one batch of 10 chains of 6.
+fn a_failing_chain_in(batch: &PlanarBatch, q: &mut [f64], qd: &[f64]) {
+    let (chains, n) = (10, 6);
     let mut clean = vec![0.0; chains * n];
-    assert!(batch.accelerations(&q, &qd, None, None, &mut clean).expect("clean").is_empty());
+    let (nan, inf) = (q[5 * n + 2], q[9 * n]);
+    assert!(batch.accelerations(q, qd, None, None, &mut clean).expect("clean").is_empty());
     q[5 * n + 2] = f64::NAN;
     q[9 * n] = f64::INFINITY;
     let mut out = vec![0.0; chains * n];
-    let failures = batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+    let failures = batch.accelerations(q, qd, None, None, &mut out).expect("batch");
+    (q[5 * n + 2], q[9 * n]) = (nan, inf);
     let said: Vec<_> = failures.iter().map(|f| f.to_string()).collect();
     assert_eq!(said, ["chain 5: q[2] must be finite, got NaN", "chain 9: q[0] must be finite, got inf"]);
     assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [5, 9]);
@@ -408,7 +437,7 @@ fn planar_rk4_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
             (0..chains).map(|k| planar_rk4_alone(&chain[k], Some(inputs(k)), &start[k], h, 30)).collect();
         let free: Vec<_> = (0..chains).map(|k| planar_rk4_alone(&chain[k], None, &start[k], h, 30)).collect();
         let (torque, pivot) = (Some(&torque[..]), Some(&pivot[..]));
-        for pool in pools() {
+        for (batch, pool) in widths_and_pools(&batch) {
             // 30 steps in one call, 10 calls of 3, the batch split in two; and free chains.
             let mut run = start.clone();
             assert!(
@@ -427,7 +456,9 @@ fn planar_rk4_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
             let (first, second) = halves.split_at_mut(cut);
             for (range, states) in [(0..cut, first), (cut..chains, second)] {
                 if !range.is_empty() {
-                    let half = PlanarBatch::new(chain[range.clone()].to_vec()).expect("half");
+                    let half = PlanarBatch::new(chain[range.clone()].to_vec())
+                        .expect("half")
+                        .with_avx512(batch.uses_avx512());
                     let (t, p) = (
                         &torque.unwrap()[range.start * n..range.end * n],
                         &pivot.unwrap()[2 * range.start..2 * range.end],
@@ -471,7 +502,6 @@ fn a_planar_chain_that_fails_stops_at_its_last_good_state_and_the_others_run_on(
     let mut r = ChaCha8Rng::seed_from_u64(43);
     let n = 6;
     let chain: Vec<_> = (0..7).map(|_| random_chain(n, &mut r)).collect();
-    let batch = PlanarBatch::new(chain.clone()).expect("batch");
     let x = |rate: f64| State::new(0.0, DVector::from_fn(2 * n, |i, _| if i < n { 0.4 } else { rate }));
     let mut start: Vec<State<Dyn>> = (0..7).map(|_| x(0.5)).collect();
     // Chain 1 starts with a NaN, chain 3 with an infinite torque; chain 5 spins so fast that
@@ -483,8 +513,23 @@ fn a_planar_chain_that_fails_stops_at_its_last_good_state_and_the_others_run_on(
     let mut torque = vec![0.0; 7 * n];
     torque[3 * n + 4] = f64::INFINITY;
     let h = 1e-3;
-    let mut states = start.clone();
-    let failures = batch.integrate_rk4(&mut states, Some(&torque), None, h, 40).expect("batch");
+    for avx512 in [true, false] {
+        let batch = PlanarBatch::new(chain.clone()).expect("batch").with_avx512(avx512);
+        a_planar_chain_that_fails_in(&batch, &chain, (&start, &bad, &torque), h);
+    }
+}
+
+/// [`a_planar_chain_that_fails_stops_at_its_last_good_state_and_the_others_run_on`] for one
+/// batch of 7 chains of 6, from `start` (chain 1's state is `bad`).
+fn a_planar_chain_that_fails_in(
+    batch: &PlanarBatch,
+    chain: &[Chain<Dyn>],
+    (start, bad, torque): (&[State<Dyn>], &DVector<f64>, &[f64]),
+    h: f64,
+) {
+    let n = 6;
+    let mut states = start.to_vec();
+    let failures = batch.integrate_rk4(&mut states, Some(torque), None, h, 40).expect("batch");
     assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 3, 5], "{failures:?}");
     let said = |k: usize| failures[k].error.to_string();
     assert_eq!(said(0), Error::NonFinite { what: "x", index: n + 2, value: f64::NAN }.to_string());

@@ -5,19 +5,18 @@
 use nalgebra::Dyn;
 
 use super::transpose::{gather_rows, scatter_some_rows};
-use super::{F64x4, WIDTH};
 use crate::integrate::State;
-use crate::lanes::Lanes;
+use crate::lanes::{Lanes, one_row_at_a_time};
 
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
 /// into `t`, the states into `x`, their compensations into `carry`.
 #[inline(always)]
-pub(super) fn into_lanes(
-    states: [&State<Dyn>; WIDTH],
+pub(super) fn into_lanes<const W: usize>(
+    states: [&State<Dyn>; W],
     m: usize,
-    t: &mut [F64x4; 2],
-    x: &mut [F64x4],
-    carry: &mut [F64x4],
+    t: &mut [Lanes<W>; 2],
+    x: &mut [Lanes<W>],
+    carry: &mut [Lanes<W>],
 ) {
     let parts = states.map(State::parts);
     *t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
@@ -25,18 +24,18 @@ pub(super) fn into_lanes(
     gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
 }
 
-/// The block's states (up to [`WIDTH`], lane `k` for the `k`-th) that `ran` (flag `1`) out
+/// The block's states (up to `W`, lane `k` for the `k`-th) that `ran` (flag `1`) out
 /// of the lanes [`into_lanes`] filled (by the tiles' transposes for a whole block: one
 /// number at a time, this was a quarter of a one-step call).
 #[inline(always)]
-pub(super) fn out_of_lanes<'a>(
+pub(super) fn out_of_lanes<'a, const W: usize>(
     states: impl IntoIterator<Item = &'a mut State<Dyn>>,
-    ran: [u64; WIDTH],
+    ran: [u64; W],
     m: usize,
-    (t, x, carry): (&[F64x4; 2], &[F64x4], &[F64x4]),
+    (t, x, carry): (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
 ) {
-    let mut xs: [Option<&mut [f64]>; WIDTH] = Default::default();
-    let mut carries: [Option<&mut [f64]>; WIDTH] = Default::default();
+    let mut xs: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
+    let mut carries: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
     for (k, state) in states.into_iter().enumerate().filter(|(k, _)| ran[*k] != 0) {
         let (time, time_carry, x, carry) = state.parts_mut();
         (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
@@ -51,13 +50,14 @@ pub(super) fn out_of_lanes<'a>(
 /// loop of flags was vectorised across entries and transposed back, with spills).
 #[inline(always)]
 #[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
-pub(super) fn non_finite_lanes(v: &[F64x4]) -> [u64; WIDTH] {
-    let mut sums = [Lanes([0.0; WIDTH]); 4];
+pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
+    let mut sums = [Lanes([0.0; W]); 4];
     let mut quads = v.chunks_exact(4);
     for quad in quads.by_ref() {
         for (sum, y) in sums.iter_mut().zip(quad) {
             *sum += *y - *y;
         }
+        one_row_at_a_time();
     }
     for (sum, y) in sums.iter_mut().zip(quads.remainder()) {
         *sum += *y - *y;

@@ -55,8 +55,15 @@ pub const WIDTH: usize = 4;
 /// Chains per block in single precision: eight `f32` lanes, one AVX2 register.
 pub const WIDTH_F32: usize = 8;
 
+/// Chains per block of the planar batch on a CPU with AVX-512: eight `f64` lanes, one
+/// AVX-512 register.
+pub const WIDTH_AVX512: usize = 8;
+
 /// Four chains' numbers, one per lane.
 pub(crate) type F64x4 = Lanes<WIDTH>;
+
+/// Eight chains' numbers, one per lane: one AVX-512 register.
+pub(crate) type F64x8 = Lanes<WIDTH_AVX512>;
 
 /// Eight chains' numbers in single precision, one per lane: one AVX2 register.
 pub(crate) type F32x8 = Lanes32<WIDTH_F32>;
@@ -226,12 +233,13 @@ pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
 /// `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
 /// `#[inline(always)]` all the way down for its lanes to become registers), and
 /// `fn dispatch(&self, args…)`, which runs the AVX2 one when the CPU has AVX2 and the
-/// kernel as it is otherwise:
+/// kernel as it is otherwise; optionally `fn avx512(&self, args…)`, the kernel compiled for
+/// AVX-512, for the caller to run (unsafely) where the CPU has it:
 /// ```text
 /// simd_kernel! {
 ///     /// docs
 ///     fn kernel<const C: usize>(&self, a: A, …) -> R { … }
-///     dispatch pub(super) fn dispatch, avx2
+///     dispatch pub(super) fn dispatch, avx2, avx512 avx512
 /// }
 /// ```
 macro_rules! simd_kernel {
@@ -253,6 +261,27 @@ macro_rules! simd_kernel {
         $vis:vis fn $kernel:ident ($($args:tt)*) $($rest:tt)*
     ) => {
         $crate::batch::simd_kernel!(@emit [] [] $(#[$meta])* $vis fn $kernel ($($args)*) $($rest)*);
+    };
+    (
+        @emit [$($decl:tt)*] [$($name:tt)*]
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident (&$this:ident, $($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
+        $body:block
+        dispatch $dvis:vis fn $dispatch:ident, $avx2:ident, avx512 $avx512:ident
+    ) => {
+        $crate::batch::simd_kernel!(
+            @emit [$($decl)*] [$($name)*] $(#[$meta])*
+            $vis fn $kernel (&$this, $($arg: $ty),*) $(-> $ret)? $body
+            dispatch $dvis fn $dispatch, $avx2
+        );
+
+        /// [`Self::$kernel`] compiled for AVX-512 (foundation): only for a CPU that has it.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f")]
+        #[allow(clippy::too_many_arguments)]
+        fn $avx512 <$($decl)*> (&$this, $($arg: $ty),*) $(-> $ret)? {
+            $this.$kernel::<$($name)*>($($arg),*)
+        }
     };
     (
         @emit [$($decl:tt)*] [$($name:tt)*]

@@ -5,13 +5,13 @@ use nalgebra::Dyn;
 
 use super::transpose::Transpose;
 use super::{
-    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
+    F32x8, F64x4, F64x8, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
     first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32};
+use crate::lanes::{Lane, Lanes, Lanes32, has_avx512, one_row_at_a_time};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
@@ -24,7 +24,8 @@ use crate::rods::{Load, Rods, Rows, damping_pull, pull};
 /// [`accelerations`](Self::accelerations) gives every chain's `θ̈` equal bit for bit to
 /// [`PlanarTension::accelerations`](crate::model::Model::accelerations) of that chain alone
 /// (module docs of [`batch`](super)), and [`integrate_rk4`](Self::integrate_rk4) its RK4
-/// steps.
+/// steps. Four chains per AVX2 register, eight per AVX-512 register where the CPU has it
+/// ([`with_avx512`](Self::with_avx512)): the same bits either way.
 #[derive(Debug, Clone)]
 pub struct PlanarBatch {
     /// One model per chain, or one for all ([`repeated`](Self::repeated)).
@@ -32,6 +33,10 @@ pub struct PlanarBatch {
     /// Per block of [`WIDTH`] chains, their constants side by side (one block for all when
     /// the chains are one chain repeated).
     pub(super) blocks: Vec<Block>,
+    /// The same per block of [`WIDTH_AVX512`](super::WIDTH_AVX512) chains where the CPU has AVX-512 (and
+    /// [`with_avx512`](Self::with_avx512) allows it), else none: the `f64` calls then run
+    /// eight chains a register.
+    pub(super) blocks_avx512: Vec<Block<F64x8>>,
     /// The same in single precision, per block of [`WIDTH_F32`] chains.
     pub(super) blocks_f32: Vec<Block<F32x8>>,
     count: usize,
@@ -105,7 +110,7 @@ impl<V: Lane> Block<V> {
         out: &mut [V],
     ) {
         // The loads in a pass of their own: built inside the solve, the builder is not
-        // inlined (as in the single-chain model).
+        // inlined (as in the single-chain model). Each link ends with `one_row_at_a_time`.
         let drag = self.rods.drag();
         if V::any(torqued) {
             let inverse_length = self.rods.inverse_length();
@@ -113,10 +118,12 @@ impl<V: Lane> Block<V> {
                 let torqued_pull = pull(torque[i], inverse_length[i], drag[i], rates[i]);
                 let pull = V::select(torqued, torqued_pull, damping_pull(drag[i], rates[i]));
                 *load = planar_load(sin[i], cos[i], rates[i], pull);
+                one_row_at_a_time();
             }
         } else {
             for (i, load) in work.loads.iter_mut().enumerate() {
                 *load = planar_load(sin[i], cos[i], rates[i], damping_pull(drag[i], rates[i]));
+                one_row_at_a_time();
             }
         }
         let loads = &work.loads;
@@ -140,15 +147,8 @@ impl PlanarBatch {
     pub fn new(chains: Vec<Chain<Dyn>>) -> Result<Self> {
         let links = check_links(chains.iter().map(Chain::links))?;
         let chains: Vec<_> = chains.into_iter().map(PlanarTension::new).collect();
-        let blocks = (0..chains.len().div_ceil(WIDTH))
-            .map(|b| {
-                let lanes = block_chains(b, chains.len());
-                Block {
-                    rods: Rods::interleave(lanes.map(|c| chains[c].rods())),
-                    down: Lanes(lanes.map(|c| -Model::chain(chains[c].dense()).gravity())),
-                }
-            })
-            .collect();
+        let blocks = f64_blocks(&chains);
+        let blocks_avx512 = if has_avx512() { f64_blocks(&chains) } else { Vec::new() };
         let blocks_f32 = (0..chains.len().div_ceil(WIDTH_F32))
             .map(|b| {
                 let lanes = block_chains::<WIDTH_F32>(b, chains.len());
@@ -158,7 +158,21 @@ impl PlanarBatch {
                 }
             })
             .collect();
-        Ok(Self { count: chains.len(), chains, blocks, blocks_f32, links })
+        Ok(Self { count: chains.len(), chains, blocks, blocks_avx512, blocks_f32, links })
+    }
+
+    /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
+    /// AVX-512 (the default), or keep four per AVX2 register (`false`). The results are the
+    /// same bits either way; the choice is speed (eight lanes are faster on the AMD EPYC
+    /// measured in `docs/ensembles.md`; some Intel CPUs lower their clock under AVX-512).
+    pub fn with_avx512(mut self, allowed: bool) -> Self {
+        self.blocks_avx512 = if allowed && has_avx512() { f64_blocks(&self.chains) } else { Vec::new() };
+        self
+    }
+
+    /// Whether the `f64` calls run eight lanes (AVX-512).
+    pub fn uses_avx512(&self) -> bool {
+        !self.blocks_avx512.is_empty()
     }
 
     /// `count` copies of `chain`: one model at `count` states per call. The lanes' constants
@@ -215,8 +229,15 @@ impl PlanarBatch {
             check_len("torque", torque, self.len(), self.links)?;
         }
         let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            return Ok(self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
+                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
+                unsafe { self.block_avx512(&self.blocks_avx512, b, lanes, q, qd, torque, pivot, s, out) }
+            }));
+        }
         Ok(self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
-            self.block_simd(b, lanes, q, qd, torque, pivot, s, out)
+            self.block_simd::<WIDTH>(&self.blocks, b, lanes, q, qd, torque, pivot, s, out)
         }))
     }
 
@@ -320,22 +341,23 @@ impl PlanarBatch {
     }
 
     simd_kernel! {
-        /// One block: gather, `sin θ` and `cos θ` of all its angles at once, the solve in lanes,
-        /// scatter into `out` (the block's rows).
-        fn block(
+        /// One block of `W` chains (constants in `blocks`): gather, `sin θ` and `cos θ` of all
+        /// its angles at once, the solve in lanes, scatter into `out` (the block's rows).
+        fn block<const W: usize>(
             &self,
+            blocks: &[Block<Lanes<W>>],
             b: usize,
-            lanes: [usize; WIDTH],
+            lanes: [usize; W],
             q: &[f64],
             qd: &[f64],
             torque: Option<&[f64]>,
             pivot: Option<&[f64]>,
-            s: &mut Scratch,
+            s: &mut Scratch<Lanes<W>>,
             out: &mut [f64],
         ) {
             let n = self.links;
-            let block = &self.blocks[b.min(self.blocks.len() - 1)];
-            let torqued = torque.map_or(F64x4::none(), |t| {
+            let block = &blocks[b.min(blocks.len() - 1)];
+            let torqued = torque.map_or(Lanes::<W>::none(), |t| {
                 gather_torques(t, lanes, n, Lanes::flatten_mut(&mut s.torque)).map(u64::from)
             });
             gather(q, lanes, n, Lanes::flatten_mut(&mut s.angles));
@@ -345,17 +367,30 @@ impl PlanarBatch {
                 Lanes::flatten_mut(&mut s.cos),
             );
             gather(qd, lanes, n, Lanes::flatten_mut(&mut s.rates));
-            let zero = Lanes([0.0; WIDTH]);
+            let zero = Lanes([0.0; W]);
             let pivot = match pivot {
                 Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [zero; 2],
             };
             let trig = [&s.sin[..], &s.cos, &s.rates];
             block.accelerations(trig, (&s.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
-            scatter::<_, WIDTH>(Lanes::flatten(&s.accelerations), n, out);
+            scatter::<_, W>(Lanes::flatten(&s.accelerations), n, out);
         }
-        dispatch fn block_simd, block_avx2
+        dispatch fn block_simd, block_avx2, avx512 block_avx512
     }
+}
+
+/// The constants of `chains` in blocks of `W`, side by side.
+fn f64_blocks<const W: usize>(chains: &[PlanarTension<Dyn>]) -> Vec<Block<Lanes<W>>> {
+    (0..chains.len().div_ceil(W))
+        .map(|b| {
+            let lanes = block_chains::<W>(b, chains.len());
+            Block {
+                rods: Rods::interleave(lanes.map(|c| chains[c].rods())),
+                down: Lanes(lanes.map(|c| -Model::chain(chains[c].dense()).gravity())),
+            }
+        })
+        .collect()
 }
 
 /// The joint torques of the chains `lanes` (rows of `n` of `torque`) into lane order in

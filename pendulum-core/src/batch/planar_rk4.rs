@@ -1,27 +1,29 @@
 //! Runs of RK4 for a batch of planar chains in link angles, in lanes: [`Rk4`] on each
 //! chain's first-order system `x = (θ, θ̇)` with its torques and pivot acceleration held,
 //! the states in lanes from the first step to the last; in `f64` (four chains a register,
-//! bit for bit the chain alone) or `f32` (eight).
+//! eight with AVX-512, bit for bit the chain alone) or `f32` (eight).
 //!
 //! [`Rk4`]: crate::integrate::Rk4
 
 use nalgebra::Dyn;
 
+#[cfg(target_arch = "x86_64")]
+use super::F64x8;
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
-    F32x8, F64x4, Failure, PlanarBatch, WIDTH, WIDTH_F32, block_chains, check_len, check_states, for_blocks,
-    for_blocks_of, non_finite, simd_kernel,
+    F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states, for_blocks_of,
+    non_finite, simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32};
+use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
 
-/// The lanes a planar run steps in, with their precision's sine kernel: [`F64x4`] or
-/// [`F32x8`].
+/// The lanes a planar run steps in, with their precision's sine kernel: [`F64x4`] (or
+/// eight `f64` lanes) or [`F32x8`].
 pub(super) trait RunLane: Lane + Send {
     /// The number type of one lane.
     type Num: Transpose + Into<f64> + Send + Sync;
@@ -42,7 +44,7 @@ pub(super) trait RunLane: Lane + Send {
     fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
 }
 
-impl RunLane for F64x4 {
+impl<const W: usize> RunLane for Lanes<W> {
     type Num = f64;
     #[inline(always)]
     fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
@@ -53,7 +55,7 @@ impl RunLane for F64x4 {
         Lanes::from_fn(f)
     }
     #[inline(always)]
-    fn mask(flag: impl Fn(usize) -> bool) -> [u64; WIDTH] {
+    fn mask(flag: impl Fn(usize) -> bool) -> [u64; W] {
         std::array::from_fn(|k| u64::from(flag(k)))
     }
     #[inline(always)]
@@ -61,15 +63,15 @@ impl RunLane for F64x4 {
         sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(sin), Lanes::flatten_mut(cos));
     }
     #[inline(always)]
-    fn non_finite(v: &[Self]) -> [u64; WIDTH] {
+    fn non_finite(v: &[Self]) -> [u64; W] {
         non_finite_lanes(v)
     }
     #[inline(always)]
-    fn and_not(a: [u64; WIDTH], b: [u64; WIDTH]) -> [u64; WIDTH] {
+    fn and_not(a: [u64; W], b: [u64; W]) -> [u64; W] {
         std::array::from_fn(|k| a[k] & !b[k])
     }
     #[inline(always)]
-    fn and(a: [u64; WIDTH], b: [u64; WIDTH]) -> [u64; WIDTH] {
+    fn and(a: [u64; W], b: [u64; W]) -> [u64; W] {
         std::array::from_fn(|k| a[k] & b[k])
     }
 }
@@ -167,43 +169,65 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        let (n, m) = (self.links, 2 * self.links);
-        check_states(states, self.len(), m)?;
+        check_states(states, self.len(), 2 * self.links)?;
         self.check_run(torque, pivot, h)?;
+        #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            let step = |block: &Block<F64x8>, alive, s: &mut Run<F64x8>| {
+                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
+                unsafe { self.rk4_step_avx512(block, h, alive, s) }
+            };
+            return Ok(self.run_f64(&self.blocks_avx512, states, (torque, pivot), (h, steps), step));
+        }
+        let step = |block: &Block<F64x4>, alive, s: &mut Run<F64x4>| self.rk4_step_simd(block, h, alive, s);
+        Ok(self.run_f64(&self.blocks, states, (torque, pivot), (h, steps), step))
+    }
+
+    /// [`integrate_rk4`](Self::integrate_rk4)'s runs (arguments checked) in blocks of `W`
+    /// chains with constants `blocks`, `step` making one step of a block's alive lanes.
+    fn run_f64<const W: usize>(
+        &self,
+        blocks: &[Block<Lanes<W>>],
+        states: &mut [State<Dyn>],
+        (torque, pivot): Inputs<'_, f64>,
+        (h, steps): (f64, usize),
+        step: impl Fn(&Block<Lanes<W>>, [u64; W], &mut Run<Lanes<W>>) -> [u64; W] + Sync + Send,
+    ) -> Vec<Failure> {
+        let (n, m) = (self.links, 2 * self.links);
         let solves = n.saturating_mul(4).saturating_mul(steps);
-        Ok(for_blocks(
+        for_blocks_of::<W, _, _, _>(
             states,
             1,
             solves,
-            || Run::<F64x4>::new(n),
+            || Run::<Lanes<W>>::new(n),
             |s, b, block| {
-                let ids = block_chains::<WIDTH>(b, self.len());
-                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(block.len() - 1));
+                let ids = block_chains::<W>(b, self.len());
+                let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let (mut failures, ran) =
                     start(s, (ids, block.len(), n), (torque, pivot), |k| block[k].x().as_slice());
                 let mut alive = ran.map(u64::from);
-                let mut t = [Lanes([0.0; WIDTH]); 2];
+                let mut t = [Lanes([0.0; W]); 2];
                 into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
-                let (constants, lanes_h) = (&self.blocks[b.min(self.blocks.len() - 1)], Lanes([h; WIDTH]));
+                let (constants, lanes_h) = (&blocks[b.min(blocks.len() - 1)], Lanes([h; W]));
                 for _ in 0..steps {
-                    if alive == [0; WIDTH] {
+                    if alive == [0; W] {
                         break;
                     }
-                    let failed = self.rk4_step_simd(constants, h, alive, s);
-                    let keep = F64x4::and_not(alive, failed);
+                    let failed = step(constants, alive, s);
+                    let keep = Lanes::<W>::and_not(alive, failed);
                     let (new_t, new_carry) = kahan_add(t[0], t[1], lanes_h);
                     for (k, _) in failed.iter().enumerate().filter(|(_, f)| **f != 0) {
                         let error = Error::NonFiniteState { t: t[0].0[k], h };
                         failures.push(Failure { chain: ids[k], error });
                     }
-                    t = [F64x4::select(keep, new_t, t[0]), F64x4::select(keep, new_carry, t[1])];
+                    t = [Lanes::select(keep, new_t, t[0]), Lanes::select(keep, new_carry, t[1])];
                     alive = keep;
                 }
                 out_of_lanes(block.iter_mut(), ran.map(u64::from), m, (&t, &s.x, &s.carry));
                 failures.sort_by_key(|f| f.chain);
                 failures
             },
-        ))
+        )
     }
 
     /// [`integrate_rk4`](Self::integrate_rk4) in single precision: the states as `B` rows
@@ -293,32 +317,38 @@ impl PlanarBatch {
             let inputs = ((&torque[..], *torqued), *pivot);
             rates(block, inputs, x, (sin, cos, work), k1);
             // k_{j+1} = f(y) at y = x + a k_j, as nalgebra's `axpy(a, k_j, 1.0)` forms it.
+            // (Each loop over rows ends with `one_row_at_a_time`.)
             let (a_half, a_full) = (V::splat(0.5 * h), V::splat(h));
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k1) {
                 *y = a_half * *k + *x;
+                one_row_at_a_time();
             }
             rates(block, inputs, y, (sin, cos, work), k2);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k2) {
                 *y = a_half * *k + *x;
+                one_row_at_a_time();
             }
             rates(block, inputs, y, (sin, cos, work), k3);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k3) {
                 *y = a_full * *k + *x;
+                one_row_at_a_time();
             }
             rates(block, inputs, y, (sin, cos, work), k4);
             let (sixth, two) = (V::splat(h / 6.0), V::splat(2.0));
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
                 *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
+                one_row_at_a_time();
             }
             let bad = V::non_finite(y);
             let keep = V::and_not(alive, bad);
             for ((x, carry), y) in x.iter_mut().zip(carry.iter_mut()).zip(&*y) {
                 let (new, new_carry) = kahan_add(*x, *carry, *y);
                 (*x, *carry) = (V::select(keep, new, *x), V::select(keep, new_carry, *carry));
+                one_row_at_a_time();
             }
             V::and(alive, bad)
         }
-        dispatch fn rk4_step_simd, rk4_step_avx2
+        dispatch fn rk4_step_simd, rk4_step_avx2, avx512 rk4_step_avx512
     }
 }
 

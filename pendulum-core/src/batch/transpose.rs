@@ -1,7 +1,7 @@
 //! The batch's two layouts: arrays chain by chain (`B` rows of `m`, as numpy holds them) and
 //! lanes link by link (`m` groups of `W` chains). [`gather`] and [`scatter`] turn one into
 //! the other in tiles of `W × W` numbers, transposed in registers (AVX2 shuffles for four
-//! `f64` or eight `f32` lanes, when the CPU has AVX2; a plain loop otherwise). A copy: every
+//! or eight `f64` or eight `f32` lanes, when the CPU has AVX2; a plain loop otherwise). A copy: every
 //! number arrives unchanged.
 //!
 //! The tiles are addressed by pointers set in plain loops: arrays of slices built with
@@ -34,16 +34,26 @@ pub(crate) trait Transpose: Copy {
 impl Transpose for f64 {
     #[inline(always)]
     fn has_simd<const W: usize>() -> bool {
-        cfg!(target_arch = "x86_64") && W == 4 && has_avx2()
+        cfg!(target_arch = "x86_64") && (W == 4 || W == 8) && has_avx2()
     }
 
     #[inline(always)]
     #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     unsafe fn transpose_simd<const W: usize>(src: [*const f64; W], dst: [*mut f64; W]) {
-        // SAFETY: the caller's contract: AVX2, W = 4, valid pointers.
+        // SAFETY: the caller's contract: AVX2, W = 4 or 8, valid pointers. An 8 × 8 tile
+        // is four 4 × 4 ones: quarter (a, b) of `src` goes to quarter (b, a) of `dst`.
         #[cfg(target_arch = "x86_64")]
         unsafe {
-            transpose_4x4(src, dst)
+            if W == 4 {
+                return transpose_4x4(src, dst);
+            }
+            for a in [0, 4] {
+                for b in [0, 4] {
+                    let rows = [src[a].add(b), src[a + 1].add(b), src[a + 2].add(b), src[a + 3].add(b)];
+                    let out = [dst[b].add(a), dst[b + 1].add(a), dst[b + 2].add(a), dst[b + 3].add(a)];
+                    transpose_4x4(rows, out);
+                }
+            }
         };
     }
 }
@@ -317,6 +327,7 @@ mod tests {
     #[test]
     fn gather_and_scatter_copy_every_number_to_its_place() {
         round_trip::<f64, 4>();
+        round_trip::<f64, 8>();
         round_trip::<f32, 8>();
         round_trip::<f64, 2>();
         round_trip::<f32, 4>();
