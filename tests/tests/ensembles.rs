@@ -46,12 +46,18 @@ fn widths_and_pools(batch: &PlanarBatch) -> Vec<(PlanarBatch, rayon::ThreadPool)
 }
 
 #[test]
-fn the_planar_batch_runs_eight_lanes_exactly_where_the_cpu_has_avx512() {
-    let batch = PlanarBatch::new(vec![Chain::uniform(3, 0.1, 0.2, 9.81).expect("chain"); 5]).expect("batch");
+fn batches_run_eight_lanes_exactly_where_the_cpu_has_avx512() {
+    let chain = Chain::uniform(3, 0.1, 0.2, 9.81).expect("chain");
+    let planar = PlanarBatch::new(vec![chain.clone(); 5]).expect("batch");
+    let spatial = DirectionsBatch::new(vec![Directions::<U3>::new(chain); 5]).expect("batch");
     #[cfg(target_arch = "x86_64")]
-    assert_eq!(batch.uses_avx512(), std::arch::is_x86_feature_detected!("avx512f"));
-    assert!(!batch.clone().with_avx512(false).uses_avx512());
-    assert_eq!(batch.clone().with_avx512(false).with_avx512(true).uses_avx512(), batch.uses_avx512());
+    for uses in [planar.uses_avx512(), spatial.uses_avx512()] {
+        assert_eq!(uses, std::arch::is_x86_feature_detected!("avx512f"));
+    }
+    assert!(!planar.clone().with_avx512(false).uses_avx512());
+    assert!(!spatial.clone().with_avx512(false).uses_avx512());
+    assert_eq!(planar.clone().with_avx512(false).with_avx512(true).uses_avx512(), planar.uses_avx512());
+    assert_eq!(spatial.clone().with_avx512(false).with_avx512(true).uses_avx512(), spatial.uses_avx512());
 }
 
 #[test]
@@ -208,8 +214,11 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
                 rk4.step(model, state, h).expect("single");
             }
         }
-        for pool in pools() {
-            // Step by step, and 20 steps in one call.
+        let pools_and_widths = [true, false]
+            .into_iter()
+            .flat_map(|avx512| pools().map(|pool| (batch.clone().with_avx512(avx512), pool)));
+        for (batch, pool) in pools_and_widths {
+            // Step by step, and 20 steps in one call; in eight lanes (AVX-512) and four.
             let mut states = start.clone();
             for _ in 0..20 {
                 let failures = pool.install(|| batch.step_rk4(&mut states, h)).expect("batch");
@@ -228,12 +237,15 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
         // The accelerations alone, too.
         let m = batch.state_len();
         let flat: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
-        let mut out = vec![0.0; chains * m / 2];
-        assert!(batch.accelerations(0.3, &flat, &mut out).expect("batch").is_empty());
-        for (k, (model, x)) in models.iter().zip(&x).enumerate() {
-            let mut one = vec![0.0; m / 2];
-            model.accelerations(0.3, x, &mut one, None).expect("single");
-            assert_bits(&out[k * m / 2..(k + 1) * m / 2], &one, &format!("ü of chain {k}"));
+        for batch in [batch.clone(), batch.with_avx512(false)] {
+            let mut out = vec![0.0; chains * m / 2];
+            assert!(batch.accelerations(0.3, &flat, &mut out).expect("batch").is_empty());
+            for (k, (model, x)) in models.iter().zip(&x).enumerate() {
+                let mut one = vec![0.0; m / 2];
+                model.accelerations(0.3, x, &mut one, None).expect("single");
+                let what = format!("ü of chain {k}, AVX-512 {}", batch.uses_avx512());
+                assert_bits(&out[k * m / 2..(k + 1) * m / 2], &one, &what);
+            }
         }
     }
 }
@@ -257,6 +269,13 @@ fn with_their_energy_ledgers_the_steps_equal_the_accounted_chain_bit_for_bit() {
     let h = 5e-4;
     let mut states = start.clone();
     assert!(batch.integrate_rk4(&mut states, h, 40).expect("batch").is_empty());
+    let mut four_lanes = start.clone();
+    assert!(
+        batch.clone().with_avx512(false).integrate_rk4(&mut four_lanes, h, 40).expect("batch").is_empty()
+    );
+    for (k, state) in four_lanes.iter().enumerate() {
+        assert_bits(state.x().as_slice(), states[k].x().as_slice(), &format!("chain {k} in four lanes"));
+    }
     for (k, (model, state)) in models.iter().zip(&states).enumerate() {
         let system = Accounted::of(model.clone());
         let mut alone = start[k].clone();
@@ -280,7 +299,19 @@ fn a_batched_run_is_each_chain_run_alone_samples_and_summaries_included() {
     let n = 12;
     let (models, x): (Vec<_>, Vec<_>) = (0..7).map(|_| whirl(n, &mut r)).unzip();
     let batch = DirectionsBatch::accounted(models.clone()).expect("batch");
-    let start = accounted_states(&models, &x);
+    for batch in [batch.clone(), batch.with_avx512(false)] {
+        a_batched_run_in(&batch, &models, &x);
+    }
+}
+
+/// [`a_batched_run_is_each_chain_run_alone_samples_and_summaries_included`] for one batch
+/// of 7 whirls from `x`.
+fn a_batched_run_in(
+    batch: &DirectionsBatch<U3, Circle>,
+    models: &[Directions<U3, Circle>],
+    x: &[DVector<f64>],
+) {
+    let start = accounted_states(models, x);
     // Chain 3 stops itself after its fourth sample; the others run to the end.
     let stop_after = |k: usize| if k == 3 { 4 } else { usize::MAX };
     let (t1, h, every) = (0.1037, 1e-3, 7);

@@ -4,14 +4,14 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::{
-    F32x8, F64x4, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
+    F32x8, Failure, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
     for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
 use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::error::{Error, Result};
-use crate::lanes::{Lane, Lanes, Lanes32};
+use crate::lanes::{Lane, Lanes, Lanes32, has_avx512, one_row_at_a_time};
 use crate::models::Directions;
 use crate::models::directions::rate_load;
 use crate::rods::{Load, Rods, Rows};
@@ -23,11 +23,16 @@ use crate::rods::{Load, Rods, Rows};
 /// chain, and [`step_rk4`](Self::step_rk4) one step of
 /// `Projected::new(Rk4::new(..))` ([`Projected`](crate::integrate::Projected),
 /// [`Rk4`](crate::integrate::Rk4)) on each chain, bit for bit (module docs of
-/// [`batch`](super)).
+/// [`batch`](super)). Four chains per AVX2 register, eight per AVX-512 register where the
+/// CPU has it ([`with_avx512`](Self::with_avx512)): the same bits either way.
 #[derive(Debug, Clone)]
 pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     models: Vec<Directions<S, Dr>>,
-    blocks: Vec<Block>,
+    pub(super) blocks: Vec<Block>,
+    /// The same per block of [`WIDTH_AVX512`] chains where the CPU has AVX-512 (and
+    /// [`with_avx512`](Self::with_avx512) allows it), else none: the `f64` calls then run
+    /// eight chains a register.
+    pub(super) blocks_avx512: Vec<Block<WIDTH_AVX512>>,
     /// Per block of [`WIDTH_F32`] chains, their rods and `−g` in single precision.
     blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
     links: usize,
@@ -35,33 +40,33 @@ pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     accounted: bool,
 }
 
-/// What the solve needs of one block's chains.
+/// What the solve needs of one block's `W` chains.
 #[derive(Debug, Clone)]
-struct Block {
-    rods: Rods<F64x4>,
+pub(super) struct Block<const W: usize = WIDTH> {
+    rods: Rods<Lanes<W>>,
     /// `−g` (m/s²) per lane.
-    down: F64x4,
+    down: Lanes<W>,
     /// Per link, the mass hanging from it (kg), its length (m) and damping `λ` (N·m·s): the
     /// ledger's powers.
-    tails: Vec<F64x4>,
-    lengths: Vec<F64x4>,
-    damping: Vec<F64x4>,
+    tails: Vec<Lanes<W>>,
+    lengths: Vec<Lanes<W>>,
+    damping: Vec<Lanes<W>>,
 }
 
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
-pub(super) struct Scratch<const C: usize> {
-    pub solve: Solve<C>,
+pub(super) struct Scratch<const C: usize, const W: usize> {
+    pub solve: Solve<C, Lanes<W>>,
     /// Time and its compensation (s) per lane.
-    pub t: [F64x4; 2],
+    pub t: [Lanes<W>; 2],
     /// The compensation of the state per lane.
-    pub carry: Vec<F64x4>,
-    pub x: Vec<F64x4>,
-    pub y: Vec<F64x4>,
-    pub k: [Vec<F64x4>; 4],
+    pub carry: Vec<Lanes<W>>,
+    pub x: Vec<Lanes<W>>,
+    pub y: Vec<Lanes<W>>,
+    pub k: [Vec<Lanes<W>>; 4],
 }
 
 /// The loads and rows of one solve in lanes.
-pub(super) struct Solve<const C: usize, V: Lane = F64x4> {
+pub(super) struct Solve<const C: usize, V: Lane> {
     rows: Rows<C, V>,
     loads: Vec<Load<C, V>>,
 }
@@ -87,6 +92,7 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         for (load, ((u, w), &drag)) in self.loads.iter_mut().zip(rods_rates) {
             let (u, w) = (u.try_into().expect("C numbers"), w.try_into().expect("C numbers"));
             *load = rate_load(u, w, drag);
+            one_row_at_a_time();
         }
         self.solve_loaded(rods, gravity, pivot, out);
     }
@@ -128,9 +134,11 @@ impl<const C: usize, V: Lane> Solve<C, V> {
             yw.copy_from_slice(&w);
             velocity.copy_from_slice(&w);
             *load = rate_load(u, w, drag);
+            one_row_at_a_time();
         }
         for ((y, x), k) in y_rest.iter_mut().zip(&x[2 * half..]).zip(&k[2 * half..]) {
             *y = a * *k + *x;
+            one_row_at_a_time();
         }
         self.solve_loaded(rods, gravity, pivot, accelerations);
     }
@@ -151,12 +159,12 @@ impl<const C: usize, V: Lane> Solve<C, V> {
     }
 }
 
-impl<const C: usize> Scratch<C> {
+impl<const C: usize, const W: usize> Scratch<C, W> {
     pub fn new(links: usize, state_len: usize) -> Self {
-        let lanes = || vec![Lanes([0.0; WIDTH]); state_len];
+        let lanes = || vec![Lanes([0.0; W]); state_len];
         Self {
             solve: Solve::new(links),
-            t: [Lanes([0.0; WIDTH]); 2],
+            t: [Lanes([0.0; W]); 2],
             carry: lanes(),
             x: lanes(),
             y: lanes(),
@@ -186,22 +194,23 @@ where
                 (Rods::interleave_f32(lanes.map(|c| models[c].rods())), down)
             })
             .collect();
-        let blocks = (0..models.len().div_ceil(WIDTH))
-            .map(|b| {
-                let lanes = block_chains(b, models.len());
-                let per_link = |of: fn(&Chain<Dyn>) -> &[f64]| -> Vec<F64x4> {
-                    (0..links).map(|i| Lanes::from_fn(|k| of(models[lanes[k]].chain())[i])).collect()
-                };
-                Block {
-                    rods: Rods::interleave(lanes.map(|c| models[c].rods())),
-                    down: Lanes(lanes.map(|c| -models[c].chain().gravity())),
-                    tails: per_link(|c| c.tail_masses().as_slice()),
-                    lengths: per_link(|c| c.lengths().as_slice()),
-                    damping: per_link(|c| c.damping().as_slice()),
-                }
-            })
-            .collect();
-        Ok(Self { models, blocks, blocks_f32, links, accounted: false })
+        let blocks = f64_blocks(&models, links);
+        let blocks_avx512 = if has_avx512() { f64_blocks(&models, links) } else { Vec::new() };
+        Ok(Self { models, blocks, blocks_avx512, blocks_f32, links, accounted: false })
+    }
+
+    /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
+    /// AVX-512 (the default), or keep four per AVX2 register (`false`). The results are the
+    /// same bits either way; the choice is speed (`docs/ensembles.md`).
+    pub fn with_avx512(mut self, allowed: bool) -> Self {
+        self.blocks_avx512 =
+            if allowed && has_avx512() { f64_blocks(&self.models, self.links) } else { Vec::new() };
+        self
+    }
+
+    /// Whether the `f64` calls run eight lanes (AVX-512).
+    pub fn uses_avx512(&self) -> bool {
+        !self.blocks_avx512.is_empty()
     }
 
     /// The batch of `models` with their energy ledgers: states as
@@ -269,12 +278,18 @@ where
     }
 
     fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
-        self.in_blocks::<C, WIDTH, _, F64x4>(
-            x,
-            out,
-            (f64::NAN, Error::NotPositiveDefinite),
-            |b, chains, s, out| self.evaluate_simd::<C>(b, chains, t, x, s, out),
-        )
+        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            let blocks = &self.blocks_avx512;
+            return self.in_blocks::<C, WIDTH_AVX512, _, _>(x, out, otherwise, |b, chains, s, out| {
+                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
+                unsafe { self.evaluate_avx512::<C, WIDTH_AVX512>(&blocks[b], chains, t, x, s, out) }
+            });
+        }
+        self.in_blocks::<C, WIDTH, _, _>(x, out, otherwise, |b, chains, s, out| {
+            self.evaluate_simd::<C, WIDTH>(&self.blocks[b], chains, t, x, s, out)
+        })
     }
 
     /// Runs `kernel(b, chains, lanes, rows)` for every block of `W` chains (`lanes`: the
@@ -374,43 +389,41 @@ where
     }
 
     simd_kernel! {
-        /// `ü(t, x)` for block `b` (chains `chains`) into its rows of `out`: gathered into
-        /// `x_lanes`, the solve, into `a_lanes`, scattered.
-        fn evaluate<const C: usize>(
+        /// `ü(t, x)` for a block (chains `chains`, constants `block`) into its rows of
+        /// `out`: gathered into `x_lanes`, the solve, into `a_lanes`, scattered.
+        fn evaluate<const C: usize, const W: usize>(
             &self,
-            b: usize,
-            chains: [usize; WIDTH],
+            block: &Block<W>,
+            chains: [usize; W],
             t: f64,
             x: &[f64],
-            s: &mut Lanes3<C, F64x4>,
+            s: &mut Lanes3<C, Lanes<W>>,
             out: &mut [f64],
         ) {
             let (solve, x_lanes, a_lanes) = s;
-            let block = &self.blocks[b];
             let half = C * self.links;
             gather(x, chains, 2 * half, Lanes::flatten_mut(x_lanes));
-            let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, [t; WIDTH], Dr::acceleration, Lanes);
+            let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
             solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
-            scatter::<_, WIDTH>(Lanes::flatten(a_lanes), half, out);
+            scatter::<_, W>(Lanes::flatten(a_lanes), half, out);
         }
-        dispatch fn evaluate_simd, evaluate_avx2
+        dispatch fn evaluate_simd, evaluate_avx2, avx512 evaluate_avx512
     }
 
     /// `out = (w, ü(t, x))` for the block's chains in lanes: [`Directions`]' right-hand side,
     /// one tension solve, with each chain's pivot acceleration at its own time.
     #[inline(always)]
-    pub(super) fn flow<const C: usize>(
+    pub(super) fn flow<const C: usize, const W: usize>(
         &self,
-        b: usize,
-        chains: [usize; WIDTH],
-        t: [f64; WIDTH],
-        x: &[F64x4],
-        solve: &mut Solve<C>,
-        out: &mut [F64x4],
-    ) -> [F64x4; C] {
+        block: &Block<W>,
+        chains: [usize; W],
+        t: [f64; W],
+        x: &[Lanes<W>],
+        solve: &mut Solve<C, Lanes<W>>,
+        out: &mut [Lanes<W>],
+    ) -> [Lanes<W>; C] {
         let half = C * self.links;
-        let block = &self.blocks[b];
-        let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::acceleration, Lanes);
+        let pivot = self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes);
         let (velocity, acceleration) = out.split_at_mut(half);
         velocity.copy_from_slice(&x[half..2 * half]);
         solve.accelerations(&block.rods, gravity(block.down), pivot, x, acceleration);
@@ -421,18 +434,17 @@ where
     /// goes ([`Solve::stage`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn stage<const C: usize>(
+    pub(super) fn stage<const C: usize, const W: usize>(
         &self,
-        b: usize,
-        chains: [usize; WIDTH],
-        t: [f64; WIDTH],
-        (x, a, k): (&[F64x4], F64x4, &[F64x4]),
-        y: &mut [F64x4],
-        solve: &mut Solve<C>,
-        out: &mut [F64x4],
-    ) -> [F64x4; C] {
-        let block = &self.blocks[b];
-        let pivot = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::acceleration, Lanes);
+        block: &Block<W>,
+        chains: [usize; W],
+        t: [f64; W],
+        (x, a, k): (&[Lanes<W>], Lanes<W>, &[Lanes<W>]),
+        y: &mut [Lanes<W>],
+        solve: &mut Solve<C, Lanes<W>>,
+        out: &mut [Lanes<W>],
+    ) -> [Lanes<W>; C] {
+        let pivot = self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes);
         solve.stage(&block.rods, gravity(block.down), pivot, x, a, k, y, out);
         pivot
     }
@@ -441,23 +453,44 @@ where
     /// filled `out` at the same `(t, x)` with the pivot accelerations `pivot` (m/s²) it
     /// returned: as `Accounted`'s right-hand side gives them.
     #[inline(always)]
-    pub(super) fn ledger_rates<const C: usize>(
+    pub(super) fn ledger_rates<const C: usize, const W: usize>(
         &self,
-        b: usize,
-        chains: [usize; WIDTH],
-        t: [f64; WIDTH],
-        x: &[F64x4],
-        pivot: [F64x4; C],
-        out: &mut [F64x4],
+        block: &Block<W>,
+        chains: [usize; W],
+        t: [f64; W],
+        x: &[Lanes<W>],
+        pivot: [Lanes<W>; C],
+        out: &mut [Lanes<W>],
     ) {
         let half = C * self.links;
-        let block = &self.blocks[b];
-        let velocity = self.pivot_lanes::<C, WIDTH, _>(chains, t, Dr::velocity, Lanes);
+        let velocity = self.pivot_lanes::<C, W, _>(chains, t, Dr::velocity, Lanes);
         let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
         let (rates, accelerations) = (&x[half..2 * half], &out[half..2 * half]);
         let (drive, damping) = direction_powers(chain, velocity, pivot, rates, accelerations);
-        out[2 * half..2 * half + LEDGER_LEN].copy_from_slice(&[drive, Lanes([0.0; WIDTH]), damping]);
+        out[2 * half..2 * half + LEDGER_LEN].copy_from_slice(&[drive, Lanes([0.0; W]), damping]);
     }
+}
+
+/// The constants of `models` (`links` each) in blocks of `W`, side by side.
+fn f64_blocks<S: DimName, Dr, const W: usize>(models: &[Directions<S, Dr>], links: usize) -> Vec<Block<W>>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    (0..models.len().div_ceil(W))
+        .map(|b| {
+            let lanes = block_chains::<W>(b, models.len());
+            let per_link = |of: fn(&Chain<Dyn>) -> &[f64]| -> Vec<Lanes<W>> {
+                (0..links).map(|i| Lanes::from_fn(|k| of(models[lanes[k]].chain())[i])).collect()
+            };
+            Block {
+                rods: Rods::interleave(lanes.map(|c| models[c].rods())),
+                down: Lanes(lanes.map(|c| -models[c].chain().gravity())),
+                tails: per_link(|c| c.tail_masses().as_slice()),
+                lengths: per_link(|c| c.lengths().as_slice()),
+                damping: per_link(|c| c.damping().as_slice()),
+            }
+        })
+        .collect()
 }
 
 /// Gravity `g⃗ = −g e_up` (m/s²) per lane, from `−g`: along the last axis.

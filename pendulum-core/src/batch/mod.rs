@@ -229,7 +229,7 @@ pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
 }
 
 /// A kernel written once, in three methods (with at most one generic parameter, a const
-/// or a type): `fn kernel(&self, args…)` as given (inlined wherever it is called),
+/// or a type, or two consts): `fn kernel(&self, args…)` as given (inlined wherever it is called),
 /// `fn avx2(&self, args…)`, the kernel compiled for AVX2 (it must be
 /// `#[inline(always)]` all the way down for its lanes to become registers), and
 /// `fn dispatch(&self, args…)`, which runs the AVX2 one when the CPU has AVX2 and the
@@ -243,7 +243,16 @@ pub(crate) fn for_blocks_of<const W: usize, T: Send, S, F: Send>(
 /// }
 /// ```
 macro_rules! simd_kernel {
-    // One generic parameter at most, a const or a type: normalised, then emitted.
+    // One generic parameter at most, a const or a type, or two consts: normalised, then
+    // emitted.
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $kernel:ident <const $c:ident: usize, const $w:ident: usize> $($rest:tt)*
+    ) => {
+        $crate::batch::simd_kernel!(
+            @emit [const $c: usize, const $w: usize] [$c, $w] $(#[$meta])* $vis fn $kernel $($rest)*
+        );
+    };
     (
         $(#[$meta:meta])*
         $vis:vis fn $kernel:ident <const $c:ident: usize> $($rest:tt)*

@@ -6,13 +6,13 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
-use super::directions::Scratch;
+use super::directions::{Block, Scratch};
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
-use super::{F64x4, Failure, WIDTH, block_chains, for_blocks, non_finite, simd_kernel};
+use super::{Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::lanes::{Lane, Lanes};
+use crate::lanes::{Lane, Lanes, one_row_at_a_time};
 use crate::models::directions::project_link;
 
 use super::DirectionsBatch;
@@ -112,22 +112,49 @@ where
     where
         F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
     {
+        #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            let step = |block: &Block<WIDTH_AVX512>, ids, alive, s: &mut Scratch<C, WIDTH_AVX512>| {
+                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
+                unsafe { self.rk4_step_avx512::<C, WIDTH_AVX512>(block, ids, plan.h, alive, s) }
+            };
+            return self.rk4_blocks(&self.blocks_avx512, states, observers, (plan, sample), step);
+        }
+        let step = |block: &Block<WIDTH>, ids, alive, s: &mut Scratch<C, WIDTH>| {
+            self.rk4_step_simd::<C, WIDTH>(block, ids, plan.h, alive, s)
+        };
+        self.rk4_blocks(&self.blocks, states, observers, (plan, sample), step)
+    }
+
+    /// [`rk4`](Self::rk4) in blocks of `W` chains with constants `blocks`, `one_step`
+    /// making one step of a block's alive lanes.
+    fn rk4_blocks<const C: usize, const W: usize, T: Send, F>(
+        &self,
+        blocks: &[Block<W>],
+        states: &mut [State<Dyn>],
+        observers: &mut [T],
+        (plan, sample): (Plan, Option<&F>),
+        one_step: impl Fn(&Block<W>, [usize; W], [u64; W], &mut Scratch<C, W>) -> [u64; W] + Sync + Send,
+    ) -> Vec<(usize, End)>
+    where
+        F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
+    {
         let (n, m) = (self.links(), self.state_len());
         let mut chains: Vec<(&mut State<Dyn>, &mut T)> =
             states.iter_mut().zip(observers.iter_mut()).collect();
         let solves = n.saturating_mul(4).saturating_mul(plan.steps.min(usize::MAX as u64) as usize);
         // Tasks of whole runs: a block's states stay in lanes from the first step to the
         // last, and go out only to be sampled.
-        for_blocks(
+        for_blocks_of::<W, _, _, _>(
             &mut chains,
             1,
             solves,
-            || Scratch::<C>::new(n, self.state_len()),
+            || Scratch::<C, W>::new(n, self.state_len()),
             |s, b, block| {
-                let ids = block_chains(b, self.len());
-                let lanes: [usize; WIDTH] = std::array::from_fn(|k| k.min(block.len() - 1));
+                let ids = block_chains::<W>(b, self.len());
+                let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
-                let mut alive = [0u64; WIDTH];
+                let mut alive = [0u64; W];
                 for (k, (state, _)) in block.iter().enumerate() {
                     match non_finite("x", state.x().as_slice()) {
                         Some(error) => ends[k].failure = Some((error, 0)),
@@ -138,7 +165,7 @@ where
                 let ran = alive;
                 // Chain `k` of the block out of its lane into its state, and sampled.
                 let take_sample =
-                    |k: usize, s: &Scratch<C>, block: &mut [(&mut State<Dyn>, &mut T)]| -> bool {
+                    |k: usize, s: &Scratch<C, W>, block: &mut [(&mut State<Dyn>, &mut T)]| -> bool {
                         let Some(sample) = sample else { return false };
                         let (state, observer) = &mut block[k];
                         let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
@@ -152,11 +179,11 @@ where
                     }
                 }
                 let mut done = 0u64;
-                while done < plan.steps && alive != [0; WIDTH] {
+                while done < plan.steps && alive != [0; W] {
                     // Up to the next sample: every `every` steps, and the last.
                     let chunk = plan.every.min(plan.steps - done);
                     for step in done..done + chunk {
-                        let failed = self.rk4_step_simd::<C>(b, ids, plan.h, alive, s);
+                        let failed = one_step(&blocks[b], ids, alive, s);
                         for (k, end) in ends.iter_mut().enumerate() {
                             if failed[k] != 0 {
                                 end.failure =
@@ -164,7 +191,7 @@ where
                                 alive[k] = 0;
                             }
                         }
-                        if alive == [0; WIDTH] {
+                        if alive == [0; W] {
                             break;
                         }
                     }
@@ -192,29 +219,32 @@ where
         /// by compensated summation ([`State`]'s), the projection of every link
         /// ([`Constrained::project`]) and the compensation cleared, as `Projected` does. Returns
         /// the alive lanes whose increment was not finite (left as they were).
-        fn rk4_step<const C: usize>(
+        fn rk4_step<const C: usize, const W: usize>(
             &self,
-            b: usize,
-            chains: [usize; WIDTH],
+            block: &Block<W>,
+            chains: [usize; W],
             h: f64,
-            alive: [u64; WIDTH],
-            s: &mut Scratch<C>,
-        ) -> [u64; WIDTH] {
-            self.rk4_increment::<C>(b, chains, s.t[0].0, h, s);
+            alive: [u64; W],
+            s: &mut Scratch<C, W>,
+        ) -> [u64; W] {
+            self.rk4_increment::<C, W>(block, chains, s.t[0].0, h, s);
             let bad = non_finite_lanes(&s.y);
-            let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !bad[k]);
+            let keep: [u64; W] = std::array::from_fn(|k| alive[k] & !bad[k]);
             let [t, t_carry] = &mut s.t;
-            let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; WIDTH]));
-            (*t, *t_carry) = (F64x4::select(keep, new_t, *t), F64x4::select(keep, new_carry, *t_carry));
-            let zero = Lanes([0.0; WIDTH]);
-            // k1 is spent: the next state goes there.
+            let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; W]));
+            (*t, *t_carry) = (Lanes::select(keep, new_t, *t), Lanes::select(keep, new_carry, *t_carry));
+            let zero = Lanes([0.0; W]);
+            // k1 is spent: the next state goes there. (Each loop over rows ends with
+            // `one_row_at_a_time`.)
             let next = &mut s.k[0];
             for (((next, x), carry), y) in next.iter_mut().zip(&s.x).zip(&s.carry).zip(&s.y) {
                 (*next, _) = kahan_add(*x, *carry, *y);
+                one_row_at_a_time();
             }
             let (u, w) = next[..2 * C * self.links()].split_at_mut(C * self.links());
             for (u, w) in u.chunks_exact_mut(C).zip(w.chunks_exact_mut(C)) {
                 project_link(u, w);
+                one_row_at_a_time();
             }
             if keep.iter().all(|&k| k != 0) {
                 // Every lane steps (the common case): the next state becomes the state, no
@@ -223,51 +253,53 @@ where
                 s.carry.fill(zero);
             } else {
                 for ((x, carry), next) in s.x.iter_mut().zip(&mut s.carry).zip(&s.k[0]) {
-                    *x = F64x4::select(keep, *next, *x);
-                    *carry = F64x4::select(keep, zero, *carry);
+                    *x = Lanes::select(keep, *next, *x);
+                    *carry = Lanes::select(keep, zero, *carry);
+                    one_row_at_a_time();
                 }
             }
             std::array::from_fn(|k| alive[k] & bad[k])
         }
-        dispatch fn rk4_step_simd, rk4_step_avx2
+        dispatch fn rk4_step_simd, rk4_step_avx2, avx512 rk4_step_avx512
     }
     /// The RK4 stages of [`Rk4`](crate::integrate::Rk4) in lanes, from `s.x` at times `t`,
     /// leaving the increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` in `s.y`.
     #[inline(always)]
-    fn rk4_increment<const C: usize>(
+    fn rk4_increment<const C: usize, const W: usize>(
         &self,
-        b: usize,
-        chains: [usize; WIDTH],
-        t: [f64; WIDTH],
+        block: &Block<W>,
+        chains: [usize; W],
+        t: [f64; W],
         h: f64,
-        s: &mut Scratch<C>,
+        s: &mut Scratch<C, W>,
     ) {
         let half = 0.5 * h;
         let (x, y, rows) = (&s.x, &mut s.y, &mut s.solve);
         let [k1, k2, k3, k4] = &mut s.k;
-        let (half_lanes, h_lanes) = (Lanes([half; WIDTH]), Lanes([h; WIDTH]));
-        let at = |dt: f64| -> [f64; WIDTH] { std::array::from_fn(|k| t[k] + dt) };
+        let (half_lanes, h_lanes) = (Lanes([half; W]), Lanes([h; W]));
+        let at = |dt: f64| -> [f64; W] { std::array::from_fn(|k| t[k] + dt) };
         // `Accounted`'s right-hand side when the states carry the ledger.
         let accounted = self.is_accounted();
-        let pivot = self.flow::<C>(b, chains, t, x, rows, k1);
+        let pivot = self.flow::<C, W>(block, chains, t, x, rows, k1);
         if accounted {
-            self.ledger_rates::<C>(b, chains, t, x, pivot, k1);
+            self.ledger_rates::<C, W>(block, chains, t, x, pivot, k1);
         }
         // k_{j+1} = f(t + c h, y) at y = x + a k_j, y formed in the stage's pass.
         let stages = [(at(half), half_lanes), (at(half), half_lanes), (at(h), h_lanes)];
         let mut ks = [&mut **k1, &mut **k2, &mut **k3, &mut **k4];
         for (j, (t, a)) in stages.into_iter().enumerate() {
             let [.., before, next] = &mut ks[..j + 2] else { unreachable!("two stages") };
-            let pivot = self.stage::<C>(b, chains, t, (x, a, before), y, rows, next);
+            let pivot = self.stage::<C, W>(block, chains, t, (x, a, before), y, rows, next);
             if accounted {
-                self.ledger_rates::<C>(b, chains, t, y, pivot, next);
+                self.ledger_rates::<C, W>(block, chains, t, y, pivot, next);
             }
         }
         let [k1, k2, k3, k4] = ks;
-        let (sixth, two) = (Lanes([h / 6.0; WIDTH]), Lanes([2.0; WIDTH]));
+        let (sixth, two) = (Lanes([h / 6.0; W]), Lanes([2.0; W]));
         // Zipped, not indexed: four bounds checks per number were a tenth of the step.
         for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
             *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
+            one_row_at_a_time();
         }
     }
 }
