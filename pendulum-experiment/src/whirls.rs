@@ -1,8 +1,8 @@
 //! Many whirls at once: a chain run from hanging at rest with its pivot on a horizontal
 //! circle (switched on or ramped), RK4 with projection and the energy ledger, the shape
 //! analysis fed every few steps, for a list of drives as one batch of chains
-//! ([`DirectionsBatch::run_rk4`]: four chains per SIMD lane group, on the current rayon
-//! pool). Each whirl is bit for bit the run of [`WhirlRuns::run_one`], so a front end (the CLI's
+//! ([`DirectionsBatch::run_rk4`]: four or eight chains per SIMD register, on the current
+//! rayon pool). Each whirl is bit for bit the run of [`WhirlRuns::run_one`], so a front end (the CLI's
 //! `sweep`, Python's `pendulum.whirls`) may batch whatever points are independent.
 
 use std::ops::ControlFlow;

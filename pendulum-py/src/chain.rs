@@ -465,7 +465,7 @@ impl Chain {
 
     /// `(q, qd)` after `steps` steps of classical RK4 of `h` seconds from each state, with
     /// its joint torques (N·m) and pivot acceleration (m/s²) held over the call (none: the
-    /// chain free; planar model): many states at once, four per SIMD register and on every
+    /// chain free; planar model): many states at once, four per SIMD register (eight with AVX-512) and on every
     /// core, each bit for bit what the chain alone would give (docs/ensembles.md).
     /// `precision="float32"` steps eight states per register in single precision and
     /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step

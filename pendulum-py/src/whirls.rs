@@ -26,7 +26,7 @@ use crate::interrupt::interruptible;
 /// each one number for all the whirls or a sequence, one per whirl (those given as
 /// sequences must have the same length).
 ///
-/// The whirls run together as a batch of chains, four per SIMD lane group, on all cores;
+/// The whirls run together as a batch of chains, four per SIMD register (eight with AVX-512), on all cores;
 /// each gives exactly what it gives alone. Defaults: ``duration`` 12 decay times of the
 /// chain's first mode (200 periods undamped), ``step`` the sweep's for the fastest
 /// ``omega`` and largest ``radius``. The GIL is released; Ctrl-C raises KeyboardInterrupt.

@@ -66,7 +66,7 @@ def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
     rng = np.random.default_rng(1)
     chain = pendulum.Chain([0.1] * 8, [0.1] * 8, damping=0.01)
     q, qd = rng.uniform(-2, 2, (3, 5, 8)), rng.normal(size=(3, 5, 8))
-    # Many states go through the batch of chains (four per SIMD lane group): still the
+    # Many states go through the batch of chains (four or eight per SIMD register): still the
     # states one at a time, bit for bit, torques on some and none on others.
     torque = rng.normal(size=(3, 5, 8))
     torque[1] = 0.0

@@ -138,7 +138,7 @@ impl Sweep {
             if !self.down.is_empty() {
                 s.spawn_fifo(|_| runs.down());
             }
-            // The independent points as batches of chains, four per SIMD lane group, on the
+            // The independent points as batches of chains, four per SIMD register (eight with AVX-512), on the
             // pool's threads, in rounds of two blocks per thread (a stop keeps finished rounds).
             if !self.singles.is_empty() {
                 s.spawn_fifo(|_| {
