@@ -4,14 +4,14 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::{
-    F32x8, Failure, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
-    for_blocks_of, gather, non_finite, scatter, simd_kernel,
+    Blocks, F32x8, Failure, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
+    failed_rows, for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
 use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::error::{Error, Result};
-use crate::lanes::{Lane, Lanes, Lanes32, has_avx512, one_row_at_a_time};
+use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
 use crate::models::Directions;
 use crate::models::directions::rate_load;
 use crate::rods::{Load, Rods, Rows};
@@ -28,11 +28,7 @@ use crate::rods::{Load, Rods, Rows};
 #[derive(Debug, Clone)]
 pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     models: Vec<Directions<S, Dr>>,
-    pub(super) blocks: Vec<Block>,
-    /// The same per block of [`WIDTH_AVX512`] chains where the CPU has AVX-512 (and
-    /// [`with_avx512`](Self::with_avx512) allows it), else none: the `f64` calls then run
-    /// eight chains a register.
-    pub(super) blocks_avx512: Vec<Block<WIDTH_AVX512>>,
+    pub(super) blocks: Blocks<Block, Block<WIDTH_AVX512>>,
     /// Per block of [`WIDTH_F32`] chains, their rods and `−g` in single precision.
     blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
     links: usize,
@@ -194,23 +190,24 @@ where
                 (Rods::interleave_f32(lanes.map(|c| models[c].rods())), down)
             })
             .collect();
-        let blocks = f64_blocks(&models, links);
-        let blocks_avx512 = if has_avx512() { f64_blocks(&models, links) } else { Vec::new() };
-        Ok(Self { models, blocks, blocks_avx512, blocks_f32, links, accounted: false })
+        let blocks = Blocks::new(true, || f64_blocks(&models, links), || f64_blocks(&models, links));
+        Ok(Self { models, blocks, blocks_f32, links, accounted: false })
     }
 
     /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
     /// AVX-512 (the default), or keep four per AVX2 register (`false`). The results are the
     /// same bits either way; the choice is speed (`docs/ensembles.md`).
     pub fn with_avx512(mut self, allowed: bool) -> Self {
-        self.blocks_avx512 =
-            if allowed && has_avx512() { f64_blocks(&self.models, self.links) } else { Vec::new() };
+        if allowed != self.uses_avx512() {
+            let (models, links) = (&self.models, self.links);
+            self.blocks = Blocks::new(allowed, || f64_blocks(models, links), || f64_blocks(models, links));
+        }
         self
     }
 
     /// Whether the `f64` calls run eight lanes (AVX-512).
     pub fn uses_avx512(&self) -> bool {
-        !self.blocks_avx512.is_empty()
+        self.blocks.eight()
     }
 
     /// The batch of `models` with their energy ledgers: states as
@@ -279,17 +276,22 @@ where
 
     fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
         let otherwise = (f64::NAN, Error::NotPositiveDefinite);
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            let blocks = &self.blocks_avx512;
-            return self.in_blocks::<C, WIDTH_AVX512, _, _>(x, out, otherwise, |b, chains, s, out| {
-                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
-                unsafe { self.evaluate_avx512::<C, WIDTH_AVX512>(&blocks[b], chains, t, x, s, out) }
-            });
+        match &self.blocks {
+            Blocks::Four(blocks) => {
+                self.in_blocks::<C, WIDTH, _, _>(x, out, otherwise, |b, chains, s, out| {
+                    self.evaluate_simd::<C, WIDTH>(&blocks[b], chains, t, x, s, out)
+                })
+            }
+            #[cfg(target_arch = "x86_64")]
+            Blocks::Eight(blocks) => {
+                self.in_blocks::<C, WIDTH_AVX512, _, _>(x, out, otherwise, |b, chains, s, out| {
+                    // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
+                    unsafe { self.evaluate_avx512::<C, WIDTH_AVX512>(&blocks[b], chains, t, x, s, out) }
+                })
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
         }
-        self.in_blocks::<C, WIDTH, _, _>(x, out, otherwise, |b, chains, s, out| {
-            self.evaluate_simd::<C, WIDTH>(&self.blocks[b], chains, t, x, s, out)
-        })
     }
 
     /// Runs `kernel(b, chains, lanes, rows)` for every block of `W` chains (`lanes`: the

@@ -55,8 +55,8 @@ pub const WIDTH: usize = 4;
 /// Chains per block in single precision: eight `f32` lanes, one AVX2 register.
 pub const WIDTH_F32: usize = 8;
 
-/// Chains per block of the planar batch on a CPU with AVX-512: eight `f64` lanes, one
-/// AVX-512 register.
+/// Chains per block of the `f64` planar and direction batches on a CPU with AVX-512: eight
+/// `f64` lanes, one AVX-512 register.
 pub const WIDTH_AVX512: usize = 8;
 
 /// Four chains' numbers, one per lane.
@@ -67,6 +67,42 @@ pub(crate) type F64x8 = Lanes<WIDTH_AVX512>;
 
 /// Eight chains' numbers in single precision, one per lane: one AVX2 register.
 pub(crate) type F32x8 = Lanes32<WIDTH_F32>;
+
+/// A batch's `f64` constants in lanes, block by block: blocks of [`WIDTH`] chains (`Four`,
+/// AVX2) or, on a CPU with AVX-512, of [`WIDTH_AVX512`] (`Eight`). One or the other: the
+/// lanes a call runs in follow from which.
+#[derive(Debug, Clone)]
+pub(crate) enum Blocks<Four, Eight> {
+    Four(Vec<Four>),
+    #[cfg(target_arch = "x86_64")]
+    Eight(Vec<Eight>),
+    /// Other targets have no eight-lane kernels: this keeps `Eight` a parameter there.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[allow(dead_code)]
+    Never(std::marker::PhantomData<Eight>),
+}
+
+impl<Four, Eight> Blocks<Four, Eight> {
+    /// Eight lanes where `eight_allowed` and the CPU has AVX-512 (`eight()` builds them),
+    /// else four (`four()`).
+    pub(crate) fn new(
+        eight_allowed: bool,
+        four: impl FnOnce() -> Vec<Four>,
+        eight: impl FnOnce() -> Vec<Eight>,
+    ) -> Self {
+        #[cfg(target_arch = "x86_64")]
+        if eight_allowed && crate::lanes::has_avx512() {
+            return Self::Eight(eight());
+        }
+        let _ = (eight_allowed, eight);
+        Self::Four(four())
+    }
+
+    /// Whether the blocks are of eight lanes.
+    pub(crate) fn eight(&self) -> bool {
+        !matches!(self, Self::Four(_))
+    }
+}
 
 /// A chain of a batch that failed, and why; the other chains finished.
 #[derive(Debug, Clone, PartialEq)]

@@ -5,13 +5,13 @@ use nalgebra::Dyn;
 
 use super::transpose::Transpose;
 use super::{
-    F32x8, F64x4, F64x8, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links, failed_rows,
-    first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
+    Blocks, F32x8, F64x4, F64x8, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
+    failed_rows, first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32, has_avx512, one_row_at_a_time};
+use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
@@ -32,11 +32,7 @@ pub struct PlanarBatch {
     chains: Vec<PlanarTension<Dyn>>,
     /// Per block of [`WIDTH`] chains, their constants side by side (one block for all when
     /// the chains are one chain repeated).
-    pub(super) blocks: Vec<Block>,
-    /// The same per block of [`WIDTH_AVX512`](super::WIDTH_AVX512) chains where the CPU has AVX-512 (and
-    /// [`with_avx512`](Self::with_avx512) allows it), else none: the `f64` calls then run
-    /// eight chains a register.
-    pub(super) blocks_avx512: Vec<Block<F64x8>>,
+    pub(super) blocks: Blocks<Block, Block<F64x8>>,
     /// The same in single precision, per block of [`WIDTH_F32`] chains.
     pub(super) blocks_f32: Vec<Block<F32x8>>,
     count: usize,
@@ -147,8 +143,7 @@ impl PlanarBatch {
     pub fn new(chains: Vec<Chain<Dyn>>) -> Result<Self> {
         let links = check_links(chains.iter().map(Chain::links))?;
         let chains: Vec<_> = chains.into_iter().map(PlanarTension::new).collect();
-        let blocks = f64_blocks(&chains);
-        let blocks_avx512 = if has_avx512() { f64_blocks(&chains) } else { Vec::new() };
+        let blocks = Blocks::new(true, || f64_blocks(&chains), || f64_blocks(&chains));
         let blocks_f32 = (0..chains.len().div_ceil(WIDTH_F32))
             .map(|b| {
                 let lanes = block_chains::<WIDTH_F32>(b, chains.len());
@@ -158,7 +153,7 @@ impl PlanarBatch {
                 }
             })
             .collect();
-        Ok(Self { count: chains.len(), chains, blocks, blocks_avx512, blocks_f32, links })
+        Ok(Self { count: chains.len(), chains, blocks, blocks_f32, links })
     }
 
     /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
@@ -166,13 +161,15 @@ impl PlanarBatch {
     /// same bits either way; the choice is speed (eight lanes are faster on the AMD EPYC
     /// measured in `docs/ensembles.md`; some Intel CPUs lower their clock under AVX-512).
     pub fn with_avx512(mut self, allowed: bool) -> Self {
-        self.blocks_avx512 = if allowed && has_avx512() { f64_blocks(&self.chains) } else { Vec::new() };
+        if allowed != self.uses_avx512() {
+            self.blocks = Blocks::new(allowed, || f64_blocks(&self.chains), || f64_blocks(&self.chains));
+        }
         self
     }
 
     /// Whether the `f64` calls run eight lanes (AVX-512).
     pub fn uses_avx512(&self) -> bool {
-        !self.blocks_avx512.is_empty()
+        self.blocks.eight()
     }
 
     /// `count` copies of `chain`: one model at `count` states per call. The lanes' constants
@@ -229,16 +226,22 @@ impl PlanarBatch {
             check_len("torque", torque, self.len(), self.links)?;
         }
         let otherwise = (f64::NAN, Error::NotPositiveDefinite);
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            return Ok(self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
-                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
-                unsafe { self.block_avx512(&self.blocks_avx512, b, lanes, q, qd, torque, pivot, s, out) }
-            }));
-        }
-        Ok(self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
-            self.block_simd::<WIDTH>(&self.blocks, b, lanes, q, qd, torque, pivot, s, out)
-        }))
+        Ok(match &self.blocks {
+            Blocks::Four(blocks) => {
+                self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
+                    self.block_simd::<WIDTH>(blocks, b, lanes, q, qd, torque, pivot, s, out)
+                })
+            }
+            #[cfg(target_arch = "x86_64")]
+            Blocks::Eight(blocks) => {
+                self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {
+                    // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
+                    unsafe { self.block_avx512(blocks, b, lanes, q, qd, torque, pivot, s, out) }
+                })
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
+        })
     }
 
     /// [`accelerations`](Self::accelerations) in single precision: arrays in `f32`, eight

@@ -14,8 +14,8 @@ use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
-    F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states, for_blocks_of,
-    non_finite, simd_kernel,
+    Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,
+    for_blocks_of, non_finite, simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -171,16 +171,24 @@ impl PlanarBatch {
     ) -> Result<Vec<Failure>> {
         check_states(states, self.len(), 2 * self.links)?;
         self.check_run(torque, pivot, h)?;
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            let step = |block: &Block<F64x8>, alive, s: &mut Run<F64x8>| {
-                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
-                unsafe { self.rk4_step_avx512(block, h, alive, s) }
-            };
-            return Ok(self.run_f64(&self.blocks_avx512, states, (torque, pivot), (h, steps), step));
-        }
-        let step = |block: &Block<F64x4>, alive, s: &mut Run<F64x4>| self.rk4_step_simd(block, h, alive, s);
-        Ok(self.run_f64(&self.blocks, states, (torque, pivot), (h, steps), step))
+        let run = (states, (torque, pivot), (h, steps));
+        Ok(match &self.blocks {
+            Blocks::Four(blocks) => {
+                let step =
+                    |block: &Block<F64x4>, alive, s: &mut Run<F64x4>| self.rk4_step_simd(block, h, alive, s);
+                self.run_f64(blocks, run, step)
+            }
+            #[cfg(target_arch = "x86_64")]
+            Blocks::Eight(blocks) => {
+                let step = |block: &Block<F64x8>, alive, s: &mut Run<F64x8>| {
+                    // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
+                    unsafe { self.rk4_step_avx512(block, h, alive, s) }
+                };
+                self.run_f64(blocks, run, step)
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
+        })
     }
 
     /// [`integrate_rk4`](Self::integrate_rk4)'s runs (arguments checked) in blocks of `W`
@@ -188,9 +196,7 @@ impl PlanarBatch {
     fn run_f64<const W: usize>(
         &self,
         blocks: &[Block<Lanes<W>>],
-        states: &mut [State<Dyn>],
-        (torque, pivot): Inputs<'_, f64>,
-        (h, steps): (f64, usize),
+        (states, (torque, pivot), (h, steps)): (&mut [State<Dyn>], Inputs<'_, f64>, (f64, usize)),
         step: impl Fn(&Block<Lanes<W>>, [u64; W], &mut Run<Lanes<W>>) -> [u64; W] + Sync + Send,
     ) -> Vec<Failure> {
         let (n, m) = (self.links, 2 * self.links);

@@ -8,7 +8,7 @@ use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::{Block, Scratch};
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
-use super::{Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, simd_kernel};
+use super::{Blocks, Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, simd_kernel};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -112,18 +112,24 @@ where
     where
         F: Fn(&mut T, f64, &DVector<f64>) -> ControlFlow<()> + Sync,
     {
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            let step = |block: &Block<WIDTH_AVX512>, ids, alive, s: &mut Scratch<C, WIDTH_AVX512>| {
-                // SAFETY: the eight-lane blocks exist only where the CPU has AVX-512.
-                unsafe { self.rk4_step_avx512::<C, WIDTH_AVX512>(block, ids, plan.h, alive, s) }
-            };
-            return self.rk4_blocks(&self.blocks_avx512, states, observers, (plan, sample), step);
+        match &self.blocks {
+            Blocks::Four(blocks) => {
+                let step = |block: &Block<WIDTH>, ids, alive, s: &mut Scratch<C, WIDTH>| {
+                    self.rk4_step_simd::<C, WIDTH>(block, ids, plan.h, alive, s)
+                };
+                self.rk4_blocks(blocks, states, observers, (plan, sample), step)
+            }
+            #[cfg(target_arch = "x86_64")]
+            Blocks::Eight(blocks) => {
+                let step = |block: &Block<WIDTH_AVX512>, ids, alive, s: &mut Scratch<C, WIDTH_AVX512>| {
+                    // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
+                    unsafe { self.rk4_step_avx512::<C, WIDTH_AVX512>(block, ids, plan.h, alive, s) }
+                };
+                self.rk4_blocks(blocks, states, observers, (plan, sample), step)
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
         }
-        let step = |block: &Block<WIDTH>, ids, alive, s: &mut Scratch<C, WIDTH>| {
-            self.rk4_step_simd::<C, WIDTH>(block, ids, plan.h, alive, s)
-        };
-        self.rk4_blocks(&self.blocks, states, observers, (plan, sample), step)
     }
 
     /// [`rk4`](Self::rk4) in blocks of `W` chains with constants `blocks`, `one_step`
