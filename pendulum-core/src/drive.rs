@@ -36,6 +36,11 @@ where
     fn velocity(&self, t: f64) -> OVector<f64, S>;
     /// Pivot acceleration `p̈(t)`, m/s².
     fn acceleration(&self, t: f64) -> OVector<f64, S>;
+    /// `(ṗ(t), p̈(t))` at once, equal bit for bit to the two calls: a drive may share their
+    /// work (the circles compute `sin`, `cos` of the phase once).
+    fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (self.velocity(t), self.acceleration(t))
+    }
 }
 
 impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for &D
@@ -51,6 +56,9 @@ where
     fn acceleration(&self, t: f64) -> OVector<f64, S> {
         (**self).acceleration(t)
     }
+    fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (**self).velocity_and_acceleration(t)
+    }
 }
 
 impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for Box<D>
@@ -65,6 +73,9 @@ where
     }
     fn acceleration(&self, t: f64) -> OVector<f64, S> {
         (**self).acceleration(t)
+    }
+    fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (**self).velocity_and_acceleration(t)
     }
 }
 
@@ -234,13 +245,15 @@ impl Drive<U3> for Circle {
         Vector3::new(c, s, 0.0) * self.radius
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
-        let (s, c) = (self.angular_frequency * t).sin_cos();
-        Vector3::new(-s, c, 0.0) * (self.radius * self.angular_frequency)
+        self.velocity_and_acceleration(t).0
     }
     fn acceleration(&self, t: f64) -> Vector3<f64> {
+        self.velocity_and_acceleration(t).1
+    }
+    fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let w = self.angular_frequency;
         let (s, c) = (w * t).sin_cos();
-        Vector3::new(c, s, 0.0) * (-self.radius * w * w)
+        (Vector3::new(-s, c, 0.0) * (self.radius * w), Vector3::new(c, s, 0.0) * (-self.radius * w * w))
     }
 }
 
@@ -385,14 +398,16 @@ impl Drive<U3> for RampedCircle {
         Vector3::new(c, s, 0.0) * self.radius
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
-        let (phi, rate, _) = self.angle(t);
-        let (s, c) = phi.sin_cos();
-        Vector3::new(-s, c, 0.0) * (self.radius * rate)
+        self.velocity_and_acceleration(t).0
     }
     fn acceleration(&self, t: f64) -> Vector3<f64> {
+        self.velocity_and_acceleration(t).1
+    }
+    fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let (phi, rate, spin) = self.angle(t);
         let (s, c) = phi.sin_cos();
-        (Vector3::new(-s, c, 0.0) * spin - Vector3::new(c, s, 0.0) * (rate * rate)) * self.radius
+        let velocity = Vector3::new(-s, c, 0.0) * (self.radius * rate);
+        (velocity, (Vector3::new(-s, c, 0.0) * spin - Vector3::new(c, s, 0.0) * (rate * rate)) * self.radius)
     }
 }
 

@@ -413,24 +413,42 @@ where
         dispatch fn evaluate_simd, evaluate_avx2, avx512 evaluate_avx512
     }
 
+    /// Each lane's pivot acceleration `p̈` (m/s²) at its time `t[k]`, and with `velocity`
+    /// its velocity `ṗ` (m/s) too, from one evaluation of the drive
+    /// ([`Drive::velocity_and_acceleration`]).
+    #[inline(always)]
+    pub(super) fn pivot_motion<const C: usize, const W: usize>(
+        &self,
+        chains: [usize; W],
+        t: [f64; W],
+        velocity: bool,
+    ) -> ([Lanes<W>; C], Option<[Lanes<W>; C]>) {
+        if !velocity {
+            return (self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes), None);
+        }
+        let motion: [_; W] =
+            std::array::from_fn(|k| self.models[chains[k]].drive().velocity_and_acceleration(t[k]));
+        let velocity = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].0[c])));
+        let acceleration = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].1[c])));
+        (acceleration, Some(velocity))
+    }
+
     /// `out = (w, ü(t, x))` for the block's chains in lanes: [`Directions`]' right-hand side,
-    /// one tension solve, with each chain's pivot acceleration at its own time.
+    /// one tension solve, with each chain's pivot acceleration `pivot` (m/s², at its own
+    /// time).
     #[inline(always)]
     pub(super) fn flow<const C: usize, const W: usize>(
         &self,
         block: &Block<W>,
-        chains: [usize; W],
-        t: [f64; W],
+        pivot: [Lanes<W>; C],
         x: &[Lanes<W>],
         solve: &mut Solve<C, Lanes<W>>,
         out: &mut [Lanes<W>],
-    ) -> [Lanes<W>; C] {
+    ) {
         let half = C * self.links;
-        let pivot = self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes);
         let (velocity, acceleration) = out.split_at_mut(half);
         velocity.copy_from_slice(&x[half..2 * half]);
         solve.accelerations(&block.rods, gravity(block.down), pivot, x, acceleration);
-        pivot
     }
 
     /// [`flow`](Self::flow) at the Runge–Kutta stage `y = x + a·k`, written into `y` as it
@@ -440,33 +458,27 @@ where
     pub(super) fn stage<const C: usize, const W: usize>(
         &self,
         block: &Block<W>,
-        chains: [usize; W],
-        t: [f64; W],
+        pivot: [Lanes<W>; C],
         (x, a, k): (&[Lanes<W>], Lanes<W>, &[Lanes<W>]),
         y: &mut [Lanes<W>],
         solve: &mut Solve<C, Lanes<W>>,
         out: &mut [Lanes<W>],
-    ) -> [Lanes<W>; C] {
-        let pivot = self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes);
+    ) {
         solve.stage(&block.rods, gravity(block.down), pivot, x, a, k, y, out);
-        pivot
     }
 
     /// The ledger's rates `(P_drive, 0, P_damping)` (W) into `out[2·S·n..]` after [`flow`](Self::flow)
-    /// filled `out` at the same `(t, x)` with the pivot accelerations `pivot` (m/s²) it
-    /// returned: as `Accounted`'s right-hand side gives them.
+    /// filled `out` at the same `(t, x)` with the pivot accelerations `pivot` (m/s²), the
+    /// pivots moving at `velocity` (m/s): as `Accounted`'s right-hand side gives them.
     #[inline(always)]
     pub(super) fn ledger_rates<const C: usize, const W: usize>(
         &self,
         block: &Block<W>,
-        chains: [usize; W],
-        t: [f64; W],
         x: &[Lanes<W>],
-        pivot: [Lanes<W>; C],
+        (velocity, pivot): ([Lanes<W>; C], [Lanes<W>; C]),
         out: &mut [Lanes<W>],
     ) {
         let half = C * self.links;
-        let velocity = self.pivot_lanes::<C, W, _>(chains, t, Dr::velocity, Lanes);
         let chain = (&block.tails[..], &block.lengths[..], &block.damping[..], -block.down);
         let (rates, accelerations) = (&x[half..2 * half], &out[half..2 * half]);
         let (drive, damping) = direction_powers(chain, velocity, pivot, rates, accelerations);

@@ -284,20 +284,23 @@ where
         let [k1, k2, k3, k4] = &mut s.k;
         let (half_lanes, h_lanes) = (Lanes([half; W]), Lanes([h; W]));
         let at = |dt: f64| -> [f64; W] { std::array::from_fn(|k| t[k] + dt) };
-        // `Accounted`'s right-hand side when the states carry the ledger.
+        // `Accounted`'s right-hand side when the states carry the ledger (which needs the
+        // pivots' velocities too).
         let accounted = self.is_accounted();
-        let pivot = self.flow::<C, W>(block, chains, t, x, rows, k1);
-        if accounted {
-            self.ledger_rates::<C, W>(block, chains, t, x, pivot, k1);
+        let (pivot, velocity) = self.pivot_motion::<C, W>(chains, t, accounted);
+        self.flow::<C, W>(block, pivot, x, rows, k1);
+        if let Some(velocity) = velocity {
+            self.ledger_rates::<C, W>(block, x, (velocity, pivot), k1);
         }
         // k_{j+1} = f(t + c h, y) at y = x + a k_j, y formed in the stage's pass.
         let stages = [(at(half), half_lanes), (at(half), half_lanes), (at(h), h_lanes)];
         let mut ks = [&mut **k1, &mut **k2, &mut **k3, &mut **k4];
         for (j, (t, a)) in stages.into_iter().enumerate() {
             let [.., before, next] = &mut ks[..j + 2] else { unreachable!("two stages") };
-            let pivot = self.stage::<C, W>(block, chains, t, (x, a, before), y, rows, next);
-            if accounted {
-                self.ledger_rates::<C, W>(block, chains, t, y, pivot, next);
+            let (pivot, velocity) = self.pivot_motion::<C, W>(chains, t, accounted);
+            self.stage::<C, W>(block, pivot, (x, a, before), y, rows, next);
+            if let Some(velocity) = velocity {
+                self.ledger_rates::<C, W>(block, y, (velocity, pivot), next);
             }
         }
         let [k1, k2, k3, k4] = ks;
