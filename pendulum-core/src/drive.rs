@@ -239,21 +239,38 @@ impl Circle {
     }
 }
 
+impl Circle {
+    /// `(sin φ, cos φ)` of the phase `φ = ωt` (rad) at `t` (s).
+    fn turn(&self, t: f64) -> (f64, f64) {
+        (self.angular_frequency * t).sin_cos()
+    }
+
+    /// `ṗ = Rω (−sin φ, cos φ, 0)` (m/s) from `(sin φ, cos φ)`.
+    fn velocity_from(&self, (s, c): (f64, f64)) -> Vector3<f64> {
+        Vector3::new(-s, c, 0.0) * (self.radius * self.angular_frequency)
+    }
+
+    /// `p̈ = −Rω² (cos φ, sin φ, 0)` (m/s²) from `(sin φ, cos φ)`.
+    fn acceleration_from(&self, (s, c): (f64, f64)) -> Vector3<f64> {
+        let w = self.angular_frequency;
+        Vector3::new(c, s, 0.0) * (-self.radius * w * w)
+    }
+}
+
 impl Drive<U3> for Circle {
     fn position(&self, t: f64) -> Vector3<f64> {
-        let (s, c) = (self.angular_frequency * t).sin_cos();
+        let (s, c) = self.turn(t);
         Vector3::new(c, s, 0.0) * self.radius
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
-        self.velocity_and_acceleration(t).0
+        self.velocity_from(self.turn(t))
     }
     fn acceleration(&self, t: f64) -> Vector3<f64> {
-        self.velocity_and_acceleration(t).1
+        self.acceleration_from(self.turn(t))
     }
     fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let w = self.angular_frequency;
-        let (s, c) = (w * t).sin_cos();
-        (Vector3::new(-s, c, 0.0) * (self.radius * w), Vector3::new(c, s, 0.0) * (-self.radius * w * w))
+        let turn = self.turn(t);
+        (self.velocity_from(turn), self.acceleration_from(turn))
     }
 }
 
@@ -392,22 +409,35 @@ impl RampedCircle {
     }
 }
 
+impl RampedCircle {
+    /// `ṗ = R φ̇ (−sin φ, cos φ, 0)` (m/s) from `(φ, φ̇, φ̈)` and `(sin φ, cos φ)`.
+    fn velocity_from(&self, (_, rate, _): (f64, f64, f64), (s, c): (f64, f64)) -> Vector3<f64> {
+        Vector3::new(-s, c, 0.0) * (self.radius * rate)
+    }
+
+    /// `p̈ = R φ̈ (−sin φ, cos φ, 0) − R φ̇² (cos φ, sin φ, 0)` (m/s²), the same way.
+    fn acceleration_from(&self, (_, rate, spin): (f64, f64, f64), (s, c): (f64, f64)) -> Vector3<f64> {
+        (Vector3::new(-s, c, 0.0) * spin - Vector3::new(c, s, 0.0) * (rate * rate)) * self.radius
+    }
+}
+
 impl Drive<U3> for RampedCircle {
     fn position(&self, t: f64) -> Vector3<f64> {
         let (s, c) = self.angle(t).0.sin_cos();
         Vector3::new(c, s, 0.0) * self.radius
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
-        self.velocity_and_acceleration(t).0
+        let angle = self.angle(t);
+        self.velocity_from(angle, angle.0.sin_cos())
     }
     fn acceleration(&self, t: f64) -> Vector3<f64> {
-        self.velocity_and_acceleration(t).1
+        let angle = self.angle(t);
+        self.acceleration_from(angle, angle.0.sin_cos())
     }
     fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let (phi, rate, spin) = self.angle(t);
-        let (s, c) = phi.sin_cos();
-        let velocity = Vector3::new(-s, c, 0.0) * (self.radius * rate);
-        (velocity, (Vector3::new(-s, c, 0.0) * spin - Vector3::new(c, s, 0.0) * (rate * rate)) * self.radius)
+        let angle = self.angle(t);
+        let turn = angle.0.sin_cos();
+        (self.velocity_from(angle, turn), self.acceleration_from(angle, turn))
     }
 }
 

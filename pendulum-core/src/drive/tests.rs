@@ -16,6 +16,10 @@ where
         let (v, a) = (drive.velocity(t), drive.acceleration(t));
         assert!((&dp - &v).norm() < 1e-7 * (1.0 + v.norm()), "ṗ {v} vs {dp}");
         assert!((&dv - &a).norm() < 1e-7 * (1.0 + a.norm()), "p̈ {a} vs {dv}");
+        // Both at once are the two calls, bit for bit (the batch relies on it).
+        let (both_v, both_a) = drive.velocity_and_acceleration(t);
+        let bits = |x: &OVector<f64, S>| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!((bits(&both_v), bits(&both_a)), (bits(&v), bits(&a)), "t = {t}");
     }
 }
 
@@ -84,6 +88,9 @@ fn assert_consistent_at(drive: &impl Drive<U3>, times: &[f64]) {
         let (v, a) = (drive.velocity(t), drive.acceleration(t));
         assert!((dp - v).norm() < 1e-7 * (1.0 + v.norm()), "t = {t}: ṗ {v} vs {dp}");
         assert!((dv - a).norm() < 1e-7 * (1.0 + a.norm()), "t = {t}: p̈ {a} vs {dv}");
+        let (both_v, both_a) = drive.velocity_and_acceleration(t);
+        let bits = |x: &Vector3<f64>| x.map(f64::to_bits);
+        assert_eq!((bits(&both_v), bits(&both_a)), (bits(&v), bits(&a)), "t = {t}: both at once");
     }
 }
 
