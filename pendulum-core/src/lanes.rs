@@ -43,9 +43,11 @@ pub(crate) fn one_row_at_a_time() {
     std::sync::atomic::compiler_fence(std::sync::atomic::Ordering::SeqCst);
 }
 
-/// The arithmetic the tension solve needs, lane by lane.
+/// The arithmetic the tension solve needs, lane by lane (numbers, owning nothing: a batch
+/// keeps rooms of them between calls).
 pub trait Lane:
     Copy
+    + 'static
     + std::fmt::Debug
     + Add<Output = Self>
     + Sub<Output = Self>

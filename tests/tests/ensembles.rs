@@ -138,6 +138,55 @@ fn one_chain_repeated_is_that_chain_at_every_state() {
 }
 
 #[test]
+fn the_scratch_a_batch_keeps_between_calls_changes_no_result() {
+    // A batch lends each call's tasks the scratch of its earlier calls: a call with torques,
+    // pivots and failing chains, then one with none of them, must give what a new batch
+    // gives, on one and two threads, in eight lanes and four, in f64 and f32.
+    let mut r = ChaCha8Rng::seed_from_u64(17);
+    let (chains, n) = (21, 30);
+    let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+    let mut rows = |scale: f64| (0..chains * n).map(|_| r.random_range(-scale..scale)).collect::<Vec<f64>>();
+    let (mut q1, qd1, torque, q2, qd2) = (rows(3.0), rows(5.0), rows(0.1), rows(3.0), rows(5.0));
+    q1[4 * n + 3] = f64::NAN;
+    let pivot: Vec<f64> = (0..2 * chains).map(|_| r.random_range(-30.0..30.0)).collect();
+    let fresh = PlanarBatch::new(chain.clone()).expect("batch");
+    for (batch, pool) in widths_and_pools(&fresh) {
+        let mut out = vec![0.0; chains * n];
+        let first = pool.install(|| batch.accelerations(&q1, &qd1, Some(&torque), Some(&pivot), &mut out));
+        assert_eq!(first.expect("first").iter().map(|f| f.chain).collect::<Vec<_>>(), [4]);
+        assert!(pool.install(|| batch.accelerations(&q2, &qd2, None, None, &mut out)).expect("b").is_empty());
+        let mut new = vec![0.0; chains * n];
+        let unused = fresh.clone().with_avx512(batch.uses_avx512());
+        assert!(unused.accelerations(&q2, &qd2, None, None, &mut new).expect("new").is_empty());
+        assert_bits(&out, &new, &format!("{} threads", pool.current_num_threads()));
+    }
+    let single = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (q1, qd1, q2, qd2) = (single(&q1), single(&qd1), single(&q2), single(&qd2));
+    let (mut out, mut new) = (vec![0.0f32; chains * n], vec![0.0f32; chains * n]);
+    let batch = fresh.clone();
+    assert_eq!(batch.accelerations_f32(&q1, &qd1, None, &mut out).expect("first").len(), 1);
+    assert!(batch.accelerations_f32(&q2, &qd2, None, &mut out).expect("second").is_empty());
+    assert!(fresh.clone().accelerations_f32(&q2, &qd2, None, &mut new).expect("new").is_empty());
+    assert_eq!(
+        out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        new.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    // The whirls' accelerations at two states, against a new batch at the second.
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(8, &mut r)).unzip();
+    let spatial = DirectionsBatch::new(models).expect("batch");
+    let flat = |k: usize| {
+        x.iter().flat_map(|x| x.iter().map(move |v| v * (1.0 + 0.1 * k as f64))).collect::<Vec<f64>>()
+    };
+    let half = chains * spatial.state_len() / 2;
+    let (mut out, mut new) = (vec![0.0; half], vec![0.0; half]);
+    for (t, k) in [(0.1, 0), (0.7, 1)] {
+        assert!(spatial.accelerations(t, &flat(k), &mut out).expect("batch").is_empty());
+    }
+    assert!(spatial.clone().accelerations(0.7, &flat(1), &mut new).expect("new").is_empty());
+    assert_bits(&out, &new, "directions");
+}
+
+#[test]
 fn a_failing_chain_is_named_and_the_others_finish() {
     let mut r = ChaCha8Rng::seed_from_u64(7);
     let (chains, n) = (10, 6);

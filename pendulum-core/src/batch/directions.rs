@@ -3,8 +3,10 @@
 
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
+use super::lane_states::non_finite_lanes;
+use super::planar_rk4::RunLane;
 use super::{
-    Blocks, F32x8, Failure, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
+    Blocks, F32x8, Failure, Rooms, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
     failed_rows, for_blocks_of, gather, non_finite, scatter, simd_kernel,
 };
 use crate::chain::Chain;
@@ -34,6 +36,8 @@ pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     links: usize,
     /// Whether the states carry the energy ledger of [`Accounted`].
     accounted: bool,
+    /// The calls' scratch, kept for the next calls.
+    pub(super) rooms: Rooms,
 }
 
 /// What the solve needs of one block's `W` chains.
@@ -191,7 +195,7 @@ where
             })
             .collect();
         let blocks = Blocks::new(true, || f64_blocks(&models, links), || f64_blocks(&models, links));
-        Ok(Self { models, blocks, blocks_f32, links, accounted: false })
+        Ok(Self { models, blocks, blocks_f32, links, accounted: false, rooms: Rooms::default() })
     }
 
     /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
@@ -305,7 +309,7 @@ where
         x: &[T],
         out: &mut [T],
         (nan, otherwise): (T, Error),
-        kernel: impl Fn(usize, [usize; W], &mut Lanes3<C, V>, &mut [T]) + Sync + Send,
+        kernel: impl Fn(usize, [usize; W], &mut Lanes3<C, V>, &mut [T]) -> [bool; W] + Sync + Send,
     ) -> Vec<Failure>
     where
         T: Copy + Into<f64> + Send + Sync,
@@ -318,11 +322,11 @@ where
             out,
             half,
             n,
-            || (Solve::<C, V>::new(n), lanes(m), lanes(half)),
+            || self.rooms.take(|| (Solve::<C, V>::new(n), lanes(m), lanes(half))),
             |s, b, out| {
                 let ids = block_chains::<W>(b, chains);
-                kernel(b, ids, s, out);
-                failed_rows(out, half, ids, nan, |chain| {
+                let suspect = kernel(b, ids, s, out);
+                failed_rows(out, half, (ids, suspect), nan, |chain| {
                     non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or_else(|| otherwise.clone())
                 })
             },
@@ -371,6 +375,7 @@ where
     simd_kernel! {
         /// `ü(t, x)` for the single-precision block `b` (chains `chains`) into its rows of
         /// `out`: gathered into the lanes `x_lanes`, the solve, into `a_lanes`, scattered.
+        /// Returns the lanes with a result not finite.
         fn flow_f32<const C: usize>(
             &self,
             b: usize,
@@ -379,7 +384,7 @@ where
             x: &[f32],
             s: &mut Lanes3<C, F32x8>,
             out: &mut [f32],
-        ) {
+        ) -> [bool; WIDTH_F32] {
             let (solve, x_lanes, a_lanes) = s;
             let (rods, down) = &self.blocks_f32[b];
             let half = C * self.links;
@@ -387,13 +392,15 @@ where
             let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
             solve.accelerations(rods, gravity(*down), pivot, x_lanes, a_lanes);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(a_lanes), half, out);
+            F32x8::non_finite(a_lanes).map(|flag| flag != 0)
         }
         dispatch fn flow_f32_simd, flow_f32_avx2
     }
 
     simd_kernel! {
         /// `ü(t, x)` for a block (chains `chains`, constants `block`) into its rows of
-        /// `out`: gathered into `x_lanes`, the solve, into `a_lanes`, scattered.
+        /// `out`: gathered into `x_lanes`, the solve, into `a_lanes`, scattered. Returns the
+        /// lanes with a result not finite.
         fn evaluate<const C: usize, const W: usize>(
             &self,
             block: &Block<W>,
@@ -402,13 +409,14 @@ where
             x: &[f64],
             s: &mut Lanes3<C, Lanes<W>>,
             out: &mut [f64],
-        ) {
+        ) -> [bool; W] {
             let (solve, x_lanes, a_lanes) = s;
             let half = C * self.links;
             gather(x, chains, 2 * half, Lanes::flatten_mut(x_lanes));
             let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
             solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
             scatter::<_, W>(Lanes::flatten(a_lanes), half, out);
+            non_finite_lanes(a_lanes).map(|flag| flag != 0)
         }
         dispatch fn evaluate_simd, evaluate_avx2, avx512 evaluate_avx512
     }

@@ -6,7 +6,7 @@ use nalgebra::Dyn;
 
 use super::transpose::{gather_rows, scatter_some_rows};
 use crate::integrate::State;
-use crate::lanes::{Lanes, one_row_at_a_time};
+use crate::lanes::{Lane, Lanes, one_row_at_a_time};
 
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
 /// into `t`, the states into `x`, their compensations into `carry`.
@@ -45,13 +45,21 @@ pub(super) fn out_of_lanes<'a, const W: usize>(
     scatter_some_rows(Lanes::flatten(carry), m, carries);
 }
 
-/// The lanes in which some entry of `v` is not finite (flag `1`): `y − y` is `0` for a
-/// finite `y` and NaN otherwise, summed lane by lane in four independent sums (a per-lane
-/// loop of flags was vectorised across entries and transposed back, with spills).
+/// The lanes in which some entry of `v` is not finite (flag `1`).
+#[inline(always)]
+pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
+    let total = non_finite_sum(v);
+    std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
+}
+
+/// Lane by lane, NaN where some entry of `v` is not finite and `0` elsewhere: `y − y` is `0`
+/// for a finite `y` and NaN otherwise, summed in four independent sums (one sum waited on
+/// each addition; a per-lane loop of flags was vectorised across entries and transposed
+/// back, with spills).
 #[inline(always)]
 #[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
-pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
-    let mut sums = [Lanes([0.0; W]); 4];
+pub(super) fn non_finite_sum<V: Lane>(v: &[V]) -> V {
+    let mut sums = [V::splat(0.0); 4];
     let mut quads = v.chunks_exact(4);
     for quad in quads.by_ref() {
         for (sum, y) in sums.iter_mut().zip(quad) {
@@ -62,6 +70,5 @@ pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
     for (sum, y) in sums.iter_mut().zip(quads.remainder()) {
         *sum += *y - *y;
     }
-    let total = (sums[0] + sums[1]) + (sums[2] + sums[3]);
-    std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
+    (sums[0] + sums[1]) + (sums[2] + sums[3])
 }

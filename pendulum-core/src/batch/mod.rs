@@ -40,12 +40,14 @@ mod planar;
 mod planar_rk4;
 mod rk4;
 mod rod_midpoint;
+mod rooms;
 mod run;
 pub(crate) mod transpose;
 mod unrolled;
 
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
+pub(crate) use rooms::Rooms;
 pub(crate) use transpose::{gather, scatter};
 pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
 
@@ -182,16 +184,19 @@ fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
 }
 
 /// The chains of a block whose rows of `out` (`m` each, row `k` for chain `chains[k]`) are
-/// not all finite, each with `error(chain)`; their rows set to `nan`.
+/// not all finite, each with `error(chain)`; their rows set to `nan`. Only the rows of the
+/// lanes flagged in `suspect` are read: the kernels find the lanes with a non-finite result
+/// in lanes, where it costs a sum per row of lanes (scanning every row of a short block's
+/// result here was a seventh of a call).
 pub(crate) fn failed_rows<T: Copy + Into<f64>, const W: usize>(
     out: &mut [T],
     m: usize,
-    chains: [usize; W],
+    (chains, suspect): ([usize; W], [bool; W]),
     nan: T,
     error: impl Fn(usize) -> Error,
 ) -> Vec<Failure> {
     let mut failures = Vec::new();
-    for (k, row) in out.chunks_exact_mut(m).enumerate() {
+    for (k, row) in out.chunks_exact_mut(m).enumerate().filter(|(k, _)| suspect[*k]) {
         if !all_finite(row) {
             row.fill(nan);
             failures.push(Failure { chain: chains[k], error: error(chains[k]) });

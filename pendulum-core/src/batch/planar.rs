@@ -3,9 +3,11 @@
 
 use nalgebra::Dyn;
 
+use super::lane_states::non_finite_lanes;
+use super::planar_rk4::RunLane;
 use super::transpose::Transpose;
 use super::{
-    Blocks, F32x8, F64x4, F64x8, Failure, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
+    Blocks, F32x8, F64x4, F64x8, Failure, Rooms, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
     failed_rows, first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
 };
 use crate::chain::Chain;
@@ -37,6 +39,8 @@ pub struct PlanarBatch {
     pub(super) blocks_f32: Vec<Block<F32x8>>,
     count: usize,
     pub(super) links: usize,
+    /// The calls' scratch, kept for the next calls.
+    pub(super) rooms: Rooms,
 }
 
 /// What the solve needs of one block's chains, in lanes `V`.
@@ -153,7 +157,7 @@ impl PlanarBatch {
                 }
             })
             .collect();
-        Ok(Self { count: chains.len(), chains, blocks, blocks_f32, links })
+        Ok(Self { count: chains.len(), chains, blocks, blocks_f32, links, rooms: Rooms::default() })
     }
 
     /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
@@ -280,7 +284,7 @@ impl PlanarBatch {
         pivot: Option<&[T]>,
         out: &mut [T],
         (nan, otherwise): (T, Error),
-        kernel: impl Fn(usize, [usize; W], &mut Scratch<V>, &mut [T]) + Sync + Send,
+        kernel: impl Fn(usize, [usize; W], &mut Scratch<V>, &mut [T]) -> [bool; W] + Sync + Send,
     ) -> Vec<Failure>
     where
         T: Copy + Into<f64> + Send + Sync,
@@ -291,11 +295,11 @@ impl PlanarBatch {
             out,
             n,
             n,
-            || Scratch::new(n),
+            || self.rooms.take(|| Scratch::new(n)),
             |scratch, b, out| {
                 let lanes = block_chains::<W>(b, chains);
-                kernel(b, lanes, scratch, out);
-                failed_rows(out, n, lanes, nan, |chain| {
+                let suspect = kernel(b, lanes, scratch, out);
+                failed_rows(out, n, (lanes, suspect), nan, |chain| {
                     first_bad_input(chain, n, [q, qd], torque, pivot).unwrap_or_else(|| otherwise.clone())
                 })
             },
@@ -322,7 +326,7 @@ impl PlanarBatch {
             pivot: Option<&[f32]>,
             s: &mut Scratch<F32x8>,
             out: &mut [f32],
-        ) {
+        ) -> [bool; WIDTH_F32] {
             let n = self.links;
             let block = &self.blocks_f32[b.min(self.blocks_f32.len() - 1)];
             gather(q, lanes, n, Lanes32::flatten_mut(&mut s.angles));
@@ -339,6 +343,7 @@ impl PlanarBatch {
             let trig = [&s.sin[..], &s.cos, &s.rates];
             block.accelerations(trig, (&s.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
+            F32x8::non_finite(&s.accelerations).map(|flag| flag != 0)
         }
         dispatch fn block_f32_simd, block_f32_avx2
     }
@@ -346,6 +351,7 @@ impl PlanarBatch {
     simd_kernel! {
         /// One block of `W` chains (constants in `blocks`): gather, `sin θ` and `cos θ` of all
         /// its angles at once, the solve in lanes, scatter into `out` (the block's rows).
+        /// Returns the lanes with a result not finite.
         fn block<const W: usize>(
             &self,
             blocks: &[Block<Lanes<W>>],
@@ -357,7 +363,7 @@ impl PlanarBatch {
             pivot: Option<&[f64]>,
             s: &mut Scratch<Lanes<W>>,
             out: &mut [f64],
-        ) {
+        ) -> [bool; W] {
             let n = self.links;
             let block = &blocks[b.min(blocks.len() - 1)];
             let torqued = torque.map_or(Lanes::<W>::none(), |t| {
@@ -378,6 +384,7 @@ impl PlanarBatch {
             let trig = [&s.sin[..], &s.cos, &s.rates];
             block.accelerations(trig, (&s.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, W>(Lanes::flatten(&s.accelerations), n, out);
+            non_finite_lanes(&s.accelerations).map(|flag| flag != 0)
         }
         dispatch fn block_simd, block_avx2, avx512 block_avx512
     }

@@ -9,7 +9,7 @@ use nalgebra::Dyn;
 
 #[cfg(target_arch = "x86_64")]
 use super::F64x8;
-use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
+use super::lane_states::{into_lanes, non_finite_lanes, non_finite_sum, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_some_rows};
@@ -95,9 +95,8 @@ impl RunLane for F32x8 {
         sin_cos_split_f32(Lanes32::flatten(angles), Lanes32::flatten_mut(sin), Lanes32::flatten_mut(cos));
     }
     #[inline(always)]
-    #[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
     fn non_finite(v: &[Self]) -> [u32; WIDTH_F32] {
-        let total = v.iter().fold(Lanes32([0.0; WIDTH_F32]), |sum, y| sum + (*y - *y));
+        let total = non_finite_sum(v);
         std::array::from_fn(|k| u32::from(total.0[k].is_nan()))
     }
     #[inline(always)]
@@ -205,8 +204,9 @@ impl PlanarBatch {
             states,
             1,
             solves,
-            || Run::<Lanes<W>>::new(n),
-            |s, b, block| {
+            || self.rooms.take(|| Run::<Lanes<W>>::new(n)),
+            |room, b, block| {
+                let s = &mut **room;
                 let ids = block_chains::<W>(b, self.len());
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let (mut failures, ran) =
@@ -266,7 +266,7 @@ impl PlanarBatch {
             &mut chains,
             1,
             solves,
-            || Run::<F32x8>::new(n),
+            || self.rooms.take(|| Run::<F32x8>::new(n)),
             |s, b, block| {
                 let (ids, count) = (block_chains::<WIDTH_F32>(b, self.len()), block.len());
                 let (mut failures, ran) = start(s, (ids, count, n), (torque, pivot), |k| &*block[k].0);

@@ -155,8 +155,9 @@ where
             &mut chains,
             1,
             solves,
-            || Scratch::<C, W>::new(n, self.state_len()),
-            |s, b, block| {
+            || self.rooms.take(|| Scratch::<C, W>::new(n, self.state_len())),
+            |room, b, block| {
+                let s = &mut **room;
                 let ids = block_chains::<W>(b, self.len());
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
