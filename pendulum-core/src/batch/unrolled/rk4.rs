@@ -5,7 +5,7 @@
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
 use super::precision::Precision;
-use super::{PlanarKernel, UnrolledBatch};
+use super::{LinkConstants, PlanarKernel, UnrolledBatch};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks, simd_kernel};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -21,6 +21,35 @@ struct Block<const N: usize> {
     t_carry: F64x4,
 }
 
+/// `θ̈(θ, θ̇)` for [`increment`]: a type of its own rather than a closure, for the lanes'
+/// kernel must be inlined into its caller to run with the caller's target features, and a
+/// closure called four times was compiled as a function of its own, without them (SSE2 in
+/// the AVX2 run, half its time).
+trait Accelerations<V, const N: usize> {
+    /// `θ̈` (rad/s²) at angles `q` (rad) and rates `qd` (rad/s).
+    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N];
+}
+
+/// A model's kernel on a block of lanes, pivot at rest and no torques.
+struct Kernel<'a, M, const N: usize>(&'a LinkConstants<F64x4, N>, std::marker::PhantomData<M>);
+
+impl<M: PlanarKernel<N>, const N: usize> Accelerations<F64x4, N> for Kernel<'_, M, N> {
+    #[inline(always)]
+    fn at(&mut self, q: &[F64x4; N], qd: &[F64x4; N]) -> [F64x4; N] {
+        let zero = F64x4::splat(0.0);
+        M::kernel(self.0, &<f64 as Precision>::sin_cos(q), qd, &[zero; N], [zero; 2])
+    }
+}
+
+/// Any `θ̈(θ, θ̇)` as a closure (out of the hot path).
+struct Closure<F>(F);
+
+impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N> for Closure<F> {
+    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
+        (self.0)(q, qd)
+    }
+}
+
 /// The increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` of one step of
 /// [`Rk4`](crate::integrate::Rk4) from `(θ, θ̇)`, for the first-order system
 /// `(θ, θ̇)' = (θ̇, θ̈)` with `θ̈ = accelerations(θ, θ̇)`, rounded as `Rk4` rounds it: lane by
@@ -30,19 +59,19 @@ fn increment<V: Lane, const N: usize>(
     q: &[V; N],
     qd: &[V; N],
     h: f64,
-    mut accelerations: impl FnMut(&[V; N], &[V; N]) -> [V; N],
+    mut accelerations: impl Accelerations<V, N>,
 ) -> ([V; N], [V; N]) {
     let (half, whole, sixth, two) = (V::splat(0.5 * h), V::splat(h), V::splat(h / 6.0), V::splat(2.0));
     // `y = x + a k` as `Rk4`'s `axpy` rounds it.
     let axpy = |x: &[V; N], a: V, k: &[V; N]| -> [V; N] { std::array::from_fn(|i| a * k[i] + x[i]) };
     // k_s = (θ̇_s, θ̈_s), the stages of `Rk4::stages`.
-    let a1 = accelerations(q, qd);
+    let a1 = accelerations.at(q, qd);
     let (q2, qd2) = (axpy(q, half, qd), axpy(qd, half, &a1));
-    let a2 = accelerations(&q2, &qd2);
+    let a2 = accelerations.at(&q2, &qd2);
     let (q3, qd3) = (axpy(q, half, &qd2), axpy(qd, half, &a2));
-    let a3 = accelerations(&q3, &qd3);
+    let a3 = accelerations.at(&q3, &qd3);
     let (q4, qd4) = (axpy(q, whole, &qd3), axpy(qd, whole, &a3));
-    let a4 = accelerations(&q4, &qd4);
+    let a4 = accelerations.at(&q4, &qd4);
     let sum = |k1: &[V; N], k2: &[V; N], k3: &[V; N], k4: &[V; N]| -> [V; N] {
         std::array::from_fn(|i| sixth * (k1[i] + two * (k2[i] + k3[i]) + k4[i]))
     };
@@ -120,17 +149,24 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         let model = &self.models[chain];
         let inputs = model.zero_inputs();
         let mut first = None;
-        increment::<f64, N>(x[..N].try_into().expect("N"), x[N..].try_into().expect("N"), h, |q, qd| {
-            let mut out = SVector::<f64, N>::zeros();
-            let (q, qd) = (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
-            match model.accelerations(&q, &qd, &inputs, &mut out) {
-                Ok(()) => out.data.0[0],
-                Err(error) => {
-                    first.get_or_insert(error);
-                    [f64::NAN; N]
+        let (q, qd) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
+        increment::<f64, N>(
+            q,
+            qd,
+            h,
+            Closure(|q: &[f64; N], qd: &[f64; N]| {
+                let mut out = SVector::<f64, N>::zeros();
+                let (q, qd) =
+                    (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
+                match model.accelerations(&q, &qd, &inputs, &mut out) {
+                    Ok(()) => out.data.0[0],
+                    Err(error) => {
+                        first.get_or_insert(error);
+                        [f64::NAN; N]
+                    }
                 }
-            }
-        });
+            }),
+        );
         first.unwrap_or(Error::NonFiniteState { t, h })
     }
 
@@ -140,11 +176,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         fn rk4_run(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [u64; WIDTH] {
             let c = &self.blocks[b];
             let zero = Lanes([0.0; WIDTH]);
-            let accelerations =
-                |q: &[F64x4; N], qd: &[F64x4; N]| M::kernel(c, &<f64 as Precision>::sin_cos(q), qd, &[zero; N], [zero; 2]);
             let mut alive = [1u64; WIDTH];
             for _ in 0..steps {
-                let (dq, dqd) = increment(&s.q, &s.qd, h, accelerations);
+                let (dq, dqd) = increment(&s.q, &s.qd, h, Kernel::<M, N>(c, std::marker::PhantomData));
                 // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
                 #[allow(clippy::eq_op)]
                 let probe = dq.iter().chain(&dqd).fold(zero, |p, d| p + (*d - *d));
