@@ -6,12 +6,46 @@ use nalgebra::Dyn;
 
 use super::transpose::{gather_rows, scatter_some_rows};
 use crate::integrate::State;
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::has_avx2;
 use crate::lanes::{Lane, Lanes, one_row_at_a_time};
 
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
-/// into `t`, the states into `x`, their compensations into `carry`.
-#[inline(always)]
+/// into `t`, the states into `x`, their compensations into `carry`. Compiled for AVX2 where
+/// the CPU has it, so that the tiles' transposes are inlined (called tile by tile from code
+/// without AVX2, getting a whirl's states into lanes and back was a quarter of a one-step
+/// call).
 pub(super) fn into_lanes<const W: usize>(
+    states: [&State<Dyn>; W],
+    m: usize,
+    t: &mut [Lanes<W>; 2],
+    x: &mut [Lanes<W>],
+    carry: &mut [Lanes<W>],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { into_lanes_avx2(states, m, t, x, carry) };
+    }
+    fill_lanes(states, m, t, x, carry)
+}
+
+/// [`fill_lanes`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn into_lanes_avx2<const W: usize>(
+    states: [&State<Dyn>; W],
+    m: usize,
+    t: &mut [Lanes<W>; 2],
+    x: &mut [Lanes<W>],
+    carry: &mut [Lanes<W>],
+) {
+    fill_lanes(states, m, t, x, carry)
+}
+
+/// The body of [`into_lanes`].
+#[inline(always)]
+fn fill_lanes<const W: usize>(
     states: [&State<Dyn>; W],
     m: usize,
     t: &mut [Lanes<W>; 2],
@@ -26,21 +60,51 @@ pub(super) fn into_lanes<const W: usize>(
 
 /// The block's states (up to `W`, lane `k` for the `k`-th) that `ran` (flag `1`) out
 /// of the lanes [`into_lanes`] filled (by the tiles' transposes for a whole block: one
-/// number at a time, this was a quarter of a one-step call).
-#[inline(always)]
+/// number at a time, this was a quarter of a one-step call). Compiled for AVX2 where the
+/// CPU has it, as [`into_lanes`].
 pub(super) fn out_of_lanes<'a, const W: usize>(
     states: impl IntoIterator<Item = &'a mut State<Dyn>>,
     ran: [u64; W],
     m: usize,
-    (t, x, carry): (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    lanes: (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
 ) {
     let mut xs: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
     let mut carries: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
+    let (t, _, _) = lanes;
     for (k, state) in states.into_iter().enumerate().filter(|(k, _)| ran[*k] != 0) {
         let (time, time_carry, x, carry) = state.parts_mut();
         (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
         (xs[k], carries[k]) = (Some(x), Some(carry));
     }
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { empty_lanes_avx2(m, lanes, xs, carries) };
+    }
+    empty_lanes(m, lanes, xs, carries)
+}
+
+/// [`empty_lanes`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn empty_lanes_avx2<const W: usize>(
+    m: usize,
+    lanes: (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    xs: [Option<&mut [f64]>; W],
+    carries: [Option<&mut [f64]>; W],
+) {
+    empty_lanes(m, lanes, xs, carries)
+}
+
+/// The states and their compensations out of the lanes into the rows given (`None`: a
+/// lane left out).
+#[inline(always)]
+fn empty_lanes<const W: usize>(
+    m: usize,
+    (_, x, carry): (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    xs: [Option<&mut [f64]>; W],
+    carries: [Option<&mut [f64]>; W],
+) {
     scatter_some_rows(Lanes::flatten(x), m, xs);
     scatter_some_rows(Lanes::flatten(carry), m, carries);
 }
