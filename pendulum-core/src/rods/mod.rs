@@ -92,6 +92,21 @@ pub(crate) fn damping_pull<V: Lane>(drag: V, rate: V) -> V {
 
 /// What the solve needs to know of rod `i`: its direction `u_i`, `|u̇_i|²` (1/s²) and the
 /// force pair `F_i` (N) acting on it (on mass `i`; the opposite on mass `i−1`).
+/// Where the solve reads rod `i`'s [`Load`]: a closure, or a type whose `#[inline(always)]`
+/// method builds the load where it is read (a closure called from two places was compiled
+/// apart from the lanes' kernel, without its target features).
+pub(crate) trait Loads<const S: usize, V: Lane> {
+    /// Rod `i`'s load.
+    fn load(&mut self, i: usize) -> Load<S, V>;
+}
+
+impl<const S: usize, V: Lane, F: FnMut(usize) -> Load<S, V>> Loads<S, V> for F {
+    #[inline(always)]
+    fn load(&mut self, i: usize) -> Load<S, V> {
+        self(i)
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Load<const S: usize, V: Lane = f64> {
     pub direction: [V; S],

@@ -85,7 +85,7 @@ impl<V: Lane> Rods<V> {
         gravity: [V; S],
         pivot_acceleration: [V; S],
         rows: &mut Rows<S, V>,
-        load: impl FnMut(usize) -> Load<S, V>,
+        load: impl Loads<S, V>,
         emit: impl FnMut(usize, [V; S], &[V; S], V),
     ) {
         let rows = &mut rows.0[..self.length.len()];
@@ -106,7 +106,7 @@ impl<V: Lane> Rods<V> {
         gravity: [V; S],
         pivot_acceleration: [V; S],
         rows: &mut [Row<S, V>],
-        mut load: impl FnMut(usize) -> Load<S, V>,
+        mut load: impl Loads<S, V>,
     ) -> V::Mask {
         let n = rows.len();
         let zero = V::splat(0.0);
@@ -117,10 +117,10 @@ impl<V: Lane> Rods<V> {
         // 1/D_{i−1}, e_{i−1}.
         let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
         for (i, row) in rows.iter_mut().enumerate() {
-            let here = load(i);
+            let here = load.load(i);
             // Below the last rod, no load (no `Option`: copied through one, a load of lanes
             // fell apart into scalars).
-            let pair_below = if i + 1 < n { load(i + 1).pair } else { [zero; S] };
+            let pair_below = if i + 1 < n { load.load(i + 1).pair } else { [zero; S] };
             let im = self.inverse_mass[i];
             let u = here.direction;
             let mut a = gravity;
