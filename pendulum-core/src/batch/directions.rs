@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
 use crate::models::Directions;
 use crate::models::directions::rate_load;
-use crate::rods::{Load, Rods, Rows};
+use crate::rods::{Load, Loads, Rods, Rows};
 
 /// `B` chains in unit link directions with the same number of links `n`, each with its own
 /// masses, lengths, damping, gravity and drive (`S = U2` planar, `U3` spatial).
@@ -67,10 +67,30 @@ pub(super) struct Scratch<const C: usize, const W: usize> {
     pub k: [Vec<Lanes<W>>; 4],
 }
 
-/// The loads and rows of one solve in lanes.
+/// The rows of one solve in lanes (the loads are built where the solve reads them:
+/// [`RateLoads`]).
 pub(super) struct Solve<const C: usize, V: Lane> {
     rows: Rows<C, V>,
-    loads: Vec<Load<C, V>>,
+    links: usize,
+}
+
+/// The loads of rods at directions `u` and rates `w` (`C` numbers a rod each, rod after rod)
+/// with drags `λ_i/l_i` (N·s): [`rate_load`], built where the solve reads it by a method
+/// inlined into the kernel (as a closure called from two places it was compiled apart,
+/// without the kernel's target features, and a pass of its own into an array was needed).
+struct RateLoads<'a, const C: usize, V> {
+    directions: &'a [V],
+    rates: &'a [V],
+    drag: &'a [V],
+}
+
+impl<const C: usize, V: Lane> Loads<C, V> for RateLoads<'_, C, V> {
+    #[inline(always)]
+    fn load(&mut self, i: usize) -> Load<C, V> {
+        let u = self.directions[C * i..C * (i + 1)].try_into().expect("C numbers");
+        let w = self.rates[C * i..C * (i + 1)].try_into().expect("C numbers");
+        rate_load(u, w, self.drag[i])
+    }
 }
 
 /// A task's room for one evaluation in lanes: the solve, the block's states, its results.
@@ -78,7 +98,7 @@ type Lanes3<const C: usize, V> = (Solve<C, V>, Vec<V>, Vec<V>);
 
 impl<const C: usize, V: Lane> Solve<C, V> {
     fn new(links: usize) -> Self {
-        Self { rows: Rows::with_len(links), loads: vec![Load::zero(); links] }
+        Self { rows: Rows::with_len(links), links }
     }
 
     /// The direction accelerations `ü` (1/s²) into `out` (its first `C·n`) of chains with rods `rods`
@@ -86,17 +106,9 @@ impl<const C: usize, V: Lane> Solve<C, V> {
     /// accelerations `p̈` (m/s²): [`Directions`]' tension solve, in lanes of any precision.
     #[inline(always)]
     fn accelerations(&mut self, rods: &Rods<V>, gravity: [V; C], pivot: [V; C], x: &[V], out: &mut [V]) {
-        let half = C * self.loads.len();
+        let half = C * self.links;
         let (directions, rates) = (&x[..half], &x[half..2 * half]);
-        // The loads in a pass of their own: built inside the solve, the builder is not
-        // inlined.
-        let rods_rates = directions.chunks_exact(C).zip(rates.chunks_exact(C)).zip(rods.drag());
-        for (load, ((u, w), &drag)) in self.loads.iter_mut().zip(rods_rates) {
-            let (u, w) = (u.try_into().expect("C numbers"), w.try_into().expect("C numbers"));
-            *load = rate_load(u, w, drag);
-            one_row_at_a_time();
-        }
-        self.solve_loaded(rods, gravity, pivot, out);
+        self.solve_loaded(rods, gravity, pivot, RateLoads { directions, rates, drag: rods.drag() }, out);
     }
 
     /// [`accelerations`](Self::accelerations) at a Runge–Kutta stage `y = x + a·k`, formed
@@ -117,47 +129,49 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         y: &mut [V],
         out: &mut [V],
     ) {
-        let half = C * self.loads.len();
+        let half = C * self.links;
         let (y_motion, y_rest) = y.split_at_mut(2 * half);
         let (yu, yw) = y_motion.split_at_mut(half);
         let (velocities, accelerations) = out[..2 * half].split_at_mut(half);
         let links = (yu.chunks_exact_mut(C).zip(yw.chunks_exact_mut(C)))
             .zip(x[..half].chunks_exact(C).zip(x[half..2 * half].chunks_exact(C)))
             .zip(k[..half].chunks_exact(C).zip(k[half..2 * half].chunks_exact(C)))
-            .zip(velocities.chunks_exact_mut(C).zip(rods.drag()));
-        for (load, ((((yu, yw), (xu, xw)), (ku, kw)), (velocity, &drag))) in self.loads.iter_mut().zip(links)
-        {
-            let (mut u, mut w) = ([V::splat(0.0); C], [V::splat(0.0); C]);
+            .zip(velocities.chunks_exact_mut(C));
+        for ((((yu, yw), (xu, xw)), (ku, kw)), velocity) in links {
             for c in 0..C {
-                u[c] = a * ku[c] + xu[c];
-                w[c] = a * kw[c] + xw[c];
+                yu[c] = a * ku[c] + xu[c];
+                yw[c] = a * kw[c] + xw[c];
             }
-            yu.copy_from_slice(&u);
-            yw.copy_from_slice(&w);
-            velocity.copy_from_slice(&w);
-            *load = rate_load(u, w, drag);
+            velocity.copy_from_slice(yw);
             one_row_at_a_time();
         }
         for ((y, x), k) in y_rest.iter_mut().zip(&x[2 * half..]).zip(&k[2 * half..]) {
             *y = a * *k + *x;
             one_row_at_a_time();
         }
-        self.solve_loaded(rods, gravity, pivot, accelerations);
-    }
-
-    /// The tension solve of the loads in `self.loads`: `ü` into `out` (`C·n`).
-    #[inline(always)]
-    fn solve_loaded(&mut self, rods: &Rods<V>, gravity: [V; C], pivot: [V; C], out: &mut [V]) {
-        let loads = &self.loads;
-        rods.solve(
+        let (directions, rates) = (&y[..half], &y[half..2 * half]);
+        self.solve_loaded(
+            rods,
             gravity,
             pivot,
-            &mut self.rows,
-            |i| loads[i],
-            |i, a, _, _| {
-                out[i * C..(i + 1) * C].copy_from_slice(&a);
-            },
+            RateLoads { directions, rates, drag: rods.drag() },
+            accelerations,
         );
+    }
+
+    /// The tension solve of `loads`: `ü` into `out` (`C·n`).
+    #[inline(always)]
+    fn solve_loaded(
+        &mut self,
+        rods: &Rods<V>,
+        gravity: [V; C],
+        pivot: [V; C],
+        loads: RateLoads<'_, C, V>,
+        out: &mut [V],
+    ) {
+        rods.solve(gravity, pivot, &mut self.rows, loads, |i, a, _, _| {
+            out[i * C..(i + 1) * C].copy_from_slice(&a);
+        });
     }
 }
 

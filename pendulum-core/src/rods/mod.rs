@@ -114,14 +114,6 @@ pub(crate) struct Load<const S: usize, V: Lane = f64> {
     pub pair: [V; S],
 }
 
-impl<const S: usize, V: Lane> Load<S, V> {
-    /// All zeros (room for a load).
-    pub fn zero() -> Self {
-        let zero = V::splat(0.0);
-        Self { direction: [zero; S], rate_squared: zero, pair: [zero; S] }
-    }
-}
-
 /// What the down pass leaves for the up pass, per rod: the direction `u_i`, the free
 /// acceleration `a°_i` of the mass (m/s²), the elimination factor `f_i = c_i / D_{i−1}`, the
 /// scaled eliminated right-hand side `h_i = e_i / D_i` (N) and the right-hand side `b_i`
