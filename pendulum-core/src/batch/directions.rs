@@ -27,7 +27,7 @@ use crate::rods::{Load, Loads, Rods, Rows};
 /// [`Rk4`](crate::integrate::Rk4)) on each chain, bit for bit (module docs of
 /// [`batch`](super)). Four chains per AVX2 register, eight per AVX-512 register where the
 /// CPU has it ([`with_avx512`](Self::with_avx512)): the same bits either way. A batch keeps
-/// its calls' scratch for the next calls (at most one of a kind per thread; about 3.7 kB
+/// its calls' scratch for the next calls (at most one of a kind per thread; about 3.3 kB
 /// per link for a 3D RK4 step in eight lanes), so build it once and call it often.
 #[derive(Debug, Clone)]
 pub struct DirectionsBatch<S: DimName, Dr = Fixed> {

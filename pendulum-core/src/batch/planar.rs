@@ -28,7 +28,7 @@ use crate::rods::{Load, Loads, Rods, Rows, damping_pull, pull};
 /// (module docs of [`batch`](super)), and [`integrate_rk4`](Self::integrate_rk4) its RK4
 /// steps. Four chains per AVX2 register, eight per AVX-512 register where the CPU has it
 /// ([`with_avx512`](Self::with_avx512)): the same bits either way. A batch keeps its calls'
-/// scratch for the next calls (at most one of a kind per thread; about 1.2 kB per link for
+/// scratch for the next calls (at most one of a kind per thread; about 0.8 kB per link for
 /// the accelerations in eight lanes), so build it once and call it often.
 #[derive(Debug, Clone)]
 pub struct PlanarBatch {

@@ -72,9 +72,10 @@ impl<V: Lane> Rods<V> {
 
     /// The tension solve (module docs): a down pass and an up pass over the chain.
     ///
-    /// `load(i)` gives rod `i`'s [`Load`] (called for rods `i` and `i + 1` at row `i`, so
-    /// twice per rod: reading a load where it is needed, rather than carrying it from row to
-    /// row, spares the registers spills, in lanes and for one chain alike);
+    /// `load.load(i)` gives rod `i`'s [`Load`] (called for rods `i` and `i + 1` at row `i`,
+    /// so twice per rod: reading a load where it is needed, rather than carrying it from row
+    /// to row, spares the registers spills, in lanes and for one chain alike; a closure
+    /// serves, and the lanes' kernels pass types with inlined methods, [`Loads`]);
     /// `emit(i, ü_i, u_i, T_i)` receives rod `i`'s direction acceleration (1/s²), its
     /// direction and its tension (N), once per rod in order `n−1, …, 0`. Gravity `g⃗` and
     /// the pivot acceleration `p̈` in m/s². Work O(n), one division per rod (off the serial
