@@ -3,8 +3,7 @@
 
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
-use super::lane_states::non_finite_lanes;
-use super::planar_rk4::RunLane;
+use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
 use super::{
     Blocks, F32x8, Failure, Rooms, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
     failed_rows, for_blocks_of, gather, non_finite, scatter, simd_kernel,
@@ -408,7 +407,7 @@ where
             let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
             solve.accelerations(rods, gravity(*down), pivot, x_lanes, a_lanes);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(a_lanes), half, out);
-            F32x8::non_finite(a_lanes).map(|flag| flag != 0)
+            non_finite_lanes_f32(a_lanes).map(|flag| flag != 0)
         }
         dispatch fn flow_f32_simd, flow_f32_avx2
     }

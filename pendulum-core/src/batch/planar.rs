@@ -3,8 +3,7 @@
 
 use nalgebra::Dyn;
 
-use super::lane_states::non_finite_lanes;
-use super::planar_rk4::RunLane;
+use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
 use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, F64x4, F64x8, Failure, Rooms, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
@@ -368,7 +367,7 @@ impl PlanarBatch {
             let trig = [&s.sin[..], &s.cos, &s.rates];
             block.accelerations(trig, (&s.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
-            F32x8::non_finite(&s.accelerations).map(|flag| flag != 0)
+            non_finite_lanes_f32(&s.accelerations).map(|flag| flag != 0)
         }
         dispatch fn block_f32_simd, block_f32_avx2
     }

@@ -9,7 +9,7 @@ use nalgebra::Dyn;
 
 #[cfg(target_arch = "x86_64")]
 use super::F64x8;
-use super::lane_states::{into_lanes, non_finite_lanes, non_finite_sum, out_of_lanes};
+use super::lane_states::{into_lanes, non_finite_lanes, non_finite_lanes_f32, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
 use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_some_rows};
@@ -96,8 +96,7 @@ impl RunLane for F32x8 {
     }
     #[inline(always)]
     fn non_finite(v: &[Self]) -> [u32; WIDTH_F32] {
-        let total = non_finite_sum(v);
-        std::array::from_fn(|k| u32::from(total.0[k].is_nan()))
+        non_finite_lanes_f32(v)
     }
     #[inline(always)]
     fn and_not(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
