@@ -109,6 +109,17 @@ fn accelerations(c: &mut Criterion) {
                 },
             );
         }
+        // What `with_avx512(false)` trades, on a CPU with AVX-512: four lanes instead of eight.
+        let four = batch.clone().with_avx512(false);
+        for threads in [1, 2].into_iter().filter(|_| n == 100 && batch.uses_avx512()) {
+            let pool = pool(threads);
+            let id = BenchmarkId::new(format!("planar/batch_{threads}_threads_four_lanes"), n);
+            group.bench_with_input(id, &n, |b, _| {
+                in_pool(b, &pool, || {
+                    four.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+                })
+            });
+        }
         let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
         let (q32, qd32, mut out32) = (narrow(&q), narrow(&qd), vec![0.0f32; out.len()]);
         let pool1 = pool(1);
@@ -151,6 +162,16 @@ fn accelerations(c: &mut Criterion) {
                     })
                 },
             );
+        }
+        let four = batch.clone().with_avx512(false);
+        for threads in [1, 2].into_iter().filter(|_| n == 100 && batch.uses_avx512()) {
+            let pool = pool(threads);
+            let id = BenchmarkId::new(format!("spatial/batch_{threads}_threads_four_lanes"), n);
+            group.bench_with_input(id, &n, |b, _| {
+                in_pool(b, &pool, || {
+                    four.accelerations(0.0, &flat, &mut out).expect("batch");
+                })
+            });
         }
         let (flat, mut out) = (flat.iter().map(|&v| v as f32).collect::<Vec<_>>(), vec![0.0f32; out.len()]);
         let pool = pool(1);
