@@ -221,6 +221,8 @@ where
         if allowed != self.uses_avx512() {
             let (models, links) = (&self.models, self.links);
             self.blocks = Blocks::new(allowed, || f64_blocks(models, links), || f64_blocks(models, links));
+            // The kept scratch is in the other width's lanes: no call would take it again.
+            self.rooms = Rooms::default();
         }
         self
     }

@@ -191,6 +191,8 @@ impl PlanarBatch {
     pub fn with_avx512(mut self, allowed: bool) -> Self {
         if allowed != self.uses_avx512() {
             self.blocks = Blocks::new(allowed, || f64_blocks(&self.chains), || f64_blocks(&self.chains));
+            // The kept scratch is in the other width's lanes: no call would take it again.
+            self.rooms = Rooms::default();
         }
         self
     }

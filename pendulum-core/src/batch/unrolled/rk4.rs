@@ -41,12 +41,10 @@ impl<M: PlanarKernel<N>, const N: usize> Accelerations<F64x4, N> for Kernel<'_, 
     }
 }
 
-/// Any `θ̈(θ, θ̇)` as a closure (out of the hot path).
-struct Closure<F>(F);
-
-impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N> for Closure<F> {
+/// Any closure `θ̈(θ, θ̇)` (out of the hot path: a closure is compiled apart).
+impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N> for F {
     fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
-        (self.0)(q, qd)
+        self(q, qd)
     }
 }
 
@@ -150,23 +148,17 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         let inputs = model.zero_inputs();
         let mut first = None;
         let (q, qd) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
-        increment::<f64, N>(
-            q,
-            qd,
-            h,
-            Closure(|q: &[f64; N], qd: &[f64; N]| {
-                let mut out = SVector::<f64, N>::zeros();
-                let (q, qd) =
-                    (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
-                match model.accelerations(&q, &qd, &inputs, &mut out) {
-                    Ok(()) => out.data.0[0],
-                    Err(error) => {
-                        first.get_or_insert(error);
-                        [f64::NAN; N]
-                    }
+        increment::<f64, N>(q, qd, h, |q: &[f64; N], qd: &[f64; N]| {
+            let mut out = SVector::<f64, N>::zeros();
+            let (q, qd) = (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
+            match model.accelerations(&q, &qd, &inputs, &mut out) {
+                Ok(()) => out.data.0[0],
+                Err(error) => {
+                    first.get_or_insert(error);
+                    [f64::NAN; N]
                 }
-            }),
-        );
+            }
+        });
         first.unwrap_or(Error::NonFiniteState { t, h })
     }
 
