@@ -4,9 +4,11 @@
 //! A planar model generated with `algorithm: tension` (the default from four links) writes
 //! its accelerations once, as a kernel generic over [`Lane`] ([`PlanarKernel::kernel`]).
 //! Its own `Model::accelerations` runs the kernel on `f64`; [`UnrolledBatch`] runs it on
-//! [`Lanes`] of four chains, compiled for AVX2 where the CPU has it. The operations are
-//! the same, lane by lane, with the same sine kernel, so every chain of a batch gets its
-//! single model's `θ̈` bit for bit.
+//! four chains at once: where the CPU has AVX2, compiled for it on lanes that are one
+//! register each (`Avx4`, `Sse4` in single precision: every operation one instruction,
+//! where LLVM left half of [`Lanes`]' arrays scalar or spilled in a kernel this long),
+//! elsewhere on [`Lanes`]. The operations are the same, lane by lane, with the same sine
+//! kernel, so every chain of a batch gets its single model's `θ̈` bit for bit.
 
 mod precision;
 mod rk4;
@@ -15,7 +17,7 @@ mod single;
 use nalgebra::{Const, SVector, U2, Vector2};
 
 use self::precision::Precision;
-use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, gather, scatter, simd_kernel};
+use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, gather, scatter};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
@@ -64,6 +66,32 @@ impl<const N: usize> LinkConstants<f64, N> {
             gravity: lanes(chains.map(|c| c.gravity)),
         }
     }
+}
+
+impl<L: Copy, const N: usize> LinkConstants<L, N> {
+    /// The constants in lanes of type `V`.
+    #[inline(always)]
+    fn in_lanes<V: Lane + From<L>>(&self) -> LinkConstants<V, N> {
+        LinkConstants {
+            inverse_mass: convert(&self.inverse_mass),
+            length: convert(&self.length),
+            inverse_length: convert(&self.inverse_length),
+            drag: convert(&self.drag),
+            diagonal: convert(&self.diagonal),
+            gravity: self.gravity.into(),
+        }
+    }
+}
+
+/// Each lane group of `v` in type `V`: a loop, not `array::map`, whose closure was compiled
+/// apart from the AVX2 kernel (without its target features, the conversions not inlined).
+#[inline(always)]
+fn convert<L: Copy + Into<V>, V: Lane, const N: usize>(v: &[L; N]) -> [V; N] {
+    let mut out = [V::splat(0.0); N];
+    for i in 0..N {
+        out[i] = v[i].into();
+    }
+    out
 }
 
 /// A planar model of `N` links whose `θ̈` is one straight-line kernel over [`Lane`]s: what
@@ -236,34 +264,80 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         Ok(failures)
     }
 
-    simd_kernel! {
-        /// One block, constants `c`: gather into lanes, the sines and cosines of all its
-        /// angles at once, the kernel, scatter into `out` (the block's rows).
-        fn block<P: Precision>(
-            &self,
-            c: &LinkConstants<P::Lanes, N>,
-            lanes: [usize; WIDTH],
-            q: &[P],
-            qd: &[P],
-            torque: Option<&[P]>,
-            pivot: Option<&[P]>,
-            out: &mut [P],
-        ) {
-            let zero = P::Lanes::splat(0.0);
-            let gather = |v: &[P]| -> [P::Lanes; N] {
-                let mut out = [zero; N];
-                gather::<P, WIDTH>(v, lanes, N, P::flatten_mut(&mut out));
-                out
-            };
-            let trig = P::sin_cos(&gather(q));
-            let torque = torque.map_or([zero; N], gather);
-            let pivot = match pivot {
-                Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
-                None => [zero; 2],
-            };
-            let accelerations = M::kernel(c, &trig, &gather(qd), &torque, pivot);
-            scatter::<P, WIDTH>(P::flatten(&accelerations), N, out);
+    /// One block, constants `c`: gather into lanes, the sines and cosines of all its angles
+    /// at once, the kernel in lanes of type `V`, scatter into `out` (the block's rows).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn block<P: Precision, V: Lane + From<P::Lanes> + Into<P::Lanes>>(
+        &self,
+        c: &LinkConstants<P::Lanes, N>,
+        lanes: [usize; WIDTH],
+        q: &[P],
+        qd: &[P],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+    ) {
+        let zero = P::Lanes::splat(0.0);
+        let gather = |v: &[P]| -> [P::Lanes; N] {
+            let mut out = [zero; N];
+            gather::<P, WIDTH>(v, lanes, N, P::flatten_mut(&mut out));
+            out
+        };
+        let trig = P::sin_cos(&gather(q));
+        let torque = torque.map_or([zero; N], gather);
+        let pivot = match pivot {
+            Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
+            None => [zero; 2],
+        };
+        let mut trig_lanes = [[V::splat(0.0); 2]; N];
+        for (lanes, t) in trig_lanes.iter_mut().zip(&trig) {
+            *lanes = convert(t);
         }
-        dispatch fn block_simd, block_avx2
+        let accelerations =
+            M::kernel(&c.in_lanes(), &trig_lanes, &convert(&gather(qd)), &convert(&torque), convert(&pivot));
+        let mut result = [zero; N];
+        for (r, a) in result.iter_mut().zip(accelerations) {
+            *r = a.into();
+        }
+        scatter::<P, WIDTH>(P::flatten(&result), N, out);
+    }
+
+    /// [`block`](Self::block) in AVX2 registers when the CPU has them, else in
+    /// [`Precision::Lanes`].
+    #[allow(clippy::too_many_arguments)]
+    fn block_simd<P: Precision>(
+        &self,
+        c: &LinkConstants<P::Lanes, N>,
+        lanes: [usize; WIDTH],
+        q: &[P],
+        qd: &[P],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::has_avx2() {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.block_avx2::<P>(c, lanes, q, qd, torque, pivot, out) };
+        }
+        self.block::<P, P::Lanes>(c, lanes, q, qd, torque, pivot, out)
+    }
+
+    /// [`block`](Self::block) compiled for AVX2, in [`Precision::Registers`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    fn block_avx2<P: Precision>(
+        &self,
+        c: &LinkConstants<P::Lanes, N>,
+        lanes: [usize; WIDTH],
+        q: &[P],
+        qd: &[P],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+    ) {
+        self.block::<P, P::Registers>(c, lanes, q, qd, torque, pivot, out)
     }
 }

@@ -10,6 +10,10 @@ use crate::lanes::{Lane, Lanes, Lanes32};
 pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     /// [`WIDTH`] numbers, one per chain of a block.
     type Lanes: Lane + Send + Sync;
+    /// The same lanes as the kernel computes in them when the CPU has AVX2: one register
+    /// each ([`Avx4`](crate::lanes::Avx4) for `f64`, [`Sse4`](crate::lanes::Sse4) for `f32`), converted from and to [`Lanes`](Self::Lanes).
+    #[cfg(target_arch = "x86_64")]
+    type Registers: Lane + From<Self::Lanes> + Into<Self::Lanes>;
     /// Not a number.
     const NAN: Self;
     /// `f(k)` in lane `k`.
@@ -25,6 +29,8 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
 
 impl Precision for f64 {
     type Lanes = Lanes<WIDTH>;
+    #[cfg(target_arch = "x86_64")]
+    type Registers = crate::lanes::Avx4;
     const NAN: Self = f64::NAN;
 
     #[inline(always)]
@@ -49,6 +55,8 @@ impl Precision for f64 {
 
 impl Precision for f32 {
     type Lanes = Lanes32<WIDTH>;
+    #[cfg(target_arch = "x86_64")]
+    type Registers = crate::lanes::Sse4;
     const NAN: Self = f32::NAN;
 
     #[inline(always)]

@@ -5,8 +5,8 @@
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
 use super::precision::Precision;
-use super::{LinkConstants, PlanarKernel, UnrolledBatch};
-use crate::batch::{F64x4, Failure, WIDTH, for_blocks, simd_kernel};
+use super::{LinkConstants, PlanarKernel, UnrolledBatch, convert};
+use crate::batch::{F64x4, Failure, WIDTH, for_blocks};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::lanes::{Lane, Lanes};
@@ -30,14 +30,21 @@ trait Accelerations<V, const N: usize> {
     fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N];
 }
 
-/// A model's kernel on a block of lanes, pivot at rest and no torques.
-struct Kernel<'a, M, const N: usize>(&'a LinkConstants<F64x4, N>, std::marker::PhantomData<M>);
+/// A model's kernel on a block of lanes of type `V`, pivot at rest and no torques.
+struct Kernel<'a, M, V, const N: usize>(&'a LinkConstants<V, N>, std::marker::PhantomData<M>);
 
-impl<M: PlanarKernel<N>, const N: usize> Accelerations<F64x4, N> for Kernel<'_, M, N> {
+impl<M: PlanarKernel<N>, V: Lane + From<F64x4> + Into<F64x4>, const N: usize> Accelerations<V, N>
+    for Kernel<'_, M, V, N>
+{
     #[inline(always)]
-    fn at(&mut self, q: &[F64x4; N], qd: &[F64x4; N]) -> [F64x4; N] {
-        let zero = F64x4::splat(0.0);
-        M::kernel(self.0, &<f64 as Precision>::sin_cos(q), qd, &[zero; N], [zero; 2])
+    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
+        let zero = V::splat(0.0);
+        let trig = <f64 as Precision>::sin_cos(&convert(q));
+        let mut lanes = [[zero; 2]; N];
+        for (lanes, t) in lanes.iter_mut().zip(&trig) {
+            *lanes = convert(t);
+        }
+        M::kernel(self.0, &lanes, qd, &[zero; N], [zero; 2])
     }
 }
 
@@ -126,7 +133,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
                 for (k, state) in block.iter_mut().enumerate() {
                     let x = (s.q.iter().zip(&s.q_carry)).chain(s.qd.iter().zip(&s.qd_carry));
                     state.set_parts(s.t.0[k], s.t_carry.0[k], x.map(|(x, carry)| (x.0[k], carry.0[k])));
-                    if alive[k] == 0 {
+                    if !alive[k] {
                         let chain = WIDTH * b + k;
                         failures.push(Failure {
                             chain,
@@ -162,35 +169,73 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         first.unwrap_or(Error::NonFiniteState { t, h })
     }
 
-    simd_kernel! {
-        /// `steps` RK4 steps of block `b` in lanes; a lane whose increment is not finite
-        /// stops at the start of that step. Returns the lanes that ran to the end.
-        fn rk4_run(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [u64; WIDTH] {
-            let c = &self.blocks[b];
-            let zero = Lanes([0.0; WIDTH]);
-            let mut alive = [1u64; WIDTH];
-            for _ in 0..steps {
-                let (dq, dqd) = increment(&s.q, &s.qd, h, Kernel::<M, N>(c, std::marker::PhantomData));
-                // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
+    /// `steps` RK4 steps of block `b` in lanes of type `V`; a lane whose increment is not
+    /// finite stops at the start of that step. Returns the lanes that ran to the end.
+    #[inline(always)]
+    fn rk4_run<V: Lane + From<F64x4> + Into<F64x4>>(
+        &self,
+        b: usize,
+        h: f64,
+        steps: usize,
+        s: &mut Block<N>,
+    ) -> [bool; WIDTH] {
+        let c = self.blocks[b].in_lanes::<V>();
+        let (mut q, mut qd): ([V; N], [V; N]) = (convert(&s.q), convert(&s.qd));
+        let (mut q_carry, mut qd_carry): ([V; N], [V; N]) = (convert(&s.q_carry), convert(&s.qd_carry));
+        let (mut t, mut t_carry) = (V::from(s.t), V::from(s.t_carry));
+        let zero = V::splat(0.0);
+        let mut stopped = V::none();
+        for _ in 0..steps {
+            let (dq, dqd) = increment(&q, &qd, h, Kernel::<M, V, N>(&c, std::marker::PhantomData));
+            // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
+            let mut probe = zero;
+            for d in dq.iter().chain(&dqd) {
                 #[allow(clippy::eq_op)]
-                let probe = dq.iter().chain(&dqd).fold(zero, |p, d| p + (*d - *d));
-                let keep: [u64; WIDTH] = std::array::from_fn(|k| alive[k] & !probe.outside(0, 0)[k]);
-                let advance = |x: &mut F64x4, carry: &mut F64x4, delta: F64x4| {
-                    let (new, new_carry) = kahan_add(*x, *carry, delta);
-                    (*x, *carry) = (F64x4::select(keep, new, *x), F64x4::select(keep, new_carry, *carry));
-                };
-                advance(&mut s.t, &mut s.t_carry, F64x4::splat(h));
-                for i in 0..N {
-                    advance(&mut s.q[i], &mut s.q_carry[i], dq[i]);
-                    advance(&mut s.qd[i], &mut s.qd_carry[i], dqd[i]);
-                }
-                alive = keep;
-                if alive == [0; WIDTH] {
-                    break;
-                }
+                let nan_if_not_finite = *d - *d;
+                probe += nan_if_not_finite;
             }
-            alive
+            stopped = V::or(stopped, probe.outside(0, 0));
+            let advance = |x: &mut V, carry: &mut V, delta: V| {
+                let (new, new_carry) = kahan_add(*x, *carry, delta);
+                (*x, *carry) = (V::select(stopped, *x, new), V::select(stopped, *carry, new_carry));
+            };
+            advance(&mut t, &mut t_carry, V::splat(h));
+            for i in 0..N {
+                advance(&mut q[i], &mut q_carry[i], dq[i]);
+                advance(&mut qd[i], &mut qd_carry[i], dqd[i]);
+            }
+            if V::all(stopped) {
+                break;
+            }
         }
-        dispatch fn rk4_run_simd, rk4_run_avx2
+        let back = |v: &[V; N], to: &mut [F64x4; N]| {
+            for (to, v) in to.iter_mut().zip(v) {
+                *to = (*v).into();
+            }
+        };
+        back(&q, &mut s.q);
+        back(&qd, &mut s.qd);
+        back(&q_carry, &mut s.q_carry);
+        back(&qd_carry, &mut s.qd_carry);
+        (s.t, s.t_carry) = (t.into(), t_carry.into());
+        V::select(stopped, zero, V::splat(1.0)).into().0.map(|alive| alive == 1.0)
+    }
+
+    /// [`rk4_run`](Self::rk4_run) in AVX2 registers when the CPU has them, else in
+    /// [`Lanes`].
+    fn rk4_run_simd(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [bool; WIDTH] {
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::has_avx2() {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.rk4_run_avx2(b, h, steps, s) };
+        }
+        self.rk4_run::<F64x4>(b, h, steps, s)
+    }
+
+    /// [`rk4_run`](Self::rk4_run) compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn rk4_run_avx2(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [bool; WIDTH] {
+        self.rk4_run::<crate::lanes::Avx4>(b, h, steps, s)
     }
 }

@@ -11,6 +11,11 @@
 
 use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
+#[cfg(target_arch = "x86_64")]
+mod registers;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use registers::{Avx4, Sse4};
+
 /// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
 /// std).
 #[inline(always)]
@@ -82,6 +87,8 @@ pub trait Lane:
     fn or(a: Self::Mask, b: Self::Mask) -> Self::Mask;
     /// Whether any lane is flagged.
     fn any(mask: Self::Mask) -> bool;
+    /// Whether every lane is flagged.
+    fn all(mask: Self::Mask) -> bool;
     /// `a` in the flagged lanes, `b` in the others.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// `2^−e` for `x = f·2^e` with `1 ≤ f < 2`, lane by lane: the exact power of two that
@@ -123,6 +130,10 @@ impl Lane for f64 {
     }
     #[inline(always)]
     fn any(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn all(mask: bool) -> bool {
         mask
     }
     #[inline(always)]
@@ -291,7 +302,7 @@ pub const CONTINUANT_RANGE: (u64, u64) = {
 /// `2⁻⁸⁰` and `2⁸⁰` as `f32` bit patterns: the continuants' range in single precision, wide
 /// enough for the chains of a few dozen links of grams and centimetres in SI units and far
 /// enough from `f32`'s overflow (`2¹²⁸`) for the products the solve forms with them.
-const CONTINUANT_RANGE_32: (u32, u32) = {
+pub(crate) const CONTINUANT_RANGE_32: (u32, u32) = {
     let low = (127 - 80) << 23;
     let high = (127 + 80) << 23;
     (low, high - low)
@@ -330,6 +341,10 @@ impl<const W: usize> Lane for Lanes32<W> {
     #[inline(always)]
     fn any(mask: [u32; W]) -> bool {
         any_mask(mask)
+    }
+    #[inline(always)]
+    fn all(mask: [u32; W]) -> bool {
+        mask.iter().all(|&m| m != 0)
     }
     #[inline(always)]
     fn select(mask: [u32; W], a: Self, b: Self) -> Self {
@@ -388,6 +403,10 @@ impl<const W: usize> Lane for Lanes<W> {
         any_mask(mask)
     }
     #[inline(always)]
+    fn all(mask: [u64; W]) -> bool {
+        mask.iter().all(|&m| m != 0)
+    }
+    #[inline(always)]
     fn select(mask: [u64; W], a: Self, b: Self) -> Self {
         Self(select_lanes(mask, a.0, b.0))
     }
@@ -416,6 +435,7 @@ mod tests {
             Lanes([1.0, 0.0, f64::NAN, 2f64.powi(900)]).outside(CONTINUANT_RANGE.0, CONTINUANT_RANGE.1);
         assert_eq!(mask, [0, 1, 1, 1]);
         assert!(Lanes::<4>::any(mask) && !Lanes::<4>::any(Lanes::<4>::none()));
+        assert!(!Lanes::<4>::all(mask) && Lanes::<4>::all([1, 1, 1, 1]));
         assert_eq!(Lanes::select(mask, a, b).0[..2], [0.1f64, -2.0][..]);
     }
 
