@@ -16,7 +16,7 @@ mod single;
 
 use nalgebra::{Const, SVector, U2, Vector2};
 
-use self::precision::Precision;
+use self::precision::{KernelLanes, Precision, convert};
 use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, gather, scatter};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
@@ -81,17 +81,6 @@ impl<L: Copy, const N: usize> LinkConstants<L, N> {
             gravity: self.gravity.into(),
         }
     }
-}
-
-/// Each lane group of `v` in type `V`: a loop, not `array::map`, whose closure was compiled
-/// apart from the AVX2 kernel (without its target features, the conversions not inlined).
-#[inline(always)]
-fn convert<L: Copy + Into<V>, V: Lane, const N: usize>(v: &[L; N]) -> [V; N] {
-    let mut out = [V::splat(0.0); N];
-    for i in 0..N {
-        out[i] = v[i].into();
-    }
-    out
 }
 
 /// A planar model of `N` links whose `θ̈` is one straight-line kernel over [`Lane`]s: what
@@ -268,7 +257,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     /// at once, the kernel in lanes of type `V`, scatter into `out` (the block's rows).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn block<P: Precision, V: Lane + From<P::Lanes> + Into<P::Lanes>>(
+    fn block<P: Precision, V: KernelLanes<P>>(
         &self,
         c: &LinkConstants<P::Lanes, N>,
         lanes: [usize; WIDTH],
@@ -284,18 +273,14 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             gather::<P, WIDTH>(v, lanes, N, P::flatten_mut(&mut out));
             out
         };
-        let trig = P::sin_cos(&gather(q));
+        let trig = V::sin_cos(&convert::<_, V, N>(&gather(q)));
         let torque = torque.map_or([zero; N], gather);
         let pivot = match pivot {
             Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
             None => [zero; 2],
         };
-        let mut trig_lanes = [[V::splat(0.0); 2]; N];
-        for (lanes, t) in trig_lanes.iter_mut().zip(&trig) {
-            *lanes = convert(t);
-        }
         let accelerations =
-            M::kernel(&c.in_lanes(), &trig_lanes, &convert(&gather(qd)), &convert(&torque), convert(&pivot));
+            M::kernel(&c.in_lanes(), &trig, &convert::<_, V, N>(&gather(qd)), &convert::<_, V, N>(&torque), convert::<_, V, 2>(&pivot));
         let mut result = [zero; N];
         for (r, a) in result.iter_mut().zip(accelerations) {
             *r = a.into();

@@ -4,8 +4,8 @@
 
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
-use super::precision::Precision;
-use super::{LinkConstants, PlanarKernel, UnrolledBatch, convert};
+use super::precision::{KernelLanes, convert};
+use super::{LinkConstants, PlanarKernel, UnrolledBatch};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -33,18 +33,11 @@ trait Accelerations<V, const N: usize> {
 /// A model's kernel on a block of lanes of type `V`, pivot at rest and no torques.
 struct Kernel<'a, M, V, const N: usize>(&'a LinkConstants<V, N>, std::marker::PhantomData<M>);
 
-impl<M: PlanarKernel<N>, V: Lane + From<F64x4> + Into<F64x4>, const N: usize> Accelerations<V, N>
-    for Kernel<'_, M, V, N>
-{
+impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N> for Kernel<'_, M, V, N> {
     #[inline(always)]
     fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
         let zero = V::splat(0.0);
-        let trig = <f64 as Precision>::sin_cos(&convert(q));
-        let mut lanes = [[zero; 2]; N];
-        for (lanes, t) in lanes.iter_mut().zip(&trig) {
-            *lanes = convert(t);
-        }
-        M::kernel(self.0, &lanes, qd, &[zero; N], [zero; 2])
+        M::kernel(self.0, &V::sin_cos(q), qd, &[zero; N], [zero; 2])
     }
 }
 
@@ -172,7 +165,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     /// `steps` RK4 steps of block `b` in lanes of type `V`; a lane whose increment is not
     /// finite stops at the start of that step. Returns the lanes that ran to the end.
     #[inline(always)]
-    fn rk4_run<V: Lane + From<F64x4> + Into<F64x4>>(
+    fn rk4_run<V: KernelLanes<f64>>(
         &self,
         b: usize,
         h: f64,
