@@ -37,6 +37,17 @@ pub(crate) fn has_avx512() -> bool {
     return false;
 }
 
+/// Whether the CPU has AVX-512's foundation and its instructions on 256-bit registers
+/// (`avx512vl`): code on four-`f64`-lane registers compiled for it gets 32 vector
+/// registers instead of 16 (the generated models' batch, whose long kernels spill).
+#[inline(always)]
+pub(crate) fn has_avx512vl() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return has_avx512() && std::arch::is_x86_feature_detected!("avx512vl");
+    #[cfg(not(target_arch = "x86_64"))]
+    return false;
+}
+
 /// Ends the body of a loop over rows of lanes (one link's, one state entry's): a compiler
 /// fence, which emits no instruction but keeps LLVM's loop vectorizer from running the
 /// loop across rows, one lane per gather. It did so with eight `f64` lanes under AVX-512,

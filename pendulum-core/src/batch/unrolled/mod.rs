@@ -17,10 +17,30 @@ mod single;
 use nalgebra::{Const, SVector, U2, Vector2};
 
 use self::precision::{KernelLanes, Precision, convert};
-use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks, gather, scatter};
+use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
+
+/// Blocks of [`WIDTH`] chains whose angles go through the sine kernel in one call: a
+/// block's sixteen angles at n = 4 are one turn of the AVX-512 loop, its chain of
+/// dependent operations waited on with nothing beside it; four blocks' turns overlap.
+const GROUP: usize = 4;
+
+/// A task's arrays for a group's angles and their sines and cosines, in lanes: kept for the
+/// task's groups (zeroed per group they were 3% of the n = 8 call).
+struct SineRoom<L, const N: usize> {
+    angles: [[L; N]; GROUP],
+    sin: [[L; N]; GROUP],
+    cos: [[L; N]; GROUP],
+}
+
+impl<L: Lane, const N: usize> SineRoom<L, N> {
+    fn new() -> Self {
+        let zero = [[L::splat(0.0); N]; GROUP];
+        Self { angles: zero, sin: zero, cos: zero }
+    }
+}
 
 /// A chain's per-link constants as a generated tension model reads them, `N` of each: one
 /// number per link (`V = f64`), or one per chain of a block (`V = Lanes<W>`).
@@ -231,20 +251,23 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         if let Some(p) = pivot {
             check_len("pivot", p, chains, 2)?;
         }
-        let failures = for_blocks(
+        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(
             out,
             N,
             N,
-            || (),
-            |_, b, out| {
-                let lanes = block_chains(b, chains);
-                self.block_simd::<P>(&blocks[b], lanes, q, qd, torque, pivot, out);
+            SineRoom::new,
+            |room, g, out| {
+                let first = GROUP * g;
+                let count = (out.len() / N).div_ceil(WIDTH);
+                let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
+                self.group_simd::<P>(&blocks[first..first + count], room, lanes, [q, qd], torque, pivot, out);
                 let mut failures = Vec::new();
                 for (k, row) in out.chunks_exact_mut(N).enumerate() {
                     if row.iter().all(|&v| v.into().is_finite()) {
                         continue;
                     }
-                    failures.push(Failure { chain: lanes[k], error: error(lanes[k]) });
+                    let chain = WIDTH * first + k;
+                    failures.push(Failure { chain, error: error(chain) });
                     row.fill(P::NAN);
                 }
                 failures
@@ -253,76 +276,119 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         Ok(failures)
     }
 
-    /// One block, constants `c`: gather into lanes, the sines and cosines of all its angles
-    /// at once, the kernel in lanes of type `V`, scatter into `out` (the block's rows).
+    /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`): each
+    /// block's angles gathered into lanes, the sines and cosines of all of them in one call
+    /// of the sine kernel, then block by block the kernel in lanes of type `V`, scattered
+    /// into `out` (the group's rows).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn block<P: Precision, V: KernelLanes<P>>(
+    fn group<P: Precision, V: KernelLanes<P>>(
         &self,
-        c: &LinkConstants<P::Lanes, N>,
-        lanes: [usize; WIDTH],
-        q: &[P],
-        qd: &[P],
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N>,
+        lanes: [[usize; WIDTH]; GROUP],
+        [q, qd]: [&[P]; 2],
         torque: Option<&[P]>,
         pivot: Option<&[P]>,
         out: &mut [P],
     ) {
         let zero = P::Lanes::splat(0.0);
-        let gather = |v: &[P]| -> [P::Lanes; N] {
-            let mut out = [zero; N];
-            gather::<P, WIDTH>(v, lanes, N, P::flatten_mut(&mut out));
-            out
-        };
-        let trig = V::sin_cos(&convert::<_, V, N>(&gather(q)));
-        let torque = torque.map_or([zero; N], gather);
-        let pivot = match pivot {
-            Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
-            None => [zero; 2],
-        };
-        let accelerations =
-            M::kernel(&c.in_lanes(), &trig, &convert::<_, V, N>(&gather(qd)), &convert::<_, V, N>(&torque), convert::<_, V, 2>(&pivot));
-        let mut result = [zero; N];
-        for (r, a) in result.iter_mut().zip(accelerations) {
-            *r = a.into();
+        let count = c.len();
+        let SineRoom { angles, sin, cos } = room;
+        for (angles, &lanes) in angles.iter_mut().zip(&lanes).take(count) {
+            gather::<P, WIDTH>(q, lanes, N, P::flatten_mut(angles));
         }
-        scatter::<P, WIDTH>(P::flatten(&result), N, out);
+        P::sin_cos_split(
+            P::flatten(angles[..count].as_flattened()),
+            P::flatten_mut(sin[..count].as_flattened_mut()),
+            P::flatten_mut(cos[..count].as_flattened_mut()),
+        );
+        for (j, (c, &lanes)) in c.iter().zip(&lanes).enumerate() {
+            let mut trig = [[V::splat(0.0); 2]; N];
+            for (t, (&sin, &cos)) in trig.iter_mut().zip(sin[j].iter().zip(&cos[j])) {
+                *t = [V::from(sin), V::from(cos)];
+            }
+            let mut rates = [zero; N];
+            gather::<P, WIDTH>(qd, lanes, N, P::flatten_mut(&mut rates));
+            let mut torques = [zero; N];
+            if let Some(t) = torque {
+                gather::<P, WIDTH>(t, lanes, N, P::flatten_mut(&mut torques));
+            }
+            let pivot = match pivot {
+                Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
+                None => [zero; 2],
+            };
+            let accelerations = M::kernel(
+                &c.in_lanes(),
+                &trig,
+                &convert::<_, V, N>(&rates),
+                &convert::<_, V, N>(&torques),
+                convert::<_, V, 2>(&pivot),
+            );
+            let mut result = [zero; N];
+            for (r, a) in result.iter_mut().zip(accelerations) {
+                *r = a.into();
+            }
+            let rows = WIDTH * N * j..(WIDTH * N * (j + 1)).min(out.len());
+            scatter::<P, WIDTH>(P::flatten(&result), N, &mut out[rows]);
+        }
     }
 
-    /// [`block`](Self::block) in AVX2 registers when the CPU has them, else in
+    /// [`group`](Self::group) in AVX2 registers when the CPU has them, else in
     /// [`Precision::Lanes`].
-    #[allow(clippy::too_many_arguments)]
-    fn block_simd<P: Precision>(
+    fn group_simd<P: Precision>(
         &self,
-        c: &LinkConstants<P::Lanes, N>,
-        lanes: [usize; WIDTH],
-        q: &[P],
-        qd: &[P],
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N>,
+        lanes: [[usize; WIDTH]; GROUP],
+        states: [&[P]; 2],
         torque: Option<&[P]>,
         pivot: Option<&[P]>,
         out: &mut [P],
     ) {
         #[cfg(target_arch = "x86_64")]
+        if crate::lanes::has_avx512vl() {
+            // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
+            return unsafe { self.group_avx512::<P>(c, room, lanes, states, torque, pivot, out) };
+        }
+        #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx2() {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.block_avx2::<P>(c, lanes, q, qd, torque, pivot, out) };
+            return unsafe { self.group_avx2::<P>(c, room, lanes, states, torque, pivot, out) };
         }
-        self.block::<P, P::Lanes>(c, lanes, q, qd, torque, pivot, out)
+        self.group::<P, P::Lanes>(c, room, lanes, states, torque, pivot, out)
     }
 
-    /// [`block`](Self::block) compiled for AVX2, in [`Precision::Registers`].
+    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Registers`]: the
+    /// same four-lane instructions with 32 registers instead of 16, for a kernel that spills
+    /// (1.04–1.08× the AVX2 one, `docs/ensembles.md`).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    fn block_avx2<P: Precision>(
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    fn group_avx512<P: Precision>(
         &self,
-        c: &LinkConstants<P::Lanes, N>,
-        lanes: [usize; WIDTH],
-        q: &[P],
-        qd: &[P],
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N>,
+        lanes: [[usize; WIDTH]; GROUP],
+        states: [&[P]; 2],
         torque: Option<&[P]>,
         pivot: Option<&[P]>,
         out: &mut [P],
     ) {
-        self.block::<P, P::Registers>(c, lanes, q, qd, torque, pivot, out)
+        self.group::<P, P::Registers>(c, room, lanes, states, torque, pivot, out)
+    }
+
+    /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn group_avx2<P: Precision>(
+        &self,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N>,
+        lanes: [[usize; WIDTH]; GROUP],
+        states: [&[P]; 2],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+    ) {
+        self.group::<P, P::Registers>(c, room, lanes, states, torque, pivot, out)
     }
 }

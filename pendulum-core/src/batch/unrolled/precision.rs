@@ -55,6 +55,8 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     fn flatten(v: &[Self::Lanes]) -> &[Self];
     /// [`flatten`](Self::flatten), mutably.
     fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self];
+    /// `sin[i]`, `cos[i]` of `angles[i]` (rad), by this precision's sine kernel.
+    fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
     /// `[sin θ_i, cos θ_i]` of every lane of every angle, by this precision's sine kernel
     /// over the angles' array (inlined, so that it runs with its caller's target features).
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N];
@@ -77,6 +79,10 @@ impl Precision for f64 {
     #[inline(always)]
     fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self] {
         Lanes::flatten_mut(v)
+    }
+    #[inline(always)]
+    fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
+        sin_cos_split(angles, sin, cos)
     }
     #[inline(always)]
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
@@ -103,6 +109,10 @@ impl Precision for f32 {
     #[inline(always)]
     fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self] {
         Lanes32::flatten_mut(v)
+    }
+    #[inline(always)]
+    fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
+        sin_cos_split_f32(angles, sin, cos)
     }
     #[inline(always)]
     fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
