@@ -27,6 +27,17 @@ use crate::model::{Inputs, Model};
 /// dependent operations waited on with nothing beside it; four blocks' turns overlap.
 const GROUP: usize = 4;
 
+/// The arrays a call evaluates, in precision `P`: `B` rows of angles `q` (rad), rates `qd`
+/// (rad/s), joint torques (N·m; `None`: none) and pivot accelerations (2 a row, m/s²;
+/// `None`: at rest).
+#[derive(Clone, Copy)]
+struct Rows<'a, P> {
+    q: &'a [P],
+    qd: &'a [P],
+    torque: Option<&'a [P]>,
+    pivot: Option<&'a [P]>,
+}
+
 /// A task's arrays for a group's angles and their sines and cosines, in lanes: kept for the
 /// task's groups (zeroed per group they were 3% of the n = 8 call).
 struct SineRoom<L, const N: usize> {
@@ -260,7 +271,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
                 let first = GROUP * g;
                 let count = (out.len() / N).div_ceil(WIDTH);
                 let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
-                self.group_simd::<P>(&blocks[first..first + count], room, lanes, [q, qd], torque, pivot, out);
+                let rows = Rows { q, qd, torque, pivot };
+                self.group_simd::<P>(&blocks[first..first + count], room, lanes, rows, out);
                 let mut failures = Vec::new();
                 for (k, row) in out.chunks_exact_mut(N).enumerate() {
                     if row.iter().all(|&v| v.into().is_finite()) {
@@ -286,9 +298,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         c: &[LinkConstants<P::Lanes, N>],
         room: &mut SineRoom<P::Lanes, N>,
         lanes: [[usize; WIDTH]; GROUP],
-        [q, qd]: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
+        Rows { q, qd, torque, pivot }: Rows<'_, P>,
         out: &mut [P],
     ) {
         let zero = P::Lanes::splat(0.0);
@@ -340,22 +350,20 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         c: &[LinkConstants<P::Lanes, N>],
         room: &mut SineRoom<P::Lanes, N>,
         lanes: [[usize; WIDTH]; GROUP],
-        states: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
+        rows: Rows<'_, P>,
         out: &mut [P],
     ) {
         #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx512vl() {
             // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
-            return unsafe { self.group_avx512::<P>(c, room, lanes, states, torque, pivot, out) };
+            return unsafe { self.group_avx512::<P>(c, room, lanes, rows, out) };
         }
         #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx2() {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.group_avx2::<P>(c, room, lanes, states, torque, pivot, out) };
+            return unsafe { self.group_avx2::<P>(c, room, lanes, rows, out) };
         }
-        self.group::<P, P::Lanes>(c, room, lanes, states, torque, pivot, out)
+        self.group::<P, P::Lanes>(c, room, lanes, rows, out)
     }
 
     /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Registers`]: the
@@ -368,12 +376,10 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         c: &[LinkConstants<P::Lanes, N>],
         room: &mut SineRoom<P::Lanes, N>,
         lanes: [[usize; WIDTH]; GROUP],
-        states: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
+        rows: Rows<'_, P>,
         out: &mut [P],
     ) {
-        self.group::<P, P::Registers>(c, room, lanes, states, torque, pivot, out)
+        self.group::<P, P::Registers>(c, room, lanes, rows, out)
     }
 
     /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].
@@ -384,11 +390,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         c: &[LinkConstants<P::Lanes, N>],
         room: &mut SineRoom<P::Lanes, N>,
         lanes: [[usize; WIDTH]; GROUP],
-        states: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
+        rows: Rows<'_, P>,
         out: &mut [P],
     ) {
-        self.group::<P, P::Registers>(c, room, lanes, states, torque, pivot, out)
+        self.group::<P, P::Registers>(c, room, lanes, rows, out)
     }
 }

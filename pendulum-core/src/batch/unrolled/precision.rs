@@ -9,7 +9,7 @@ use crate::lanes::{Lane, Lanes, Lanes32};
 
 /// Lanes a generated kernel runs in, in precision `P`: `P`'s arrays of lanes themselves, or
 /// registers loaded from them.
-pub(crate) trait KernelLanes<P: Precision + ?Sized>: Lane + From<P::Lanes> + Into<P::Lanes> {
+pub(crate) trait KernelLanes<P: Precision>: Lane + From<P::Lanes> + Into<P::Lanes> {
     /// `[sin θ_i, cos θ_i]` of every lane of every angle, [`Precision::sin_cos`]'s: the
     /// angles stored into `P`'s arrays, the results loaded back. (In the registers, four
     /// angles an instruction, it was 0.76× at n = 8: the array kernel runs eight with
@@ -25,7 +25,7 @@ pub(crate) trait KernelLanes<P: Precision + ?Sized>: Lane + From<P::Lanes> + Int
     }
 }
 
-impl<P: Precision + ?Sized, V: Lane + From<P::Lanes> + Into<P::Lanes>> KernelLanes<P> for V {}
+impl<P: Precision, V: Lane + From<P::Lanes> + Into<P::Lanes>> KernelLanes<P> for V {}
 
 /// Each lane group of `v` in type `V`: a loop, not `array::map`, whose closure was compiled
 /// apart from the AVX2 kernel (without its target features, the conversions not inlined).
