@@ -59,7 +59,13 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
     /// `[sin θ_i, cos θ_i]` of every lane of every angle, by this precision's sine kernel
     /// over the angles' array (inlined, so that it runs with its caller's target features).
-    fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N];
+    #[inline(always)]
+    fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
+        let zero = Self::Lanes::splat(0.0);
+        let (mut sin, mut cos) = ([zero; N], [zero; N]);
+        Self::sin_cos_split(Self::flatten(angles), Self::flatten_mut(&mut sin), Self::flatten_mut(&mut cos));
+        std::array::from_fn(|i| [sin[i], cos[i]])
+    }
 }
 
 impl Precision for f64 {
@@ -84,12 +90,6 @@ impl Precision for f64 {
     fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
         sin_cos_split(angles, sin, cos)
     }
-    #[inline(always)]
-    fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
-        let (mut sin, mut cos) = ([Lanes::splat(0.0); N], [Lanes::splat(0.0); N]);
-        sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(&mut sin), Lanes::flatten_mut(&mut cos));
-        std::array::from_fn(|i| [sin[i], cos[i]])
-    }
 }
 
 impl Precision for f32 {
@@ -113,15 +113,5 @@ impl Precision for f32 {
     #[inline(always)]
     fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
         sin_cos_split_f32(angles, sin, cos)
-    }
-    #[inline(always)]
-    fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
-        let (mut sin, mut cos) = ([Lanes32::splat(0.0); N], [Lanes32::splat(0.0); N]);
-        sin_cos_split_f32(
-            Lanes32::flatten(angles),
-            Lanes32::flatten_mut(&mut sin),
-            Lanes32::flatten_mut(&mut cos),
-        );
-        std::array::from_fn(|i| [sin[i], cos[i]])
     }
 }
