@@ -96,12 +96,30 @@ macro_rules! register_lanes {
 }
 
 register_lanes!(
-    Avx4, Lanes, f64, _mm256_loadu_pd, _mm256_storeu_pd, _mm256_add_pd, _mm256_sub_pd,
-    _mm256_mul_pd, _mm256_div_pd, _mm256_xor_pd, _mm256_set1_pd
+    Avx4,
+    Lanes,
+    f64,
+    _mm256_loadu_pd,
+    _mm256_storeu_pd,
+    _mm256_add_pd,
+    _mm256_sub_pd,
+    _mm256_mul_pd,
+    _mm256_div_pd,
+    _mm256_xor_pd,
+    _mm256_set1_pd
 );
 register_lanes!(
-    Sse4, Lanes32, f32, _mm_loadu_ps, _mm_storeu_ps, _mm_add_ps, _mm_sub_ps, _mm_mul_ps,
-    _mm_div_ps, _mm_xor_ps, _mm_set1_ps
+    Sse4,
+    Lanes32,
+    f32,
+    _mm_loadu_ps,
+    _mm_storeu_ps,
+    _mm_add_ps,
+    _mm_sub_ps,
+    _mm_mul_ps,
+    _mm_div_ps,
+    _mm_xor_ps,
+    _mm_set1_ps
 );
 
 impl Lane for Avx4 {

@@ -262,12 +262,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         if let Some(p) = pivot {
             check_len("pivot", p, chains, 2)?;
         }
-        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(
-            out,
-            N,
-            N,
-            SineRoom::new,
-            |room, g, out| {
+        let failures =
+            for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, N, N, SineRoom::new, |room, g, out| {
                 let first = GROUP * g;
                 let count = (out.len() / N).div_ceil(WIDTH);
                 let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
@@ -283,8 +279,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
                     row.fill(P::NAN);
                 }
                 failures
-            },
-        );
+            });
         Ok(failures)
     }
 
