@@ -227,17 +227,6 @@ pub(crate) fn blocks_per_task(width: usize, solves: usize) -> usize {
     (2048 / (width * solves).max(1)).max(1)
 }
 
-/// [`for_blocks_of`] in blocks of [`WIDTH`] chains.
-pub(crate) fn for_blocks<T: Send, S, F: Send>(
-    out: &mut [T],
-    m: usize,
-    solves: usize,
-    init: impl Fn() -> S + Sync + Send,
-    block: impl Fn(&mut S, usize, &mut [T]) -> Vec<F> + Sync + Send,
-) -> Vec<F> {
-    for_blocks_of::<WIDTH, _, _, _>(out, m, solves, init, block)
-}
-
 /// Runs `block(scratch, b, rows)` for every block `b` of `out` (`W` rows of `m` numbers
 /// each, the last one shorter) across the current rayon pool, with a `scratch` from `init`
 /// per task, and collects the failures (or what `block` reports) in block order.

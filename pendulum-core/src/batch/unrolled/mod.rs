@@ -40,14 +40,14 @@ struct Rows<'a, P> {
 
 /// A task's arrays for a group's angles and their sines and cosines, in lanes: kept for the
 /// task's groups (zeroed per group they were 3% of the n = 8 call).
-struct SineRoom<L, const N: usize> {
+pub(super) struct SineRoom<L, const N: usize> {
     angles: [[L; N]; GROUP],
     sin: [[L; N]; GROUP],
     cos: [[L; N]; GROUP],
 }
 
 impl<L: Lane, const N: usize> SineRoom<L, N> {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         let zero = [[L::splat(0.0); N]; GROUP];
         Self { angles: zero, sin: zero, cos: zero }
     }

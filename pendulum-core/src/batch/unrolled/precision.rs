@@ -8,22 +8,8 @@ use crate::kinematics::trig32::sin_cos_split_f32;
 use crate::lanes::{Lane, Lanes, Lanes32};
 
 /// Lanes a generated kernel runs in, in precision `P`: `P`'s arrays of lanes themselves, or
-/// registers loaded from them.
-pub(crate) trait KernelLanes<P: Precision>: Lane + From<P::Lanes> + Into<P::Lanes> {
-    /// `[sin θ_i, cos θ_i]` of every lane of every angle, [`Precision::sin_cos`]'s: the
-    /// angles stored into `P`'s arrays, the results loaded back. (In the registers, four
-    /// angles an instruction, it was 0.76× at n = 8: the array kernel runs eight with
-    /// AVX-512.)
-    #[inline(always)]
-    fn sin_cos<const N: usize>(angles: &[Self; N]) -> [[Self; 2]; N] {
-        let trig = P::sin_cos(&convert::<Self, P::Lanes, N>(angles));
-        let mut out = [[Self::splat(0.0); 2]; N];
-        for (o, t) in out.iter_mut().zip(&trig) {
-            *o = convert::<P::Lanes, Self, 2>(t);
-        }
-        out
-    }
-}
+/// registers loaded from them and stored back.
+pub(crate) trait KernelLanes<P: Precision>: Lane + From<P::Lanes> + Into<P::Lanes> {}
 
 impl<P: Precision, V: Lane + From<P::Lanes> + Into<P::Lanes>> KernelLanes<P> for V {}
 
@@ -57,15 +43,6 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     fn flatten_mut(v: &mut [Self::Lanes]) -> &mut [Self];
     /// `sin[i]`, `cos[i]` of `angles[i]` (rad), by this precision's sine kernel.
     fn sin_cos_split(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
-    /// `[sin θ_i, cos θ_i]` of every lane of every angle, by this precision's sine kernel
-    /// over the angles' array (inlined, so that it runs with its caller's target features).
-    #[inline(always)]
-    fn sin_cos<const N: usize>(angles: &[Self::Lanes; N]) -> [[Self::Lanes; 2]; N] {
-        let zero = Self::Lanes::splat(0.0);
-        let (mut sin, mut cos) = ([zero; N], [zero; N]);
-        Self::sin_cos_split(Self::flatten(angles), Self::flatten_mut(&mut sin), Self::flatten_mut(&mut cos));
-        std::array::from_fn(|i| [sin[i], cos[i]])
-    }
 }
 
 impl Precision for f64 {

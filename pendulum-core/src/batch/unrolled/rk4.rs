@@ -5,10 +5,11 @@
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
 use super::precision::{KernelLanes, convert};
-use super::{LinkConstants, PlanarKernel, UnrolledBatch};
-use crate::batch::{F64x4, Failure, WIDTH, for_blocks};
+use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch};
+use crate::batch::{F64x4, Failure, WIDTH, for_blocks_of};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
+use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Lane, Lanes};
 
 /// A block's states in lanes: `θ`, `θ̇` and their compensations, `t` and its compensation.
@@ -21,47 +22,79 @@ struct Block<const N: usize> {
     t_carry: F64x4,
 }
 
+impl<const N: usize> Default for Block<N> {
+    fn default() -> Self {
+        let zero = Lanes([0.0; WIDTH]);
+        Self { q: [zero; N], qd: [zero; N], q_carry: [zero; N], qd_carry: [zero; N], t: zero, t_carry: zero }
+    }
+}
+
 /// `θ̈(θ, θ̇)` for [`increment`]: a type of its own rather than a closure, for the lanes'
 /// kernel must be inlined into its caller to run with the caller's target features, and a
 /// closure called four times was compiled as a function of its own, without them (SSE2 in
 /// the AVX2 run, half its time).
-trait Accelerations<V, const N: usize> {
-    /// `θ̈` (rad/s²) at angles `q` (rad) and rates `qd` (rad/s).
-    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N];
+trait Accelerations<V, const N: usize, const G: usize> {
+    /// `θ̈` (rad/s²) of `G` blocks at angles `q` (rad) and rates `qd` (rad/s).
+    fn at(&mut self, q: &[[V; N]; G], qd: &[[V; N]; G]) -> [[V; N]; G];
 }
 
-/// A model's kernel on a block of lanes of type `V`, pivot at rest and no torques.
-struct Kernel<'a, M, V, const N: usize>(&'a LinkConstants<V, N>, std::marker::PhantomData<M>);
+/// A model's kernels on the first `count` blocks of a group, constants `c`, in lanes of
+/// type `V`, pivot at rest and no torques: the sines and cosines of all their angles in
+/// one call of the sine kernel (in `room`), then block by block the kernel.
+struct Kernel<'a, M, V, const N: usize> {
+    c: &'a [LinkConstants<V, N>; GROUP],
+    count: usize,
+    room: &'a mut SineRoom<F64x4, N>,
+    model: std::marker::PhantomData<M>,
+}
 
-impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N> for Kernel<'_, M, V, N> {
+impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N, GROUP>
+    for Kernel<'_, M, V, N>
+{
     #[inline(always)]
-    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
+    fn at(&mut self, q: &[[V; N]; GROUP], qd: &[[V; N]; GROUP]) -> [[V; N]; GROUP] {
         let zero = V::splat(0.0);
-        M::kernel(self.0, &V::sin_cos(q), qd, &[zero; N], [zero; 2])
+        let SineRoom { angles, sin, cos } = &mut *self.room;
+        for (angles, q) in angles.iter_mut().zip(q).take(self.count) {
+            *angles = convert(q);
+        }
+        let count = self.count;
+        sin_cos_split(
+            Lanes::flatten(angles[..count].as_flattened()),
+            Lanes::flatten_mut(sin[..count].as_flattened_mut()),
+            Lanes::flatten_mut(cos[..count].as_flattened_mut()),
+        );
+        let mut out = [[zero; N]; GROUP];
+        for j in 0..count {
+            let mut trig = [[zero; 2]; N];
+            for (t, (&sin, &cos)) in trig.iter_mut().zip(sin[j].iter().zip(&cos[j])) {
+                *t = [V::from(sin), V::from(cos)];
+            }
+            out[j] = M::kernel(&self.c[j], &trig, &qd[j], &[zero; N], [zero; 2]);
+        }
+        out
     }
 }
 
-/// Any closure `θ̈(θ, θ̇)` (out of the hot path: a closure is compiled apart).
-impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N> for F {
-    fn at(&mut self, q: &[V; N], qd: &[V; N]) -> [V; N] {
-        self(q, qd)
+/// Any closure `θ̈(θ, θ̇)` of one block (out of the hot path: a closure is compiled apart).
+impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N, 1> for F {
+    fn at(&mut self, q: &[[V; N]; 1], qd: &[[V; N]; 1]) -> [[V; N]; 1] {
+        [self(&q[0], &qd[0])]
     }
 }
 
 /// The increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` of one step of
 /// [`Rk4`](crate::integrate::Rk4) from `(θ, θ̇)`, for the first-order system
 /// `(θ, θ̇)' = (θ̇, θ̈)` with `θ̈ = accelerations(θ, θ̇)`, rounded as `Rk4` rounds it: lane by
-/// lane (`V = Lanes`) or for one chain (`V = f64`).
+/// lane (`V = Lanes`) or for one chain (`V = f64`), for `G` blocks at once.
 #[inline(always)]
-fn increment<V: Lane, const N: usize>(
-    q: &[V; N],
-    qd: &[V; N],
+fn increment<V: Lane, const N: usize, const G: usize>(
+    q: &[[V; N]; G],
+    qd: &[[V; N]; G],
     h: f64,
-    mut accelerations: impl Accelerations<V, N>,
-) -> ([V; N], [V; N]) {
+    mut accelerations: impl Accelerations<V, N, G>,
+) -> ([[V; N]; G], [[V; N]; G]) {
     let (half, whole, sixth, two) = (V::splat(0.5 * h), V::splat(h), V::splat(h / 6.0), V::splat(2.0));
-    // `y = x + a k` as `Rk4`'s `axpy` rounds it.
-    let axpy = |x: &[V; N], a: V, k: &[V; N]| -> [V; N] { std::array::from_fn(|i| a * k[i] + x[i]) };
     // k_s = (θ̇_s, θ̈_s), the stages of `Rk4::stages`.
     let a1 = accelerations.at(q, qd);
     let (q2, qd2) = (axpy(q, half, qd), axpy(qd, half, &a1));
@@ -70,10 +103,38 @@ fn increment<V: Lane, const N: usize>(
     let a3 = accelerations.at(&q3, &qd3);
     let (q4, qd4) = (axpy(q, whole, &qd3), axpy(qd, whole, &a3));
     let a4 = accelerations.at(&q4, &qd4);
-    let sum = |k1: &[V; N], k2: &[V; N], k3: &[V; N], k4: &[V; N]| -> [V; N] {
-        std::array::from_fn(|i| sixth * (k1[i] + two * (k2[i] + k3[i]) + k4[i]))
-    };
-    (sum(qd, &qd2, &qd3, &qd4), sum(&a1, &a2, &a3, &a4))
+    (weighted_sum(sixth, two, [qd, &qd2, &qd3, &qd4]), weighted_sum(sixth, two, [&a1, &a2, &a3, &a4]))
+}
+
+/// `y = x + a k` as `Rk4`'s `axpy` rounds it, for `G` blocks. A function, not a closure
+/// in [`increment`]: called six times, a closure was compiled apart, without the kernel's
+/// target features (each lane operation a call, 0.23× the run).
+#[inline(always)]
+fn axpy<V: Lane, const N: usize, const G: usize>(x: &[[V; N]; G], a: V, k: &[[V; N]; G]) -> [[V; N]; G] {
+    let mut y = *x;
+    for (y, k) in y.iter_mut().zip(k) {
+        for (y, &k) in y.iter_mut().zip(k) {
+            *y = a * k + *y;
+        }
+    }
+    y
+}
+
+/// `(h/6) (k1 + 2 (k2 + k3) + k4)` as `Rk4` rounds it, for `G` blocks (`sixth` = h/6,
+/// `two` = 2).
+#[inline(always)]
+fn weighted_sum<V: Lane, const N: usize, const G: usize>(
+    sixth: V,
+    two: V,
+    [k1, k2, k3, k4]: [&[[V; N]; G]; 4],
+) -> [[V; N]; G] {
+    let mut out = *k1;
+    for j in 0..G {
+        for i in 0..N {
+            out[j][i] = sixth * (k1[j][i] + two * (k2[j][i] + k3[j][i]) + k4[j][i]);
+        }
+    }
+    out
 }
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
@@ -103,35 +164,42 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             return Err(Error::LengthMismatch { what: "x", expected: 2 * N, got: s.x().len() });
         }
         let solves = (4 * N).saturating_mul(steps);
-        let failures = for_blocks(
+        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(
             states,
             1,
             solves,
-            || (),
-            |_, b, block| {
-                let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
-                let entries = |j: usize, carry: bool| {
-                    Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
-                };
-                let mut s = Block {
-                    q: std::array::from_fn(|i| entries(i, false)),
-                    qd: std::array::from_fn(|i| entries(N + i, false)),
-                    q_carry: std::array::from_fn(|i| entries(i, true)),
-                    qd_carry: std::array::from_fn(|i| entries(N + i, true)),
-                    t: Lanes::from_fn(|k| parts[k].0),
-                    t_carry: Lanes::from_fn(|k| parts[k].1),
-                };
-                let alive = self.rk4_run_simd(b, h, steps, &mut s);
+            SineRoom::new,
+            |room, g, states| {
+                let first = GROUP * g;
+                let count = states.len().div_ceil(WIDTH);
+                let mut s: [Block<N>; GROUP] = std::array::from_fn(|_| Block::default());
+                for (s, block) in s.iter_mut().zip(states.chunks(WIDTH)) {
+                    let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
+                    let entries = |j: usize, carry: bool| {
+                        Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
+                    };
+                    *s = Block {
+                        q: std::array::from_fn(|i| entries(i, false)),
+                        qd: std::array::from_fn(|i| entries(N + i, false)),
+                        q_carry: std::array::from_fn(|i| entries(i, true)),
+                        qd_carry: std::array::from_fn(|i| entries(N + i, true)),
+                        t: Lanes::from_fn(|k| parts[k].0),
+                        t_carry: Lanes::from_fn(|k| parts[k].1),
+                    };
+                }
+                let alive = self.rk4_run_simd(first, count, room, h, steps, &mut s);
                 let mut failures = Vec::new();
-                for (k, state) in block.iter_mut().enumerate() {
-                    let x = (s.q.iter().zip(&s.q_carry)).chain(s.qd.iter().zip(&s.qd_carry));
-                    state.set_parts(s.t.0[k], s.t_carry.0[k], x.map(|(x, carry)| (x.0[k], carry.0[k])));
-                    if !alive[k] {
-                        let chain = WIDTH * b + k;
-                        failures.push(Failure {
-                            chain,
-                            error: self.step_error(chain, state.t(), state.x().as_slice(), h),
-                        });
+                for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
+                    for (k, state) in block.iter_mut().enumerate() {
+                        let x = (s.q.iter().zip(&s.q_carry)).chain(s.qd.iter().zip(&s.qd_carry));
+                        state.set_parts(s.t.0[k], s.t_carry.0[k], x.map(|(x, carry)| (x.0[k], carry.0[k])));
+                        if !alive[j][k] {
+                            let chain = WIDTH * (first + j) + k;
+                            failures.push(Failure {
+                                chain,
+                                error: self.step_error(chain, state.t(), state.x().as_slice(), h),
+                            });
+                        }
                     }
                 }
                 failures
@@ -147,8 +215,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         let model = &self.models[chain];
         let inputs = model.zero_inputs();
         let mut first = None;
-        let (q, qd) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
-        increment::<f64, N>(q, qd, h, |q: &[f64; N], qd: &[f64; N]| {
+        let (q, qd): ([f64; N], [f64; N]) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
+        increment::<f64, N, 1>(&[q], &[qd], h, |q: &[f64; N], qd: &[f64; N]| {
             let mut out = SVector::<f64, N>::zeros();
             let (q, qd) = (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
             match model.accelerations(&q, &qd, &inputs, &mut out) {
@@ -162,73 +230,106 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         first.unwrap_or(Error::NonFiniteState { t, h })
     }
 
-    /// `steps` RK4 steps of block `b` in lanes of type `V`; a lane whose increment is not
-    /// finite stops at the start of that step. Returns the lanes that ran to the end.
+    /// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the
+    /// first `count` of them), in lanes of type `V`; a lane whose increment is not finite
+    /// stops at the start of that step. Returns the lanes that ran to the end.
     #[inline(always)]
     fn rk4_run<V: KernelLanes<f64>>(
         &self,
-        b: usize,
+        (first, count): (usize, usize),
+        room: &mut SineRoom<F64x4, N>,
         h: f64,
         steps: usize,
-        s: &mut Block<N>,
-    ) -> [bool; WIDTH] {
-        let c = self.blocks[b].in_lanes::<V>();
-        let (mut q, mut qd): ([V; N], [V; N]) = (convert(&s.q), convert(&s.qd));
-        let (mut q_carry, mut qd_carry): ([V; N], [V; N]) = (convert(&s.q_carry), convert(&s.qd_carry));
-        let (mut t, mut t_carry) = (V::from(s.t), V::from(s.t_carry));
+        s: &mut [Block<N>; GROUP],
+    ) -> [[bool; WIDTH]; GROUP] {
         let zero = V::splat(0.0);
-        let mut stopped = V::none();
+        let c: [LinkConstants<V, N>; GROUP] =
+            std::array::from_fn(|j| self.blocks[first + j.min(count - 1)].in_lanes::<V>());
+        let (mut q, mut qd) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
+        let (mut q_carry, mut qd_carry) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
+        let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
+        for j in 0..count {
+            (q[j], qd[j]) = (convert(&s[j].q), convert(&s[j].qd));
+            (q_carry[j], qd_carry[j]) = (convert(&s[j].q_carry), convert(&s[j].qd_carry));
+            (t[j], t_carry[j]) = (V::from(s[j].t), V::from(s[j].t_carry));
+        }
+        let mut stopped = [V::none(); GROUP];
         for _ in 0..steps {
-            let (dq, dqd) = increment(&q, &qd, h, Kernel::<M, V, N>(&c, std::marker::PhantomData));
-            // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
-            let mut probe = zero;
-            for d in dq.iter().chain(&dqd) {
-                #[allow(clippy::eq_op)]
-                let nan_if_not_finite = *d - *d;
-                probe += nan_if_not_finite;
+            let kernel =
+                Kernel::<M, V, N> { c: &c, count, room: &mut *room, model: std::marker::PhantomData };
+            let (dq, dqd) = increment(&q, &qd, h, kernel);
+            for j in 0..count {
+                // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
+                let mut probe = zero;
+                for d in dq[j].iter().chain(&dqd[j]) {
+                    #[allow(clippy::eq_op)]
+                    let nan_if_not_finite = *d - *d;
+                    probe += nan_if_not_finite;
+                }
+                let stop = V::or(stopped[j], probe.outside(0, 0));
+                stopped[j] = stop;
+                let advance = |x: &mut V, carry: &mut V, delta: V| {
+                    let (new, new_carry) = kahan_add(*x, *carry, delta);
+                    (*x, *carry) = (V::select(stop, *x, new), V::select(stop, *carry, new_carry));
+                };
+                advance(&mut t[j], &mut t_carry[j], V::splat(h));
+                for i in 0..N {
+                    advance(&mut q[j][i], &mut q_carry[j][i], dq[j][i]);
+                    advance(&mut qd[j][i], &mut qd_carry[j][i], dqd[j][i]);
+                }
             }
-            stopped = V::or(stopped, probe.outside(0, 0));
-            let advance = |x: &mut V, carry: &mut V, delta: V| {
-                let (new, new_carry) = kahan_add(*x, *carry, delta);
-                (*x, *carry) = (V::select(stopped, *x, new), V::select(stopped, *carry, new_carry));
-            };
-            advance(&mut t, &mut t_carry, V::splat(h));
-            for i in 0..N {
-                advance(&mut q[i], &mut q_carry[i], dq[i]);
-                advance(&mut qd[i], &mut qd_carry[i], dqd[i]);
-            }
-            if V::all(stopped) {
+            if stopped[..count].iter().all(|&stop| V::all(stop)) {
                 break;
             }
         }
-        let back = |v: &[V; N], to: &mut [F64x4; N]| {
-            for (to, v) in to.iter_mut().zip(v) {
-                *to = (*v).into();
-            }
-        };
-        back(&q, &mut s.q);
-        back(&qd, &mut s.qd);
-        back(&q_carry, &mut s.q_carry);
-        back(&qd_carry, &mut s.qd_carry);
-        (s.t, s.t_carry) = (t.into(), t_carry.into());
-        V::select(stopped, zero, V::splat(1.0)).into().0.map(|alive| alive == 1.0)
+        let mut alive = [[false; WIDTH]; GROUP];
+        for j in 0..count {
+            let back = |v: &[V; N], to: &mut [F64x4; N]| {
+                for (to, v) in to.iter_mut().zip(v) {
+                    *to = (*v).into();
+                }
+            };
+            back(&q[j], &mut s[j].q);
+            back(&qd[j], &mut s[j].qd);
+            back(&q_carry[j], &mut s[j].q_carry);
+            back(&qd_carry[j], &mut s[j].qd_carry);
+            (s[j].t, s[j].t_carry) = (t[j].into(), t_carry[j].into());
+            alive[j] = V::select(stopped[j], zero, V::splat(1.0)).into().0.map(|alive| alive == 1.0);
+        }
+        alive
     }
 
     /// [`rk4_run`](Self::rk4_run) in AVX2 registers when the CPU has them, else in
     /// [`Lanes`].
-    fn rk4_run_simd(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [bool; WIDTH] {
+    fn rk4_run_simd(
+        &self,
+        first: usize,
+        count: usize,
+        room: &mut SineRoom<F64x4, N>,
+        h: f64,
+        steps: usize,
+        s: &mut [Block<N>; GROUP],
+    ) -> [[bool; WIDTH]; GROUP] {
         #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx2() {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.rk4_run_avx2(b, h, steps, s) };
+            return unsafe { self.rk4_run_avx2(first, count, room, h, steps, s) };
         }
-        self.rk4_run::<F64x4>(b, h, steps, s)
+        self.rk4_run::<F64x4>((first, count), room, h, steps, s)
     }
 
     /// [`rk4_run`](Self::rk4_run) compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn rk4_run_avx2(&self, b: usize, h: f64, steps: usize, s: &mut Block<N>) -> [bool; WIDTH] {
-        self.rk4_run::<crate::lanes::Avx4>(b, h, steps, s)
+    fn rk4_run_avx2(
+        &self,
+        first: usize,
+        count: usize,
+        room: &mut SineRoom<F64x4, N>,
+        h: f64,
+        steps: usize,
+        s: &mut [Block<N>; GROUP],
+    ) -> [[bool; WIDTH]; GROUP] {
+        self.rk4_run::<crate::lanes::Avx4>((first, count), room, h, steps, s)
     }
 }
