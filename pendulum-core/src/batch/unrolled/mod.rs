@@ -41,7 +41,8 @@ struct Rows<'a, P> {
 /// A task's arrays for a group's angles and their sines and cosines, in lanes: kept for the
 /// task's groups (zeroed per group they were 3% of the n = 8 call).
 pub(super) struct SineRoom<L, const N: usize> {
-    angles: [[L; N]; GROUP],
+    /// Each block's angles `θ_i` (rad), for the caller to fill.
+    pub(super) angles: [[L; N]; GROUP],
     sin: [[L; N]; GROUP],
     cos: [[L; N]; GROUP],
 }
@@ -50,6 +51,26 @@ impl<L: Lane, const N: usize> SineRoom<L, N> {
     pub(super) fn new() -> Self {
         let zero = [[L::splat(0.0); N]; GROUP];
         Self { angles: zero, sin: zero, cos: zero }
+    }
+
+    /// `sin θ_i`, `cos θ_i` of the first `count` blocks' angles, by `P`'s sine kernel in one
+    /// call.
+    #[inline(always)]
+    pub(super) fn sin_cos<P: Precision<Lanes = L>>(&mut self, count: usize) {
+        P::sin_cos_split(
+            P::flatten(self.angles[..count].as_flattened()),
+            P::flatten_mut(self.sin[..count].as_flattened_mut()),
+            P::flatten_mut(self.cos[..count].as_flattened_mut()),
+        );
+    }
+
+    /// Block `j`'s `[sin θ_i, cos θ_i]` (after [`sin_cos`](Self::sin_cos)) into `trig`, in
+    /// lanes `V`. (Returned by value, the array was kept on the stack at n = 16: 0.70×.)
+    #[inline(always)]
+    pub(super) fn trig<V: Lane + From<L>>(&self, j: usize, trig: &mut [[V; 2]; N]) {
+        for (t, (&sin, &cos)) in trig.iter_mut().zip(self.sin[j].iter().zip(&self.cos[j])) {
+            *t = [V::from(sin), V::from(cos)];
+        }
     }
 }
 
@@ -298,20 +319,13 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     ) {
         let zero = P::Lanes::splat(0.0);
         let count = c.len();
-        let SineRoom { angles, sin, cos } = room;
-        for (angles, &lanes) in angles.iter_mut().zip(&lanes).take(count) {
+        for (angles, &lanes) in room.angles.iter_mut().zip(&lanes).take(count) {
             gather::<P, WIDTH>(q, lanes, N, P::flatten_mut(angles));
         }
-        P::sin_cos_split(
-            P::flatten(angles[..count].as_flattened()),
-            P::flatten_mut(sin[..count].as_flattened_mut()),
-            P::flatten_mut(cos[..count].as_flattened_mut()),
-        );
+        room.sin_cos::<P>(count);
         for (j, (c, &lanes)) in c.iter().zip(&lanes).enumerate() {
             let mut trig = [[V::splat(0.0); 2]; N];
-            for (t, (&sin, &cos)) in trig.iter_mut().zip(sin[j].iter().zip(&cos[j])) {
-                *t = [V::from(sin), V::from(cos)];
-            }
+            room.trig(j, &mut trig);
             let mut rates = [zero; N];
             gather::<P, WIDTH>(qd, lanes, N, P::flatten_mut(&mut rates));
             let mut torques = [zero; N];

@@ -9,7 +9,6 @@ use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks_of};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Lane, Lanes};
 
 /// A block's states in lanes: `θ`, `θ̇` and their compensations, `t` and its compensation.
@@ -54,22 +53,15 @@ impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N
     #[inline(always)]
     fn at(&mut self, q: &[[V; N]; GROUP], qd: &[[V; N]; GROUP]) -> [[V; N]; GROUP] {
         let zero = V::splat(0.0);
-        let SineRoom { angles, sin, cos } = &mut *self.room;
-        for (angles, q) in angles.iter_mut().zip(q).take(self.count) {
+        let count = self.count;
+        for (angles, q) in self.room.angles.iter_mut().zip(q).take(count) {
             *angles = convert(q);
         }
-        let count = self.count;
-        sin_cos_split(
-            Lanes::flatten(angles[..count].as_flattened()),
-            Lanes::flatten_mut(sin[..count].as_flattened_mut()),
-            Lanes::flatten_mut(cos[..count].as_flattened_mut()),
-        );
+        self.room.sin_cos::<f64>(count);
         let mut out = [[zero; N]; GROUP];
         for j in 0..count {
             let mut trig = [[zero; 2]; N];
-            for (t, (&sin, &cos)) in trig.iter_mut().zip(sin[j].iter().zip(&cos[j])) {
-                *t = [V::from(sin), V::from(cos)];
-            }
+            self.room.trig(j, &mut trig);
             out[j] = M::kernel(&self.c[j], &trig, &qd[j], &[zero; N], [zero; 2]);
         }
         out
