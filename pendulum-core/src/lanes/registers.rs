@@ -1,6 +1,7 @@
 //! Lanes held in one x86-64 vector register: [`Avx4`], four `f64` lanes in an AVX register,
-//! and [`Sse4`], four `f32` lanes in an SSE register. They are the lane types of the
-//! generated models' batch kernel on a CPU with AVX2.
+//! [`Avx8`], eight in an AVX-512 register, and [`Sse4`], four `f32` lanes in an SSE
+//! register. They are the lane types of the generated models' batch kernel on a CPU with
+//! AVX2 (AVX-512 for [`Avx8`]).
 //!
 //! [`Lanes<4>`](super::Lanes) and [`Lanes32<4>`](super::Lanes32) leave it to LLVM's SLP
 //! vectorizer to turn each array of four into one register; in a long straight-line kernel
@@ -11,8 +12,8 @@
 //!
 //! An [`Avx4`] must only exist in code compiled for AVX2 and run on a CPU that has it (the
 //! batch checks at run time, then enters a `#[target_feature(enable = "avx2")]` function):
-//! its methods are `#[inline(always)]` intrinsics, inlined into that function. The types are
-//! private to the crate for that reason. ([`Sse4`] needs only SSE2, which every x86-64 CPU
+//! its methods are `#[inline(always)]` intrinsics, inlined into that function. The same holds
+//! for an [`Avx8`] and AVX-512 F. The types are private to the crate for that reason. ([`Sse4`] needs only SSE2, which every x86-64 CPU
 //! has.)
 
 use std::arch::x86_64::*;
@@ -25,6 +26,11 @@ use super::{CONTINUANT_RANGE, CONTINUANT_RANGE_32, Lane, Lanes, Lanes32};
 #[repr(transparent)]
 pub(crate) struct Avx4(__m256d);
 
+/// Eight `f64` lanes, one AVX-512 register (see the module's docs for where one may exist).
+#[derive(Debug, Clone, Copy)]
+#[repr(transparent)]
+pub(crate) struct Avx8(__m512d);
+
 /// Four `f32` lanes, one SSE register.
 #[derive(Debug, Clone, Copy)]
 #[repr(transparent)]
@@ -33,22 +39,23 @@ pub(crate) struct Sse4(__m128);
 /// A register type's loads and stores from its lane array, arithmetic and negation, one
 /// intrinsic each.
 macro_rules! register_lanes {
-    ($name:ident, $array:ident, $t:ty, $load:ident, $store:ident, $add:ident, $sub:ident,
-     $mul:ident, $div:ident, $xor:ident, $set1:ident) => {
-        impl From<$array<4>> for $name {
+    ($name:ident, $array:ident, $w:literal, $t:ty, $load:ident, $store:ident, $add:ident,
+     $sub:ident, $mul:ident, $div:ident, $xor:ident, $set1:ident) => {
+        impl From<$array<$w>> for $name {
             #[inline(always)]
-            fn from(v: $array<4>) -> Self {
-                // SAFETY: an `Avx4` is only made on a CPU with AVX (module docs), an `Sse4`
-                // on any x86-64; the load is unaligned and reads the four numbers of `v`.
+            fn from(v: $array<$w>) -> Self {
+                // SAFETY: an `Avx4` is only made on a CPU with AVX, an `Avx8` on one with
+                // AVX-512 F (module docs), an `Sse4` on any x86-64; the load is unaligned and
+                // reads the numbers of `v`.
                 Self(unsafe { $load(v.0.as_ptr()) })
             }
         }
 
-        impl From<$name> for $array<4> {
+        impl From<$name> for $array<$w> {
             #[inline(always)]
             fn from(v: $name) -> Self {
-                let mut out: [$t; 4] = [0.0; 4];
-                // SAFETY: as in `from`; the store writes the four numbers of `out`.
+                let mut out: [$t; $w] = [0.0; $w];
+                // SAFETY: as in `from`; the store writes the numbers of `out`.
                 unsafe { $store(out.as_mut_ptr(), v.0) };
                 $array(out)
             }
@@ -98,6 +105,7 @@ macro_rules! register_lanes {
 register_lanes!(
     Avx4,
     Lanes,
+    4,
     f64,
     _mm256_loadu_pd,
     _mm256_storeu_pd,
@@ -109,8 +117,23 @@ register_lanes!(
     _mm256_set1_pd
 );
 register_lanes!(
+    Avx8,
+    Lanes,
+    8,
+    f64,
+    _mm512_loadu_pd,
+    _mm512_storeu_pd,
+    _mm512_add_pd,
+    _mm512_sub_pd,
+    _mm512_mul_pd,
+    _mm512_div_pd,
+    xor_512,
+    _mm512_set1_pd
+);
+register_lanes!(
     Sse4,
     Lanes32,
+    4,
     f32,
     _mm_loadu_ps,
     _mm_storeu_ps,
@@ -184,6 +207,92 @@ impl Lane for Avx4 {
     }
 }
 
+/// `a` xor `b`, bit by bit (AVX-512 F has it for integers only: `_mm512_xor_pd` is DQ's).
+#[inline(always)]
+unsafe fn xor_512(a: __m512d, b: __m512d) -> __m512d {
+    // SAFETY: the caller's (an `Avx8` exists only where AVX-512 F runs, module docs).
+    unsafe { _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(a), _mm512_castpd_si512(b))) }
+}
+
+impl Avx8 {
+    /// Block `lanes[0]`'s four lanes, then `lanes[1]`'s.
+    #[inline(always)]
+    pub(crate) fn join(lanes: [Lanes<4>; 2]) -> Self {
+        // SAFETY: as in `from`; each load reads the four numbers of one block.
+        unsafe {
+            let low = _mm512_castpd256_pd512(_mm256_loadu_pd(lanes[0].0.as_ptr()));
+            Self(_mm512_insertf64x4::<1>(low, _mm256_loadu_pd(lanes[1].0.as_ptr())))
+        }
+    }
+
+    /// The first four lanes and the last four, as [`join`](Self::join) took them.
+    #[inline(always)]
+    pub(crate) fn split(self) -> [Lanes<4>; 2] {
+        let mut out = [Lanes([0.0; 4]); 2];
+        // SAFETY: as in `from`; each store writes the four numbers of one block.
+        unsafe {
+            _mm256_storeu_pd(out[0].0.as_mut_ptr(), _mm512_castpd512_pd256(self.0));
+            _mm256_storeu_pd(out[1].0.as_mut_ptr(), _mm512_extractf64x4_pd::<1>(self.0));
+        }
+        out
+    }
+}
+
+impl Lane for Avx8 {
+    /// One bit per lane, set in the flagged lanes.
+    type Mask = __mmask8;
+    const WIDTH: usize = 8;
+
+    // SAFETY (every method): an `Avx8` exists only in code compiled for AVX-512 F on a CPU
+    // that has it (module docs).
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Self(unsafe { _mm512_set1_pd(x) })
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Self(unsafe { _mm512_sqrt_pd(self.0) })
+    }
+    /// `b − low > span` as unsigned 64-bit integers (AVX-512 compares them as such).
+    #[inline(always)]
+    fn outside(self, low: u64, span: u64) -> __mmask8 {
+        unsafe {
+            let offset = _mm512_sub_epi64(_mm512_castpd_si512(self.0), _mm512_set1_epi64(low as i64));
+            _mm512_cmpgt_epu64_mask(offset, _mm512_set1_epi64(span as i64))
+        }
+    }
+    #[inline(always)]
+    fn none() -> __mmask8 {
+        0
+    }
+    #[inline(always)]
+    fn or(a: __mmask8, b: __mmask8) -> __mmask8 {
+        a | b
+    }
+    #[inline(always)]
+    fn any(mask: __mmask8) -> bool {
+        mask != 0
+    }
+    #[inline(always)]
+    fn all(mask: __mmask8) -> bool {
+        mask == 0xff
+    }
+    #[inline(always)]
+    fn select(mask: __mmask8, a: Self, b: Self) -> Self {
+        Self(unsafe { _mm512_mask_blend_pd(mask, b.0, a.0) })
+    }
+    /// `f64`'s [`normalizer`](Lane::normalizer) on the lanes' bit patterns.
+    #[inline(always)]
+    fn normalizer(self) -> Self {
+        unsafe {
+            let exponent = _mm512_set1_epi64(0x7ff);
+            let biased = _mm512_and_si512(_mm512_srli_epi64::<52>(_mm512_castpd_si512(self.0)), exponent);
+            let inverse = _mm512_and_si512(_mm512_sub_epi64(_mm512_set1_epi64(2046), biased), exponent);
+            Self(_mm512_castsi512_pd(_mm512_slli_epi64::<52>(inverse)))
+        }
+    }
+}
+
 impl Lane for Sse4 {
     /// All ones in the flagged lanes, zeros in the others.
     type Mask = __m128i;
@@ -253,12 +362,13 @@ impl Lane for Sse4 {
 mod tests {
     use super::*;
 
-    /// Each operation of `Avx4`, lane by lane, against `f64`'s, compiled for AVX2.
-    #[target_feature(enable = "avx2")]
-    fn compare(a: [f64; 4], b: [f64; 4]) {
-        let (x, y) = (Avx4::from(Lanes(a)), Avx4::from(Lanes(b)));
-        let bits = |v: Avx4| Lanes::from(v).0.map(f64::to_bits);
-        let each = |f: fn(f64, f64) -> f64| std::array::from_fn::<u64, 4, _>(|k| f(a[k], b[k]).to_bits());
+    /// Each operation of the `f64` register lanes `V` (`W` of them), lane by lane, against
+    /// `f64`'s; inlined into a caller compiled for `V`'s instructions.
+    #[inline(always)]
+    fn compare<V: Lane + From<Lanes<W>> + Into<Lanes<W>>, const W: usize>(a: [f64; W], b: [f64; W]) {
+        let (x, y) = (V::from(Lanes(a)), V::from(Lanes(b)));
+        let bits = |v: V| v.into().0.map(f64::to_bits);
+        let each = |f: fn(f64, f64) -> f64| std::array::from_fn::<u64, W, _>(|k| f(a[k], b[k]).to_bits());
         assert_eq!(bits(x + y), each(|a, b| a + b));
         assert_eq!(bits(x - y), each(|a, b| a - b));
         assert_eq!(bits(x * y), each(|a, b| a * b));
@@ -267,22 +377,35 @@ mod tests {
         assert_eq!(bits(x.sqrt()), each(|a, _| a.sqrt()));
         assert_eq!(bits(x.normalizer()), each(|a, _| a.normalizer()));
         let (low, span) = CONTINUANT_RANGE;
-        let flags = |m: __m256i| {
-            let mut out = [0u64; 4];
-            // SAFETY: writes the four lanes of `out`.
-            unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), m) };
-            out.map(|f| f != 0)
-        };
+        let flags = |m: V::Mask| V::select(m, V::splat(1.0), V::splat(0.0)).into().0.map(|f| f == 1.0);
         let outside = flags(x.continuant_outside());
         assert_eq!(outside, a.map(|v| v.outside(low, span)));
-        assert_eq!(Avx4::any(x.continuant_outside()), outside.contains(&true));
-        assert_eq!(Avx4::all(x.continuant_outside()), !outside.contains(&false));
-        assert!(Avx4::all(Avx4::splat(f64::NAN).continuant_outside()));
-        assert!(!Avx4::any(Avx4::none()));
-        let chosen = Lanes::from(Avx4::select(x.continuant_outside(), x, y)).0;
-        for k in 0..4 {
-            assert_eq!(chosen[k].to_bits(), if outside[k] { a[k] } else { b[k] }.to_bits());
-        }
+        assert_eq!(V::any(x.continuant_outside()), outside.contains(&true));
+        assert_eq!(V::all(x.continuant_outside()), !outside.contains(&false));
+        assert!(V::all(V::splat(f64::NAN).continuant_outside()));
+        assert!(!V::any(V::none()));
+        assert!(!flags(V::or(V::none(), V::none())).contains(&true));
+        assert_eq!(flags(V::or(x.continuant_outside(), V::none())), outside);
+    }
+
+    /// [`compare`] of [`Avx4`], compiled for AVX2.
+    #[target_feature(enable = "avx2")]
+    fn compare_avx4(a: [f64; 4], b: [f64; 4]) {
+        compare::<Avx4, 4>(a, b)
+    }
+
+    /// [`compare`] of [`Avx8`], compiled for AVX-512 F, and its blocks joined and split.
+    #[target_feature(enable = "avx2,avx512f")]
+    fn compare_avx8(a: [f64; 8], b: [f64; 8]) {
+        compare::<Avx8, 8>(a, b);
+        let halves =
+            |v: [f64; 8]| [Lanes(std::array::from_fn(|k| v[k])), Lanes(std::array::from_fn(|k| v[4 + k]))];
+        let joined = Lanes::<8>::from(Avx8::join(halves(a))).0;
+        assert_eq!(joined.map(f64::to_bits), a.map(f64::to_bits));
+        assert_eq!(
+            Avx8::from(Lanes(b)).split().map(|h| h.0.map(f64::to_bits)),
+            halves(b).map(|h| h.0.map(f64::to_bits))
+        );
     }
 
     /// Each operation of `Sse4`, lane by lane, against `Lanes32`'s (which do each `f32`'s).
@@ -343,7 +466,19 @@ mod tests {
         ];
         for (a, b) in cases {
             // SAFETY: the CPU has AVX2, checked above.
-            unsafe { compare(a, b) };
+            unsafe { compare_avx4(a, b) };
+        }
+        if !super::super::has_avx512() {
+            return;
+        }
+        // Each case beside each other (and itself): every lane of the eight seen in both halves.
+        for (a, b) in cases {
+            for (c, d) in cases {
+                let eight =
+                    |u: [f64; 4], v: [f64; 4]| std::array::from_fn(|k| if k < 4 { u[k] } else { v[k - 4] });
+                // SAFETY: the CPU has AVX-512 F, checked above.
+                unsafe { compare_avx8(eight(a, c), eight(b, d)) };
+            }
         }
     }
 }

@@ -7,7 +7,8 @@
 //! four chains at once: where the CPU has AVX2, compiled for it on lanes that are one
 //! register each (`Avx4`, `Sse4` in single precision: every operation one instruction,
 //! where LLVM left half of [`Lanes`]' arrays scalar or spilled in a kernel this long),
-//! elsewhere on [`Lanes`]. The operations are the same, lane by lane, with the same sine
+//! on eight (two blocks in one `Avx8` register) where it has AVX-512 VL, elsewhere on
+//! [`Lanes`]. The operations are the same, lane by lane, with the same sine
 //! kernel, so every chain of a batch gets its single model's `θ̈` bit for bit.
 
 mod precision;
@@ -16,7 +17,7 @@ mod single;
 
 use nalgebra::{Const, SVector, U2, Vector2};
 
-use self::precision::{KernelLanes, Precision, convert};
+use self::precision::{KernelLanes, Precision, join};
 use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
@@ -64,13 +65,35 @@ impl<L: Lane, const N: usize> SineRoom<L, N> {
         );
     }
 
-    /// Block `j`'s `[sin θ_i, cos θ_i]` (after [`sin_cos`](Self::sin_cos)) into `trig`, in
-    /// lanes `V`. (Returned by value, the array was kept on the stack at n = 16: 0.70×.)
+    /// Blocks `blocks`' `[sin θ_i, cos θ_i]` (after [`sin_cos`](Self::sin_cos)) into `trig`,
+    /// in lanes `V` (`blocks[1]` joined only when `V` holds two). (Returned by value, the
+    /// array was kept on the stack at n = 16: 0.70×.)
     #[inline(always)]
-    pub(super) fn trig<V: Lane + From<L>>(&self, j: usize, trig: &mut [[V; 2]; N]) {
-        for (t, (&sin, &cos)) in trig.iter_mut().zip(self.sin[j].iter().zip(&self.cos[j])) {
-            *t = [V::from(sin), V::from(cos)];
+    pub(super) fn trig<P: Precision<Lanes = L>, V: KernelLanes<P>>(
+        &self,
+        [a, b]: [usize; 2],
+        trig: &mut [[V; 2]; N],
+    ) {
+        for (i, t) in trig.iter_mut().enumerate() {
+            *t = [V::join([self.sin[a][i], self.sin[b][i]]), V::join([self.cos[a][i], self.cos[b][i]])];
         }
+    }
+}
+
+/// Rows `v` (`N` a chain) of the chains `blocks[0]`, then `blocks[1]` when `V` holds two
+/// blocks, into lanes `out` (link `i` in `out[i]`).
+#[inline(always)]
+fn gather_joined<P: Precision, V: KernelLanes<P>, const N: usize>(
+    v: &[P],
+    blocks: [[usize; WIDTH]; 2],
+    out: &mut [V; N],
+) {
+    let mut lanes = [[P::Lanes::splat(0.0); N]; 2];
+    for (lanes, &chains) in lanes.iter_mut().zip(&blocks).take(V::BLOCKS) {
+        gather::<P, WIDTH>(v, chains, N, P::flatten_mut(lanes));
+    }
+    for (i, out) in out.iter_mut().enumerate() {
+        *out = V::join([lanes[0][i], lanes[1][i]]);
     }
 }
 
@@ -121,16 +144,17 @@ impl<const N: usize> LinkConstants<f64, N> {
 }
 
 impl<L: Copy, const N: usize> LinkConstants<L, N> {
-    /// The constants in lanes of type `V`.
+    /// The constants of blocks `[a, b]` in lanes of type `V` (`b`'s joined only when `V`
+    /// holds two blocks).
     #[inline(always)]
-    fn in_lanes<V: Lane + From<L>>(&self) -> LinkConstants<V, N> {
+    fn joined<P: Precision<Lanes = L>, V: KernelLanes<P>>([a, b]: [&Self; 2]) -> LinkConstants<V, N> {
         LinkConstants {
-            inverse_mass: convert(&self.inverse_mass),
-            length: convert(&self.length),
-            inverse_length: convert(&self.inverse_length),
-            drag: convert(&self.drag),
-            diagonal: convert(&self.diagonal),
-            gravity: self.gravity.into(),
+            inverse_mass: join([&a.inverse_mass, &b.inverse_mass]),
+            length: join([&a.length, &b.length]),
+            inverse_length: join([&a.inverse_length, &b.inverse_length]),
+            drag: join([&a.drag, &b.drag]),
+            diagonal: join([&a.diagonal, &b.diagonal]),
+            gravity: V::join([a.gravity, b.gravity]),
         }
     }
 }
@@ -159,7 +183,8 @@ pub trait PlanarKernel<const N: usize>:
 }
 
 /// `B` chains of one generated planar model type `M` (`N` links each, each its own masses,
-/// lengths, damping and gravity), evaluated four per instruction stream.
+/// lengths, damping and gravity), evaluated four per instruction stream (eight in `f64` with
+/// AVX-512).
 ///
 /// ```
 /// use pendulum_core::batch::UnrolledBatch;
@@ -306,8 +331,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
 
     /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`): each
     /// block's angles gathered into lanes, the sines and cosines of all of them in one call
-    /// of the sine kernel, then block by block the kernel in lanes of type `V`, scattered
-    /// into `out` (the group's rows).
+    /// of the sine kernel, then the kernel in lanes of type `V`, on one block or two at
+    /// once ([`KernelLanes::BLOCKS`]), scattered into `out` (the group's rows).
     #[inline(always)]
     fn group<P: Precision, V: KernelLanes<P>>(
         &self,
@@ -323,32 +348,40 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             gather::<P, WIDTH>(q, lanes, N, P::flatten_mut(angles));
         }
         room.sin_cos::<P>(count);
-        for (j, (c, &lanes)) in c.iter().zip(&lanes).enumerate() {
+        for first in (0..count).step_by(V::BLOCKS) {
+            // The blocks in `V` (the last one twice when an odd one is left).
+            let pair = [first, (first + V::BLOCKS - 1).min(count - 1)];
             let mut trig = [[V::splat(0.0); 2]; N];
-            room.trig(j, &mut trig);
-            let mut rates = [zero; N];
-            gather::<P, WIDTH>(qd, lanes, N, P::flatten_mut(&mut rates));
-            let mut torques = [zero; N];
+            room.trig(pair, &mut trig);
+            let blocks = pair.map(|j| lanes[j]);
+            let mut rates = [V::splat(0.0); N];
+            gather_joined::<P, V, N>(qd, blocks, &mut rates);
+            let mut torques = [V::splat(0.0); N];
             if let Some(t) = torque {
-                gather::<P, WIDTH>(t, lanes, N, P::flatten_mut(&mut torques));
+                gather_joined::<P, V, N>(t, blocks, &mut torques);
             }
-            let pivot = match pivot {
-                Some(p) => [P::lanes(|k| p[2 * lanes[k]]), P::lanes(|k| p[2 * lanes[k] + 1])],
-                None => [zero; 2],
-            };
+            let mut pivots = [V::splat(0.0); 2];
+            if let Some(p) = pivot {
+                let [a, b] = blocks;
+                let along =
+                    |axis: usize| [P::lanes(|k| p[2 * a[k] + axis]), P::lanes(|k| p[2 * b[k] + axis])];
+                pivots = [V::join(along(0)), V::join(along(1))];
+            }
             let accelerations = M::kernel(
-                &c.in_lanes(),
+                &LinkConstants::joined([&c[pair[0]], &c[pair[1]]]),
                 &trig,
-                &convert::<_, V, N>(&rates),
-                &convert::<_, V, N>(&torques),
-                convert::<_, V, 2>(&pivot),
+                &rates,
+                &torques,
+                pivots,
             );
-            let mut result = [zero; N];
-            for (r, a) in result.iter_mut().zip(accelerations) {
-                *r = a.into();
+            let mut result = [[zero; N]; 2];
+            for (i, a) in accelerations.into_iter().enumerate() {
+                [result[0][i], result[1][i]] = a.split();
             }
-            let rows = WIDTH * N * j..(WIDTH * N * (j + 1)).min(out.len());
-            scatter::<P, WIDTH>(P::flatten(&result), N, &mut out[rows]);
+            for (result, j) in result.iter().zip(first..count).take(V::BLOCKS) {
+                let rows = WIDTH * N * j..(WIDTH * N * (j + 1)).min(out.len());
+                scatter::<P, WIDTH>(P::flatten(result), N, &mut out[rows]);
+            }
         }
     }
 
@@ -375,9 +408,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         self.group::<P, P::Lanes>(c, room, lanes, rows, out)
     }
 
-    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Registers`]: the
-    /// same four-lane instructions with 32 registers instead of 16, for a kernel that spills
-    /// (1.04–1.08× the AVX2 one, `docs/ensembles.md`).
+    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Wide`]: two blocks
+    /// an instruction in `f64` (1.08–1.17× four lanes, `docs/ensembles.md`), and 32
+    /// registers instead of 16 for a kernel that spills.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl")]
     fn group_avx512<P: Precision>(
@@ -388,7 +421,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         rows: Rows<'_, P>,
         out: &mut [P],
     ) {
-        self.group::<P, P::Registers>(c, room, lanes, rows, out)
+        self.group::<P, P::Wide>(c, room, lanes, rows, out)
     }
 
     /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].

@@ -7,19 +7,65 @@ use crate::kinematics::trig::sin_cos_split;
 use crate::kinematics::trig32::sin_cos_split_f32;
 use crate::lanes::{Lane, Lanes, Lanes32};
 
-/// Lanes a generated kernel runs in, in precision `P`: `P`'s arrays of lanes themselves, or
-/// registers loaded from them and stored back.
-pub(crate) trait KernelLanes<P: Precision>: Lane + From<P::Lanes> + Into<P::Lanes> {}
+/// Lanes a generated kernel runs in, in precision `P`: [`BLOCKS`](Self::BLOCKS) blocks of
+/// [`WIDTH`] chains side by side. One block: `P`'s arrays of lanes themselves, or a register
+/// loaded from them; two: one register of eight lanes (`Avx8` for `f64`).
+pub(crate) trait KernelLanes<P: Precision>: Lane {
+    /// Blocks one value holds: 1 or 2.
+    const BLOCKS: usize;
+    /// The lanes of `blocks[0]`, then those of `blocks[1]` when [`BLOCKS`](Self::BLOCKS) is 2.
+    fn join(blocks: [P::Lanes; 2]) -> Self;
+    /// The blocks' lanes back, as [`join`](Self::join) took them (the one block twice when
+    /// [`BLOCKS`](Self::BLOCKS) is 1).
+    fn split(self) -> [P::Lanes; 2];
+}
 
-impl<P: Precision, V: Lane + From<P::Lanes> + Into<P::Lanes>> KernelLanes<P> for V {}
+/// A lane type of one block of precision `P`, converted from and to `P`'s lanes.
+macro_rules! one_block {
+    ($p:ty: $($v:ty),+) => {$(
+        impl KernelLanes<$p> for $v {
+            const BLOCKS: usize = 1;
+            #[inline(always)]
+            fn join(blocks: [<$p as Precision>::Lanes; 2]) -> Self {
+                blocks[0].into()
+            }
+            #[inline(always)]
+            fn split(self) -> [<$p as Precision>::Lanes; 2] {
+                let block = self.into();
+                [block, block]
+            }
+        }
+    )+};
+}
 
-/// Each lane group of `v` in type `V`: a loop, not `array::map`, whose closure was compiled
-/// apart from the AVX2 kernel (without its target features, the conversions not inlined).
+one_block!(f64: Lanes<WIDTH>);
+one_block!(f32: Lanes32<WIDTH>);
+#[cfg(target_arch = "x86_64")]
+one_block!(f64: crate::lanes::Avx4);
+#[cfg(target_arch = "x86_64")]
+one_block!(f32: crate::lanes::Sse4);
+
+#[cfg(target_arch = "x86_64")]
+impl KernelLanes<f64> for crate::lanes::Avx8 {
+    const BLOCKS: usize = 2;
+    #[inline(always)]
+    fn join(blocks: [Lanes<WIDTH>; 2]) -> Self {
+        Self::join(blocks)
+    }
+    #[inline(always)]
+    fn split(self) -> [Lanes<WIDTH>; 2] {
+        self.split()
+    }
+}
+
+/// Lane `i` of `blocks[0]` and `blocks[1]` (see [`KernelLanes::join`]) for each `i`: a loop,
+/// not `array::map`, whose closure was compiled apart from the AVX2 kernel (without its
+/// target features, the conversions not inlined).
 #[inline(always)]
-pub(crate) fn convert<L: Copy + Into<V>, V: Lane, const N: usize>(v: &[L; N]) -> [V; N] {
+pub(crate) fn join<P: Precision, V: KernelLanes<P>, const N: usize>(blocks: [&[P::Lanes; N]; 2]) -> [V; N] {
     let mut out = [V::splat(0.0); N];
     for i in 0..N {
-        out[i] = v[i].into();
+        out[i] = V::join([blocks[0][i], blocks[1][i]]);
     }
     out
 }
@@ -33,6 +79,11 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     /// `f32`).
     #[cfg(target_arch = "x86_64")]
     type Registers: KernelLanes<Self>;
+    /// The lanes the kernel computes in when the CPU has AVX-512 VL: two blocks in one
+    /// [`Avx8`](crate::lanes::Avx8) register for `f64`, [`Sse4`](crate::lanes::Sse4) for
+    /// `f32`.
+    #[cfg(target_arch = "x86_64")]
+    type Wide: KernelLanes<Self>;
     /// Not a number.
     const NAN: Self;
     /// `f(k)` in lane `k`.
@@ -49,6 +100,8 @@ impl Precision for f64 {
     type Lanes = Lanes<WIDTH>;
     #[cfg(target_arch = "x86_64")]
     type Registers = crate::lanes::Avx4;
+    #[cfg(target_arch = "x86_64")]
+    type Wide = crate::lanes::Avx8;
     const NAN: Self = f64::NAN;
 
     #[inline(always)]
@@ -73,6 +126,8 @@ impl Precision for f32 {
     type Lanes = Lanes32<WIDTH>;
     #[cfg(target_arch = "x86_64")]
     type Registers = crate::lanes::Sse4;
+    #[cfg(target_arch = "x86_64")]
+    type Wide = crate::lanes::Sse4;
     const NAN: Self = f32::NAN;
 
     #[inline(always)]

@@ -4,7 +4,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
-use super::precision::{KernelLanes, convert};
+use super::precision::{KernelLanes, join};
 use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks_of};
 use crate::error::{Error, Result};
@@ -55,13 +55,15 @@ impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N
         let zero = V::splat(0.0);
         let count = self.count;
         for (angles, q) in self.room.angles.iter_mut().zip(q).take(count) {
-            *angles = convert(q);
+            for (angle, q) in angles.iter_mut().zip(q) {
+                *angle = q.split()[0];
+            }
         }
         self.room.sin_cos::<f64>(count);
         let mut out = [[zero; N]; GROUP];
         for j in 0..count {
             let mut trig = [[zero; 2]; N];
-            self.room.trig(j, &mut trig);
+            self.room.trig([j, j], &mut trig);
             out[j] = M::kernel(&self.c[j], &trig, &qd[j], &[zero; N], [zero; 2]);
         }
         out
@@ -235,15 +237,17 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         s: &mut [Block<N>; GROUP],
     ) -> [[bool; WIDTH]; GROUP] {
         let zero = V::splat(0.0);
-        let c: [LinkConstants<V, N>; GROUP] =
-            std::array::from_fn(|j| self.blocks[first + j.min(count - 1)].in_lanes::<V>());
+        let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|j| {
+            let block = &self.blocks[first + j.min(count - 1)];
+            LinkConstants::joined([block, block])
+        });
         let (mut q, mut qd) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
         let (mut q_carry, mut qd_carry) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
         let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
         for j in 0..count {
-            (q[j], qd[j]) = (convert(&s[j].q), convert(&s[j].qd));
-            (q_carry[j], qd_carry[j]) = (convert(&s[j].q_carry), convert(&s[j].qd_carry));
-            (t[j], t_carry[j]) = (V::from(s[j].t), V::from(s[j].t_carry));
+            (q[j], qd[j]) = (join([&s[j].q; 2]), join([&s[j].qd; 2]));
+            (q_carry[j], qd_carry[j]) = (join([&s[j].q_carry; 2]), join([&s[j].qd_carry; 2]));
+            (t[j], t_carry[j]) = (V::join([s[j].t; 2]), V::join([s[j].t_carry; 2]));
         }
         let mut stopped = [V::none(); GROUP];
         for _ in 0..steps {
@@ -278,15 +282,15 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         for j in 0..count {
             let back = |v: &[V; N], to: &mut [F64x4; N]| {
                 for (to, v) in to.iter_mut().zip(v) {
-                    *to = (*v).into();
+                    *to = v.split()[0];
                 }
             };
             back(&q[j], &mut s[j].q);
             back(&qd[j], &mut s[j].qd);
             back(&q_carry[j], &mut s[j].q_carry);
             back(&qd_carry[j], &mut s[j].qd_carry);
-            (s[j].t, s[j].t_carry) = (t[j].into(), t_carry[j].into());
-            alive[j] = V::select(stopped[j], zero, V::splat(1.0)).into().0.map(|alive| alive == 1.0);
+            (s[j].t, s[j].t_carry) = (t[j].split()[0], t_carry[j].split()[0]);
+            alive[j] = V::select(stopped[j], zero, V::splat(1.0)).split()[0].0.map(|alive| alive == 1.0);
         }
         alive
     }
