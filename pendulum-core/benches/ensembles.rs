@@ -5,6 +5,8 @@
 //! (criterion's throughput line, in chains per second):
 //! - `accelerations/{planar,spatial}/…/n`: the single-chain call in a loop
 //!   (`PlanarTension`, `Directions<U3>`) against the batch on one thread and on two;
+//!   `accelerations/…/batch_{1,2}_threads_1024_chains/100`: one call of 1024 chains of 100
+//!   links on one thread and on two;
 //! - `rk4/whirl_100`: one projected RK4 step of 1 ms of 64 whirls (3D, n = 100, each pivot on
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
 //!   (throughput in chain-steps per second), and 10 steps of the implicit rod midpoint
@@ -13,8 +15,8 @@
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
-//!   the same models in lanes (`UnrolledBatch`), on one thread and on two, and in single
-//!   precision on one;
+//!   the same models in lanes (`UnrolledBatch`), on one thread and on two (and in four lanes
+//!   instead of eight on a CPU with AVX-512), and in single precision on one;
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps);
 //! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time
@@ -66,6 +68,57 @@ fn in_pool(b: &mut Bencher<'_>, pool: &rayon::ThreadPool, mut f: impl FnMut() + 
             start.elapsed()
         })
     })
+}
+
+/// A random state of each 3D chain of `models`: polar angles in [0.1, 1), azimuths in
+/// [0, 6), rates 0.5.
+fn spatial_states(models: &[Directions<U3>], r: &mut ChaCha8Rng) -> Vec<DVector<f64>> {
+    models
+        .iter()
+        .map(|m| {
+            let n = m.links();
+            let angles: Vec<f64> = (0..2 * n)
+                .map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) })
+                .collect();
+            m.from_spherical(&angles, &vec![0.5; 2 * n]).expect("state")
+        })
+        .collect()
+}
+
+/// One call of accelerations for 1024 chains of 100 links, planar and 3D, on one thread and
+/// on two: the same calls as `accelerations/…/100` with sixteen times the work per call.
+fn large_batches(c: &mut Criterion) {
+    const LARGE: usize = 1024;
+    const N: usize = 100;
+    let mut group = c.benchmark_group("accelerations");
+    group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(20);
+    group.throughput(Throughput::Elements(LARGE as u64));
+    let mut r = ChaCha8Rng::seed_from_u64(43);
+    let chains: Vec<_> = (0..LARGE).map(|_| random_chain(N, 2.0, &mut r)).collect();
+    let q: Vec<f64> = (0..LARGE * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let qd: Vec<f64> = (0..LARGE * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let mut out = vec![0.0; LARGE * N];
+    let planar = PlanarBatch::new(chains.clone()).expect("batch");
+    let models: Vec<_> = chains.into_iter().map(Directions::<U3>::new).collect();
+    let x: Vec<f64> = spatial_states(&models, &mut r).iter().flat_map(|x| x.iter().copied()).collect();
+    let spatial = DirectionsBatch::new(models).expect("batch");
+    let mut out3 = vec![0.0; LARGE * 3 * N];
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let id = BenchmarkId::new(format!("planar/batch_{threads}_threads_{LARGE}_chains"), N);
+        group.bench_with_input(id, &N, |b, _| {
+            in_pool(b, &pool, || {
+                planar.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+            })
+        });
+        let id = BenchmarkId::new(format!("spatial/batch_{threads}_threads_{LARGE}_chains"), N);
+        group.bench_with_input(id, &N, |b, _| {
+            in_pool(b, &pool, || {
+                spatial.accelerations(0.0, &x, &mut out3).expect("batch");
+            })
+        });
+    }
+    group.finish();
 }
 
 fn accelerations(c: &mut Criterion) {
@@ -130,15 +183,7 @@ fn accelerations(c: &mut Criterion) {
         });
 
         let models: Vec<_> = chains.iter().cloned().map(Directions::<U3>::new).collect();
-        let x: Vec<DVector<f64>> = models
-            .iter()
-            .map(|m| {
-                let angles: Vec<f64> = (0..2 * n)
-                    .map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) })
-                    .collect();
-                m.from_spherical(&angles, &vec![0.5; 2 * n]).expect("state")
-            })
-            .collect();
+        let x = spatial_states(&models, &mut r);
         let mut one = vec![0.0; 3 * n];
         group.bench_with_input(BenchmarkId::new("spatial/single", n), &n, |b, _| {
             b.iter(|| {
@@ -324,7 +369,7 @@ fn planar_rk4(c: &mut Criterion) {
 }
 
 /// One generated model type: its `CHAINS` models one call each against the batch.
-fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
+fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>> + Clone, const N: usize>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     r: &mut ChaCha8Rng,
 ) {
@@ -357,9 +402,18 @@ fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
             })
         });
     }
+    let pool = pool(1);
+    // What `with_avx512(false)` trades, on a CPU with AVX-512: four lanes instead of eight.
+    if batch.uses_avx512() {
+        let four = batch.clone().with_avx512(false);
+        group.bench_with_input(BenchmarkId::new("planar/batch_1_threads_four_lanes", N), &N, |b, _| {
+            in_pool(b, &pool, || {
+                four.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+            })
+        });
+    }
     let (q32, qd32): (Vec<f32>, Vec<f32>) = q.iter().zip(&qd).map(|(&a, &b)| (a as f32, b as f32)).unzip();
     let mut out32 = vec![0.0f32; CHAINS * N];
-    let pool = pool(1);
     group.bench_with_input(BenchmarkId::new("planar/batch_f32_1_thread", N), &N, |b, _| {
         in_pool(b, &pool, || {
             batch.accelerations_f32(&q32, &qd32, None, None, &mut out32).expect("batch");
@@ -473,5 +527,5 @@ fn jacobians(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, accelerations, rk4, planar_rk4, generated, jacobians);
+criterion_group!(benches, accelerations, large_batches, rk4, planar_rk4, generated, jacobians);
 criterion_main!(benches);

@@ -88,10 +88,16 @@ fn check<M: PlanarKernel<N> + Clone, const N: usize>(models: Vec<M>, inputs: &[V
             .expect("batch")
     };
     let batch = UnrolledBatch::new(models.clone()).expect("batch");
-    for pool in pools() {
+    // Both kernels where the CPU has AVX-512 (eight lanes a register, and four).
+    let four = batch.clone().with_avx512(false);
+    for (pool, batch) in pools().iter().flat_map(|pool| [(pool, &batch), (pool, &four)]) {
         let mut out = vec![0.0; chains * N];
-        let failures = pool.install(|| run(&batch, 0..chains, &mut out));
-        let what = format!("{chains} chains of {N}, {} threads", pool.current_num_threads());
+        let failures = pool.install(|| run(batch, 0..chains, &mut out));
+        let what = format!(
+            "{chains} chains of {N}, {} threads, AVX-512 {}",
+            pool.current_num_threads(),
+            batch.uses_avx512()
+        );
         let mut failed = failures.iter();
         for (k, alone) in single.iter().enumerate() {
             let row = &out[k * N..(k + 1) * N];
@@ -338,6 +344,14 @@ fn f32_error<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize>(
     let failures =
         batch.accelerations_f32(&to32(&q), &to32(&qd), None, Some(&to32(&pivot)), &mut out).expect("batch");
     assert!(failures.is_empty(), "{failures:?}");
+    // The AVX2 kernel gives the same bits as the AVX-512 one.
+    let mut avx2 = vec![0.0f32; chains * N];
+    let four = batch.with_avx512(false);
+    four.accelerations_f32(&to32(&q), &to32(&qd), None, Some(&to32(&pivot)), &mut avx2).expect("batch");
+    assert_eq!(
+        avx2.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+        out.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    );
     exact
         .iter()
         .enumerate()

@@ -14,7 +14,7 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssi
 #[cfg(target_arch = "x86_64")]
 mod registers;
 #[cfg(target_arch = "x86_64")]
-pub(crate) use registers::{Avx4, Avx8, Sse4};
+pub(crate) use registers::{Avx4, Avx8, AvxF32};
 
 /// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
 /// std).

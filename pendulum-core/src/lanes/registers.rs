@@ -1,5 +1,5 @@
 //! Lanes held in one x86-64 vector register: [`Avx4`], four `f64` lanes in an AVX register,
-//! [`Avx8`], eight in an AVX-512 register, and [`Sse4`], four `f32` lanes in an SSE
+//! [`Avx8`], eight in an AVX-512 register, and [`AvxF32`], eight `f32` lanes in an AVX
 //! register. They are the lane types of the generated models' batch kernel on a CPU with
 //! AVX2 (AVX-512 for [`Avx8`]).
 //!
@@ -13,8 +13,8 @@
 //! An [`Avx4`] must only exist in code compiled for AVX2 and run on a CPU that has it (the
 //! batch checks at run time, then enters a `#[target_feature(enable = "avx2")]` function):
 //! its methods are `#[inline(always)]` intrinsics, inlined into that function. The same holds
-//! for an [`Avx8`] and AVX-512 F. The types are private to the crate for that reason. ([`Sse4`] needs only SSE2, which every x86-64 CPU
-//! has.)
+//! for an [`AvxF32`], and for an [`Avx8`] and AVX-512 F. The types are private to the crate
+//! for that reason.
 
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
@@ -31,10 +31,10 @@ pub(crate) struct Avx4(__m256d);
 #[repr(transparent)]
 pub(crate) struct Avx8(__m512d);
 
-/// Four `f32` lanes, one SSE register.
+/// Eight `f32` lanes, one AVX register (see the module's docs for where one may exist).
 #[derive(Debug, Clone, Copy)]
 #[repr(transparent)]
-pub(crate) struct Sse4(__m128);
+pub(crate) struct AvxF32(__m256);
 
 /// A register type's loads and stores from its lane array, arithmetic and negation, one
 /// intrinsic each.
@@ -44,9 +44,9 @@ macro_rules! register_lanes {
         impl From<$array<$w>> for $name {
             #[inline(always)]
             fn from(v: $array<$w>) -> Self {
-                // SAFETY: an `Avx4` is only made on a CPU with AVX, an `Avx8` on one with
-                // AVX-512 F (module docs), an `Sse4` on any x86-64; the load is unaligned and
-                // reads the numbers of `v`.
+                // SAFETY: an `Avx4` or an `AvxF32` is only made on a CPU with AVX2, an `Avx8`
+                // on one with AVX-512 F (module docs); the load is unaligned and reads the
+                // numbers of `v`.
                 Self(unsafe { $load(v.0.as_ptr()) })
             }
         }
@@ -130,20 +130,6 @@ register_lanes!(
     xor_512,
     _mm512_set1_pd
 );
-register_lanes!(
-    Sse4,
-    Lanes32,
-    4,
-    f32,
-    _mm_loadu_ps,
-    _mm_storeu_ps,
-    _mm_add_ps,
-    _mm_sub_ps,
-    _mm_mul_ps,
-    _mm_div_ps,
-    _mm_xor_ps,
-    _mm_set1_ps
-);
 
 impl Lane for Avx4 {
     /// All ones in the flagged lanes, zeros in the others.
@@ -206,6 +192,21 @@ impl Lane for Avx4 {
         self.outside(low, span)
     }
 }
+
+register_lanes!(
+    AvxF32,
+    Lanes32,
+    8,
+    f32,
+    _mm256_loadu_ps,
+    _mm256_storeu_ps,
+    _mm256_add_ps,
+    _mm256_sub_ps,
+    _mm256_mul_ps,
+    _mm256_div_ps,
+    _mm256_xor_ps,
+    _mm256_set1_ps
+);
 
 /// `a` xor `b`, bit by bit (AVX-512 F has it for integers only: `_mm512_xor_pd` is DQ's).
 #[inline(always)]
@@ -293,67 +294,88 @@ impl Lane for Avx8 {
     }
 }
 
-impl Lane for Sse4 {
+impl AvxF32 {
+    /// Block `lanes[0]`'s four lanes, then `lanes[1]`'s.
+    #[inline(always)]
+    pub(crate) fn join(lanes: [Lanes32<4>; 2]) -> Self {
+        // SAFETY: as in `from`; each load reads the four numbers of one block.
+        unsafe { Self(_mm256_set_m128(_mm_loadu_ps(lanes[1].0.as_ptr()), _mm_loadu_ps(lanes[0].0.as_ptr()))) }
+    }
+
+    /// The first four lanes and the last four, as [`join`](Self::join) took them.
+    #[inline(always)]
+    pub(crate) fn split(self) -> [Lanes32<4>; 2] {
+        let mut out = [Lanes32([0.0; 4]); 2];
+        // SAFETY: as in `from`; each store writes the four numbers of one block.
+        unsafe {
+            _mm_storeu_ps(out[0].0.as_mut_ptr(), _mm256_castps256_ps128(self.0));
+            _mm_storeu_ps(out[1].0.as_mut_ptr(), _mm256_extractf128_ps::<1>(self.0));
+        }
+        out
+    }
+}
+
+impl Lane for AvxF32 {
     /// All ones in the flagged lanes, zeros in the others.
-    type Mask = __m128i;
-    const WIDTH: usize = 4;
+    type Mask = __m256i;
+    const WIDTH: usize = 8;
     const RESCALE_ROWS: usize = 4;
 
-    // SAFETY (every method): SSE2 is part of every x86-64 CPU.
+    // SAFETY (every method): an `AvxF32` exists only in code compiled for AVX2 on a CPU
+    // that has it (module docs).
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Self(unsafe { _mm_set1_ps(x as f32) })
+        Self(unsafe { _mm256_set1_ps(x as f32) })
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
-        Self(unsafe { _mm_sqrt_ps(self.0) })
+        Self(unsafe { _mm256_sqrt_ps(self.0) })
     }
     /// As [`Lanes32`]'s: each lane widened to `f64` (exact) and checked (out of the hot path).
     #[inline(always)]
-    fn outside(self, low: u64, span: u64) -> __m128i {
-        let flags = Lanes32::from(self).outside(low, span).map(|f| -(f as i32));
-        unsafe { _mm_loadu_si128(flags.as_ptr().cast()) }
+    fn outside(self, low: u64, span: u64) -> __m256i {
+        let flags = Lanes32::<8>::from(self).outside(low, span).map(|f| -(f as i32));
+        unsafe { _mm256_loadu_si256(flags.as_ptr().cast()) }
     }
     #[inline(always)]
-    fn none() -> __m128i {
-        unsafe { _mm_setzero_si128() }
+    fn none() -> __m256i {
+        unsafe { _mm256_setzero_si256() }
     }
     #[inline(always)]
-    fn or(a: __m128i, b: __m128i) -> __m128i {
-        unsafe { _mm_or_si128(a, b) }
+    fn or(a: __m256i, b: __m256i) -> __m256i {
+        unsafe { _mm256_or_si256(a, b) }
     }
     #[inline(always)]
-    fn any(mask: __m128i) -> bool {
-        unsafe { _mm_movemask_epi8(mask) != 0 }
+    fn any(mask: __m256i) -> bool {
+        unsafe { _mm256_testz_si256(mask, mask) == 0 }
     }
     #[inline(always)]
-    fn all(mask: __m128i) -> bool {
-        unsafe { _mm_movemask_ps(_mm_castsi128_ps(mask)) == 0xf }
+    fn all(mask: __m256i) -> bool {
+        unsafe { _mm256_movemask_ps(_mm256_castsi256_ps(mask)) == 0xff }
     }
     #[inline(always)]
-    fn select(mask: __m128i, a: Self, b: Self) -> Self {
-        let mask = unsafe { _mm_castsi128_ps(mask) };
-        Self(unsafe { _mm_or_ps(_mm_and_ps(mask, a.0), _mm_andnot_ps(mask, b.0)) })
+    fn select(mask: __m256i, a: Self, b: Self) -> Self {
+        Self(unsafe { _mm256_blendv_ps(b.0, a.0, _mm256_castsi256_ps(mask)) })
     }
     /// `f32`'s normalizer (as [`Lanes32`]'s) on the lanes' bit patterns.
     #[inline(always)]
     fn normalizer(self) -> Self {
         unsafe {
-            let exponent = _mm_set1_epi32(0xff);
-            let biased = _mm_and_si128(_mm_srli_epi32::<23>(_mm_castps_si128(self.0)), exponent);
-            let inverse = _mm_and_si128(_mm_sub_epi32(_mm_set1_epi32(254), biased), exponent);
-            Self(_mm_castsi128_ps(_mm_slli_epi32::<23>(inverse)))
+            let exponent = _mm256_set1_epi32(0xff);
+            let biased = _mm256_and_si256(_mm256_srli_epi32::<23>(_mm256_castps_si256(self.0)), exponent);
+            let inverse = _mm256_and_si256(_mm256_sub_epi32(_mm256_set1_epi32(254), biased), exponent);
+            Self(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(inverse)))
         }
     }
     /// `b − low > span` on the lanes' `f32` bit patterns, with [`CONTINUANT_RANGE_32`]: both
-    /// sides with their top bit flipped, then SSE2's signed comparison.
+    /// sides with their top bit flipped, then AVX2's signed comparison.
     #[inline(always)]
-    fn continuant_outside(self) -> __m128i {
+    fn continuant_outside(self) -> __m256i {
         let (low, span) = CONTINUANT_RANGE_32;
         unsafe {
-            let top = _mm_set1_epi32(i32::MIN);
-            let offset = _mm_sub_epi32(_mm_castps_si128(self.0), _mm_set1_epi32(low as i32));
-            _mm_cmpgt_epi32(_mm_xor_si128(offset, top), _mm_set1_epi32((span ^ (1 << 31)) as i32))
+            let top = _mm256_set1_epi32(i32::MIN);
+            let offset = _mm256_sub_epi32(_mm256_castps_si256(self.0), _mm256_set1_epi32(low as i32));
+            _mm256_cmpgt_epi32(_mm256_xor_si256(offset, top), _mm256_set1_epi32((span ^ (1 << 31)) as i32))
         }
     }
 }
@@ -408,49 +430,64 @@ mod tests {
         );
     }
 
-    /// Each operation of `Sse4`, lane by lane, against `Lanes32`'s (which do each `f32`'s).
-    fn compare_f32(a: [f32; 4], b: [f32; 4]) {
-        let (x, y) = (Sse4::from(Lanes32(a)), Sse4::from(Lanes32(b)));
+    /// Each operation of the `f32` register lanes `V` (`W` of them), lane by lane, against
+    /// `Lanes32`'s (which do each `f32`'s); inlined into a caller compiled for `V`'s
+    /// instructions.
+    #[inline(always)]
+    fn compare_f32<V: Lane + From<Lanes32<W>> + Into<Lanes32<W>>, const W: usize>(a: [f32; W], b: [f32; W]) {
+        let (x, y) = (V::from(Lanes32(a)), V::from(Lanes32(b)));
         let (u, v) = (Lanes32(a), Lanes32(b));
-        let bits = |w: Lanes32<4>| w.0.map(f32::to_bits);
-        let sse = |w: Sse4| bits(Lanes32::from(w));
-        assert_eq!(sse(x + y), bits(u + v));
-        assert_eq!(sse(x - y), bits(u - v));
-        assert_eq!(sse(x * y), bits(u * v));
-        assert_eq!(sse(x / y), bits(u / v));
-        assert_eq!(sse(-x), bits(-u));
-        assert_eq!(sse(x.sqrt()), bits(u.sqrt()));
-        assert_eq!(sse(x.normalizer()), bits(u.normalizer()));
-        assert_eq!(sse(Sse4::splat(0.1)), bits(Lanes32::splat(0.1)));
-        let flags = |m: __m128i| {
-            let mut out = [0u32; 4];
-            // SAFETY: writes the four lanes of `out`.
-            unsafe { _mm_storeu_si128(out.as_mut_ptr().cast(), m) };
-            out.map(|f| f != 0)
-        };
+        let bits = |w: Lanes32<W>| w.0.map(f32::to_bits);
+        let reg = |w: V| bits(w.into());
+        assert_eq!(reg(x + y), bits(u + v));
+        assert_eq!(reg(x - y), bits(u - v));
+        assert_eq!(reg(x * y), bits(u * v));
+        assert_eq!(reg(x / y), bits(u / v));
+        assert_eq!(reg(-x), bits(-u));
+        assert_eq!(reg(x.sqrt()), bits(u.sqrt()));
+        assert_eq!(reg(x.normalizer()), bits(u.normalizer()));
+        assert_eq!(reg(V::splat(0.1)), bits(Lanes32::splat(0.1)));
+        let flags = |m: V::Mask| V::select(m, V::splat(1.0), V::splat(0.0)).into().0.map(|f| f == 1.0);
         let expected = u.continuant_outside().map(|f| f != 0);
         assert_eq!(flags(x.continuant_outside()), expected);
         let (low, span) = CONTINUANT_RANGE;
         assert_eq!(flags(x.outside(low, span)), u.outside(low, span).map(|f| f != 0));
-        assert_eq!(Sse4::any(x.continuant_outside()), expected.contains(&true));
-        assert_eq!(Sse4::all(x.continuant_outside()), !expected.contains(&false));
-        assert!(Sse4::all(Sse4::splat(f64::NAN).continuant_outside()));
-        assert!(!Sse4::any(Sse4::none()));
-        let chosen = Lanes32::from(Sse4::select(x.continuant_outside(), x, y)).0;
-        for k in 0..4 {
-            assert_eq!(chosen[k].to_bits(), if expected[k] { a[k] } else { b[k] }.to_bits());
-        }
+        assert_eq!(V::any(x.continuant_outside()), expected.contains(&true));
+        assert_eq!(V::all(x.continuant_outside()), !expected.contains(&false));
+        assert!(V::all(V::splat(f64::NAN).continuant_outside()));
+        assert!(!V::any(V::none()));
+        assert_eq!(flags(V::or(x.continuant_outside(), V::none())), expected);
+    }
+
+    /// [`compare_f32`] of [`AvxF32`], compiled for AVX2, and its blocks joined and split.
+    #[target_feature(enable = "avx2")]
+    fn compare_avx_f32(a: [f32; 8], b: [f32; 8]) {
+        compare_f32::<AvxF32, 8>(a, b);
+        let halves = |v: [f32; 8]| {
+            [Lanes32(std::array::from_fn(|k| v[k])), Lanes32(std::array::from_fn(|k| v[4 + k]))]
+        };
+        assert_eq!(Lanes32::<8>::from(AvxF32::join(halves(a))).0.map(f32::to_bits), a.map(f32::to_bits));
+        let split = AvxF32::from(Lanes32(b)).split().map(|h| h.0.map(f32::to_bits));
+        assert_eq!(split, halves(b).map(|h| h.0.map(f32::to_bits)));
     }
 
     #[test]
-    fn sse_lanes_do_what_each_f32_does() {
+    fn avx_lanes_do_what_each_f32_does() {
         let cases = [
             ([1.5, -2.0, 3e-30, 7.0], [0.1, 3.0, 1e30, -0.0]),
             ([f32::NAN, 0.0, -1.0, 2f32.powi(90)], [1.0, 0.0, f32::INFINITY, 3.0]),
             ([2f32.powi(-80), 2f32.powi(80), 1e-40, -0.0], [2.0, 0.5, 1e-40, f32::MIN_POSITIVE]),
         ];
+        if !super::super::has_avx2() {
+            return;
+        }
         for (a, b) in cases {
-            compare_f32(a, b);
+            for (c, d) in cases {
+                let eight =
+                    |u: [f32; 4], v: [f32; 4]| std::array::from_fn(|k| if k < 4 { u[k] } else { v[k - 4] });
+                // SAFETY: the CPU has AVX2, checked above.
+                unsafe { compare_avx_f32(eight(a, c), eight(b, d)) };
+            }
         }
     }
 

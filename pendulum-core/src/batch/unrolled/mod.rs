@@ -5,10 +5,10 @@
 //! its accelerations once, as a kernel generic over [`Lane`] ([`PlanarKernel::kernel`]).
 //! Its own `Model::accelerations` runs the kernel on `f64`; [`UnrolledBatch`] runs it on
 //! four chains at once: where the CPU has AVX2, compiled for it on lanes that are one
-//! register each (`Avx4`, `Sse4` in single precision: every operation one instruction,
-//! where LLVM left half of [`Lanes`]' arrays scalar or spilled in a kernel this long),
-//! on eight (two blocks in one `Avx8` register) where it has AVX-512 VL, elsewhere on
-//! [`Lanes`]. The operations are the same, lane by lane, with the same sine
+//! register each (`Avx4`: every operation one instruction, where LLVM left half of
+//! [`Lanes`]' arrays scalar or spilled in a kernel this long), on eight (two blocks in one
+//! `Avx8` register) where it has AVX-512 VL, elsewhere on [`Lanes`]. Single precision runs
+//! eight chains a register with AVX2 (`AvxF32`). The operations are the same, lane by lane, with the same sine
 //! kernel, so every chain of a batch gets its single model's `θ̈` bit for bit.
 
 mod precision;
@@ -184,7 +184,7 @@ pub trait PlanarKernel<const N: usize>:
 
 /// `B` chains of one generated planar model type `M` (`N` links each, each its own masses,
 /// lengths, damping and gravity), evaluated four per instruction stream (eight in `f64` with
-/// AVX-512).
+/// AVX-512, eight in `f32` with AVX2).
 ///
 /// ```
 /// use pendulum_core::batch::UnrolledBatch;
@@ -207,6 +207,8 @@ pub struct UnrolledBatch<M, const N: usize> {
     blocks: Vec<LinkConstants<F64x4, N>>,
     /// The same in single precision.
     blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
+    /// Whether the calls may use AVX-512 where the CPU has it.
+    avx512: bool,
 }
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
@@ -221,7 +223,21 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         let count = models.len().div_ceil(WIDTH);
         let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
         let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
-        Ok(Self { models, blocks, blocks_f32 })
+        Ok(Self { models, blocks, blocks_f32, avx512: true })
+    }
+
+    /// Whether the evaluations may run eight `f64` chains per AVX-512 register where the CPU
+    /// has AVX-512 VL (the default), or keep four per AVX2 register (`false`; `f32` keeps
+    /// eight per AVX2 register either way). The results are the same bits either way; the
+    /// choice is speed (`docs/ensembles.md`), and the other path for tests.
+    pub fn with_avx512(mut self, allowed: bool) -> Self {
+        self.avx512 = allowed;
+        self
+    }
+
+    /// Whether the evaluations run with AVX-512 (allowed, and the CPU has AVX-512 VL).
+    pub fn uses_avx512(&self) -> bool {
+        self.avx512 && crate::lanes::has_avx512vl()
     }
 
     /// Number of chains `B`.
@@ -396,7 +412,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         out: &mut [P],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if crate::lanes::has_avx512vl() {
+        if self.uses_avx512() {
             // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
             return unsafe { self.group_avx512::<P>(c, room, lanes, rows, out) };
         }

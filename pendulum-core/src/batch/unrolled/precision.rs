@@ -9,7 +9,8 @@ use crate::lanes::{Lane, Lanes, Lanes32};
 
 /// Lanes a generated kernel runs in, in precision `P`: [`BLOCKS`](Self::BLOCKS) blocks of
 /// [`WIDTH`] chains side by side. One block: `P`'s arrays of lanes themselves, or a register
-/// loaded from them; two: one register of eight lanes (`Avx8` for `f64`).
+/// loaded from them; two: one register of eight lanes (`Avx8` for `f64`, `AvxF32` for
+/// `f32`).
 pub(crate) trait KernelLanes<P: Precision>: Lane {
     /// Blocks one value holds: 1 or 2.
     const BLOCKS: usize;
@@ -42,21 +43,28 @@ one_block!(f64: Lanes<WIDTH>);
 one_block!(f32: Lanes32<WIDTH>);
 #[cfg(target_arch = "x86_64")]
 one_block!(f64: crate::lanes::Avx4);
-#[cfg(target_arch = "x86_64")]
-one_block!(f32: crate::lanes::Sse4);
+
+/// A lane type of two blocks of precision `P`, by its own `join` and `split`.
+macro_rules! two_blocks {
+    ($p:ty: $v:ty) => {
+        impl KernelLanes<$p> for $v {
+            const BLOCKS: usize = 2;
+            #[inline(always)]
+            fn join(blocks: [<$p as Precision>::Lanes; 2]) -> Self {
+                <$v>::join(blocks)
+            }
+            #[inline(always)]
+            fn split(self) -> [<$p as Precision>::Lanes; 2] {
+                <$v>::split(self)
+            }
+        }
+    };
+}
 
 #[cfg(target_arch = "x86_64")]
-impl KernelLanes<f64> for crate::lanes::Avx8 {
-    const BLOCKS: usize = 2;
-    #[inline(always)]
-    fn join(blocks: [Lanes<WIDTH>; 2]) -> Self {
-        Self::join(blocks)
-    }
-    #[inline(always)]
-    fn split(self) -> [Lanes<WIDTH>; 2] {
-        self.split()
-    }
-}
+two_blocks!(f64: crate::lanes::Avx8);
+#[cfg(target_arch = "x86_64")]
+two_blocks!(f32: crate::lanes::AvxF32);
 
 /// Lane `i` of `blocks[0]` and `blocks[1]` (see [`KernelLanes::join`]) for each `i`: a loop,
 /// not `array::map`, whose closure was compiled apart from the AVX2 kernel (without its
@@ -74,14 +82,14 @@ pub(crate) fn join<P: Precision, V: KernelLanes<P>, const N: usize>(blocks: [&[P
 pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     /// [`WIDTH`] numbers, one per chain of a block.
     type Lanes: KernelLanes<Self> + Send + Sync;
-    /// The same lanes as the kernel computes in them when the CPU has AVX2: one register
-    /// each ([`Avx4`](crate::lanes::Avx4) for `f64`, [`Sse4`](crate::lanes::Sse4) for
-    /// `f32`).
+    /// The lanes the kernel computes in when the CPU has AVX2: one register each
+    /// ([`Avx4`](crate::lanes::Avx4), one block, for `f64`; [`AvxF32`](crate::lanes::AvxF32),
+    /// two blocks, for `f32`).
     #[cfg(target_arch = "x86_64")]
     type Registers: KernelLanes<Self>;
     /// The lanes the kernel computes in when the CPU has AVX-512 VL: two blocks in one
-    /// [`Avx8`](crate::lanes::Avx8) register for `f64`, [`Sse4`](crate::lanes::Sse4) for
-    /// `f32`.
+    /// register, [`Avx8`](crate::lanes::Avx8) for `f64`, [`AvxF32`](crate::lanes::AvxF32)
+    /// for `f32`.
     #[cfg(target_arch = "x86_64")]
     type Wide: KernelLanes<Self>;
     /// Not a number.
@@ -125,9 +133,9 @@ impl Precision for f64 {
 impl Precision for f32 {
     type Lanes = Lanes32<WIDTH>;
     #[cfg(target_arch = "x86_64")]
-    type Registers = crate::lanes::Sse4;
+    type Registers = crate::lanes::AvxF32;
     #[cfg(target_arch = "x86_64")]
-    type Wide = crate::lanes::Sse4;
+    type Wide = crate::lanes::AvxF32;
     const NAN: Self = f32::NAN;
 
     #[inline(always)]
