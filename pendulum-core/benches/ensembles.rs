@@ -18,7 +18,8 @@
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two (and in four lanes
 //!   instead of eight on a CPU with AVX-512), and in single precision on one;
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
-//!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps);
+//!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
+//!   lanes instead of eight too);
 //! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time
 //!   against `PlanarBatch::state_jacobians` on one thread and on two.
 //!
@@ -460,6 +461,21 @@ fn generated_rk4<M, const N: usize, const D: usize>(
                 in_pool(b, &pool, || {
                     let mut run = states.clone();
                     batch.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                    black_box(&run);
+                })
+            },
+        );
+    }
+    // What `with_avx512(false)` trades, on a CPU with AVX-512: four lanes instead of eight.
+    if batch.uses_avx512() {
+        let (four, pool) = (batch.clone().with_avx512(false), pool(1));
+        group.bench_with_input(
+            BenchmarkId::new("rk4_100_steps/batch_1_threads_four_lanes", N),
+            &N,
+            |b, _| {
+                in_pool(b, &pool, || {
+                    let mut run = states.clone();
+                    four.integrate_rk4(&mut run, H, STEPS).expect("batch");
                     black_box(&run);
                 })
             },

@@ -230,7 +230,8 @@ fn random_states<const D: usize>(chains: usize, r: &mut ChaCha8Rng) -> Vec<State
 }
 
 /// The batch's RK4 runs equal each chain's alone in time, state and compensation: with 1
-/// and 2 threads, and in two calls of half the steps each.
+/// and 2 threads, and in two calls of half the steps each; in eight lanes a register and in
+/// four (`with_avx512(false)`).
 fn check_rk4<M, const N: usize, const D: usize>(
     models: Vec<M>,
     states: Vec<State<Const<D>>>,
@@ -241,10 +242,28 @@ fn check_rk4<M, const N: usize, const D: usize>(
     Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
 {
     let alone = stepped_alone(&models, &states, h, steps);
-    let batch = UnrolledBatch::new(models).expect("batch");
+    let eight = UnrolledBatch::new(models).expect("batch");
+    let four = eight.clone().with_avx512(false);
+    for batch in [&eight, &four] {
+        check_rk4_runs(batch, &states, &alone, h, steps);
+    }
+}
+
+/// [`check_rk4`] of one batch against the chains stepped `alone`.
+fn check_rk4_runs<M: PlanarKernel<N>, const N: usize, const D: usize>(
+    batch: &UnrolledBatch<M, N>,
+    states: &[State<Const<D>>],
+    alone: &[(State<Const<D>>, Option<Error>)],
+    h: f64,
+    steps: usize,
+) where
+    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
+{
+    let avx512 = batch.uses_avx512();
     let compare = |batched: &[State<Const<D>>], failures: &[pendulum_core::batch::Failure], what: &str| {
         let mut failed = failures.iter();
-        for (k, (state, (single, error))) in batched.iter().zip(&alone).enumerate() {
+        let what = format!("{what}, AVX-512 {avx512}");
+        for (k, (state, (single, error))) in batched.iter().zip(alone).enumerate() {
             assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
             assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
             assert_bits(
@@ -260,7 +279,7 @@ fn check_rk4<M, const N: usize, const D: usize>(
         assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
     };
     for pool in pools() {
-        let mut batched = states.clone();
+        let mut batched = states.to_vec();
         let failures = pool.install(|| batch.integrate_rk4(&mut batched, h, steps)).expect("batch");
         compare(
             &batched,
@@ -268,7 +287,7 @@ fn check_rk4<M, const N: usize, const D: usize>(
             &format!("{} chains of {N}, {} threads", states.len(), pool.current_num_threads()),
         );
     }
-    let mut batched = states.clone();
+    let mut batched = states.to_vec();
     let first = batch.integrate_rk4(&mut batched, h, steps / 2).expect("batch");
     let mut failures = batch.integrate_rk4(&mut batched, h, steps - steps / 2).expect("batch");
     failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
@@ -281,8 +300,9 @@ fn check_rk4<M, const N: usize, const D: usize>(
 fn rk4_runs_of_a_batch_equal_each_chain_stepped_alone_bit_for_bit() {
     let mut r = ChaCha8Rng::seed_from_u64(61);
     // 37 chains: ten blocks of four, in groups of four blocks (the last one short), each
-    // group a task of its own on two threads.
-    for chains in [1, 6, 13, 37] {
+    // group a task of its own on two threads; 9 chains: three blocks, the last alone in its
+    // pair of blocks with AVX-512.
+    for chains in [1, 6, 9, 13, 37] {
         let states = random_states::<8>(chains, &mut r);
         check_rk4::<Planar4, 4, 8>(random_models(chains, &mut r), states, 1e-3, 20);
         let states = random_states::<16>(chains, &mut r);

@@ -226,16 +226,17 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         Ok(Self { models, blocks, blocks_f32, avx512: true })
     }
 
-    /// Whether the evaluations may run eight `f64` chains per AVX-512 register where the CPU
-    /// has AVX-512 VL (the default), or keep four per AVX2 register (`false`; `f32` keeps
-    /// eight per AVX2 register either way). The results are the same bits either way; the
-    /// choice is speed (`docs/ensembles.md`), and the other path for tests.
+    /// Whether the evaluations and RK4 runs may work on eight `f64` chains per AVX-512
+    /// register where the CPU has AVX-512 VL (the default), or keep four per AVX2 register
+    /// (`false`; `f32` keeps eight per AVX2 register either way). The results are the same
+    /// bits either way; the choice is speed (`docs/ensembles.md`), and the other path for
+    /// tests.
     pub fn with_avx512(mut self, allowed: bool) -> Self {
         self.avx512 = allowed;
         self
     }
 
-    /// Whether the evaluations run with AVX-512 (allowed, and the CPU has AVX-512 VL).
+    /// Whether the calls run with AVX-512 (allowed, and the CPU has AVX-512 VL).
     pub fn uses_avx512(&self) -> bool {
         self.avx512 && crate::lanes::has_avx512vl()
     }

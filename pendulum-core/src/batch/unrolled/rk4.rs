@@ -47,6 +47,14 @@ struct Kernel<'a, M, V, const N: usize> {
     model: std::marker::PhantomData<M>,
 }
 
+/// The blocks of unit `u` of the first `count` blocks of a group, in lanes holding
+/// `blocks` blocks each: `[u, u]` for one, `[2u, 2u + 1]` for two (`[2u, 2u]` for an odd
+/// block left at the end).
+#[inline(always)]
+fn unit_blocks(u: usize, blocks: usize, count: usize) -> [usize; 2] {
+    [blocks * u, (blocks * u + blocks - 1).min(count - 1)]
+}
+
 impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N, GROUP>
     for Kernel<'_, M, V, N>
 {
@@ -54,17 +62,19 @@ impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N
     fn at(&mut self, q: &[[V; N]; GROUP], qd: &[[V; N]; GROUP]) -> [[V; N]; GROUP] {
         let zero = V::splat(0.0);
         let count = self.count;
-        for (angles, q) in self.room.angles.iter_mut().zip(q).take(count) {
-            for (angle, q) in angles.iter_mut().zip(q) {
-                *angle = q.split()[0];
+        let units = count.div_ceil(V::BLOCKS);
+        for (u, q) in q.iter().enumerate().take(units) {
+            let [a, b] = unit_blocks(u, V::BLOCKS, count);
+            for (i, q) in q.iter().enumerate() {
+                [self.room.angles[a][i], self.room.angles[b][i]] = q.split();
             }
         }
         self.room.sin_cos::<f64>(count);
         let mut out = [[zero; N]; GROUP];
-        for j in 0..count {
+        for u in 0..units {
             let mut trig = [[zero; 2]; N];
-            self.room.trig([j, j], &mut trig);
-            out[j] = M::kernel(&self.c[j], &trig, &qd[j], &[zero; N], [zero; 2]);
+            self.room.trig(unit_blocks(u, V::BLOCKS, count), &mut trig);
+            out[u] = M::kernel(&self.c[u], &trig, &qd[u], &[zero; N], [zero; 2]);
         }
         out
     }
@@ -225,8 +235,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     }
 
     /// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the
-    /// first `count` of them), in lanes of type `V`; a lane whose increment is not finite
-    /// stops at the start of that step. Returns the lanes that ran to the end.
+    /// first `count` of them), in lanes of type `V` (holding one block each, or two); a lane
+    /// whose increment is not finite stops at the start of that step. Returns the lanes
+    /// that ran to the end.
     #[inline(always)]
     fn rk4_run<V: KernelLanes<f64>>(
         &self,
@@ -237,65 +248,73 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         s: &mut [Block<N>; GROUP],
     ) -> [[bool; WIDTH]; GROUP] {
         let zero = V::splat(0.0);
-        let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|j| {
-            let block = &self.blocks[first + j.min(count - 1)];
-            LinkConstants::joined([block, block])
+        let units = count.div_ceil(V::BLOCKS);
+        let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|u| {
+            let [a, b] = unit_blocks(u.min(units - 1), V::BLOCKS, count);
+            LinkConstants::joined([&self.blocks[first + a], &self.blocks[first + b]])
         });
         let (mut q, mut qd) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
         let (mut q_carry, mut qd_carry) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
         let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
-        for j in 0..count {
-            (q[j], qd[j]) = (join([&s[j].q; 2]), join([&s[j].qd; 2]));
-            (q_carry[j], qd_carry[j]) = (join([&s[j].q_carry; 2]), join([&s[j].qd_carry; 2]));
-            (t[j], t_carry[j]) = (V::join([s[j].t; 2]), V::join([s[j].t_carry; 2]));
+        for u in 0..units {
+            let [a, b] = unit_blocks(u, V::BLOCKS, count).map(|j| &s[j]);
+            (q[u], qd[u]) = (join([&a.q, &b.q]), join([&a.qd, &b.qd]));
+            (q_carry[u], qd_carry[u]) = (join([&a.q_carry, &b.q_carry]), join([&a.qd_carry, &b.qd_carry]));
+            (t[u], t_carry[u]) = (V::join([a.t, b.t]), V::join([a.t_carry, b.t_carry]));
         }
         let mut stopped = [V::none(); GROUP];
         for _ in 0..steps {
             let kernel =
                 Kernel::<M, V, N> { c: &c, count, room: &mut *room, model: std::marker::PhantomData };
             let (dq, dqd) = increment(&q, &qd, h, kernel);
-            for j in 0..count {
+            for u in 0..units {
                 // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
                 let mut probe = zero;
-                for d in dq[j].iter().chain(&dqd[j]) {
+                for d in dq[u].iter().chain(&dqd[u]) {
                     #[allow(clippy::eq_op)]
                     let nan_if_not_finite = *d - *d;
                     probe += nan_if_not_finite;
                 }
-                let stop = V::or(stopped[j], probe.outside(0, 0));
-                stopped[j] = stop;
+                let stop = V::or(stopped[u], probe.outside(0, 0));
+                stopped[u] = stop;
                 let advance = |x: &mut V, carry: &mut V, delta: V| {
                     let (new, new_carry) = kahan_add(*x, *carry, delta);
                     (*x, *carry) = (V::select(stop, *x, new), V::select(stop, *carry, new_carry));
                 };
-                advance(&mut t[j], &mut t_carry[j], V::splat(h));
+                advance(&mut t[u], &mut t_carry[u], V::splat(h));
                 for i in 0..N {
-                    advance(&mut q[j][i], &mut q_carry[j][i], dq[j][i]);
-                    advance(&mut qd[j][i], &mut qd_carry[j][i], dqd[j][i]);
+                    advance(&mut q[u][i], &mut q_carry[u][i], dq[u][i]);
+                    advance(&mut qd[u][i], &mut qd_carry[u][i], dqd[u][i]);
                 }
             }
-            if stopped[..count].iter().all(|&stop| V::all(stop)) {
+            if stopped[..units].iter().all(|&stop| V::all(stop)) {
                 break;
             }
         }
         let mut alive = [[false; WIDTH]; GROUP];
-        for j in 0..count {
-            let back = |v: &[V; N], to: &mut [F64x4; N]| {
-                for (to, v) in to.iter_mut().zip(v) {
-                    *to = v.split()[0];
-                }
-            };
-            back(&q[j], &mut s[j].q);
-            back(&qd[j], &mut s[j].qd);
-            back(&q_carry[j], &mut s[j].q_carry);
-            back(&qd_carry[j], &mut s[j].qd_carry);
-            (s[j].t, s[j].t_carry) = (t[j].split()[0], t_carry[j].split()[0]);
-            alive[j] = V::select(stopped[j], zero, V::splat(1.0)).split()[0].0.map(|alive| alive == 1.0);
+        for u in 0..units {
+            // Each block of the unit once (an odd last block is both halves).
+            let blocks = unit_blocks(u, V::BLOCKS, count);
+            for (half, j) in blocks.into_iter().enumerate().take(V::BLOCKS.min(count - V::BLOCKS * u)) {
+                let back = |v: &[V; N], to: &mut [F64x4; N]| {
+                    for (to, v) in to.iter_mut().zip(v) {
+                        *to = v.split()[half];
+                    }
+                };
+                back(&q[u], &mut s[j].q);
+                back(&qd[u], &mut s[j].qd);
+                back(&q_carry[u], &mut s[j].q_carry);
+                back(&qd_carry[u], &mut s[j].qd_carry);
+                (s[j].t, s[j].t_carry) = (t[u].split()[half], t_carry[u].split()[half]);
+                let ran = V::select(stopped[u], zero, V::splat(1.0)).split()[half];
+                alive[j] = ran.0.map(|alive| alive == 1.0);
+            }
         }
         alive
     }
 
-    /// [`rk4_run`](Self::rk4_run) in AVX2 registers when the CPU has them, else in
+    /// [`rk4_run`](Self::rk4_run) in AVX-512 registers (two blocks each) where the CPU has
+    /// AVX-512 VL and the batch allows it, in AVX2 registers where it has AVX2, else in
     /// [`Lanes`].
     fn rk4_run_simd(
         &self,
@@ -307,11 +326,32 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         s: &mut [Block<N>; GROUP],
     ) -> [[bool; WIDTH]; GROUP] {
         #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
+            return unsafe { self.rk4_run_avx512(first, count, room, h, steps, s) };
+        }
+        #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx2() {
             // SAFETY: the CPU has AVX2, checked just above.
             return unsafe { self.rk4_run_avx2(first, count, room, h, steps, s) };
         }
         self.rk4_run::<F64x4>((first, count), room, h, steps, s)
+    }
+
+    /// [`rk4_run`](Self::rk4_run) compiled for AVX-512, two blocks in each
+    /// [`Avx8`](crate::lanes::Avx8) register (1.18–1.26× four lanes, `docs/ensembles.md`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    fn rk4_run_avx512(
+        &self,
+        first: usize,
+        count: usize,
+        room: &mut SineRoom<F64x4, N>,
+        h: f64,
+        steps: usize,
+        s: &mut [Block<N>; GROUP],
+    ) -> [[bool; WIDTH]; GROUP] {
+        self.rk4_run::<crate::lanes::Avx8>((first, count), room, h, steps, s)
     }
 
     /// [`rk4_run`](Self::rk4_run) compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
