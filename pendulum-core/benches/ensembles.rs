@@ -53,6 +53,15 @@ fn random_chain(n: usize, spread: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {
     Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain")
 }
 
+/// `count` random chains of `n` links ([`random_chain`], spread 2) and their angles and
+/// rates, `count` rows of `n` each, uniform in [−1, 1) rad and rad/s.
+fn random_batch(count: usize, n: usize, r: &mut ChaCha8Rng) -> (Vec<Chain<Dyn>>, Vec<f64>, Vec<f64>) {
+    let chains = (0..count).map(|_| random_chain(n, 2.0, r)).collect();
+    let q = (0..count * n).map(|_| r.random_range(-1.0..1.0)).collect();
+    let qd = (0..count * n).map(|_| r.random_range(-1.0..1.0)).collect();
+    (chains, q, qd)
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool")
 }
@@ -95,9 +104,7 @@ fn large_batches(c: &mut Criterion) {
     group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(20);
     group.throughput(Throughput::Elements(LARGE as u64));
     let mut r = ChaCha8Rng::seed_from_u64(43);
-    let chains: Vec<_> = (0..LARGE).map(|_| random_chain(N, 2.0, &mut r)).collect();
-    let q: Vec<f64> = (0..LARGE * N).map(|_| r.random_range(-1.0..1.0)).collect();
-    let qd: Vec<f64> = (0..LARGE * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let (chains, q, qd) = random_batch(LARGE, N, &mut r);
     let mut out = vec![0.0; LARGE * N];
     let planar = PlanarBatch::new(chains.clone()).expect("batch");
     let models: Vec<_> = chains.into_iter().map(Directions::<U3>::new).collect();
@@ -128,9 +135,7 @@ fn accelerations(c: &mut Criterion) {
     group.throughput(Throughput::Elements(CHAINS as u64));
     let mut r = ChaCha8Rng::seed_from_u64(31);
     for n in [8, 20, 100] {
-        let chains: Vec<_> = (0..CHAINS).map(|_| random_chain(n, 2.0, &mut r)).collect();
-        let q: Vec<f64> = (0..CHAINS * n).map(|_| r.random_range(-1.0..1.0)).collect();
-        let qd: Vec<f64> = (0..CHAINS * n).map(|_| r.random_range(-1.0..1.0)).collect();
+        let (chains, q, qd) = random_batch(CHAINS, n, &mut r);
         let mut out = vec![0.0; CHAINS * n];
 
         let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
@@ -513,9 +518,7 @@ fn jacobians(c: &mut Criterion) {
     group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(30);
     group.throughput(Throughput::Elements(CHAINS as u64));
     let mut r = ChaCha8Rng::seed_from_u64(41);
-    let chains: Vec<_> = (0..CHAINS).map(|_| random_chain(N, 2.0, &mut r)).collect();
-    let q: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
-    let qd: Vec<f64> = (0..CHAINS * N).map(|_| r.random_range(-1.0..1.0)).collect();
+    let (chains, q, qd) = random_batch(CHAINS, N, &mut r);
     let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
     let inputs = Inputs::<Dyn, U2>::zeros(Dyn(N));
     let mut out = Jacobians::zeros(&singles[0]);
