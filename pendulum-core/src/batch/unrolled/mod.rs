@@ -80,6 +80,14 @@ impl<L: Lane, const N: usize> SineRoom<L, N> {
     }
 }
 
+/// The blocks of unit `u` of the first `count` blocks of a group, in lanes holding
+/// `blocks` blocks each: `[u, u]` for one, `[2u, 2u + 1]` for two (`[2u, 2u]` for an odd
+/// block left at the end).
+#[inline(always)]
+fn unit_blocks(u: usize, blocks: usize, count: usize) -> [usize; 2] {
+    [blocks * u, (blocks * u + blocks - 1).min(count - 1)]
+}
+
 /// Rows `v` (`N` a chain) of the chains `blocks[0]`, then `blocks[1]` when `V` holds two
 /// blocks, into lanes `out` (link `i` in `out[i]`).
 #[inline(always)]
@@ -365,9 +373,8 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             gather::<P, WIDTH>(q, lanes, N, P::flatten_mut(angles));
         }
         room.sin_cos::<P>(count);
-        for first in (0..count).step_by(V::BLOCKS) {
-            // The blocks in `V` (the last one twice when an odd one is left).
-            let pair = [first, (first + V::BLOCKS - 1).min(count - 1)];
+        for u in 0..count.div_ceil(V::BLOCKS) {
+            let pair = unit_blocks(u, V::BLOCKS, count);
             let mut trig = [[V::splat(0.0); 2]; N];
             room.trig(pair, &mut trig);
             let blocks = pair.map(|j| lanes[j]);
@@ -380,9 +387,9 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             let mut pivots = [V::splat(0.0); 2];
             if let Some(p) = pivot {
                 let [a, b] = blocks;
-                let along =
-                    |axis: usize| [P::lanes(|k| p[2 * a[k] + axis]), P::lanes(|k| p[2 * b[k] + axis])];
-                pivots = [V::join(along(0)), V::join(along(1))];
+                let x = [P::lanes(|k| p[2 * a[k]]), P::lanes(|k| p[2 * b[k]])];
+                let y = [P::lanes(|k| p[2 * a[k] + 1]), P::lanes(|k| p[2 * b[k] + 1])];
+                pivots = [V::join(x), V::join(y)];
             }
             let accelerations = M::kernel(
                 &LinkConstants::joined([&c[pair[0]], &c[pair[1]]]),
@@ -395,7 +402,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             for (i, a) in accelerations.into_iter().enumerate() {
                 [result[0][i], result[1][i]] = a.split();
             }
-            for (result, j) in result.iter().zip(first..count).take(V::BLOCKS) {
+            for (result, j) in result.iter().zip(V::BLOCKS * u..count).take(V::BLOCKS) {
                 let rows = WIDTH * N * j..(WIDTH * N * (j + 1)).min(out.len());
                 scatter::<P, WIDTH>(P::flatten(result), N, &mut out[rows]);
             }

@@ -5,7 +5,7 @@
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
 use super::precision::{KernelLanes, join};
-use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch};
+use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch, unit_blocks};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks_of};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -45,14 +45,6 @@ struct Kernel<'a, M, V, const N: usize> {
     count: usize,
     room: &'a mut SineRoom<F64x4, N>,
     model: std::marker::PhantomData<M>,
-}
-
-/// The blocks of unit `u` of the first `count` blocks of a group, in lanes holding
-/// `blocks` blocks each: `[u, u]` for one, `[2u, 2u + 1]` for two (`[2u, 2u]` for an odd
-/// block left at the end).
-#[inline(always)]
-fn unit_blocks(u: usize, blocks: usize, count: usize) -> [usize; 2] {
-    [blocks * u, (blocks * u + blocks - 1).min(count - 1)]
 }
 
 impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N, GROUP>
