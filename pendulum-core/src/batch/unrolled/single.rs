@@ -1,18 +1,16 @@
-//! The batch in single precision: the same generated kernel on four `f32` lanes
-//! ([`Lanes32`](crate::lanes::Lanes32)), the sines from the single-precision kernel, eight
-//! per AVX2 instruction. Four lanes rather than eight (one AVX2 register): eight were
-//! measured slower from n = 8 on, the compiler splitting most of the eight-lane kernel
-//! into four-lane and scalar instructions (`docs/ensembles.md`). Not bit for bit the
-//! `f64` model: its accuracy against it is measured in `docs/ensembles.md` and checked in
-//! the tests.
+//! The batch in single precision: the same generated kernel on eight `f32` lanes, two
+//! blocks of four chains in one AVX register where the CPU has AVX2 (`AvxF32`; four
+//! [`Lanes32`](crate::lanes::Lanes32) lanes elsewhere), the sines from the
+//! single-precision kernel, eight per AVX2 instruction. Not bit for bit the `f64` model:
+//! its accuracy against it is measured in `docs/ensembles.md` and checked in the tests.
 
 use super::{PlanarKernel, UnrolledBatch};
 use crate::batch::{Failure, first_bad_input};
 use crate::error::{Error, Result};
 
 impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
-    /// [`accelerations`](Self::accelerations) in single precision: the same solve on four
-    /// chains at once, from `f32` arrays laid out the same way (`B` rows of `N`; torques and
+    /// [`accelerations`](Self::accelerations) in single precision: the same solve on eight
+    /// chains at once (four without AVX2), from `f32` arrays laid out the same way (`B` rows of `N`; torques and
     /// pivot accelerations optional). Not bit for bit the `f64` model: about 10⁻⁶ of the
     /// largest `|θ̈|` for chains whose masses and lengths stay within a decade of each
     /// other (`docs/ensembles.md`).
