@@ -3,9 +3,10 @@
 //! `Derivatives::state_jacobians`), the chains spread over the cores. Not in SIMD lanes:
 //! each chain runs the single-chain code, so the results are its results bit for bit.
 
-use nalgebra::{DMatrixViewMut, DVector, Dyn, U2, Vector2};
+use nalgebra::{DVector, Dyn, U2, Vector2};
 use rayon::prelude::*;
 
+use super::transpose::transpose_square;
 use super::{Failure, PlanarBatch, check_len};
 use crate::error::Result;
 use crate::jacobians::{Derivatives, Jacobians};
@@ -56,8 +57,8 @@ impl PlanarBatch {
             match self.chain(k).state_jacobians(x, v, inputs, out) {
                 Ok(()) => {
                     // Row-major: the transposes of nalgebra's column-major blocks.
-                    out.q.transpose_to(&mut DMatrixViewMut::from_slice(dq, n, n));
-                    out.qd.transpose_to(&mut DMatrixViewMut::from_slice(dqd, n, n));
+                    transpose_square(out.q.as_slice(), n, dq);
+                    transpose_square(out.qd.as_slice(), n, dqd);
                     None
                 }
                 Err(error) => {
