@@ -433,7 +433,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     }
 
     /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Wide`]: two blocks
-    /// an instruction in `f64` (1.08–1.17× four lanes, `docs/ensembles.md`), and 32
+    /// an instruction in `f64` (1.07–1.17× four lanes, `docs/ensembles.md`), and 32
     /// registers instead of 16 for a kernel that spills.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl")]
