@@ -3,7 +3,7 @@
 //! for one state or a leading batch of them; their RK4 runs (`integrate`, `trajectory`, in
 //! `planar_runs`); its normal modes and linearisation.
 
-use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn};
+use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn, Vector3};
 use numpy::PyArray1;
 use pendulum_core::batch::PlanarBatch;
 use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
@@ -13,8 +13,9 @@ use rayon::prelude::*;
 
 use crate::arrays::{Rows, array, per_link};
 use crate::detach::{PARALLEL_FROM, maybe_detached};
+use crate::directions;
 use crate::errors::{core_error, invalid, run_error};
-use crate::planar_runs::{Plan, planar_run};
+use crate::planar_runs::{Plan, planar_run, run_in};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use pendulum_experiment::options::{expand, links};
 
@@ -23,8 +24,11 @@ use pendulum_experiment::options::{expand, links};
 /// `Chain(masses, lengths, gravity=9.81, damping=0.0)`: masses in kg and rod lengths in m,
 /// one number for every link or one per link (`n` from the longer list); gravity g in
 /// m/s²; damping λ_i in N·m·s. Models: `"planar"` (angles θ_i from the downward vertical,
-/// accelerations by the O(n) rod-tension solve) and `"spatial"` (spherical angles θ_i from
-/// −z and azimuths φ_i, q = (θ_1..θ_n, φ_1..φ_n); singular where a link is vertical).
+/// accelerations by the O(n) rod-tension solve), `"spatial"` (spherical angles θ_i from
+/// −z and azimuths φ_i, q = (θ_1..θ_n, φ_1..φ_n); singular where a link is vertical) and
+/// `"directions"` (3D without angles: q = (u_1..u_n), each rod's unit direction (x, y, z)
+/// with z up, qd = (u̇_1..u̇_n) in 1/s; no singularity; accelerations, integrate,
+/// trajectory and energy).
 #[pyclass(module = "pendulum._pendulum", name = "Chain", frozen)]
 #[derive(Clone)]
 pub struct Chain {
@@ -42,11 +46,17 @@ enum Kind {
 }
 
 impl Kind {
+    /// The angle model `name`; `"directions"` is refused here (the calls that serve it
+    /// read [`Route`]).
     fn of(name: &str) -> PyResult<Self> {
         match name {
             "planar" => Ok(Self::Planar),
             "spatial" => Ok(Self::Spatial),
-            _ => Err(invalid(format!("model: '{name}' is neither 'planar' nor 'spatial'"))),
+            "directions" => Err(invalid(
+                "model: 'directions' serves accelerations, integrate, trajectory and energy; \
+                 this call takes 'planar' or 'spatial'",
+            )),
+            _ => Err(invalid(format!("model: '{name}' is none of 'planar', 'spatial', 'directions'"))),
         }
     }
 
@@ -55,6 +65,23 @@ impl Kind {
         match self {
             Self::Planar => (n, 2),
             Self::Spatial => (2 * n, 3),
+        }
+    }
+}
+
+/// The model of a call that serves the chain in unit directions too.
+#[derive(Clone, Copy, PartialEq)]
+enum Route {
+    Angles(Kind),
+    /// `model="directions"` (the `directions` module).
+    Directions,
+}
+
+impl Route {
+    fn of(name: &str) -> PyResult<Self> {
+        match name {
+            "directions" => Ok(Self::Directions),
+            _ => Kind::of(name).map(Self::Angles),
         }
     }
 }
@@ -121,8 +148,9 @@ impl Chain {
     }
 
     /// `integrate` and `trajectory`: the planar model's run of `plan` from the states `q`
-    /// (`qd`, torques and pivot accelerations as for `accelerations`), in `precision`.
-    fn run_planar<'py>(
+    /// (`qd`, torques and pivot accelerations as for `accelerations`), in `precision`, or
+    /// the directions' projected RK4 run in double precision.
+    fn run<'py>(
         &self,
         py: Python<'py>,
         [q]: [&Bound<'py, PyAny>; 1],
@@ -131,14 +159,87 @@ impl Chain {
         model: &str,
         precision: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        if Kind::of(model)? != Kind::Planar {
-            return Err(invalid("integrate: serves model='planar' only"));
+        let route = Route::of(model)?;
+        if route == Route::Angles(Kind::Spatial) {
+            return Err(invalid("integrate: serves model='planar' and model='directions'"));
         }
         if !(plan.h.is_finite() && plan.h > 0.0) {
             return Err(invalid(format!("h: {} is not a positive time step (s)", plan.h)));
         }
+        if route == Route::Directions {
+            if precision != "float64" {
+                return Err(invalid(format!(
+                    "precision: '{precision}' — model='directions' integrates in 'float64' only"
+                )));
+            }
+            let b = self.directions_rows(q, qd, torque, pivot)?;
+            return run_in(py, &self.inner, [b.q, b.qd, b.torque, b.pivot], plan, directions::rk4);
+        }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
         planar_run(py, &self.inner, [b.q, b.qd, b.torque, b.pivot], plan, precision)
+    }
+
+    /// The states of `model="directions"`: `q` unit directions and `qd` their rates, rows
+    /// of `3n`; the pivot accelerations rows of 3; no torques.
+    fn directions_rows(
+        &self,
+        q: &Bound<'_, PyAny>,
+        qd: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+        pivot: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Batch> {
+        if torque.is_some_and(|t| !t.is_none()) {
+            return Err(invalid("torque: model='directions' takes no joint torques"));
+        }
+        let width = 3 * self.inner.links();
+        let q = Rows::read("q", q, width)?;
+        directions::check_unit(&q.data, width)?;
+        let qd = Rows::read_like("qd", qd, width, &q)?;
+        let torque = Rows::read_like("torque", None, width, &q)?;
+        let pivot = Rows::read_like("pivot_acceleration", pivot, 3, &q)?;
+        Ok(Batch { q, qd, torque, pivot })
+    }
+
+    /// `Chain.accelerations(..., model="directions")`: `ü` (1/s²) shaped like `q`.
+    fn directions_accelerations<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        [qd, torque, pivot]: [Option<&Bound<'py, PyAny>>; 3],
+        precision: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let known = matches!(precision, "float64" | "float32");
+        if known && torque.is_none_or(|t| t.is_none()) {
+            // One pivot acceleration for all (or none): the states read in place.
+            let pivot = match pivot.filter(|p| !p.is_none()) {
+                None => Some(Vector3::zeros()),
+                Some(p) => Rows::read("pivot_acceleration", p, 3)
+                    .ok()
+                    .filter(|p| p.lead.is_empty())
+                    .map(|p| Vector3::from_column_slice(&p.data)),
+            };
+            if let Some(pivot) = pivot
+                && let Some(out) =
+                    directions::accelerations_in_place(py, &self.inner, q, qd, pivot, precision == "float32")?
+            {
+                return Ok(out);
+            }
+        }
+        let b = self.directions_rows(q, qd, torque, pivot)?;
+        let rows = [&b.q, &b.qd, &b.pivot];
+        let (lead, width) = (&b.q.lead, [b.q.width]);
+        let numbers = b.q.data.len();
+        match precision {
+            "float64" => {
+                let out = maybe_detached(py, numbers, || directions::accelerations(&self.inner, rows));
+                Ok(array(py, out.map_err(core_error)?, lead, &width)?.into_any())
+            }
+            "float32" => {
+                let out = maybe_detached(py, numbers, || directions::accelerations_f32(&self.inner, rows));
+                Ok(array(py, out.map_err(core_error)?, lead, &width)?.into_any())
+            }
+            _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+        }
     }
 }
 
@@ -417,12 +518,14 @@ impl Chain {
 
     /// The accelerations q̈ (rad/s²) of the states `q` (rad) with rates `qd` (rad/s),
     /// torques σ (N·m) and pivot acceleration p̈ (m/s²; 2 components planar, 3 spatial),
-    /// by `model` ("planar" or "spatial"). `q` may hold many states along leading axes,
-    /// shape `(..., dof)`; `qd`, `torque` (default zeros) are one row for all or one per
-    /// state, likewise `pivot_acceleration`. Returns an array shaped like `q`.
-    /// `precision="float32"` (planar, no torques) computes in single precision, eight
-    /// states per SIMD register, and returns float32: within about 1e-5 of the largest
-    /// acceleration (docs/ensembles.md).
+    /// by `model` ("planar", "spatial" or "directions"). `q` may hold many states along
+    /// leading axes, shape `(..., dof)`; `qd`, `torque` (default zeros) are one row for
+    /// all or one per state, likewise `pivot_acceleration`. Returns an array shaped like
+    /// `q`. `precision="float32"` (planar without torques, or directions) computes in
+    /// single precision, eight states per SIMD register, and returns float32: within about
+    /// 1e-5 of the largest acceleration (docs/ensembles.md). `model="directions"`: `q` the
+    /// rods' unit directions (dof = 3n, each within 1e-6 of length 1), `qd` their rates,
+    /// the result `ü` (1/s²); no torques.
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", precision = "float64"))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn accelerations<'py>(
@@ -435,7 +538,12 @@ impl Chain {
         model: &str,
         precision: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let kind = Kind::of(model)?;
+        let kind = match Route::of(model)? {
+            Route::Angles(kind) => kind,
+            Route::Directions => {
+                return self.directions_accelerations(py, q, [qd, torque, pivot_acceleration], precision);
+            }
+        };
         match precision {
             "float64" => {}
             "float32" => return self.accelerations_f32(py, kind, q, qd, torque, pivot_acceleration),
@@ -467,6 +575,8 @@ impl Chain {
     /// its joint torques (N·m) and pivot acceleration (m/s²) held over the call (none: the
     /// chain free; planar model): many states at once, four per SIMD register (eight with AVX-512) and on every
     /// core, each bit for bit what the chain alone would give (docs/ensembles.md).
+    /// `model="directions"` steps the 3D chain in directions by RK4 with each rod put back
+    /// to unit length after every step (float64, no torques, the pivot acceleration held).
     /// `precision="float32"` steps eight states per register in single precision and
     /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
     /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
@@ -485,7 +595,7 @@ impl Chain {
         precision: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let plan = Plan { h, steps: count("steps", steps)?, every: None };
-        self.run_planar(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
+        self.run(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
     }
 
     /// `(t, q, qd)`: `integrate`'s run sampled at the start, after every `every`-th step and
@@ -511,7 +621,7 @@ impl Chain {
             every => every,
         };
         let plan = Plan { h, steps: count("steps", steps)?, every: Some(every) };
-        self.run_planar(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
+        self.run(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
@@ -564,7 +674,7 @@ impl Chain {
     }
 
     /// `(T, U)`: kinetic and potential energy (J) of the states, shaped like `q` without its
-    /// last axis.
+    /// last axis (`model="directions"`: relative to the pivot).
     #[pyo3(signature = (q, qd = None, *, model = "planar"))]
     fn energy<'py>(
         &self,
@@ -573,9 +683,17 @@ impl Chain {
         qd: Option<&Bound<'py, PyAny>>,
         model: &str,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let kind = Kind::of(model)?;
-        let b = self.batch(kind, q, qd, None, None)?;
-        let (t, u) = maybe_detached(py, b.q.data.len(), || with_model!(self, kind, |m| energies(m, &b)));
+        let b;
+        let (t, u) = match Route::of(model)? {
+            Route::Angles(kind) => {
+                b = self.batch(kind, q, qd, None, None)?;
+                maybe_detached(py, b.q.data.len(), || with_model!(self, kind, |m| energies(m, &b)))
+            }
+            Route::Directions => {
+                b = self.directions_rows(q, qd, None, None)?;
+                maybe_detached(py, b.q.data.len(), || directions::energies(&self.inner, [&b.q, &b.qd]))
+            }
+        };
         Ok((array(py, t, &b.q.lead, &[])?.into_any(), array(py, u, &b.q.lead, &[])?.into_any()))
     }
 

@@ -8,6 +8,7 @@ mod atlas;
 mod chain;
 mod claims;
 mod detach;
+mod directions;
 mod errors;
 mod interrupt;
 mod page;

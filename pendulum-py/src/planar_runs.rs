@@ -44,9 +44,9 @@ impl Plan {
 }
 
 /// A run's states `q`, `q̇` at its samples, one block of `count × n` numbers after another.
-struct Samples<T> {
-    q: Vec<T>,
-    qd: Vec<T>,
+pub struct Samples<T> {
+    pub q: Vec<T>,
+    pub qd: Vec<T>,
 }
 
 /// The run of `Chain.integrate` (`plan.every` `None`: `(q, qd)` shaped as `q`) or
@@ -67,12 +67,12 @@ pub fn planar_run<'py>(
     }
 }
 
-/// [`planar_rk4`] or [`planar_rk4_f32`].
-type PlanarRun<T> =
+/// [`planar_rk4`], [`planar_rk4_f32`] or the directions' run.
+pub type PlanarRun<T> =
     fn(&pendulum_core::Chain<Dyn>, [&Rows; 4], Plan, &AtomicBool) -> pendulum_experiment::Result<Samples<T>>;
 
-/// [`planar_run`] in one precision's `run`.
-fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
+/// [`planar_run`] in one precision's `run` (also the directions' runs).
+pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [Rows; 4],
@@ -168,7 +168,7 @@ fn planar_rk4_f32(
 /// solves each, ending at the samples), `stop` looked at before each, and
 /// `sample(states, samples)` at the plan's samples; the first failure as the error naming
 /// its state by its index in the leading shape `lead`.
-fn in_chunks<S, T>(
+pub fn in_chunks<S, T>(
     (lead, n, plan, stop): (&[usize], usize, Plan, &AtomicBool),
     states: &mut S,
     mut run: impl FnMut(&mut S, usize) -> pendulum_core::Result<Vec<Failure>>,
@@ -200,15 +200,15 @@ fn in_chunks<S, T>(
     Ok(samples)
 }
 
-/// Rows of `(θ, θ̇)` appended to the samples' `θ` and `θ̇`.
-fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, samples: &mut Samples<T>) {
+/// Rows of `(q, q̇)` (`n` numbers each) appended to the samples' `q` and `q̇`.
+pub fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, samples: &mut Samples<T>) {
     for row in rows {
         samples.q.extend_from_slice(&row[..n]);
         samples.qd.extend_from_slice(&row[n..2 * n]);
     }
 }
 
-fn core(e: pendulum_core::Error) -> Error {
+pub fn core(e: pendulum_core::Error) -> Error {
     Error::invalid(e.to_string())
 }
 

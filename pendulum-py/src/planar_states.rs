@@ -70,9 +70,31 @@ pub fn planar_table_f32<'py>(
     q: &Bound<'py, PyAny>,
     qd: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
-    let n = chain.links();
-    let Some((count, qs)) = table_f32(q, n) else { return Ok(None) };
-    let qds = match qd.map(|qd| table_f32(qd, n)) {
+    tables_f32(py, q, qd, chain.links(), |qs, qds, out| {
+        let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
+        let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, out))
+            .map_err(core_error)?;
+        match failures.is_empty() {
+            true => Ok(()),
+            false => Err(non_finite_input(qs, qds)
+                .unwrap_or_else(|| core_error(pendulum_core::Error::SinglePrecisionOverflow))),
+        }
+    })
+}
+
+/// `run(q, qd, out)` in single precision on the rows of a C-contiguous `(B, width)`
+/// float64 table `q`, `qd` the same or absent (zeros), each rounded to `f32` in one pass,
+/// into a new float32 `(B, width)` array. `None`: not this case (an array of another kind,
+/// or a number past `f32`'s range: the general path names it).
+pub fn tables_f32<'py>(
+    py: Python<'py>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+    width: usize,
+    run: impl FnOnce(&[f32], &[f32], &mut [f32]) -> PyResult<()>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let Some((count, qs)) = table_f32(q, width) else { return Ok(None) };
+    let qds = match qd.map(|qd| table_f32(qd, width)) {
         None => vec![0.0; qs.len()],
         Some(Some((c, qds))) if c == count => qds,
         Some(_) => return Ok(None),
@@ -80,20 +102,9 @@ pub fn planar_table_f32<'py>(
     if count == 0 {
         return Ok(None);
     }
-    let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
     let mut out = vec![0.0f32; qs.len()];
-    let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(&qs, &qds, None, &mut out))
-        .map_err(core_error)?;
-    if !failures.is_empty() {
-        // The general path's message for a non-finite input ([`Rows::read`]'s).
-        for (what, values) in [("q", &qs), ("qd", &qds)] {
-            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-                return Err(invalid(format!("{what}: {v} is not finite")));
-            }
-        }
-        return Err(core_error(pendulum_core::Error::SinglePrecisionOverflow));
-    }
-    Ok(Some(PyArray1::from_vec(py, out).reshape([count, n])?.into_any()))
+    run(&qs, &qds, &mut out)?;
+    Ok(Some(PyArray1::from_vec(py, out).reshape([count, width])?.into_any()))
 }
 
 /// `θ̈` of many planar states given as one C-contiguous array `q` of `T` (float64, or
@@ -109,20 +120,49 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
     qd: Option<&Bound<'py, PyAny>>,
     run: impl Fn(&PlanarBatch, &[T], &[T], &mut [T]) -> pendulum_core::Result<Vec<Failure>> + Send + Sync,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
-    let n = chain.links();
+    in_place(py, q, qd, chain.links(), |qs, qds, os| {
+        let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
+        let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
+        match failures.into_iter().next() {
+            Some(failure) => Err(non_finite_input(qs, qds).unwrap_or_else(|| core_error(failure.error))),
+            None => Ok(()),
+        }
+    })
+}
+
+/// The general path's error for a non-finite number in `q` or `qd` ([`Rows::read`]'s
+/// message, [`Rows::read`](crate::arrays::Rows)), if there is one.
+pub fn non_finite_input<T: Copy + Into<f64>>(q: &[T], qd: &[T]) -> Option<PyErr> {
+    [("q", q), ("qd", qd)].into_iter().find_map(|(what, values)| {
+        let v = values.iter().map(|&v| v.into()).find(|v: &f64| !v.is_finite())?;
+        Some(invalid(format!("{what}: {v} is not finite")))
+    })
+}
+
+/// `run(q, qd, out)` on the rows of a C-contiguous array `q` of `T` of shape `(B, width)`
+/// with `B ≥ 2`, `qd` the same or absent (zeros), read where numpy holds them, into a new
+/// `(B, width)` array (`run` names a non-finite number by [`non_finite_input`]). `None`:
+/// not this case (the general path takes it, and its errors).
+pub fn in_place<'py, T: numpy::Element + Copy + Into<f64> + Default>(
+    py: Python<'py>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+    width: usize,
+    run: impl FnOnce(&[T], &[T], &mut [T]) -> PyResult<()>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
     let Ok(q) = q.cast::<PyArray2<T>>() else { return Ok(None) };
     let q = q.readonly();
-    let [count, width] = [q.shape()[0], q.shape()[1]];
+    let [count, columns] = [q.shape()[0], q.shape()[1]];
     // C order only: `as_slice` of a Fortran-ordered array is contiguous too, column-major.
     let Ok(qs) = q.as_slice() else { return Ok(None) };
-    if width != n || count < 2 || !q.is_c_contiguous() {
+    if columns != width || count < 2 || !q.is_c_contiguous() {
         return Ok(None);
     }
     let given = match qd {
         None => None,
         Some(qd) => {
             let Ok(qd) = qd.cast::<PyArray2<T>>() else { return Ok(None) };
-            if qd.shape() != [count, n] || !qd.is_c_contiguous() {
+            if qd.shape() != [count, width] || !qd.is_c_contiguous() {
                 return Ok(None);
             }
             Some(qd.readonly())
@@ -139,21 +179,10 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
             &zeros
         }
     };
-    let out = PyArray2::<T>::zeros(py, [count, n], false);
+    let out = PyArray2::<T>::zeros(py, [count, width], false);
     {
         let mut written = out.readwrite();
-        let os = written.as_slice_mut().map_err(|e| invalid(e.to_string()))?;
-        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
-        let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        if let Some(failure) = failures.into_iter().next() {
-            // The general path's message for a non-finite input ([`Rows::read`]'s).
-            for (what, values) in [("q", qs), ("qd", qds)] {
-                if let Some(v) = values.iter().map(|&v| v.into()).find(|v: &f64| !v.is_finite()) {
-                    return Err(invalid(format!("{what}: {v} is not finite")));
-                }
-            }
-            return Err(core_error(failure.error));
-        }
+        run(qs, qds, written.as_slice_mut().map_err(|e| invalid(e.to_string()))?)?;
     }
     Ok(Some(out.into_any()))
 }

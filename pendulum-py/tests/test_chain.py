@@ -364,7 +364,7 @@ def test_a_state_that_blows_up_in_integrate_is_named():
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=1e-3, steps=-2), "steps: -2 is not a number of steps"),
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=1e-3, precision="half"), "precision: 'half' is neither"),
         (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3], h=float("nan")), "h: NaN is not a positive time step"),
-        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3, 0.1], h=1e-3, model="spatial"), "integrate: serves model='planar' only"),
+        (lambda: pendulum.Chain(1.0, 0.5).integrate([0.3, 0.1], h=1e-3, model="spatial"), "integrate: serves model='planar' and model='directions'"),
         (lambda: pendulum.Chain(1.0, [0.5, 0.5]).integrate([0.1, float("inf")], h=1e-3), "q: inf is not finite"),
     ],
 )

@@ -239,11 +239,104 @@ fn whirl(n: usize, r: &mut ChaCha8Rng) -> (Directions<U3, Circle>, DVector<f64>)
     let chain = random_chain(n, r);
     let drive = Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..10.0)).expect("drive");
     let model = Directions::<U3>::new(chain).with_drive(drive);
+    let x = whirl_state(&model, n, r);
+    (model, x)
+}
+
+#[test]
+fn one_direction_model_repeated_is_that_model_at_every_state() {
+    // One block of constants for all (`repeated`) against a model per chain: the same
+    // accelerations in f64 and f32, the same RK4 steps, in eight lanes and four.
+    let mut r = ChaCha8Rng::seed_from_u64(17);
+    let (count, n) = (19, 6);
+    let (model, _) = whirl(n, &mut r);
+    let x: Vec<DVector<f64>> = (0..count).map(|_| whirl_state(&model, n, &mut r)).collect();
+    let flat: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+    let repeated = DirectionsBatch::repeated(model.clone(), count).expect("repeated");
+    let copies = DirectionsBatch::new(vec![model.clone(); count]).expect("copies");
+    assert_eq!((repeated.len(), repeated.links()), (count, n));
+    for avx512 in [true, false] {
+        let (a, b) = (repeated.clone().with_avx512(avx512), copies.clone().with_avx512(avx512));
+        let half = a.state_len() / 2;
+        let (mut ua, mut ub) = (vec![0.0; count * half], vec![0.0; count * half]);
+        assert!(a.accelerations(0.7, &flat, &mut ua).expect("a").is_empty());
+        assert!(b.accelerations(0.7, &flat, &mut ub).expect("b").is_empty());
+        assert_bits(&ua, &ub, "ü");
+        let narrow: Vec<f32> = flat.iter().map(|&v| v as f32).collect();
+        let (mut fa, mut fb) = (vec![0.0f32; count * half], vec![0.0f32; count * half]);
+        assert!(a.accelerations_f32(0.7, &narrow, &mut fa).expect("a").is_empty());
+        assert!(b.accelerations_f32(0.7, &narrow, &mut fb).expect("b").is_empty());
+        assert_eq!(
+            fa.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            fb.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
+        let start: Vec<State<Dyn>> =
+            x.iter().enumerate().map(|(k, x)| State::new(0.01 * k as f64, x.clone())).collect();
+        let (mut sa, mut sb) = (start.clone(), start);
+        assert!(a.integrate_rk4(&mut sa, 1e-3, 7).expect("a").is_empty());
+        assert!(b.integrate_rk4(&mut sb, 1e-3, 7).expect("b").is_empty());
+        for (p, q) in sa.iter().zip(&sb) {
+            assert_bits(p.x().as_slice(), q.x().as_slice(), "RK4 state");
+        }
+    }
+    assert!(matches!(DirectionsBatch::repeated(model, 0), Err(Error::EmptyBatch)));
+}
+
+#[test]
+fn directions_and_rates_given_apart_give_the_joined_states_numbers() {
+    let mut r = ChaCha8Rng::seed_from_u64(19);
+    let (count, n) = (13, 5);
+    let (models, x): (Vec<_>, Vec<_>) = (0..count).map(|_| whirl(n, &mut r)).unzip();
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let half = 3 * n;
+    let joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+    let mut u: Vec<f64> = x.iter().flat_map(|x| x.as_slice()[..half].to_vec()).collect();
+    let mut w: Vec<f64> = x.iter().flat_map(|x| x.as_slice()[half..].to_vec()).collect();
+    for batch in [batch.clone(), batch.with_avx512(false)] {
+        let (mut a, mut b) = (vec![0.0; count * half], vec![0.0; count * half]);
+        assert!(batch.accelerations(0.4, &joined, &mut a).expect("joined").is_empty());
+        assert!(batch.accelerations_split(0.4, &u, &w, &mut b).expect("split").is_empty());
+        assert_bits(&b, &a, "ü from u and w apart");
+        // A NaN rate is named in `w`, in its chain only.
+        let kept = w[4 * half + 2];
+        w[4 * half + 2] = f64::NAN;
+        let failures = batch.accelerations_split(0.4, &u, &w, &mut b).expect("split");
+        assert_eq!(failures.len(), 1);
+        assert_eq!(failures[0].chain, 4);
+        assert!(
+            matches!(failures[0].error, Error::NonFinite { what: "w", index: 2, .. }),
+            "{:?}",
+            failures[0]
+        );
+        assert!(b[4 * half..5 * half].iter().all(|v| v.is_nan()));
+        assert_bits(&b[..4 * half], &a[..4 * half], "the chains before");
+        assert_bits(&b[5 * half..], &a[5 * half..], "the chains after");
+        w[4 * half + 2] = kept;
+        // In single precision too.
+        let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<_>>();
+        let (mut a32, mut b32) = (vec![0.0f32; count * half], vec![0.0f32; count * half]);
+        assert!(batch.accelerations_f32(0.4, &narrow(&joined), &mut a32).expect("joined").is_empty());
+        assert!(
+            batch.accelerations_split_f32(0.4, &narrow(&u), &narrow(&w), &mut b32).expect("split").is_empty()
+        );
+        assert!(a32.iter().zip(&b32).all(|(a, b)| a.to_bits() == b.to_bits()), "f32 ü from u and w apart");
+    }
+    u.pop();
+    let mut out = vec![0.0; count * half];
+    assert!(matches!(
+        DirectionsBatch::new(vec![whirl(n, &mut r).0; count])
+            .expect("batch")
+            .accelerations_split(0.0, &u, &w, &mut out),
+        Err(Error::LengthMismatch { what: "u", .. })
+    ));
+}
+
+/// A state of `model` (a whirl of `n` links) at random spherical angles and rates.
+fn whirl_state(model: &Directions<U3, Circle>, n: usize, r: &mut ChaCha8Rng) -> DVector<f64> {
     let q: Vec<f64> =
         (0..2 * n).map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) }).collect();
     let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-1.0..1.0)).collect();
-    let x = model.from_spherical(&q, &qd).expect("state");
-    (model, x)
+    model.from_spherical(&q, &qd).expect("state")
 }
 
 #[test]

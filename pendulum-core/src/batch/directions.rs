@@ -4,9 +4,10 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
 use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
+use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, Failure, Rooms, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
-    failed_rows, for_blocks_of, gather, non_finite, scatter, simd_kernel,
+    failed_rows, for_blocks_of, gather, non_finite, one_of, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
@@ -30,7 +31,9 @@ use crate::rods::{Load, Loads, Rods, Rows};
 /// per link for a 3D RK4 step in eight lanes), so build it once and call it often.
 #[derive(Debug, Clone)]
 pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
+    /// One model per chain, or one for all ([`repeated`](Self::repeated)).
     models: Vec<Directions<S, Dr>>,
+    count: usize,
     pub(super) blocks: Blocks<Block, Block<WIDTH_AVX512>>,
     /// Per block of [`WIDTH_F32`] chains, their rods and `−g` in single precision.
     blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
@@ -89,6 +92,41 @@ impl<const C: usize, V: Lane> Loads<C, V> for RateLoads<'_, C, V> {
         let u = self.directions[C * i..C * (i + 1)].try_into().expect("C numbers");
         let w = self.rates[C * i..C * (i + 1)].try_into().expect("C numbers");
         rate_load(u, w, self.drag[i])
+    }
+}
+
+/// A batch's states for one evaluation: `B` rows of `(u, w)` (`2·S·n` each), or the
+/// directions `u` and the rates `w` as two arrays of `B` rows of `S·n`.
+#[derive(Clone, Copy)]
+enum States<'a, T> {
+    Joined(&'a [T]),
+    Split(&'a [T], &'a [T]),
+}
+
+impl<T: Transpose + Into<f64>> States<'_, T> {
+    /// The states of `chains` into lanes: `out` (flattened) as [`gather`] of the joined
+    /// rows, `u` and then `w` (`half = S·n` numbers each).
+    #[inline(always)]
+    fn gather<const W: usize>(self, chains: [usize; W], half: usize, out: &mut [T]) {
+        match self {
+            States::Joined(x) => gather(x, chains, 2 * half, out),
+            States::Split(u, w) => {
+                let (out_u, out_w) = out.split_at_mut(W * half);
+                gather(u, chains, half, out_u);
+                gather(w, chains, half, out_w);
+            }
+        }
+    }
+
+    /// Chain `c`'s first non-finite number, named by its array and index there.
+    fn non_finite(self, c: usize, half: usize) -> Option<Error> {
+        match self {
+            States::Joined(x) => non_finite("x", &x[2 * half * c..2 * half * (c + 1)]),
+            States::Split(u, w) => {
+                let rows = half * c..half * (c + 1);
+                non_finite("u", &u[rows.clone()]).or_else(|| non_finite("w", &w[rows]))
+            }
+        }
     }
 }
 
@@ -210,7 +248,19 @@ where
             })
             .collect();
         let blocks = Blocks::new(true, || f64_blocks(&models, links), || f64_blocks(&models, links));
-        Ok(Self { models, blocks, blocks_f32, links, accounted: false, rooms: Rooms::default() })
+        let count = models.len();
+        Ok(Self { models, count, blocks, blocks_f32, links, accounted: false, rooms: Rooms::default() })
+    }
+
+    /// `count` copies of `model`, its drive included: one chain at `count` states per call.
+    /// The lanes' constants are built once, for one block, whatever `count`.
+    ///
+    /// Errors: [`Error::EmptyBatch`] for no copies; those of [`new`](Self::new).
+    pub fn repeated(model: Directions<S, Dr>, count: usize) -> Result<Self> {
+        if count == 0 {
+            return Err(Error::EmptyBatch);
+        }
+        Ok(Self { count, ..Self::new(vec![model])? })
     }
 
     /// Whether the `f64` calls may run eight chains per AVX-512 register where the CPU has
@@ -246,12 +296,12 @@ where
 
     /// Number of chains `B`.
     pub fn len(&self) -> usize {
-        self.models.len()
+        self.count
     }
 
     /// Never: a batch has at least one chain.
     pub fn is_empty(&self) -> bool {
-        self.models.is_empty()
+        self.count == 0
     }
 
     /// Links per chain `n`.
@@ -261,7 +311,7 @@ where
 
     /// Chain `k`'s single-chain model.
     pub fn model(&self, k: usize) -> &Directions<S, Dr> {
-        &self.models[k]
+        &self.models[k.min(self.models.len() - 1)]
     }
 
     /// Whether the states carry the energy ledger ([`accounted`](Self::accounted)).
@@ -283,10 +333,32 @@ where
     /// rows.
     pub fn accelerations(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<Vec<Failure>> {
         self.check_rows(x, out)?;
-        Ok(match S::DIM {
+        Ok(self.accelerations_of(t, States::Joined(x), out))
+    }
+
+    /// [`accelerations`](Self::accelerations) of the states given as two arrays, the
+    /// directions `u` and the rates `w`, `B` rows of `S·n` each (as numpy holds `q` and
+    /// `qd`): the same numbers, without joining them first.
+    ///
+    /// Errors: [`Error::LengthMismatch`] when an array does not hold `B` rows.
+    pub fn accelerations_split(&self, t: f64, u: &[f64], w: &[f64], out: &mut [f64]) -> Result<Vec<Failure>> {
+        self.check_split(u, w, out)?;
+        Ok(self.accelerations_of(t, States::Split(u, w), out))
+    }
+
+    /// Checks that `u`, `w` and `out` hold `B` rows of `S·n`.
+    fn check_split<T>(&self, u: &[T], w: &[T], out: &[T]) -> Result<()> {
+        let (chains, half) = (self.len(), S::DIM * self.links);
+        check_len("u", u, chains, half)?;
+        check_len("w", w, chains, half)?;
+        check_len("out", out, chains, half)
+    }
+
+    fn accelerations_of(&self, t: f64, x: States<'_, f64>, out: &mut [f64]) -> Vec<Failure> {
+        match S::DIM {
             2 => self.accelerations_in::<2>(t, x, out),
             _ => self.accelerations_in::<3>(t, x, out),
-        })
+        }
     }
 
     /// Checks that `x` holds `B` states of `(u, w)` (`2·S·n` each) and `out` `B` rows of `S·n`.
@@ -296,19 +368,21 @@ where
         check_len("out", out, chains, half)
     }
 
-    fn accelerations_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut [f64]) -> Vec<Failure> {
+    fn accelerations_in<const C: usize>(&self, t: f64, x: States<'_, f64>, out: &mut [f64]) -> Vec<Failure> {
         let otherwise = (f64::NAN, Error::NotPositiveDefinite);
         match &self.blocks {
             Blocks::Four(blocks) => {
                 self.in_blocks::<C, WIDTH, _, _>(x, out, otherwise, |b, chains, s, out| {
-                    self.evaluate_simd::<C, WIDTH>(&blocks[b], chains, t, x, s, out)
+                    self.evaluate_simd::<C, WIDTH>(one_of(blocks, b), chains, t, x, s, out)
                 })
             }
             #[cfg(target_arch = "x86_64")]
             Blocks::Eight(blocks) => {
                 self.in_blocks::<C, WIDTH_AVX512, _, _>(x, out, otherwise, |b, chains, s, out| {
                     // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
-                    unsafe { self.evaluate_avx512::<C, WIDTH_AVX512>(&blocks[b], chains, t, x, s, out) }
+                    unsafe {
+                        self.evaluate_avx512::<C, WIDTH_AVX512>(one_of(blocks, b), chains, t, x, s, out)
+                    }
                 })
             }
             #[cfg(not(target_arch = "x86_64"))]
@@ -323,13 +397,13 @@ where
     /// non-finite state by its entry, otherwise with `otherwise`.
     fn in_blocks<const C: usize, const W: usize, T, V>(
         &self,
-        x: &[T],
+        x: States<'_, T>,
         out: &mut [T],
         (nan, otherwise): (T, Error),
         kernel: impl Fn(usize, [usize; W], &mut Lanes3<C, V>, &mut [T]) -> [bool; W] + Sync + Send,
     ) -> Vec<Failure>
     where
-        T: Copy + Into<f64> + Send + Sync,
+        T: Transpose + Into<f64> + Send + Sync,
         V: Lane + Send,
     {
         let (chains, n) = (self.len(), self.links);
@@ -344,7 +418,7 @@ where
                 let ids = block_chains::<W>(b, chains);
                 let suspect = kernel(b, ids, s, out);
                 failed_rows(out, half, (ids, suspect), nan, |chain| {
-                    non_finite("x", &x[chain * m..(chain + 1) * m]).unwrap_or_else(|| otherwise.clone())
+                    x.non_finite(chain, half).unwrap_or_else(|| otherwise.clone())
                 })
             },
         )
@@ -360,13 +434,37 @@ where
     /// [`Error::LengthMismatch`] when an array does not hold `B` rows.
     pub fn accelerations_f32(&self, t: f64, x: &[f32], out: &mut [f32]) -> Result<Vec<Failure>> {
         self.check_rows(x, out)?;
-        Ok(match S::DIM {
-            2 => self.accelerations_f32_in::<2>(t, x, out),
-            _ => self.accelerations_f32_in::<3>(t, x, out),
-        })
+        Ok(self.accelerations_f32_of(t, States::Joined(x), out))
     }
 
-    fn accelerations_f32_in<const C: usize>(&self, t: f64, x: &[f32], out: &mut [f32]) -> Vec<Failure> {
+    /// [`accelerations_f32`](Self::accelerations_f32) of the states given as two arrays,
+    /// as [`accelerations_split`](Self::accelerations_split) takes them.
+    ///
+    /// Errors: [`Error::LengthMismatch`] when an array does not hold `B` rows.
+    pub fn accelerations_split_f32(
+        &self,
+        t: f64,
+        u: &[f32],
+        w: &[f32],
+        out: &mut [f32],
+    ) -> Result<Vec<Failure>> {
+        self.check_split(u, w, out)?;
+        Ok(self.accelerations_f32_of(t, States::Split(u, w), out))
+    }
+
+    fn accelerations_f32_of(&self, t: f64, x: States<'_, f32>, out: &mut [f32]) -> Vec<Failure> {
+        match S::DIM {
+            2 => self.accelerations_f32_in::<2>(t, x, out),
+            _ => self.accelerations_f32_in::<3>(t, x, out),
+        }
+    }
+
+    fn accelerations_f32_in<const C: usize>(
+        &self,
+        t: f64,
+        x: States<'_, f32>,
+        out: &mut [f32],
+    ) -> Vec<Failure> {
         self.in_blocks::<C, WIDTH_F32, _, F32x8>(
             x,
             out,
@@ -385,7 +483,7 @@ where
         of: impl Fn(&Dr, f64) -> OVector<f64, S>,
         lanes: impl Fn([f64; W]) -> V,
     ) -> [V; C] {
-        let each: [_; W] = std::array::from_fn(|k| of(self.models[chains[k]].drive(), t[k]));
+        let each: [_; W] = std::array::from_fn(|k| of(self.model(chains[k]).drive(), t[k]));
         std::array::from_fn(|c| lanes(std::array::from_fn(|k| each[k][c])))
     }
 
@@ -398,14 +496,14 @@ where
             b: usize,
             chains: [usize; WIDTH_F32],
             t: f64,
-            x: &[f32],
+            x: States<'_, f32>,
             s: &mut Lanes3<C, F32x8>,
             out: &mut [f32],
         ) -> [bool; WIDTH_F32] {
             let (solve, x_lanes, a_lanes) = s;
-            let (rods, down) = &self.blocks_f32[b];
+            let (rods, down) = one_of(&self.blocks_f32, b);
             let half = C * self.links;
-            gather(x, chains, 2 * half, Lanes32::flatten_mut(x_lanes));
+            x.gather(chains, half, Lanes32::flatten_mut(x_lanes));
             let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
             solve.accelerations(rods, gravity(*down), pivot, x_lanes, a_lanes);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(a_lanes), half, out);
@@ -423,13 +521,13 @@ where
             block: &Block<W>,
             chains: [usize; W],
             t: f64,
-            x: &[f64],
+            x: States<'_, f64>,
             s: &mut Lanes3<C, Lanes<W>>,
             out: &mut [f64],
         ) -> [bool; W] {
             let (solve, x_lanes, a_lanes) = s;
             let half = C * self.links;
-            gather(x, chains, 2 * half, Lanes::flatten_mut(x_lanes));
+            x.gather(chains, half, Lanes::flatten_mut(x_lanes));
             let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
             solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
             scatter::<_, W>(Lanes::flatten(a_lanes), half, out);
@@ -452,7 +550,7 @@ where
             return (self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes), None);
         }
         let motion: [_; W] =
-            std::array::from_fn(|k| self.models[chains[k]].drive().velocity_and_acceleration(t[k]));
+            std::array::from_fn(|k| self.model(chains[k]).drive().velocity_and_acceleration(t[k]));
         let velocity = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].0[c])));
         let acceleration = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].1[c])));
         (acceleration, Some(velocity))

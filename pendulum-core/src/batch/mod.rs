@@ -155,6 +155,13 @@ pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain
     }
 }
 
+/// Block `b`'s constants in `blocks`, or the one block of a batch of one chain repeated
+/// (`repeated`: one block for every block).
+#[inline(always)]
+pub(crate) fn one_of<T>(blocks: &[T], b: usize) -> &T {
+    &blocks[b.min(blocks.len() - 1)]
+}
+
 /// The chains of block `b` of a batch of `chains`, in blocks of `W`: lane `k` holds chain
 /// `W·b + k`, and the lanes past the last chain repeat it (their results are dropped).
 pub(crate) fn block_chains<const W: usize>(b: usize, chains: usize) -> [usize; W] {

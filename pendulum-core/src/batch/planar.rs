@@ -7,7 +7,7 @@ use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
 use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, F64x4, F64x8, Failure, Rooms, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
-    failed_rows, first_bad_input, for_blocks_of, gather, scatter, simd_kernel,
+    failed_rows, first_bad_input, for_blocks_of, gather, one_of, scatter, simd_kernel,
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
@@ -354,7 +354,7 @@ impl PlanarBatch {
             out: &mut [f32],
         ) -> [bool; WIDTH_F32] {
             let n = self.links;
-            let block = &self.blocks_f32[b.min(self.blocks_f32.len() - 1)];
+            let block = one_of(&self.blocks_f32, b);
             gather(q, lanes, n, Lanes32::flatten_mut(&mut s.angles));
             sin_cos_split_f32(
                 Lanes32::flatten(&s.angles),
@@ -391,7 +391,7 @@ impl PlanarBatch {
             out: &mut [f64],
         ) -> [bool; W] {
             let n = self.links;
-            let block = &blocks[b.min(blocks.len() - 1)];
+            let block = one_of(blocks, b);
             let torqued = torque.map_or(Lanes::<W>::none(), |t| {
                 gather_torques(t, lanes, n, Lanes::flatten_mut(&mut s.torque)).map(u64::from)
             });

@@ -15,7 +15,7 @@ use super::transpose::Transpose;
 use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
     Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,
-    for_blocks_of, non_finite, simd_kernel,
+    for_blocks_of, non_finite, one_of, simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -213,7 +213,7 @@ impl PlanarBatch {
                 let mut alive = ran.map(u64::from);
                 let mut t = [Lanes([0.0; W]); 2];
                 into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
-                let (constants, lanes_h) = (&blocks[b.min(blocks.len() - 1)], Lanes([h; W]));
+                let (constants, lanes_h) = (one_of(blocks, b), Lanes([h; W]));
                 for _ in 0..steps {
                     if alive == [0; W] {
                         break;
@@ -273,7 +273,7 @@ impl PlanarBatch {
                 let lanes: [usize; WIDTH_F32] = std::array::from_fn(|k| k.min(count - 1));
                 gather_rows(lanes.map(|k| &*block[k].0), m, Lanes32::flatten_mut(&mut s.x));
                 gather_rows(lanes.map(|k| &*block[k].1), m, Lanes32::flatten_mut(&mut s.carry));
-                let constants = &self.blocks_f32[b.min(self.blocks_f32.len() - 1)];
+                let constants = one_of(&self.blocks_f32, b);
                 for step in 0..steps {
                     if alive == [0; WIDTH_F32] {
                         break;

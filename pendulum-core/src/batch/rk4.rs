@@ -8,7 +8,9 @@ use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::{Block, Scratch};
 use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
-use super::{Blocks, Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, simd_kernel};
+use super::{
+    Blocks, Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, one_of, simd_kernel,
+};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
@@ -190,7 +192,7 @@ where
                     // Up to the next sample: every `every` steps, and the last.
                     let chunk = plan.every.min(plan.steps - done);
                     for step in done..done + chunk {
-                        let failed = one_step(&blocks[b], ids, alive, s);
+                        let failed = one_step(one_of(blocks, b), ids, alive, s);
                         for (k, end) in ends.iter_mut().enumerate() {
                             if failed[k] != 0 {
                                 end.failure =

@@ -1,0 +1,221 @@
+//! `Chain`'s `model="directions"`: the 3D chain in unit link directions
+//! ([`Directions`]), no angles and so no singularity where a link hangs straight down,
+//! for many states per call through the batch of chains in SIMD lanes
+//! ([`DirectionsBatch`]): accelerations in double or single precision, projected RK4 runs
+//! and energies.
+//!
+//! A state is `q = (u_1, …, u_n)`, each rod's unit direction `(x, y, z)` from mass `i − 1`
+//! to mass `i` (z up, the pivot mass 0), and `qd = (u̇_1, …, u̇_n)` (1/s); the pivot
+//! acceleration `p̈` (m/s², three components) is held constant over a call.
+
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::{DVector, Dyn, U3, Vector3};
+use pendulum_core::Directions;
+use pendulum_core::batch::{DirectionsBatch, Failure};
+use pendulum_core::drive::Drive;
+use pendulum_core::integrate::State;
+use pyo3::prelude::*;
+
+use crate::arrays::Rows;
+use crate::detach::maybe_detached;
+use crate::errors::{core_error, invalid};
+use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
+use crate::planar_states::{in_place, non_finite_input, tables_f32};
+
+/// How far `|u_i|` may be from 1 in a state's directions: the rounding of directions made
+/// from angles or positions in double precision is far inside, a state in other
+/// coordinates (angles, positions) far outside.
+pub const UNIT_TOLERANCE: f64 = 1e-6;
+
+/// The pivot moving with the constant acceleration `p̈` from rest at the origin:
+/// `p(t) = p̈ t²/2`, `ṗ(t) = p̈ t` (the chain feels only `p̈`).
+#[derive(Debug, Clone, Copy)]
+pub struct Accelerated(Vector3<f64>);
+
+impl Drive<U3> for Accelerated {
+    fn position(&self, t: f64) -> Vector3<f64> {
+        self.0 * (0.5 * t * t)
+    }
+    fn velocity(&self, t: f64) -> Vector3<f64> {
+        self.0 * t
+    }
+    fn acceleration(&self, _t: f64) -> Vector3<f64> {
+        self.0
+    }
+}
+
+/// The batch of `chain` with one pivot acceleration per row of `pivot`: one model
+/// repeated ([`DirectionsBatch::repeated`], its constants built once) when every row is
+/// the same, as when none is given.
+fn batch(
+    chain: &pendulum_core::Chain<Dyn>,
+    pivot: &Rows,
+) -> pendulum_core::Result<DirectionsBatch<U3, Accelerated>> {
+    let one = Directions::<U3>::new(chain.clone());
+    let drive = |k: usize| Accelerated(Vector3::from_column_slice(pivot.row(k)));
+    let count = pivot.count();
+    if (1..count).all(|k| pivot.row(k) == pivot.row(0)) {
+        return DirectionsBatch::repeated(one.with_drive(drive(0)), count);
+    }
+    DirectionsBatch::new((0..count).map(|k| one.clone().with_drive(drive(k))).collect())
+}
+
+/// Checks that every link direction of `q` (rows of `width = 3n`) is a unit vector to
+/// [`UNIT_TOLERANCE`]; the error names the state and the link. A non-finite number is
+/// left to the finiteness checks, which name it.
+pub fn check_unit<T: Copy + Into<f64>>(q: &[T], width: usize) -> PyResult<()> {
+    for (state, row) in q.chunks_exact(width.max(1)).enumerate() {
+        for (link, u) in row.chunks_exact(3).enumerate() {
+            let norm = u.iter().map(|&c| c.into() * c.into()).sum::<f64>().sqrt();
+            if norm.is_finite() && (norm - 1.0).abs() > UNIT_TOLERANCE {
+                return Err(invalid(format!(
+                    "q: link {link} of state {state} has |u| = {norm}, expected unit directions \
+                     (model='directions': q holds each rod's direction (x, y, z), not angles)"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The states `(u, u̇)` of `q`, `qd` side by side, `6n` numbers a state.
+fn states(q: &Rows, qd: &Rows) -> Vec<f64> {
+    let half = q.width;
+    let mut x = Vec::with_capacity(2 * q.data.len());
+    for (u, w) in q.data.chunks_exact(half.max(1)).zip(qd.data.chunks_exact(half.max(1))) {
+        x.extend_from_slice(u);
+        x.extend_from_slice(w);
+    }
+    x
+}
+
+/// `ü` (1/s²) of many states given as C-contiguous arrays `q` and `qd` (or none) of shape
+/// `(B, 3n)`, one pivot acceleration `pivot` (m/s²) for all, one model repeated
+/// ([`DirectionsBatch::accelerations_split`]): float64 read where numpy holds it and
+/// written into the result array, the same numbers as [`accelerations`]. With `single`
+/// ([`DirectionsBatch::accelerations_split_f32`]), float32 tables read in place and
+/// float64 ones rounded in one pass each, float32 back. `None`: not this case.
+pub fn accelerations_in_place<'py>(
+    py: Python<'py>,
+    chain: &pendulum_core::Chain<Dyn>,
+    q: &Bound<'py, PyAny>,
+    qd: Option<&Bound<'py, PyAny>>,
+    pivot: Vector3<f64>,
+    single: bool,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let width = 3 * chain.links();
+    let model = Directions::<U3>::new(chain.clone()).with_drive(Accelerated(pivot));
+    let batch = |states: usize| DirectionsBatch::repeated(model.clone(), states / width).map_err(core_error);
+    if !single {
+        return in_place(py, q, qd, width, |u, w, out| {
+            check_unit(u, width)?;
+            let batch = batch(u.len())?;
+            let failures = maybe_detached(py, u.len(), || batch.accelerations_split(0.0, u, w, out))
+                .map_err(core_error)?;
+            first_failure(failures, u, w, |failure| core_error(failure.error))
+        });
+    }
+    let run = |u: &[f32], w: &[f32], out: &mut [f32]| {
+        check_unit(u, width)?;
+        let batch = batch(u.len())?;
+        let failures = maybe_detached(py, u.len(), || batch.accelerations_split_f32(0.0, u, w, out))
+            .map_err(core_error)?;
+        first_failure(failures, u, w, |_| core_error(pendulum_core::Error::SinglePrecisionOverflow))
+    };
+    match in_place(py, q, qd, width, run)? {
+        Some(out) => Ok(Some(out)),
+        None => tables_f32(py, q, qd, width, run),
+    }
+}
+
+/// A failure's error: a non-finite input named as the general path names it, else
+/// `otherwise(failure)`.
+fn first_failure<T: Copy + Into<f64>>(
+    failures: Vec<Failure>,
+    u: &[T],
+    w: &[T],
+    otherwise: impl Fn(Failure) -> PyErr,
+) -> PyResult<()> {
+    match failures.into_iter().next() {
+        Some(failure) => Err(non_finite_input(u, w).unwrap_or_else(|| otherwise(failure))),
+        None => Ok(()),
+    }
+}
+
+/// The first failure as the error.
+fn first(failures: Vec<Failure>) -> pendulum_core::Result<()> {
+    match failures.into_iter().next() {
+        Some(failure) => Err(failure.error),
+        None => Ok(()),
+    }
+}
+
+/// `ü` (1/s²) of every state, rows of `3n`: [`DirectionsBatch::accelerations`], each row
+/// bit for bit [`Directions::accelerations`] of that state alone.
+pub fn accelerations(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, pivot]: [&Rows; 3],
+) -> pendulum_core::Result<Vec<f64>> {
+    let mut out = vec![0.0; q.data.len()];
+    if q.count() == 0 {
+        return Ok(out);
+    }
+    first(batch(chain, pivot)?.accelerations(0.0, &states(q, qd), &mut out)?)?;
+    Ok(out)
+}
+
+/// [`accelerations`] in single precision ([`DirectionsBatch::accelerations_f32`]): the
+/// states rounded to `f32`, eight per AVX2 register.
+pub fn accelerations_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, pivot]: [&Rows; 3],
+) -> pendulum_core::Result<Vec<f32>> {
+    let mut out = vec![0.0f32; q.data.len()];
+    if q.count() == 0 {
+        return Ok(out);
+    }
+    let x: Vec<f32> = states(q, qd).iter().map(|&v| v as f32).collect();
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(pendulum_core::Error::SinglePrecisionOverflow);
+    }
+    first(batch(chain, pivot)?.accelerations_f32(0.0, &x, &mut out)?)?;
+    Ok(out)
+}
+
+/// `(T, U)` (J) of every state relative to the pivot ([`Directions::kinetic_energy`],
+/// [`Directions::potential_energy`]).
+pub fn energies(chain: &pendulum_core::Chain<Dyn>, [q, qd]: [&Rows; 2]) -> (Vec<f64>, Vec<f64>) {
+    let model = Directions::<U3>::new(chain.clone());
+    let x = states(q, qd);
+    x.chunks_exact(2 * q.width.max(1))
+        .map(|x| {
+            let x = DVector::from_column_slice(x);
+            (model.kinetic_energy(&x), model.potential_energy(&x))
+        })
+        .unzip()
+}
+
+/// The projected RK4 run (`Projected<Rk4>`) of `plan` from each state, its pivot
+/// acceleration held: [`DirectionsBatch::integrate_rk4`] in chunks, the states sampled as
+/// `plan` says (the signature of the planar runs, the torques unused: the caller refuses
+/// them).
+pub fn rk4(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, _torque, pivot]: [&Rows; 4],
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f64>> {
+    let half = q.width;
+    let batch = batch(chain, pivot).map_err(core)?;
+    let mut states: Vec<State<Dyn>> = states(q, qd)
+        .chunks_exact(2 * half.max(1))
+        .map(|x| State::new(0.0, DVector::from_column_slice(x)))
+        .collect();
+    in_chunks(
+        (&q.lead, chain.links(), plan, stop),
+        &mut states,
+        |states, now| batch.integrate_rk4(states, plan.h, now),
+        |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),
+    )
+}

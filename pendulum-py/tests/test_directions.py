@@ -1,0 +1,200 @@
+"""Chain's model="directions" (the 3D chain in unit link directions, through the batch of
+chains): against the spherical-angle model by the chain rule, against the planar model in
+a vertical plane, a pivot's acceleration as a change of gravity, batches against one state
+at a time, float32 against float64, the projected RK4 run's invariants, and bad input."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import pendulum
+
+
+def directions(theta, phi):
+    """u_i = (sin θ cos φ, sin θ sin φ, −cos θ) and its first and second derivatives by θ and
+    φ, as arrays of shape (n, 3)."""
+    st_, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
+    zero = np.zeros_like(theta)
+    u = np.stack([st_ * cp, st_ * sp, -ct], 1)
+    u_t = np.stack([ct * cp, ct * sp, st_], 1)
+    u_p = np.stack([-st_ * sp, st_ * cp, zero], 1)
+    u_tp = np.stack([-ct * sp, ct * cp, zero], 1)
+    u_pp = np.stack([-st_ * cp, -st_ * sp, zero], 1)
+    return u, u_t, u_p, -u, u_tp, u_pp
+
+
+def planar_directions(theta, rate):
+    """(u, u̇) of a chain in the x–z plane at angles θ from the downward vertical, flat."""
+    zero = np.zeros_like(theta)
+    u = np.stack([np.sin(theta), zero, -np.cos(theta)], 1)
+    normal = np.stack([np.cos(theta), zero, np.sin(theta)], 1)
+    return u.ravel(), (rate[:, None] * normal).ravel()
+
+
+positive = st.floats(0.2, 3.0)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.lists(positive, min_size=3, max_size=3),
+    st.lists(positive, min_size=3, max_size=3),
+    st.floats(0.0, 0.5),
+    st.integers(0, 2**32 - 1),
+)
+def test_directions_agree_with_the_spherical_angle_model_by_the_chain_rule(masses, lengths, damping, seed):
+    # Away from the poles the spherical model is regular: ü = u_θ θ̈ + u_φ φ̈ + u_θθ θ̇² +
+    # 2 u_θφ θ̇ φ̇ + u_φφ φ̇², with θ̈, φ̈ from model="spatial" (the same chain, damping and
+    # pivot acceleration).
+    r = np.random.default_rng(seed)
+    chain = pendulum.Chain(masses, lengths, damping=damping)
+    theta, phi = r.uniform(0.4, 2.7, 3), r.uniform(-3, 3, 3)
+    rates = r.uniform(-2, 2, 6)
+    pivot = r.uniform(-5, 5, 3)
+    q = np.concatenate([theta, phi])
+    qdd = chain.accelerations(q, rates, pivot_acceleration=pivot, model="spatial")
+    u, u_t, u_p, u_tt, u_tp, u_pp = directions(theta, phi)
+    td, pd, tdd, pdd = rates[:3, None], rates[3:, None], qdd[:3, None], qdd[3:, None]
+    ud = u_t * td + u_p * pd
+    expected = u_t * tdd + u_p * pdd + u_tt * td**2 + 2 * u_tp * td * pd + u_pp * pd**2
+    got = chain.accelerations(u.ravel(), ud.ravel(), pivot_acceleration=pivot, model="directions")
+    scale = np.max(np.abs(expected)) + 1.0
+    assert np.max(np.abs(got - expected.ravel())) < 1e-9 * scale
+
+
+def test_a_chain_in_a_vertical_plane_moves_as_the_planar_model_says():
+    chain = pendulum.Chain([1.0, 0.5, 0.8, 0.3], [1.0, 0.7, 0.5, 0.4], damping=0.05)
+    r = np.random.default_rng(4)
+    theta, rate = r.uniform(-3, 3, 4), r.uniform(-3, 3, 4)
+    u, ud = planar_directions(theta, rate)
+    tdd = chain.accelerations(theta, rate, pivot_acceleration=[1.5, -2.0], model="planar")
+    got = chain.accelerations(u, ud, pivot_acceleration=[1.5, 0.0, -2.0], model="directions").reshape(4, 3)
+    normal = np.stack([np.cos(theta), np.zeros(4), np.sin(theta)], 1)
+    expected = tdd[:, None] * normal - rate[:, None] ** 2 * u.reshape(4, 3)
+    assert np.max(np.abs(got - expected)) < 1e-12 * np.max(np.abs(expected))
+
+
+def test_a_vertical_pivot_acceleration_is_a_change_of_gravity():
+    # In the pivot's frame p̈ acts as gravity g⃗ − p̈: lifting the pivot at a m/s² is gravity
+    # g + a.
+    masses, lengths = [0.3, 0.2, 0.4], [0.5, 0.4, 0.6]
+    r = np.random.default_rng(7)
+    u = r.normal(size=(3, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    w = np.cross(u, r.normal(size=(3, 3)))
+    lifted = pendulum.Chain(masses, lengths, gravity=9.81).accelerations(
+        u.ravel(), w.ravel(), pivot_acceleration=[0, 0, 2.5], model="directions"
+    )
+    heavier = pendulum.Chain(masses, lengths, gravity=12.31).accelerations(u.ravel(), w.ravel(), model="directions")
+    assert np.allclose(lifted, heavier, rtol=0, atol=1e-12 * np.max(np.abs(heavier)))
+
+
+def test_a_chain_hanging_at_rest_stays_there():
+    chain = pendulum.Chain([0.1] * 20, 0.05)
+    hanging = np.tile([0.0, 0.0, -1.0], 20)
+    assert np.max(np.abs(chain.accelerations(hanging, model="directions"))) < 1e-12
+    q, qd = chain.integrate(hanging, h=1e-3, steps=100, model="directions")
+    assert np.max(np.abs(q - hanging)) < 1e-12 and np.max(np.abs(qd)) < 1e-10
+
+
+def random_states(rng, shape, n):
+    u = rng.normal(size=(*shape, n, 3))
+    u /= np.linalg.norm(u, axis=-1, keepdims=True)
+    w = np.cross(u, rng.normal(size=(*shape, n, 3)))
+    return u.reshape(*shape, 3 * n), w.reshape(*shape, 3 * n)
+
+
+def test_many_states_equal_each_state_alone_bit_for_bit():
+    chain = pendulum.Chain([0.2, 0.1, 0.3, 0.2, 0.1], 0.2, damping=0.01)
+    r = np.random.default_rng(11)
+    u, w = random_states(r, (3, 7), 5)
+    pivot = r.uniform(-3, 3, (3, 7, 3))
+    many = chain.accelerations(u, w, pivot_acceleration=pivot, model="directions")
+    assert many.shape == (3, 7, 15)
+    for i in range(3):
+        for j in range(7):
+            one = chain.accelerations(u[i, j], w[i, j], pivot_acceleration=pivot[i, j], model="directions")
+            assert np.array_equal(one, many[i, j])
+    # One pivot row for all states is that row repeated.
+    shared = chain.accelerations(u, w, pivot_acceleration=pivot[0, 0], model="directions")
+    repeated = chain.accelerations(u, w, pivot_acceleration=np.broadcast_to(pivot[0, 0], pivot.shape), model="directions")
+    assert np.array_equal(shared, repeated)
+
+
+def test_tables_read_in_place_give_the_general_paths_numbers():
+    # A C-ordered (B, 3n) table is read where numpy holds it (one model repeated, the
+    # directions and rates apart): the same bits as the general path (a Fortran-ordered
+    # copy, a (B, 1, 3n) array), in float64 and float32, with one pivot row for all.
+    chain = pendulum.Chain([0.2, 0.1, 0.3, 0.2], 0.2, damping=0.01)
+    u, w = random_states(np.random.default_rng(12), (37,), 4)
+    pivot = [0.5, -1.0, 2.0]
+    for precision in ["float64", "float32"]:
+        table = chain.accelerations(u, w, pivot_acceleration=pivot, model="directions", precision=precision)
+        fortran = chain.accelerations(
+            np.asfortranarray(u), np.asfortranarray(w), pivot_acceleration=pivot, model="directions", precision=precision
+        )
+        lifted = chain.accelerations(u[:, None], w[:, None], pivot_acceleration=pivot, model="directions", precision=precision)
+        assert table.shape == (37, 12) and np.array_equal(table, fortran) and np.array_equal(table, lifted[:, 0])
+    single = chain.accelerations(u, w, model="directions", precision="float32")
+    from_single = chain.accelerations(u.astype(np.float32), w.astype(np.float32), model="directions", precision="float32")
+    assert from_single.dtype == np.float32 and np.array_equal(single, from_single)
+    # Bad input in a table is named as the general path names it.
+    bad = w.copy()
+    bad[5, 7] = np.nan
+    with pytest.raises(ValueError, match="qd: NaN is not finite"):
+        chain.accelerations(u, bad, model="directions")
+    with pytest.raises(ValueError, match="qd: NaN is not finite"):
+        chain.accelerations(u, bad, model="directions", precision="float32")
+    stretched = u.copy()
+    stretched[9, 3:6] *= 1.5
+    with pytest.raises(ValueError, match=r"link 1 of state 9 has \|u\| = 1.5"):
+        chain.accelerations(stretched, w, model="directions")
+
+
+def test_float32_is_within_a_few_parts_per_million_of_float64():
+    chain = pendulum.Chain([0.02, 0.01, 0.03] * 4, [0.02, 0.01, 0.015] * 4, damping=1e-4)
+    r = np.random.default_rng(3)
+    u, w = random_states(r, (200,), 12)
+    double = chain.accelerations(u, w, model="directions")
+    single = chain.accelerations(u, w, model="directions", precision="float32")
+    assert single.dtype == np.float32 and single.shape == double.shape
+    error = np.max(np.abs(single - double), axis=1) / np.max(np.abs(double), axis=1)
+    # docs/ensembles.md: below 1e-5 for spreads of masses and lengths up to 100.
+    assert np.max(error) < 1e-5
+
+
+def test_the_projected_run_keeps_rods_rigid_and_conserves_energy():
+    chain = pendulum.Chain([0.3, 0.2, 0.25, 0.1], [0.4, 0.3, 0.35, 0.2])
+    r = np.random.default_rng(5)
+    u, w = random_states(r, (6,), 4)
+    e0 = sum(chain.energy(u, w, model="directions"))
+    q, qd = chain.integrate(u, w, h=1e-4, steps=5000, model="directions")
+    e1 = sum(chain.energy(q, qd, model="directions"))
+    assert np.max(np.abs(e1 - e0) / np.abs(e0)) < 1e-7
+    links = q.reshape(6, 4, 3)
+    assert np.max(np.abs(np.linalg.norm(links, axis=-1) - 1)) < 1e-14
+    assert np.max(np.abs(np.sum(links * qd.reshape(6, 4, 3), axis=-1))) < 1e-12
+    # The trajectory's samples are integrate's states after as many steps, bit for bit.
+    t, qs, qds = chain.trajectory(u, w, h=1e-4, steps=500, every=250, model="directions")
+    assert np.allclose(t, [0.0, 0.025, 0.05]) and qs.shape == (3, 6, 12)
+    q250, qd250 = chain.integrate(u, w, h=1e-4, steps=250, model="directions")
+    assert np.array_equal(qs[0], u) and np.array_equal(qs[1], q250) and np.array_equal(qds[1], qd250)
+
+
+def test_bad_input_is_named():
+    chain = pendulum.Chain([1.0, 1.0], [1.0, 1.0])
+    u = np.array([0.0, 0.0, -1.0, 0.6, 0.0, -0.8])
+    with pytest.raises(ValueError, match=r"q: link 1 of state 2 has \|u\| = 2"):
+        chain.accelerations(np.stack([u, u, np.concatenate([u[:3], 2 * u[3:]])]), model="directions")
+    with pytest.raises(ValueError, match="the last axis has 2 entries, expected 6"):
+        chain.accelerations([0.1, 0.2], model="directions")
+    with pytest.raises(ValueError, match="takes no joint torques"):
+        chain.accelerations(u, torque=np.zeros(6), model="directions")
+    with pytest.raises(ValueError, match="integrates in 'float64' only"):
+        chain.integrate(u, h=1e-3, model="directions", precision="float32")
+    with pytest.raises(ValueError, match="this call takes 'planar' or 'spatial'"):
+        chain.jacobians(u, model="directions")
+    with pytest.raises(ValueError, match="none of 'planar', 'spatial', 'directions'"):
+        chain.accelerations(u, model="direction")
+    with pytest.raises(ValueError, match="pivot_acceleration: the last axis has 2 entries, expected 3"):
+        chain.accelerations(u, pivot_acceleration=[0.0, 1.0], model="directions")
