@@ -21,7 +21,7 @@ use crate::arrays::Rows;
 use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
-use crate::planar_states::{in_place, non_finite_input, tables_f32};
+use crate::planar_states::{first_failure, in_place, tables_f32};
 
 /// How far `|u_i|` may be from 1 in a state's directions: the rounding of directions made
 /// from angles or positions in double precision is far inside, a state in other
@@ -126,20 +126,6 @@ pub fn accelerations_in_place<'py>(
     match in_place(py, q, qd, width, run)? {
         Some(out) => Ok(Some(out)),
         None => tables_f32(py, q, qd, width, run),
-    }
-}
-
-/// A failure's error: a non-finite input named as the general path names it, else
-/// `otherwise(failure)`.
-fn first_failure<T: Copy + Into<f64>>(
-    failures: Vec<Failure>,
-    u: &[T],
-    w: &[T],
-    otherwise: impl Fn(Failure) -> PyErr,
-) -> PyResult<()> {
-    match failures.into_iter().next() {
-        Some(failure) => Err(non_finite_input(u, w).unwrap_or_else(|| otherwise(failure))),
-        None => Ok(()),
     }
 }
 

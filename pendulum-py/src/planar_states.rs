@@ -74,11 +74,7 @@ pub fn planar_table_f32<'py>(
         let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, out))
             .map_err(core_error)?;
-        match failures.is_empty() {
-            true => Ok(()),
-            false => Err(non_finite_input(qs, qds)
-                .unwrap_or_else(|| core_error(pendulum_core::Error::SinglePrecisionOverflow))),
-        }
+        first_failure(failures, qs, qds, |_| core_error(pendulum_core::Error::SinglePrecisionOverflow))
     })
 }
 
@@ -123,11 +119,22 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
     in_place(py, q, qd, chain.links(), |qs, qds, os| {
         let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        match failures.into_iter().next() {
-            Some(failure) => Err(non_finite_input(qs, qds).unwrap_or_else(|| core_error(failure.error))),
-            None => Ok(()),
-        }
+        first_failure(failures, qs, qds, |failure| core_error(failure.error))
     })
+}
+
+/// The first of a batch's `failures` as the error: a non-finite number of `q` or `qd`
+/// named as the general path names it ([`non_finite_input`]), else `otherwise(failure)`.
+pub fn first_failure<T: Copy + Into<f64>>(
+    failures: Vec<Failure>,
+    q: &[T],
+    qd: &[T],
+    otherwise: impl Fn(Failure) -> PyErr,
+) -> PyResult<()> {
+    match failures.into_iter().next() {
+        Some(failure) => Err(non_finite_input(q, qd).unwrap_or_else(|| otherwise(failure))),
+        None => Ok(()),
+    }
 }
 
 /// The general path's error for a non-finite number in `q` or `qd` ([`Rows::read`]'s
