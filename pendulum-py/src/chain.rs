@@ -28,7 +28,7 @@ use pendulum_experiment::options::{expand, links};
 /// −z and azimuths φ_i, q = (θ_1..θ_n, φ_1..φ_n); singular where a link is vertical) and
 /// `"directions"` (3D without angles: q = (u_1..u_n), each rod's unit direction (x, y, z)
 /// with z up, qd = (u̇_1..u̇_n) in 1/s; no singularity; accelerations, integrate,
-/// trajectory and energy).
+/// trajectory, jacobians and energy).
 #[pyclass(module = "pendulum._pendulum", name = "Chain", frozen)]
 #[derive(Clone)]
 pub struct Chain {
@@ -53,8 +53,8 @@ impl Kind {
             "planar" => Ok(Self::Planar),
             "spatial" => Ok(Self::Spatial),
             "directions" => Err(invalid(
-                "model: 'directions' serves accelerations, integrate, trajectory and energy; \
-                 this call takes 'planar' or 'spatial'",
+                "model: 'directions' serves accelerations, integrate, trajectory, jacobians and \
+                 energy; this call takes 'planar' or 'spatial'",
             )),
             _ => Err(invalid(format!("model: '{name}' is none of 'planar', 'spatial', 'directions'"))),
         }
@@ -350,6 +350,12 @@ where
             Ok(())
         },
     )?;
+    Ok(three_parts(&all, count, dof))
+}
+
+/// Rows of `(q̈, ∂q̈/∂q, ∂q̈/∂q̇)` (`dof + 2 dof²` numbers each) as three arrays.
+fn three_parts(all: &[f64], count: usize, dof: usize) -> [Vec<f64>; 3] {
+    let width = dof + 2 * dof * dof;
     let mut out = [
         Vec::with_capacity(count * dof),
         Vec::with_capacity(count * dof * dof),
@@ -360,7 +366,38 @@ where
         out[1].extend_from_slice(&row[dof..dof + dof * dof]);
         out[2].extend_from_slice(&row[dof + dof * dof..]);
     }
-    Ok(out)
+    out
+}
+
+/// `ü`, `∂ü/∂u` and `∂ü/∂u̇` (each row-major) of every state of `model="directions"`:
+/// the lower blocks of [`Directions::analytic_jacobian`](pendulum_core::Directions), the
+/// Jacobian of the first-order system `(u̇, ẇ) = (w, ü)` in the directions' own three
+/// components each (the constraint `|u_i| = 1` not imposed), one state at a time on every
+/// core for a large batch.
+fn direction_jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f64>; 3]> {
+    let (count, dof) = (b.q.count(), b.q.width);
+    let one = pendulum_core::Directions::<nalgebra::U3>::new(chain.clone());
+    let all = rows(
+        count,
+        dof + 2 * dof * dof,
+        || (DVector::zeros(2 * dof), DMatrix::zeros(2 * dof, 2 * dof)),
+        |(x, jacobian), i, row| {
+            x.as_mut_slice()[..dof].copy_from_slice(b.q.row(i));
+            x.as_mut_slice()[dof..].copy_from_slice(b.qd.row(i));
+            let model = one.clone().with_drive(directions::Accelerated::new(b.pivot.row(i)));
+            let (udd, blocks) = row.split_at_mut(dof);
+            model.accelerations(0.0, x, udd, None)?;
+            model.analytic_jacobian(0.0, x, jacobian)?;
+            let (du, dw) = blocks.split_at_mut(dof * dof);
+            for (r, (du, dw)) in du.chunks_exact_mut(dof).zip(dw.chunks_exact_mut(dof)).enumerate() {
+                for c in 0..dof {
+                    (du[c], dw[c]) = (jacobian[(dof + r, c)], jacobian[(dof + r, dof + c)]);
+                }
+            }
+            Ok(())
+        },
+    )?;
+    Ok(three_parts(&all, count, dof))
 }
 
 /// Every term of one state: M, c, k, d, Q, q̈, T, U.
@@ -626,7 +663,9 @@ impl Chain {
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
     /// by the coordinates (1/s²) and the rates (1/s), entry `[..., a, b]` = ∂q̈_a/∂x_b; the
-    /// states as for `accelerations`.
+    /// states as for `accelerations`. `model="directions"`: `ü` and its derivatives by the
+    /// directions' and the rates' three components each, the Jacobian of the first-order
+    /// system `(u̇, ẇ) = (w, ü)` (the constraint `|u_i| = 1` not imposed).
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
     fn jacobians<'py>(
         &self,
@@ -637,11 +676,19 @@ impl Chain {
         pivot_acceleration: Option<&Bound<'py, PyAny>>,
         model: &str,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let kind = Kind::of(model)?;
-        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
-        let [qdd, dq, dqd] =
-            maybe_detached(py, b.q.data.len() * b.q.width, || with_model!(self, kind, |m| jacobians(m, &b)))
-                .map_err(core_error)?;
+        let (b, route) = match Route::of(model)? {
+            Route::Angles(kind) => {
+                (self.batch(kind, q, qd, torque, pivot_acceleration)?, Route::Angles(kind))
+            }
+            Route::Directions => {
+                (self.directions_rows(q, qd, torque, pivot_acceleration)?, Route::Directions)
+            }
+        };
+        let [qdd, dq, dqd] = maybe_detached(py, b.q.data.len() * b.q.width, || match route {
+            Route::Angles(kind) => with_model!(self, kind, |m| jacobians(m, &b)),
+            Route::Directions => direction_jacobians(&self.inner, &b),
+        })
+        .map_err(core_error)?;
         let w = b.q.width;
         let items = [
             array(py, qdd, &b.q.lead, &[w])?,

@@ -33,6 +33,13 @@ pub const UNIT_TOLERANCE: f64 = 1e-6;
 #[derive(Debug, Clone, Copy)]
 pub struct Accelerated(Vector3<f64>);
 
+impl Accelerated {
+    /// The pivot accelerated by `p̈ = (x, y, z)` (m/s², three numbers).
+    pub fn new(acceleration: &[f64]) -> Self {
+        Self(Vector3::from_column_slice(acceleration))
+    }
+}
+
 impl Drive<U3> for Accelerated {
     fn position(&self, t: f64) -> Vector3<f64> {
         self.0 * (0.5 * t * t)
@@ -53,7 +60,7 @@ fn batch(
     pivot: &Rows,
 ) -> pendulum_core::Result<DirectionsBatch<U3, Accelerated>> {
     let one = Directions::<U3>::new(chain.clone());
-    let drive = |k: usize| Accelerated(Vector3::from_column_slice(pivot.row(k)));
+    let drive = |k: usize| Accelerated::new(pivot.row(k));
     let count = pivot.count();
     if (1..count).all(|k| pivot.row(k) == pivot.row(0)) {
         return DirectionsBatch::repeated(one.with_drive(drive(0)), count);

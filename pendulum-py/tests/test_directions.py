@@ -163,6 +163,32 @@ def test_float32_is_within_a_few_parts_per_million_of_float64():
     assert np.max(error) < 1e-5
 
 
+def test_jacobians_match_central_differences_and_batches_match_one_state():
+    # ∂ü/∂u and ∂ü/∂u̇ in the directions' own components, against central differences of
+    # the accelerations (steps of 5e-7 keep every rod within the 1e-6 of unit length the
+    # model takes).
+    chain = pendulum.Chain([0.3, 0.2, 0.4], [0.5, 0.3, 0.4], damping=0.05)
+    r = np.random.default_rng(21)
+    u, w = random_states(r, (4,), 3)
+    pivot = r.uniform(-3, 3, (4, 3))
+    udd, du, dw = chain.jacobians(u, w, pivot_acceleration=pivot, model="directions")
+    assert udd.shape == (4, 9) and du.shape == dw.shape == (4, 9, 9)
+    assert np.array_equal(udd, chain.accelerations(u, w, pivot_acceleration=pivot, model="directions"))
+    h = 5e-7
+    for k in range(4):
+        f = lambda a, b: chain.accelerations(a, b, pivot_acceleration=pivot[k], model="directions")
+        for j in range(9):
+            e = np.zeros(9)
+            e[j] = h
+            by_u = (f(u[k] + e, w[k]) - f(u[k] - e, w[k])) / (2 * h)
+            by_w = (f(u[k], w[k] + e) - f(u[k], w[k] - e)) / (2 * h)
+            scale = np.max(np.abs(du[k])) + np.max(np.abs(dw[k]))
+            assert np.max(np.abs(du[k][:, j] - by_u)) < 1e-6 * scale
+            assert np.max(np.abs(dw[k][:, j] - by_w)) < 1e-6 * scale
+        one = chain.jacobians(u[k], w[k], pivot_acceleration=pivot[k], model="directions")
+        assert all(np.array_equal(a, b[k]) for a, b in zip(one, (udd, du, dw)))
+
+
 def test_the_projected_run_keeps_rods_rigid_and_conserves_energy():
     chain = pendulum.Chain([0.3, 0.2, 0.25, 0.1], [0.4, 0.3, 0.35, 0.2])
     r = np.random.default_rng(5)
@@ -193,7 +219,7 @@ def test_bad_input_is_named():
     with pytest.raises(ValueError, match="integrates in 'float64' only"):
         chain.integrate(u, h=1e-3, model="directions", precision="float32")
     with pytest.raises(ValueError, match="this call takes 'planar' or 'spatial'"):
-        chain.jacobians(u, model="directions")
+        chain.terms(u, model="directions")
     with pytest.raises(ValueError, match="none of 'planar', 'spatial', 'directions'"):
         chain.accelerations(u, model="direction")
     with pytest.raises(ValueError, match="pivot_acceleration: the last axis has 2 entries, expected 3"):
