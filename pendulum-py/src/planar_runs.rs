@@ -1,7 +1,8 @@
 //! `Chain.integrate` and `Chain.trajectory`: RK4 steps of many planar chains in lanes, their
 //! torques and pivot accelerations held (`PlanarBatch::integrate_rk4` in double precision,
 //! bit for bit each state alone; `integrate_rk4_f32` in single), in chunks of steps between
-//! which Ctrl-C is looked at, the states sampled every so many steps if asked.
+//! which Ctrl-C is looked at, the states sampled every so many steps if asked. The chunks
+//! and samples (`run_in`, `in_chunks`) serve the directions' runs too.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

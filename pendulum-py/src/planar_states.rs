@@ -1,6 +1,7 @@
 //! `Chain.accelerations`' routes for many planar states: the batch of chains
 //! (`PlanarBatch`), in double precision with any inputs or in single precision without
-//! torques, C-ordered `(B, n)` tables read where numpy holds them.
+//! torques, C-ordered `(B, n)` tables read where numpy holds them (`in_place`,
+//! `tables_f32`: the directions' routes use them too).
 
 use nalgebra::Dyn;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
