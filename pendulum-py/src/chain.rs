@@ -1,22 +1,24 @@
 //! `pendulum.Chain`: a chain's parameters, and its models evaluated on numpy arrays —
 //! accelerations, the terms of `M q̈ + c + k + d = Q`, energies and the analytic Jacobians —
-//! for one state or a leading batch of them; their RK4 runs (`integrate`, `trajectory`, in
-//! `planar_runs`); its normal modes and linearisation.
+//! for one state or a leading batch of them (state by state in `states`, many planar
+//! states as a batch in `planar_states`, the 3D chain in directions in `directions`);
+//! their RK4 runs (`integrate`, `trajectory`, in `planar_runs`); its normal modes and
+//! linearisation.
 
-use nalgebra::{DMatrix, DVector, DefaultAllocator, Dyn, Vector3};
+use nalgebra::{DMatrix, Dyn, Vector3};
 use numpy::PyArray1;
 use pendulum_core::batch::PlanarBatch;
-use pendulum_core::{Derivatives, Inputs, Jacobians, Model, ModelAlloc, PlanarTension, Spatial};
+use pendulum_core::{PlanarTension, Spatial};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use rayon::prelude::*;
 
 use crate::arrays::{Rows, array, per_link};
-use crate::detach::{PARALLEL_FROM, maybe_detached};
+use crate::detach::maybe_detached;
 use crate::directions;
 use crate::errors::{core_error, invalid, run_error};
 use crate::planar_runs::{Plan, planar_run, run_in};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
+use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
 
 /// A chain of point masses on massless rigid rods, hung from a pivot.
@@ -84,14 +86,6 @@ impl Route {
             _ => Kind::of(name).map(Self::Angles),
         }
     }
-}
-
-/// The inputs of one call: the states and inputs as rows, checked.
-struct Batch {
-    q: Rows,
-    qd: Rows,
-    torque: Rows,
-    pivot: Rows,
 }
 
 impl Chain {
@@ -241,213 +235,6 @@ impl Chain {
             _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
         }
     }
-}
-
-/// One state's vectors and inputs for model `M`, filled row by row (allocated once per
-/// thread, not per state).
-struct State<M: Model<Dof = Dyn>>
-where
-    DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
-{
-    q: DVector<f64>,
-    qd: DVector<f64>,
-    inputs: Inputs<Dyn, M::Space>,
-}
-
-impl<M: Model<Dof = Dyn>> State<M>
-where
-    DefaultAllocator: ModelAlloc<M::Links, Dyn, M::Space>,
-{
-    fn new(dof: usize) -> Self {
-        Self { q: DVector::zeros(dof), qd: DVector::zeros(dof), inputs: Inputs::zeros(Dyn(dof)) }
-    }
-
-    /// Row `i` of the batch.
-    fn load(&mut self, b: &Batch, i: usize) -> &mut Self {
-        self.q.copy_from_slice(b.q.row(i));
-        self.qd.copy_from_slice(b.qd.row(i));
-        self.inputs.torque.copy_from_slice(b.torque.row(i));
-        self.inputs.pivot_acceleration.copy_from_slice(b.pivot.row(i));
-        self
-    }
-}
-
-/// `count` rows of `width` numbers, row `i` written by `f(scratch, i, row)` with a
-/// scratch from `init` per thread: on every core for a large batch (each row the same
-/// computation whatever the thread, so the same bits), and the first failing row's error,
-/// by index.
-fn rows<S, F>(
-    count: usize,
-    width: usize,
-    init: impl Fn() -> S + Sync,
-    f: F,
-) -> pendulum_core::Result<Vec<f64>>
-where
-    F: Fn(&mut S, usize, &mut [f64]) -> pendulum_core::Result<()> + Sync,
-{
-    let mut out = vec![0.0; count * width];
-    if width == 0 {
-        return Ok(out);
-    }
-    let results: Vec<pendulum_core::Result<()>> = if count * width < PARALLEL_FROM {
-        let mut scratch = init();
-        out.chunks_mut(width).enumerate().map(|(i, row)| f(&mut scratch, i, row)).collect()
-    } else {
-        out.par_chunks_mut(width)
-            .enumerate()
-            .map_init(&init, |scratch, (i, row)| f(scratch, i, row))
-            .collect()
-    };
-    results.into_iter().collect::<pendulum_core::Result<()>>()?;
-    Ok(out)
-}
-
-/// `q̈` of every state, row after row.
-fn accelerations<M: Model<Links = Dyn, Dof = Dyn> + Sync>(
-    model: &M,
-    b: &Batch,
-) -> pendulum_core::Result<Vec<f64>>
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
-{
-    let dof = b.q.width;
-    rows(
-        b.q.count(),
-        dof,
-        || (State::<M>::new(dof), DVector::zeros(dof)),
-        |(state, qdd), i, row| {
-            let s = state.load(b, i);
-            model.accelerations(&s.q, &s.qd, &s.inputs, qdd)?;
-            row.copy_from_slice(qdd.as_slice());
-            Ok(())
-        },
-    )
-}
-
-/// `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state (each matrix row-major).
-fn jacobians<M: Derivatives<Links = Dyn, Dof = Dyn> + Sync>(
-    model: &M,
-    b: &Batch,
-) -> pendulum_core::Result<[Vec<f64>; 3]>
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
-{
-    let (count, dof) = (b.q.count(), b.q.width);
-    let width = dof + 2 * dof * dof;
-    let all = rows(
-        count,
-        width,
-        || (State::<M>::new(dof), Jacobians::zeros(model)),
-        |(state, jac), i, row| {
-            let s = state.load(b, i);
-            model.state_jacobians(&s.q, &s.qd, &s.inputs, jac)?;
-            let (qdd, matrices) = row.split_at_mut(dof);
-            qdd.copy_from_slice(jac.accelerations.as_slice());
-            let (dq, dqd) = matrices.split_at_mut(dof * dof);
-            // nalgebra is column-major; numpy rows.
-            dq.copy_from_slice(jac.q.transpose().as_slice());
-            dqd.copy_from_slice(jac.qd.transpose().as_slice());
-            Ok(())
-        },
-    )?;
-    Ok(three_parts(&all, count, dof))
-}
-
-/// Rows of `(q̈, ∂q̈/∂q, ∂q̈/∂q̇)` (`dof + 2 dof²` numbers each) as three arrays.
-fn three_parts(all: &[f64], count: usize, dof: usize) -> [Vec<f64>; 3] {
-    let width = dof + 2 * dof * dof;
-    let mut out = [
-        Vec::with_capacity(count * dof),
-        Vec::with_capacity(count * dof * dof),
-        Vec::with_capacity(count * dof * dof),
-    ];
-    for row in all.chunks(width.max(1)).take(count) {
-        out[0].extend_from_slice(&row[..dof]);
-        out[1].extend_from_slice(&row[dof..dof + dof * dof]);
-        out[2].extend_from_slice(&row[dof + dof * dof..]);
-    }
-    out
-}
-
-/// `ü`, `∂ü/∂u` and `∂ü/∂u̇` (each row-major) of every state of `model="directions"`:
-/// the lower blocks of [`Directions::analytic_jacobian`](pendulum_core::Directions), the
-/// Jacobian of the first-order system `(u̇, ẇ) = (w, ü)` in the directions' own three
-/// components each (the constraint `|u_i| = 1` not imposed), one state at a time on every
-/// core for a large batch.
-fn direction_jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f64>; 3]> {
-    let (count, dof) = (b.q.count(), b.q.width);
-    let one = pendulum_core::Directions::<nalgebra::U3>::new(chain.clone());
-    let all = rows(
-        count,
-        dof + 2 * dof * dof,
-        || (DVector::zeros(2 * dof), DMatrix::zeros(2 * dof, 2 * dof)),
-        |(x, jacobian), i, row| {
-            x.as_mut_slice()[..dof].copy_from_slice(b.q.row(i));
-            x.as_mut_slice()[dof..].copy_from_slice(b.qd.row(i));
-            let model = one.clone().with_drive(directions::Accelerated::new(b.pivot.row(i)));
-            let (udd, blocks) = row.split_at_mut(dof);
-            model.accelerations(0.0, x, udd, None)?;
-            model.analytic_jacobian(0.0, x, jacobian)?;
-            let (du, dw) = blocks.split_at_mut(dof * dof);
-            for (r, (du, dw)) in du.chunks_exact_mut(dof).zip(dw.chunks_exact_mut(dof)).enumerate() {
-                for c in 0..dof {
-                    (du[c], dw[c]) = (jacobian[(dof + r, c)], jacobian[(dof + r, dof + c)]);
-                }
-            }
-            Ok(())
-        },
-    )?;
-    Ok(three_parts(&all, count, dof))
-}
-
-/// Every term of one state: M, c, k, d, Q, q̈, T, U.
-fn terms<M: Model<Links = Dyn, Dof = Dyn>>(py: Python<'_>, model: &M, b: &Batch) -> PyResult<Py<PyDict>>
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
-{
-    let dof = b.q.width;
-    let mut state = State::<M>::new(dof);
-    let s = state.load(b, 0);
-    let (q, qd, inputs) = (&s.q, &s.qd, &s.inputs);
-    let mut qdd = DVector::zeros(dof);
-    model.accelerations(q, qd, inputs, &mut qdd).map_err(core_error)?;
-    let mut mass = DMatrix::zeros(dof, dof);
-    model.mass_matrix(q, &mut mass);
-    let vector = |f: &dyn Fn(&mut DVector<f64>)| {
-        let mut out = DVector::zeros(dof);
-        f(&mut out);
-        out.as_slice().to_vec()
-    };
-    let d = PyDict::new(py);
-    d.set_item("mass_matrix", array(py, mass.transpose().as_slice().to_vec(), &[dof, dof], &[])?)?;
-    d.set_item("velocity_terms", PyArray1::from_vec(py, vector(&|o| model.velocity_terms(q, qd, o))))?;
-    d.set_item("gravity_terms", PyArray1::from_vec(py, vector(&|o| model.gravity_terms(q, o))))?;
-    d.set_item(
-        "pivot_terms",
-        PyArray1::from_vec(py, vector(&|o| model.pivot_terms(q, &inputs.pivot_acceleration, o))),
-    )?;
-    d.set_item(
-        "generalized_forces",
-        PyArray1::from_vec(py, vector(&|o| model.generalized_forces(q, qd, &inputs.torque, o))),
-    )?;
-    d.set_item("accelerations", PyArray1::from_vec(py, qdd.as_slice().to_vec()))?;
-    d.set_item("kinetic_energy", model.kinetic_energy(q, qd))?;
-    d.set_item("potential_energy", model.potential_energy(q))?;
-    Ok(d.unbind())
-}
-
-/// Kinetic and potential energy of every state.
-fn energies<M: Model<Links = Dyn, Dof = Dyn>>(model: &M, b: &Batch) -> (Vec<f64>, Vec<f64>)
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
-{
-    let mut state = State::<M>::new(b.q.width);
-    (0..b.q.count())
-        .map(|i| {
-            let s = state.load(b, i);
-            (model.kinetic_energy(&s.q, &s.qd), model.potential_energy(&s.q))
-        })
-        .unzip()
 }
 
 /// Evaluates `$body` with `$m` the chain's model of `$kind` (generic over it).
@@ -602,7 +389,7 @@ impl Chain {
             Kind::Planar if b.q.count() > 1 => {
                 planar_batch(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data])
             }
-            _ => with_model!(self, kind, |m| accelerations(m, &b)),
+            _ => with_model!(self, kind, |m| states::accelerations(m, &b)),
         })
         .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
@@ -685,8 +472,8 @@ impl Chain {
             }
         };
         let [qdd, dq, dqd] = maybe_detached(py, b.q.data.len() * b.q.width, || match route {
-            Route::Angles(kind) => with_model!(self, kind, |m| jacobians(m, &b)),
-            Route::Directions => direction_jacobians(&self.inner, &b),
+            Route::Angles(kind) => with_model!(self, kind, |m| states::jacobians(m, &b)),
+            Route::Directions => directions::jacobians(&self.inner, &b),
         })
         .map_err(core_error)?;
         let w = b.q.width;
@@ -717,7 +504,7 @@ impl Chain {
         if !b.q.lead.is_empty() {
             return Err(invalid("terms: one state at a time (q of shape (dof,))"));
         }
-        with_model!(self, kind, |m| terms(py, m, &b))
+        with_model!(self, kind, |m| states::terms(py, m, &b))
     }
 
     /// `(T, U)`: kinetic and potential energy (J) of the states, shaped like `q` without its
@@ -734,7 +521,7 @@ impl Chain {
         let (t, u) = match Route::of(model)? {
             Route::Angles(kind) => {
                 b = self.batch(kind, q, qd, None, None)?;
-                maybe_detached(py, b.q.data.len(), || with_model!(self, kind, |m| energies(m, &b)))
+                maybe_detached(py, b.q.data.len(), || with_model!(self, kind, |m| states::energies(m, &b)))
             }
             Route::Directions => {
                 b = self.directions_rows(q, qd, None, None)?;
@@ -780,7 +567,7 @@ impl Chain {
             return Err(invalid("linearize: one state at a time (q of shape (dof,))"));
         }
         let tolerance = if force { f64::INFINITY } else { tolerance };
-        let s = with_model!(self, kind, |m| linearize_with(m, &b, tolerance)).map_err(core_error)?;
+        let s = with_model!(self, kind, |m| states::linearize_with(m, &b, tolerance)).map_err(core_error)?;
         let d = PyDict::new(py);
         let matrix =
             |m: &DMatrix<f64>| array(py, m.transpose().as_slice().to_vec(), &[m.nrows(), m.ncols()], &[]);
@@ -794,20 +581,6 @@ impl Chain {
         d.set_item("residual", s.residual)?;
         Ok(d.unbind())
     }
-}
-
-/// [`pendulum_core::linearize`] of one model at the batch's first state.
-fn linearize_with<M: Derivatives<Links = Dyn, Dof = Dyn>>(
-    model: &M,
-    b: &Batch,
-    tolerance: f64,
-) -> pendulum_core::Result<pendulum_core::StateSpace>
-where
-    DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
-{
-    let mut state = State::<M>::new(b.q.width);
-    let s = state.load(b, 0);
-    pendulum_core::linearize(model, &s.q, &s.qd, &s.inputs, tolerance)
 }
 
 /// A count of steps from Python: `what` is refused in one line when negative.

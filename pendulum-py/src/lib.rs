@@ -15,6 +15,7 @@ mod page;
 mod planar_runs;
 mod planar_states;
 mod run;
+mod states;
 mod steady;
 mod string;
 mod sweep;
