@@ -12,7 +12,7 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DMatrix, DVector, Dyn, U3, Vector3};
 use pendulum_core::Directions;
-use pendulum_core::batch::{DirectionsBatch, Failure};
+use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::drive::Drive;
 use pendulum_core::integrate::State;
 use pyo3::prelude::*;
@@ -21,7 +21,7 @@ use crate::arrays::Rows;
 use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
-use crate::planar_states::{first_failure, in_place, tables_f32};
+use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
 use crate::states::{Batch, rows, three_parts};
 
 /// How far `|u_i|` may be from 1 in a state's directions: the rounding of directions made
@@ -87,7 +87,8 @@ pub fn check_unit<T: Copy + Into<f64>>(q: &[T], width: usize) -> PyResult<()> {
     Ok(())
 }
 
-/// The states `(u, u̇)` of `q`, `qd` side by side, `6n` numbers a state.
+/// The states `(u, u̇)` of `q`, `qd` side by side, `6n` numbers a state (as a [`State`]
+/// and the energies take them).
 fn states(q: &Rows, qd: &Rows) -> Vec<f64> {
     let half = q.width;
     let mut x = Vec::with_capacity(2 * q.data.len());
@@ -114,7 +115,8 @@ pub fn accelerations_in_place<'py>(
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     let width = 3 * chain.links();
     let model = Directions::<U3>::new(chain.clone()).with_drive(Accelerated(pivot));
-    let batch = |states: usize| DirectionsBatch::repeated(model.clone(), states / width).map_err(core_error);
+    let batch =
+        |numbers: usize| DirectionsBatch::repeated(model.clone(), numbers / width).map_err(core_error);
     if !single {
         return in_place(py, q, qd, width, |u, w, out| {
             check_unit(u, width)?;
@@ -137,16 +139,8 @@ pub fn accelerations_in_place<'py>(
     }
 }
 
-/// The first failure as the error.
-fn first(failures: Vec<Failure>) -> pendulum_core::Result<()> {
-    match failures.into_iter().next() {
-        Some(failure) => Err(failure.error),
-        None => Ok(()),
-    }
-}
-
-/// `ü` (1/s²) of every state, rows of `3n`: [`DirectionsBatch::accelerations`], each row
-/// bit for bit [`Directions::accelerations`] of that state alone.
+/// `ü` (1/s²) of every state, rows of `3n`: [`DirectionsBatch::accelerations_split`], each
+/// row bit for bit [`Directions::accelerations`] of that state alone.
 pub fn accelerations(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, pivot]: [&Rows; 3],
@@ -155,12 +149,12 @@ pub fn accelerations(
     if q.count() == 0 {
         return Ok(out);
     }
-    first(batch(chain, pivot)?.accelerations(0.0, &states(q, qd), &mut out)?)?;
+    first_error(batch(chain, pivot)?.accelerations_split(0.0, &q.data, &qd.data, &mut out)?)?;
     Ok(out)
 }
 
-/// [`accelerations`] in single precision ([`DirectionsBatch::accelerations_f32`]): the
-/// states rounded to `f32`, eight per AVX2 register.
+/// [`accelerations`] in single precision ([`DirectionsBatch::accelerations_split_f32`]):
+/// the states rounded to `f32`, eight per AVX2 register.
 pub fn accelerations_f32(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, pivot]: [&Rows; 3],
@@ -169,11 +163,13 @@ pub fn accelerations_f32(
     if q.count() == 0 {
         return Ok(out);
     }
-    let x: Vec<f32> = states(q, qd).iter().map(|&v| v as f32).collect();
-    if x.iter().any(|v| !v.is_finite()) {
+    let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<_>>();
+    let (u, w) = (narrow(&q.data), narrow(&qd.data));
+    // Finite in f64 (checked when read): an infinity here is past f32's range.
+    if u.iter().chain(&w).any(|v| !v.is_finite()) {
         return Err(pendulum_core::Error::SinglePrecisionOverflow);
     }
-    first(batch(chain, pivot)?.accelerations_f32(0.0, &x, &mut out)?)?;
+    first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
     Ok(out)
 }
 

@@ -22,11 +22,13 @@ pub fn planar_batch(
 ) -> pendulum_core::Result<Vec<f64>> {
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0; q.len()];
-    let failures = batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?;
-    match failures.into_iter().next() {
-        Some(failure) => Err(failure.error),
-        None => Ok(out),
-    }
+    first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?)?;
+    Ok(out)
+}
+
+/// The first of a batch's `failures` as the error (the first failing row's).
+pub fn first_error(failures: Vec<Failure>) -> pendulum_core::Result<()> {
+    failures.into_iter().next().map_or(Ok(()), |failure| Err(failure.error))
 }
 
 /// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states

@@ -175,6 +175,7 @@ def test_jacobians_match_central_differences_and_batches_match_one_state():
     assert udd.shape == (4, 9) and du.shape == dw.shape == (4, 9, 9)
     assert np.array_equal(udd, chain.accelerations(u, w, pivot_acceleration=pivot, model="directions"))
     h = 5e-7
+    worst = 0.0
     for k in range(4):
         f = lambda a, b: chain.accelerations(a, b, pivot_acceleration=pivot[k], model="directions")
         for j in range(9):
@@ -183,10 +184,12 @@ def test_jacobians_match_central_differences_and_batches_match_one_state():
             by_u = (f(u[k] + e, w[k]) - f(u[k] - e, w[k])) / (2 * h)
             by_w = (f(u[k], w[k] + e) - f(u[k], w[k] - e)) / (2 * h)
             scale = np.max(np.abs(du[k])) + np.max(np.abs(dw[k]))
-            assert np.max(np.abs(du[k][:, j] - by_u)) < 1e-6 * scale
-            assert np.max(np.abs(dw[k][:, j] - by_w)) < 1e-6 * scale
+            error = max(np.max(np.abs(du[k][:, j] - by_u)), np.max(np.abs(dw[k][:, j] - by_w))) / scale
+            assert error < 1e-6
+            worst = max(worst, error)
         one = chain.jacobians(u[k], w[k], pivot_acceleration=pivot[k], model="directions")
         assert all(np.array_equal(a, b[k]) for a, b in zip(one, (udd, du, dw)))
+    print(f"jacobians against central differences: worst {worst:.1e} of the largest entries")
 
 
 def test_the_projected_run_keeps_rods_rigid_and_conserves_energy():
@@ -196,7 +199,9 @@ def test_the_projected_run_keeps_rods_rigid_and_conserves_energy():
     e0 = sum(chain.energy(u, w, model="directions"))
     q, qd = chain.integrate(u, w, h=1e-4, steps=5000, model="directions")
     e1 = sum(chain.energy(q, qd, model="directions"))
-    assert np.max(np.abs(e1 - e0) / np.abs(e0)) < 1e-7
+    drift = np.max(np.abs(e1 - e0) / np.abs(e0))
+    print(f"energy after 5000 projected RK4 steps of 0.1 ms: {drift:.1e} relative")
+    assert drift < 1e-7
     links = q.reshape(6, 4, 3)
     assert np.max(np.abs(np.linalg.norm(links, axis=-1) - 1)) < 1e-14
     assert np.max(np.abs(np.sum(links * qd.reshape(6, 4, 3), axis=-1))) < 1e-12

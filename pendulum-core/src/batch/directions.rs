@@ -309,9 +309,10 @@ where
         self.links
     }
 
-    /// Chain `k`'s single-chain model.
+    /// Chain `k`'s single-chain model. Panics for `k ≥ B`.
     pub fn model(&self, k: usize) -> &Directions<S, Dr> {
-        &self.models[k.min(self.models.len() - 1)]
+        assert!(k < self.count, "chain {k} of a batch of {}", self.count);
+        one_of(&self.models, k)
     }
 
     /// Whether the states carry the energy ledger ([`accounted`](Self::accounted)).
@@ -483,7 +484,7 @@ where
         of: impl Fn(&Dr, f64) -> OVector<f64, S>,
         lanes: impl Fn([f64; W]) -> V,
     ) -> [V; C] {
-        let each: [_; W] = std::array::from_fn(|k| of(self.model(chains[k]).drive(), t[k]));
+        let each: [_; W] = std::array::from_fn(|k| of(one_of(&self.models, chains[k]).drive(), t[k]));
         std::array::from_fn(|c| lanes(std::array::from_fn(|k| each[k][c])))
     }
 
@@ -550,7 +551,7 @@ where
             return (self.pivot_lanes::<C, W, _>(chains, t, Dr::acceleration, Lanes), None);
         }
         let motion: [_; W] =
-            std::array::from_fn(|k| self.model(chains[k]).drive().velocity_and_acceleration(t[k]));
+            std::array::from_fn(|k| one_of(&self.models, chains[k]).drive().velocity_and_acceleration(t[k]));
         let velocity = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].0[c])));
         let acceleration = std::array::from_fn(|c| Lanes(std::array::from_fn(|k| motion[k].1[c])));
         (acceleration, Some(velocity))

@@ -155,11 +155,12 @@ pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain
     }
 }
 
-/// Block `b`'s constants in `blocks`, or the one block of a batch of one chain repeated
-/// (`repeated`: one block for every block).
+/// Item `k` of a batch's per-chain or per-block `items`, or the one item of a batch of one
+/// chain repeated (`repeated`: one model and one block of constants for all). Out of range
+/// otherwise, it panics as indexing does (no silent clamping).
 #[inline(always)]
-pub(crate) fn one_of<T>(blocks: &[T], b: usize) -> &T {
-    &blocks[b.min(blocks.len() - 1)]
+pub(crate) fn one_of<T>(items: &[T], k: usize) -> &T {
+    if items.len() == 1 { &items[0] } else { &items[k] }
 }
 
 /// The chains of block `b` of a batch of `chains`, in blocks of `W`: lane `k` holds chain

@@ -230,9 +230,10 @@ impl PlanarBatch {
         self.links
     }
 
-    /// Chain `k`'s single-chain model.
+    /// Chain `k`'s single-chain model. Panics for `k ≥ B`.
     pub fn chain(&self, k: usize) -> &PlanarTension<Dyn> {
-        &self.chains[k.min(self.chains.len() - 1)]
+        assert!(k < self.count, "chain {k} of a batch of {}", self.count);
+        one_of(&self.chains, k)
     }
 
     /// The angle accelerations `θ̈` (rad/s²) of every chain, written into `out` as `B` rows of
