@@ -21,7 +21,9 @@
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
 //!   lanes instead of eight too);
 //! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time
-//!   against `PlanarBatch::state_jacobians` on one thread and on two.
+//!   against `PlanarBatch::state_jacobians` on one thread and on two;
+//!   `jacobians/spatial/…/20` the same in 3D directions (`Directions::analytic_jacobian`
+//!   against `DirectionsBatch::state_jacobians`).
 //!
 //! `cargo bench -p pendulum-core --bench ensembles`
 
@@ -542,6 +544,36 @@ fn jacobians(c: &mut Criterion) {
                 batch.state_jacobians(&q, &qd, None, &mut dq, &mut dqd).expect("batch");
             })
         });
+    }
+    // The same for 64 chains of 20 links in 3D directions: each chain's
+    // `Directions::analytic_jacobian` (the whole first-order Jacobian, as a user calls it)
+    // against `DirectionsBatch::state_jacobians` (its lower blocks, row-major).
+    let models: Vec<Directions<U3>> =
+        (0..CHAINS).map(|_| Directions::new(random_chain(N, 2.0, &mut r))).collect();
+    let x = spatial_states(&models, &mut r);
+    let mut jacobian = nalgebra::DMatrix::zeros(6 * N, 6 * N);
+    group.bench_with_input(BenchmarkId::new("spatial/single", N), &N, |b, _| {
+        b.iter(|| {
+            for (model, x) in models.iter().zip(&x) {
+                model.analytic_jacobian(0.0, x, &mut jacobian).expect("single");
+                black_box(&jacobian);
+            }
+        })
+    });
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+    let (mut du, mut dw) = (vec![0.0; CHAINS * 9 * N * N], vec![0.0; CHAINS * 9 * N * N]);
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        group.bench_with_input(
+            BenchmarkId::new(format!("spatial/batch_{threads}_threads"), N),
+            &N,
+            |b, _| {
+                in_pool(b, &pool, || {
+                    batch.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
+                })
+            },
+        );
     }
     group.finish();
 }

@@ -66,7 +66,7 @@ where
         DefaultAllocator: Allocator<D, D>,
     {
         let n = self.accelerations.len();
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         for i in 0..n {
             out[(i, n + i)] = 1.0;
             for j in 0..n {

@@ -10,7 +10,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::{DMatrix, DVector, Dyn, U3, Vector3};
+use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::Directions;
 use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::drive::Drive;
@@ -22,7 +22,7 @@ use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
 use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
-use crate::states::{Batch, rows, three_parts};
+use crate::states::Batch;
 
 /// How far `|u_i|` may be from 1 in a state's directions: the rounding of directions made
 /// from angles or positions in double precision is far inside, a state in other
@@ -187,34 +187,20 @@ pub fn energies(chain: &pendulum_core::Chain<Dyn>, [q, qd]: [&Rows; 2]) -> (Vec<
 }
 
 /// `ü`, `∂ü/∂u` and `∂ü/∂u̇` (each row-major) of every state of `model="directions"`:
-/// the lower blocks of [`Directions::analytic_jacobian`](pendulum_core::Directions), the
-/// Jacobian of the first-order system `(u̇, ẇ) = (w, ü)` in the directions' own three
-/// components each (the constraint `|u_i| = 1` not imposed), one state at a time on every
-/// core for a large batch.
+/// [`DirectionsBatch::accelerations_split`] and [`DirectionsBatch::state_jacobians_split`],
+/// the lower blocks of each state's [`Directions::analytic_jacobian`](pendulum_core::Directions),
+/// the Jacobian of the first-order system `(u̇, ẇ) = (w, ü)` in the directions' own three
+/// components each (the constraint `|u_i| = 1` not imposed), the states on every core.
 pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f64>; 3]> {
     let (count, dof) = (b.q.count(), b.q.width);
-    let one = Directions::<U3>::new(chain.clone());
-    let all = rows(
-        count,
-        dof + 2 * dof * dof,
-        || (DVector::zeros(2 * dof), DMatrix::zeros(2 * dof, 2 * dof)),
-        |(x, jacobian), i, row| {
-            x.as_mut_slice()[..dof].copy_from_slice(b.q.row(i));
-            x.as_mut_slice()[dof..].copy_from_slice(b.qd.row(i));
-            let model = one.clone().with_drive(Accelerated::new(b.pivot.row(i)));
-            let (udd, blocks) = row.split_at_mut(dof);
-            model.accelerations(0.0, x, udd, None)?;
-            model.analytic_jacobian(0.0, x, jacobian)?;
-            let (du, dw) = blocks.split_at_mut(dof * dof);
-            for (r, (du, dw)) in du.chunks_exact_mut(dof).zip(dw.chunks_exact_mut(dof)).enumerate() {
-                for c in 0..dof {
-                    (du[c], dw[c]) = (jacobian[(dof + r, c)], jacobian[(dof + r, dof + c)]);
-                }
-            }
-            Ok(())
-        },
-    )?;
-    Ok(three_parts(&all, count, dof))
+    let mut udd = vec![0.0; count * dof];
+    let (mut du, mut dw) = (vec![0.0; count * dof * dof], vec![0.0; count * dof * dof]);
+    if count > 0 {
+        let batch = batch(chain, &b.pivot)?;
+        first_error(batch.accelerations_split(0.0, &b.q.data, &b.qd.data, &mut udd)?)?;
+        first_error(batch.state_jacobians_split(0.0, &b.q.data, &b.qd.data, &mut du, &mut dw)?)?;
+    }
+    Ok([udd, du, dw])
 }
 
 /// The projected RK4 run (`Projected<Rk4>`) of `plan` from each state, its pivot

@@ -783,6 +783,87 @@ fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_
 }
 
 #[test]
+fn batched_direction_jacobians_are_each_models_own_bit_for_bit_and_failures_stay_in_their_chain() {
+    let mut r = ChaCha8Rng::seed_from_u64(78);
+    for (chains, n) in [(1, 1), (6, 4), (23, 12)] {
+        let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+        let batch = DirectionsBatch::new(models.clone()).expect("batch");
+        let (half, t) = (3 * n, 0.83);
+        let mut joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+        // One chain with a NaN rate, one whose rates overflow the solve (finite input, no
+        // finite Jacobian): each fails alone.
+        let (nan, huge) = (chains / 2, chains - 1);
+        if chains > 2 {
+            joined[2 * half * nan + half + 1] = f64::NAN;
+            joined[2 * half * huge + half..2 * half * (huge + 1)].fill(1e200);
+        }
+        let block = half * half;
+        let (mut single_u, mut single_w) = (vec![f64::NAN; chains * block], vec![f64::NAN; chains * block]);
+        for (k, model) in models.iter().enumerate() {
+            let x = DVector::from_column_slice(&joined[2 * half * k..2 * half * (k + 1)]);
+            let mut jacobian = nalgebra::DMatrix::zeros(2 * half, 2 * half);
+            let result = model.analytic_jacobian(t, &x, &mut jacobian);
+            assert_eq!(result.is_err(), chains > 2 && k == nan, "chain {k}");
+            if chains > 2 && (k == nan || k == huge) {
+                continue;
+            }
+            for a in 0..half {
+                for b in 0..half {
+                    single_u[k * block + a * half + b] = jacobian[(half + a, b)];
+                    single_w[k * block + a * half + b] = jacobian[(half + a, half + b)];
+                }
+            }
+        }
+        let u: Vec<f64> = joined.chunks(2 * half).flat_map(|x| x[..half].to_vec()).collect();
+        let w: Vec<f64> = joined.chunks(2 * half).flat_map(|x| x[half..].to_vec()).collect();
+        for pool in pools() {
+            let what = format!("{chains} chains of {n}, {} threads", pool.current_num_threads());
+            let (mut du, mut dw) = (vec![0.0; chains * block], vec![0.0; chains * block]);
+            let failures =
+                pool.install(|| batch.state_jacobians(t, &joined, &mut du, &mut dw)).expect("joined");
+            assert_bits(&du, &single_u, &format!("{what}: ∂ü/∂u"));
+            assert_bits(&dw, &single_w, &format!("{what}: ∂ü/∂w"));
+            if chains > 2 {
+                assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [nan, huge], "{what}");
+                assert_eq!(failures[0].error.to_string(), format!("x[{}] must be finite, got NaN", half + 1));
+                assert!(matches!(failures[1].error, Error::NotPositiveDefinite), "{:?}", failures[1]);
+            } else {
+                assert!(failures.is_empty(), "{what}: {failures:?}");
+            }
+            let (mut du2, mut dw2) = (vec![0.0; chains * block], vec![0.0; chains * block]);
+            let split =
+                pool.install(|| batch.state_jacobians_split(t, &u, &w, &mut du2, &mut dw2)).expect("split");
+            assert_bits(&du2, &du, &format!("{what}: ∂ü/∂u from u and w apart"));
+            assert_bits(&dw2, &dw, &format!("{what}: ∂ü/∂w from u and w apart"));
+            assert_eq!(
+                split.iter().map(|f| f.chain).collect::<Vec<_>>(),
+                failures.iter().map(|f| f.chain).collect::<Vec<_>>()
+            );
+        }
+    }
+    // Planar chains in directions, and arrays of the wrong size.
+    let planar: Vec<_> = (0..3).map(|_| Directions::<U2>::new(random_chain(5, &mut r))).collect();
+    let x: Vec<f64> = (0..3 * 20)
+        .map(|i| if i % 20 < 10 { if i % 2 == 0 { 0.6 } else { -0.8 } } else { r.random_range(-2.0..2.0) })
+        .collect();
+    let batch = DirectionsBatch::new(planar.clone()).expect("planar");
+    let (mut du, mut dw) = (vec![0.0; 300], vec![0.0; 300]);
+    assert!(batch.state_jacobians(0.0, &x, &mut du, &mut dw).expect("planar").is_empty());
+    let mut jacobian = nalgebra::DMatrix::zeros(20, 20);
+    planar[2].analytic_jacobian(0.0, &DVector::from_column_slice(&x[40..]), &mut jacobian).expect("alone");
+    assert_eq!(du[200 + 3 * 10 + 7].to_bits(), jacobian[(13, 7)].to_bits());
+    assert_eq!(dw[200 + 9 * 10 + 2].to_bits(), jacobian[(19, 12)].to_bits());
+    assert!(matches!(
+        batch.state_jacobians(0.0, &x, &mut du[1..], &mut dw),
+        Err(Error::LengthMismatch { what: "du", expected: 300, got: 299 })
+    ));
+    assert!(matches!(
+        batch.state_jacobians(0.0, &x[1..], &mut du, &mut dw),
+        Err(Error::LengthMismatch { what: "x", .. })
+    ));
+}
+
+#[test]
 fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_chain() {
     let mut r = ChaCha8Rng::seed_from_u64(19);
     let (chains, n, h, steps) = (6, 12, 1e-3, 10);

@@ -197,7 +197,7 @@ fn reduced(model: &Directions<U3, Circle>, eq: &RelativeEquilibrium) -> Result<D
         let w = x0.fixed_rows::<3>(3 * (n + i)).into_owned();
         for (k, tk) in [t1, t2].into_iter().enumerate() {
             for velocity in [false, true] {
-                b.fill(0.0);
+                b.as_mut_slice().fill(0.0);
                 if velocity {
                     b.fixed_rows_mut::<3>(3 * (n + i)).copy_from(tk);
                 } else {

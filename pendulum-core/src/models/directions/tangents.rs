@@ -95,14 +95,32 @@ where
         if out.shape() != (len, len) {
             return Err(Error::LengthMismatch { what: "jacobian", expected: len * len, got: out.len() });
         }
-        match S::DIM {
-            2 => self.jacobian_in::<2>(t, x.as_slice(), out),
-            _ => self.jacobian_in::<3>(t, x.as_slice(), out),
+        let half = len / 2;
+        let mut lower = vec![0.0; half * len];
+        self.lower_jacobian_of_valid(t, x.as_slice(), &mut lower);
+        // On the slice: nalgebra's `fill` went entry by entry, half of the call at n = 20.
+        out.as_mut_slice().fill(0.0);
+        for i in 0..half {
+            out[(i, half + i)] = 1.0;
+        }
+        // Column by column (column-major): the lower half of each of `out`'s is one of `lower`'s.
+        let columns = out.as_mut_slice().chunks_exact_mut(len);
+        for (column, lower) in columns.zip(lower.chunks_exact(half)) {
+            column[half..].copy_from_slice(lower);
         }
         Ok(())
     }
 
-    fn jacobian_in<const C: usize>(&self, t: f64, x: &[f64], out: &mut DMatrix<f64>) {
+    /// The lower blocks of [`analytic_jacobian`](Self::analytic_jacobian), `[∂ü/∂u, ∂ü/∂w]`
+    /// (`S·n` rows, `2·S·n` columns), column-major into `lower`, at a state already checked.
+    pub(crate) fn lower_jacobian_of_valid(&self, t: f64, x: &[f64], lower: &mut [f64]) {
+        match S::DIM {
+            2 => self.lower_jacobian_in::<2>(t, x, lower),
+            _ => self.lower_jacobian_in::<3>(t, x, lower),
+        }
+    }
+
+    fn lower_jacobian_in<const C: usize>(&self, t: f64, x: &[f64], lower: &mut [f64]) {
         let n = self.links();
         let half = C * n;
         let solve = self.linearised::<C>(t, x);
@@ -123,13 +141,7 @@ where
             columns.push(Column { rod, load });
         }
         let green = solve.green(&self.rods, &rows);
-        let mut lower = vec![0.0; half * 2 * half];
-        solve.columns(&self.rods, &rows, &green, &columns, &mut lower);
-        out.fill(0.0);
-        for i in 0..half {
-            out[(i, half + i)] = 1.0;
-        }
-        out.view_mut((half, 0), (half, 2 * half)).copy_from_slice(&lower);
+        solve.columns(&self.rods, &rows, &green, &columns, lower);
     }
 }
 
