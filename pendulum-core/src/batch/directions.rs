@@ -13,7 +13,7 @@ use crate::chain::Chain;
 use crate::drive::{Drive, Fixed};
 use crate::energy::ledger::{LEDGER_LEN, direction_powers};
 use crate::error::{Error, Result};
-use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
+use crate::lanes::{Aligned, Lane, Lanes, Lanes32, one_row_at_a_time};
 use crate::models::Directions;
 use crate::models::directions::rate_load;
 use crate::rods::{Load, Loads, Rods, Rows};
@@ -52,9 +52,9 @@ pub(super) struct Block<const W: usize = WIDTH> {
     down: Lanes<W>,
     /// Per link, the mass hanging from it (kg), its length (m) and damping `λ` (N·m·s): the
     /// ledger's powers.
-    tails: Vec<Lanes<W>>,
-    lengths: Vec<Lanes<W>>,
-    damping: Vec<Lanes<W>>,
+    tails: Aligned<Lanes<W>>,
+    lengths: Aligned<Lanes<W>>,
+    damping: Aligned<Lanes<W>>,
 }
 
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
@@ -63,10 +63,10 @@ pub(super) struct Scratch<const C: usize, const W: usize> {
     /// Time and its compensation (s) per lane.
     pub t: [Lanes<W>; 2],
     /// The compensation of the state per lane.
-    pub carry: Vec<Lanes<W>>,
-    pub x: Vec<Lanes<W>>,
-    pub y: Vec<Lanes<W>>,
-    pub k: [Vec<Lanes<W>>; 4],
+    pub carry: Aligned<Lanes<W>>,
+    pub x: Aligned<Lanes<W>>,
+    pub y: Aligned<Lanes<W>>,
+    pub k: [Aligned<Lanes<W>>; 4],
 }
 
 /// The rows of one solve in lanes (the loads are built where the solve reads them:
@@ -131,7 +131,7 @@ impl<T: Transpose + Into<f64>> States<'_, T> {
 }
 
 /// A task's room for one evaluation in lanes: the solve, the block's states, its results.
-type Lanes3<const C: usize, V> = (Solve<C, V>, Vec<V>, Vec<V>);
+type Lanes3<const C: usize, V> = (Solve<C, V>, Aligned<V>, Aligned<V>);
 
 impl<const C: usize, V: Lane> Solve<C, V> {
     fn new(links: usize) -> Self {
@@ -214,7 +214,7 @@ impl<const C: usize, V: Lane> Solve<C, V> {
 
 impl<const C: usize, const W: usize> Scratch<C, W> {
     pub fn new(links: usize, state_len: usize) -> Self {
-        let lanes = || vec![Lanes([0.0; W]); state_len];
+        let lanes = || Aligned::filled(Lanes([0.0; W]), state_len);
         Self {
             solve: Solve::new(links),
             t: [Lanes([0.0; W]); 2],
@@ -409,7 +409,7 @@ where
     {
         let (chains, n) = (self.len(), self.links);
         let (half, m) = (C * n, 2 * C * n);
-        let lanes = |len: usize| vec![V::splat(0.0); len];
+        let lanes = |len: usize| Aligned::filled(V::splat(0.0), len);
         for_blocks_of::<W, _, _, _>(
             out,
             half,
@@ -618,7 +618,7 @@ where
     (0..models.len().div_ceil(W))
         .map(|b| {
             let lanes = block_chains::<W>(b, models.len());
-            let per_link = |of: fn(&Chain<Dyn>) -> &[f64]| -> Vec<Lanes<W>> {
+            let per_link = |of: fn(&Chain<Dyn>) -> &[f64]| -> Aligned<Lanes<W>> {
                 (0..links).map(|i| Lanes::from_fn(|k| of(models[lanes[k]].chain())[i])).collect()
             };
             Block {

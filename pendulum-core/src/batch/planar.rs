@@ -12,7 +12,7 @@ use super::{
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32};
+use crate::lanes::{Aligned, Lane, Lanes, Lanes32};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
@@ -55,18 +55,18 @@ pub(super) struct Block<V: Lane = F64x4> {
 /// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates and joint
 /// torques, the solve's room and the accelerations.
 struct Scratch<V: Lane = F64x4> {
-    angles: Vec<V>,
-    sin: Vec<V>,
-    cos: Vec<V>,
-    rates: Vec<V>,
-    torque: Vec<V>,
+    angles: Aligned<V>,
+    sin: Aligned<V>,
+    cos: Aligned<V>,
+    rates: Aligned<V>,
+    torque: Aligned<V>,
     work: Work<V>,
-    accelerations: Vec<V>,
+    accelerations: Aligned<V>,
 }
 
 impl<V: Lane> Scratch<V> {
     fn new(links: usize) -> Self {
-        let lanes = || vec![V::splat(0.0); links];
+        let lanes = || Aligned::filled(V::splat(0.0), links);
         Self {
             angles: lanes(),
             sin: lanes(),

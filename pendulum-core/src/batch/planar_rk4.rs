@@ -20,7 +20,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
+use crate::lanes::{Aligned, Lane, Lanes, Lanes32, one_row_at_a_time};
 
 /// The lanes a planar run steps in, with their precision's sine kernel: [`F64x4`] (or
 /// eight `f64` lanes) or [`F32x8`].
@@ -113,21 +113,21 @@ impl RunLane for F32x8 {
 /// compensations, the stage state `y` (then the increment) and the stages `k1 … k4`, each
 /// `2n` lanes.
 struct Run<V: RunLane> {
-    sin: Vec<V>,
-    cos: Vec<V>,
+    sin: Aligned<V>,
+    cos: Aligned<V>,
     work: Work<V>,
-    torque: Vec<V>,
+    torque: Aligned<V>,
     pivot: [V; 2],
     torqued: V::Mask,
-    x: Vec<V>,
-    carry: Vec<V>,
-    y: Vec<V>,
-    k: [Vec<V>; 4],
+    x: Aligned<V>,
+    carry: Aligned<V>,
+    y: Aligned<V>,
+    k: [Aligned<V>; 4],
 }
 
 impl<V: RunLane> Run<V> {
     fn new(links: usize) -> Self {
-        let lanes = |len: usize| vec![V::splat(0.0); len];
+        let lanes = |len: usize| Aligned::filled(V::splat(0.0), len);
         Self {
             sin: lanes(links),
             cos: lanes(links),

@@ -11,8 +11,11 @@
 
 use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
+mod aligned;
 #[cfg(target_arch = "x86_64")]
 mod registers;
+
+pub(crate) use aligned::Aligned;
 #[cfg(target_arch = "x86_64")]
 pub(crate) use registers::{Avx4, Avx8, AvxF32};
 

@@ -42,7 +42,7 @@
 //! `tests/tests/large_chains.rs` compare it with the dense route to round-off.
 use std::cell::RefCell;
 
-use crate::lanes::Lane;
+use crate::lanes::{Aligned, Lane};
 
 mod angle_jacobians;
 mod angles;
@@ -59,10 +59,10 @@ pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
 /// those of `W` chains side by side.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Rods<V: Lane = f64> {
-    inverse_mass: Vec<V>,
-    inverse_length: Vec<V>,
-    length: Vec<V>,
-    drag: Vec<V>,
+    inverse_mass: Aligned<V>,
+    inverse_length: Aligned<V>,
+    length: Aligned<V>,
+    drag: Aligned<V>,
 }
 
 /// A chain's per-link constants as the tension solve reads them, `n` entries each:
@@ -129,11 +129,11 @@ struct Row<const S: usize, V: Lane = f64> {
 
 /// The rows the down pass leaves for the up pass (see [`Rods::solve`]).
 #[derive(Debug)]
-pub(crate) struct Rows<const S: usize, V: Lane = f64>(Vec<Row<S, V>>);
+pub(crate) struct Rows<const S: usize, V: Lane = f64>(Aligned<Row<S, V>>);
 
 impl<const S: usize, V: Lane> Default for Rows<S, V> {
     fn default() -> Self {
-        Self(Vec::new())
+        Self(Aligned::new())
     }
 }
 
@@ -141,7 +141,10 @@ impl<const S: usize, V: Lane> Rows<S, V> {
     /// Room for `n` rods.
     pub fn with_len(n: usize) -> Self {
         let zero = V::splat(0.0);
-        Self(vec![Row { direction: [zero; S], free: [zero; S], factor: zero, scaled: zero, rhs: zero }; n])
+        Self(Aligned::filled(
+            Row { direction: [zero; S], free: [zero; S], factor: zero, scaled: zero, rhs: zero },
+            n,
+        ))
     }
 }
 

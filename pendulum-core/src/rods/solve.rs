@@ -12,7 +12,7 @@ impl Rods {
         Self {
             inverse_mass: masses.iter().map(|m| 1.0 / m).collect(),
             inverse_length: lengths.iter().map(|l| 1.0 / l).collect(),
-            length: lengths.to_vec(),
+            length: lengths.iter().copied().collect(),
             drag: damping.iter().zip(lengths).map(|(d, l)| d / l).collect(),
         }
     }
@@ -47,8 +47,9 @@ impl Rods {
     /// Each constant of `chains`, lane `k` holding `chains[k]`'s, made a lane type by `lanes`.
     fn side_by_side<const W: usize, V: Lane>(chains: [&Rods; W], lanes: impl Fn([f64; W]) -> V) -> Rods<V> {
         let n = chains[0].len();
-        let each =
-            |of: fn(&Rods) -> &[f64]| -> Vec<V> { (0..n).map(|i| lanes(chains.map(|c| of(c)[i]))).collect() };
+        let each = |of: fn(&Rods) -> &[f64]| -> Aligned<V> {
+            (0..n).map(|i| lanes(chains.map(|c| of(c)[i]))).collect()
+        };
         Rods {
             inverse_mass: each(|c| &c.inverse_mass),
             inverse_length: each(|c| &c.inverse_length),
