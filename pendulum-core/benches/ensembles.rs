@@ -14,6 +14,8 @@
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
+//!   at n = 20 also each pivot shaken vertically, `FirstOrder::with_inputs(PlanarTension,
+//!   Driven)` alone against `integrate_rk4_driven` (`…/single_driven`, `…_driven`);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two (and in four lanes
 //!   instead of eight on a CPU with AVX-512), and in single precision on one;
@@ -35,7 +37,8 @@ use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Chain, Circle, Derivatives, Directions, FirstOrder, Inputs, Jacobians, Model, PlanarTension, RodMidpoint,
+    Chain, Circle, ConstantTorque, Derivatives, Directions, Driven, FirstOrder, Harmonic, Inputs, Jacobians,
+    Model, PlanarTension, RodMidpoint,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -345,7 +348,7 @@ fn planar_rk4(c: &mut Criterion) {
                 }
             })
         });
-        let batch = PlanarBatch::new(chains).expect("batch");
+        let batch = PlanarBatch::new(chains.clone()).expect("batch");
         for threads in [1, 2] {
             let pool = pool(threads);
             let mut states = start.clone();
@@ -356,6 +359,45 @@ fn planar_rk4(c: &mut Criterion) {
                     in_pool(b, &pool, || {
                         let failures =
                             batch.integrate_rk4(&mut states, None, None, 1e-4, STEPS).expect("batch");
+                        assert!(failures.is_empty(), "{failures:?}");
+                    })
+                },
+            );
+        }
+        // Each chain's pivot shaken vertically (Kapitza), read at every stage: alone (`Rk4`
+        // on `FirstOrder::with_inputs(PlanarTension, Driven)`) and in the batch, one thread.
+        if n == 20 {
+            let drives: Vec<Harmonic<U2>> = (0..CHAINS)
+                .map(|k| Harmonic::vertical(0.002, 200.0 + k as f64, 0.0).expect("drive"))
+                .collect();
+            let driven: Vec<_> = chains
+                .iter()
+                .zip(&drives)
+                .map(|(c, d)| {
+                    let inputs = Driven::new(d.clone(), ConstantTorque(DVector::zeros(n)));
+                    FirstOrder::with_inputs(PlanarTension::new(c.clone()), inputs)
+                })
+                .collect();
+            let mut solvers: Vec<_> = driven.iter().map(Rk4::new).collect();
+            let mut states = start.clone();
+            group.bench_with_input(BenchmarkId::new("planar_100_steps/single_driven", n), &n, |b, _| {
+                b.iter(|| {
+                    for ((system, rk4), state) in driven.iter().zip(&mut solvers).zip(&mut states) {
+                        for _ in 0..STEPS {
+                            rk4.step(system, state, 1e-4).expect("single");
+                        }
+                    }
+                })
+            });
+            let (one, mut states) = (pool(1), start.clone());
+            group.bench_with_input(
+                BenchmarkId::new("planar_100_steps/batch_1_threads_driven", n),
+                &n,
+                |b, _| {
+                    in_pool(b, &one, || {
+                        let failures = batch
+                            .integrate_rk4_driven(&mut states, &drives, None, 1e-4, STEPS)
+                            .expect("batch");
                         assert!(failures.is_empty(), "{failures:?}");
                     })
                 },

@@ -9,8 +9,8 @@ use pendulum_core::RodMidpoint;
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{
-    Accounted, Chain, Circle, Derivatives, Directions, Error, FirstOrder, Inputs, Jacobians, Model,
-    PlanarTension, trajectory,
+    Accounted, Chain, Circle, ConstantTorque, Derivatives, Directions, Driven, Error, FirstOrder, Harmonic,
+    Inputs, Jacobians, Model, PlanarTension, trajectory,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -668,6 +668,95 @@ fn planar_rk4_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
             }
         }
     }
+}
+
+#[test]
+fn driven_planar_runs_of_a_batch_equal_each_chain_alone_bit_for_bit() {
+    // Each chain's pivot shaken along its own line (Kapitza's vertical among them), read at
+    // every stage's time, against `Rk4` on `FirstOrder::with_inputs(PlanarTension, Driven)`.
+    let mut r = ChaCha8Rng::seed_from_u64(43);
+    let (h, steps) = (1e-4, 30);
+    for (chains, n) in [(1, 2), (7, 5), (10, 30)] {
+        let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+        let drives: Vec<Harmonic<U2>> = (0..chains)
+            .map(|k| {
+                let direction =
+                    nalgebra::Vector2::new(if k % 3 == 0 { 0.0 } else { r.random_range(-1.0..1.0) }, 1.0);
+                let (a, w, phase) =
+                    (r.random_range(0.0..0.01), r.random_range(10.0..400.0), r.random::<f64>());
+                Harmonic::new(direction, a, w, phase).expect("drive")
+            })
+            .collect();
+        let start: Vec<State<Dyn>> = (0..chains)
+            .map(|k| {
+                let x = (0..2 * n)
+                    .map(|i| if i < n { r.random_range(-3.0..3.0) } else { r.random_range(-2.0..2.0) });
+                State::new(0.013 * k as f64, DVector::from_iterator(2 * n, x))
+            })
+            .collect();
+        let torque: Vec<f64> = (0..chains * n)
+            .map(|i| if (i / n) % 2 == 1 { 0.0 } else { r.random_range(-0.05..0.05) })
+            .collect();
+        for with_torque in [false, true] {
+            let alone: Vec<State<Dyn>> = (0..chains)
+                .map(|k| {
+                    let q = DVector::from_column_slice(&torque[k * n..(k + 1) * n]);
+                    let q = if with_torque { q } else { DVector::zeros(n) };
+                    let inputs = Driven::new(drives[k].clone(), ConstantTorque(q));
+                    let system = FirstOrder::with_inputs(PlanarTension::new(chain[k].clone()), inputs);
+                    let (mut state, mut rk4) = (start[k].clone(), Rk4::new(&system));
+                    for _ in 0..steps {
+                        rk4.step(&system, &mut state, h).expect("alone");
+                    }
+                    state
+                })
+                .collect();
+            let torque = with_torque.then_some(&torque[..]);
+            let batch = PlanarBatch::new(chain.clone()).expect("batch");
+            for (batch, pool) in widths_and_pools(&batch) {
+                let what = format!(
+                    "{chains} chains of {n}, torques {with_torque}, {} threads",
+                    pool.current_num_threads()
+                );
+                // One call of 30 steps, and three of 10.
+                let mut once = start.clone();
+                let failures =
+                    pool.install(|| batch.integrate_rk4_driven(&mut once, &drives, torque, h, steps));
+                assert!(failures.expect("run").is_empty(), "{what}");
+                let mut thrice = start.clone();
+                for _ in 0..3 {
+                    let failures =
+                        pool.install(|| batch.integrate_rk4_driven(&mut thrice, &drives, torque, h, 10));
+                    assert!(failures.expect("run").is_empty(), "{what}");
+                }
+                for ((a, b), c) in once.iter().zip(&thrice).zip(&alone) {
+                    for s in [a, b] {
+                        assert_eq!(s.t().to_bits(), c.t().to_bits(), "{what}: t");
+                        assert_bits(s.x().as_slice(), c.x().as_slice(), &format!("{what}: x"));
+                    }
+                }
+            }
+        }
+    }
+    // A drive whose acceleration is not finite fails its chain alone; too few drives is an
+    // error.
+    let chain: Vec<_> = (0..3).map(|_| random_chain(4, &mut r)).collect();
+    let batch = PlanarBatch::new(chain).expect("batch");
+    let drives: Vec<Harmonic<U2>> = [1e300, 0.01, 0.01]
+        .into_iter()
+        .map(|w| Harmonic::new(nalgebra::Vector2::new(0.0, 1.0), 1.0, w, 0.3).expect("drive"))
+        .collect();
+    let mut states: Vec<State<Dyn>> =
+        (0..3).map(|_| State::new(0.0, DVector::from_element(8, 0.5))).collect();
+    let failures = batch.integrate_rk4_driven(&mut states, &drives, None, 1e-3, 5).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [0]);
+    assert!(matches!(failures[0].error, Error::NonFiniteState { .. }), "{:?}", failures[0]);
+    assert_eq!(states[0].x().as_slice(), &[0.5; 8], "the failed chain stays at its start");
+    assert!(states[1].t() > 0.0 && states[2].x()[0] != 0.5);
+    assert!(matches!(
+        batch.integrate_rk4_driven(&mut states, &drives[..2], None, 1e-3, 5),
+        Err(Error::LengthMismatch { what: "drives", expected: 3, got: 2 })
+    ));
 }
 
 #[test]

@@ -5,7 +5,7 @@
 //!
 //! [`Rk4`]: crate::integrate::Rk4
 
-use nalgebra::Dyn;
+use nalgebra::{Dyn, U2};
 
 #[cfg(target_arch = "x86_64")]
 use super::F64x8;
@@ -17,6 +17,7 @@ use super::{
     Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,
     for_blocks_of, non_finite, one_of, simd_kernel,
 };
+use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
@@ -117,7 +118,9 @@ struct Run<V: RunLane> {
     cos: Aligned<V>,
     work: Work<V>,
     torque: Aligned<V>,
-    pivot: [V; 2],
+    /// The pivot accelerations at the stages' times `t`, `t + h/2` and `t + h` (all three
+    /// the same when held).
+    pivot: [[V; 2]; 3],
     torqued: V::Mask,
     x: Aligned<V>,
     carry: Aligned<V>,
@@ -133,7 +136,7 @@ impl<V: RunLane> Run<V> {
             cos: lanes(links),
             work: Work::new(links),
             torque: lanes(links),
-            pivot: [V::splat(0.0); 2],
+            pivot: [[V::splat(0.0); 2]; 3],
             torqued: V::none(),
             x: lanes(2 * links),
             carry: lanes(2 * links),
@@ -169,12 +172,50 @@ impl PlanarBatch {
     ) -> Result<Vec<Failure>> {
         check_states(states, self.len(), 2 * self.links)?;
         self.check_run(torque, pivot, h)?;
-        let run = (states, (torque, pivot), (h, steps));
-        Ok(match &self.blocks {
+        Ok(self.runs_f64((states, (torque, pivot), (h, steps)), None))
+    }
+
+    /// [`integrate_rk4`](Self::integrate_rk4) with chain `k`'s pivot moved by `drives[k]`
+    /// (its pivot acceleration `p̈(t)`, m/s², at each stage's time, as the single chain's RK4
+    /// asks for it: `t`, `t + h/2`, `t + h`) and its torques held: equal bit for bit to
+    /// `steps` steps of [`Rk4`](crate::integrate::Rk4) on
+    /// `FirstOrder::with_inputs(PlanarTension::new(chain), Driven::new(drives[k], ConstantTorque(torque_k)))`
+    /// ([`Driven`](crate::Driven), [`ConstantTorque`](crate::ConstantTorque)) of that chain
+    /// alone. A Kapitza pendulum per chain ([`Harmonic::vertical`](crate::Harmonic::vertical)),
+    /// say, each with its own amplitude and frequency.
+    ///
+    /// Returns the chains that failed, as [`integrate_rk4`](Self::integrate_rk4) does (a
+    /// drive whose acceleration is not finite fails its chain at that step). Errors as
+    /// there, and [`Error::LengthMismatch`] for a number of drives other than `B`.
+    pub fn integrate_rk4_driven<Dr: Drive<U2> + Sync>(
+        &self,
+        states: &mut [State<Dyn>],
+        drives: &[Dr],
+        torque: Option<&[f64]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        check_states(states, self.len(), 2 * self.links)?;
+        self.check_run(torque, None, h)?;
+        if drives.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "drives", expected: self.len(), got: drives.len() });
+        }
+        let drive = |chain: usize, t: f64| {
+            let a = drives[chain].acceleration(t);
+            [a[0], a[1]]
+        };
+        Ok(self.runs_f64((states, (torque, None), (h, steps)), Some(&drive)))
+    }
+
+    /// The `f64` runs in this batch's lanes (arguments checked), the pivots from `drive`
+    /// (chain, time) when given, else held.
+    fn runs_f64(&self, run: RunArgs<'_, '_>, drive: Option<PivotAt<'_>>) -> Vec<Failure> {
+        let h = (run.2).0;
+        match &self.blocks {
             Blocks::Four(blocks) => {
                 let step =
                     |block: &Block<F64x4>, alive, s: &mut Run<F64x4>| self.rk4_step_simd(block, h, alive, s);
-                self.run_f64(blocks, run, step)
+                self.run_f64(blocks, run, drive, step)
             }
             #[cfg(target_arch = "x86_64")]
             Blocks::Eight(blocks) => {
@@ -182,11 +223,11 @@ impl PlanarBatch {
                     // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
                     unsafe { self.rk4_step_avx512(block, h, alive, s) }
                 };
-                self.run_f64(blocks, run, step)
+                self.run_f64(blocks, run, drive, step)
             }
             #[cfg(not(target_arch = "x86_64"))]
             Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
-        })
+        }
     }
 
     /// [`integrate_rk4`](Self::integrate_rk4)'s runs (arguments checked) in blocks of `W`
@@ -194,7 +235,8 @@ impl PlanarBatch {
     fn run_f64<const W: usize>(
         &self,
         blocks: &[Block<Lanes<W>>],
-        (states, (torque, pivot), (h, steps)): (&mut [State<Dyn>], Inputs<'_, f64>, (f64, usize)),
+        (states, (torque, pivot), (h, steps)): RunArgs<'_, '_>,
+        drive: Option<PivotAt<'_>>,
         step: impl Fn(&Block<Lanes<W>>, [u64; W], &mut Run<Lanes<W>>) -> [u64; W] + Sync + Send,
     ) -> Vec<Failure> {
         let (n, m) = (self.links, 2 * self.links);
@@ -217,6 +259,14 @@ impl PlanarBatch {
                 for _ in 0..steps {
                     if alive == [0; W] {
                         break;
+                    }
+                    if let Some(drive) = drive {
+                        // The stages' times as `Rk4` forms them from the step's start.
+                        for (stage, pivot) in s.pivot.iter_mut().enumerate() {
+                            let at = |t: f64| [t, t + 0.5 * h, t + h][stage];
+                            let p: [[f64; 2]; W] = std::array::from_fn(|k| drive(ids[k], at(t[0].0[k])));
+                            *pivot = [Lanes::from_fn(|k| p[k][0]), Lanes::from_fn(|k| p[k][1])];
+                        }
                     }
                     let failed = step(constants, alive, s);
                     let keep = Lanes::<W>::and_not(alive, failed);
@@ -319,8 +369,8 @@ impl PlanarBatch {
         fn rk4_step<V: RunLane>(&self, block: &Block<V>, h: f64, alive: V::Mask, s: &mut Run<V>) -> V::Mask {
             let Run { sin, cos, work, torque, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
             // Plain calls, not a closure: a closure is not compiled with the kernel's AVX2.
-            let inputs = ((&torque[..], *torqued), *pivot);
-            rates(block, inputs, x, (sin, cos, work), k1);
+            let at = |stage: usize| ((&torque[..], *torqued), pivot[stage]);
+            rates(block, at(0), x, (sin, cos, work), k1);
             // k_{j+1} = f(y) at y = x + a k_j, as nalgebra's `axpy(a, k_j, 1.0)` forms it.
             // (Each loop over rows ends with `one_row_at_a_time`.)
             let (a_half, a_full) = (V::splat(0.5 * h), V::splat(h));
@@ -328,17 +378,17 @@ impl PlanarBatch {
                 *y = a_half * *k + *x;
                 one_row_at_a_time();
             }
-            rates(block, inputs, y, (sin, cos, work), k2);
+            rates(block, at(1), y, (sin, cos, work), k2);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k2) {
                 *y = a_half * *k + *x;
                 one_row_at_a_time();
             }
-            rates(block, inputs, y, (sin, cos, work), k3);
+            rates(block, at(1), y, (sin, cos, work), k3);
             for ((y, x), k) in y.iter_mut().zip(&*x).zip(&*k3) {
                 *y = a_full * *k + *x;
                 one_row_at_a_time();
             }
-            rates(block, inputs, y, (sin, cos, work), k4);
+            rates(block, at(2), y, (sin, cos, work), k4);
             let (sixth, two) = (V::splat(h / 6.0), V::splat(2.0));
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
                 *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
@@ -359,6 +409,12 @@ impl PlanarBatch {
 
 /// A run's joint torques and pivot accelerations, each optional.
 type Inputs<'a, T> = (Option<&'a [T]>, Option<&'a [T]>);
+
+/// An `f64` run's states, held inputs, and step size and count.
+type RunArgs<'s, 'a> = (&'s mut [State<Dyn>], Inputs<'a, f64>, (f64, usize));
+
+/// Chain `k`'s pivot acceleration (m/s²) at time `t` (s), as `(k, t) ↦ [p̈_x, p̈_y]`.
+type PivotAt<'a> = &'a (dyn Fn(usize, f64) -> [f64; 2] + Sync);
 
 /// A block's start: its first `count` chains `ids` (of `n` links) with a non-finite state
 /// (`x(k)` for chain `ids[k]`) or input, as failures; which ones can step; the inputs into
@@ -390,10 +446,10 @@ where
         }
         None => V::none(),
     };
-    s.pivot = match pivot {
+    s.pivot = [match pivot {
         Some(p) => [V::from_nums(|k| p[2 * ids[k]]), V::from_nums(|k| p[2 * ids[k] + 1])],
         None => [V::splat(0.0); 2],
-    };
+    }; 3];
     (failures, ok)
 }
 
