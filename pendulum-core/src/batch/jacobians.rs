@@ -1,8 +1,9 @@
 //! The Jacobians of a batch: each planar chain's O(n) tangents
 //! ([`PlanarTangents`](crate::PlanarTangents), through `PlanarTension`'s
 //! `Derivatives::state_jacobians`), each chain in directions' O(n²) Jacobian
-//! ([`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian)), the chains spread over the cores. Not in SIMD
-//! lanes: each chain runs the single-chain code, so the results are its results bit for bit.
+//! ([`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian)), the chains
+//! spread over the cores. Not in SIMD lanes: each chain runs the single-chain code, so the
+//! results are its results bit for bit.
 
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, U2, Vector2, allocator::Allocator};
 use rayon::prelude::*;
@@ -81,7 +82,8 @@ where
     /// `∂ü/∂u` (1/s²) and `∂ü/∂w` (1/s) of every chain at time `t` (s) and states
     /// `x = (u, w)` (`B` rows of `2·S·n`): written into `du` and `dw` as `B` blocks of
     /// `h × h`, `h = S·n`, row-major (`du[k h² + a h + b] = ∂ü_a/∂u_b` of chain `k`). They
-    /// are the lower blocks of each chain's [`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian), bit for bit:
+    /// are the lower blocks of each chain's
+    /// [`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian), bit for bit:
     /// the Jacobian of the first-order system in the directions' own `S` components each
     /// (the constraint `|u_i| = 1` not imposed), one O(n²) pass a chain. The chains go over
     /// the current rayon pool, each on its own (not in lanes).
