@@ -5,7 +5,8 @@ angle model (one state at a time in Rust, on every core), from Python, in one ru
 
 10⁴ states of an 8-link 3D chain: accelerations in spherical angles (`model="spatial"`),
 in directions in float64, in float32 from float64 tables and from float32 tables, and
-100 projected RK4 steps of 1 ms of every state in directions. Prints the best of 7 repeats, and how far the two models' `ü`
+100 projected RK4 steps of 1 ms of every state in directions, and the directions'
+Jacobians (`chain.jacobians(..., model="directions")`). Prints the best of 7 repeats, and how far the two models' `ü`
 are apart (the chain rule of the angle model's `q̈`).
 """
 
@@ -47,12 +48,17 @@ calls = {
         lambda: chain.integrate(u, ud, h=1e-3, steps=100, model="directions"),
         1,
     ),
+    "Jacobians, directions": (lambda: chain.jacobians(u, ud, model="directions"), 1),
 }
 best = {name: min(timeit.repeat(call, number=k, repeat=7)) / k for name, (call, k) in calls.items()}
 base = best["accelerations, spatial angles"]
 for name, seconds in best.items():
-    if name.startswith("100 RK4"):
-        print(f"{name:42s} {seconds * 1e3:8.3f} ms  ({seconds / (100 * count) * 1e9:.0f} ns a state-step)")
+    if name.startswith(("100 RK4", "Jacobians")):
+        if name.startswith("100 RK4"):
+            per = f"{seconds / (100 * count) * 1e9:.0f} ns a state-step"
+        else:
+            per = f"{seconds / count * 1e6:.1f} µs a state"
+        print(f"{name:42s} {seconds * 1e3:8.3f} ms  ({per})")
     else:
         print(f"{name:42s} {seconds * 1e3:8.3f} ms  ({base / seconds:.2f}× the angle model's call)")
 qdd = chain.accelerations(q, qd, model="spatial")
