@@ -35,7 +35,7 @@ use std::time::{Duration, Instant};
 use criterion::{Bencher, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
 use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
-use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
+use pendulum_core::integrate::{Integrator, Projected, Rk4, State, System};
 use pendulum_core::{
     Chain, Circle, ConstantTorque, Derivatives, Directions, Driven, FirstOrder, Harmonic, Inputs, Jacobians,
     Model, PlanarTension, RodMidpoint,
@@ -340,13 +340,7 @@ fn planar_rk4(c: &mut Criterion) {
         let mut solvers: Vec<_> = systems.iter().map(Rk4::new).collect();
         let mut states = start.clone();
         group.bench_with_input(BenchmarkId::new("planar_100_steps/single", n), &n, |b, _| {
-            b.iter(|| {
-                for ((system, rk4), state) in systems.iter().zip(&mut solvers).zip(&mut states) {
-                    for _ in 0..STEPS {
-                        rk4.step(system, state, 1e-4).expect("single");
-                    }
-                }
-            })
+            b.iter(|| each_alone(&systems, &mut solvers, &mut states, STEPS))
         });
         let batch = PlanarBatch::new(chains.clone()).expect("batch");
         for threads in [1, 2] {
@@ -381,13 +375,7 @@ fn planar_rk4(c: &mut Criterion) {
             let mut solvers: Vec<_> = driven.iter().map(Rk4::new).collect();
             let mut states = start.clone();
             group.bench_with_input(BenchmarkId::new("planar_100_steps/single_driven", n), &n, |b, _| {
-                b.iter(|| {
-                    for ((system, rk4), state) in driven.iter().zip(&mut solvers).zip(&mut states) {
-                        for _ in 0..STEPS {
-                            rk4.step(system, state, 1e-4).expect("single");
-                        }
-                    }
-                })
+                b.iter(|| each_alone(&driven, &mut solvers, &mut states, STEPS))
             });
             let (one, mut states) = (pool(1), start.clone());
             group.bench_with_input(
@@ -416,6 +404,20 @@ fn planar_rk4(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// `steps` RK4 steps of 0.1 ms of each system from its state, one chain after another.
+fn each_alone<Sys: System<Dim = Dyn>>(
+    systems: &[Sys],
+    solvers: &mut [Rk4<Dyn>],
+    states: &mut [State<Dyn>],
+    steps: usize,
+) {
+    for ((system, rk4), state) in systems.iter().zip(solvers).zip(states) {
+        for _ in 0..steps {
+            rk4.step(system, state, 1e-4).expect("single");
+        }
+    }
 }
 
 /// One generated model type: its `CHAINS` models one call each against the batch.

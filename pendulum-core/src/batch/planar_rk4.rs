@@ -170,9 +170,7 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        check_states(states, self.len(), 2 * self.links)?;
-        self.check_run(torque, pivot, h)?;
-        Ok(self.runs_f64((states, (torque, pivot), (h, steps)), None))
+        self.runs_f64((states, (torque, pivot), (h, steps)), None)
     }
 
     /// [`integrate_rk4`](Self::integrate_rk4) with chain `k`'s pivot moved by `drives[k]`
@@ -195,8 +193,6 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        check_states(states, self.len(), 2 * self.links)?;
-        self.check_run(torque, None, h)?;
         if drives.len() != self.len() {
             return Err(Error::LengthMismatch { what: "drives", expected: self.len(), got: drives.len() });
         }
@@ -204,14 +200,17 @@ impl PlanarBatch {
             let a = drives[chain].acceleration(t);
             [a[0], a[1]]
         };
-        Ok(self.runs_f64((states, (torque, None), (h, steps)), Some(&drive)))
+        self.runs_f64((states, (torque, None), (h, steps)), Some(&drive))
     }
 
-    /// The `f64` runs in this batch's lanes (arguments checked), the pivots from `drive`
-    /// (chain, time) when given, else held.
-    fn runs_f64(&self, run: RunArgs<'_, '_>, drive: Option<PivotAt<'_>>) -> Vec<Failure> {
-        let h = (run.2).0;
-        match &self.blocks {
+    /// The `f64` runs in this batch's lanes, the pivots from `drive` (chain, time) when
+    /// given, else held; the arguments checked first.
+    fn runs_f64(&self, run: RunArgs<'_, '_>, drive: Option<PivotAt<'_>>) -> Result<Vec<Failure>> {
+        let (states, (torque, pivot), (h, _)) = &run;
+        check_states(states, self.len(), 2 * self.links)?;
+        self.check_run(*torque, *pivot, *h)?;
+        let h = *h;
+        Ok(match &self.blocks {
             Blocks::Four(blocks) => {
                 let step =
                     |block: &Block<F64x4>, alive, s: &mut Run<F64x4>| self.rk4_step_simd(block, h, alive, s);
@@ -227,7 +226,7 @@ impl PlanarBatch {
             }
             #[cfg(not(target_arch = "x86_64"))]
             Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
-        }
+        })
     }
 
     /// [`integrate_rk4`](Self::integrate_rk4)'s runs (arguments checked) in blocks of `W`
