@@ -1,5 +1,6 @@
 """`Chain.integrate` against the RK4 a user would write around `Chain.accelerations` in
-numpy, and in single precision: 10⁴ states of an 8-link planar chain, 100 steps of 1 ms
+numpy, in single precision, and with every pivot shaken at its own frequency
+(`drive=pendulum.Harmonic`): 10⁴ states of an 8-link planar chain, 100 steps of 1 ms
 (docs/ensembles.md).
 
     target/python/bin/python pendulum-py/bench/integrate.py
@@ -12,19 +13,22 @@ import numpy as np
 import pendulum
 
 
-def numpy_rk4(chain, q, qd, h, steps):
-    """Classical RK4 around `Chain.accelerations`, the states as one (B, 2n) array."""
+def numpy_rk4(chain, q, qd, h, steps, pivot=None):
+    """Classical RK4 around `Chain.accelerations`, the states as one (B, 2n) array; the
+    pivot accelerations `pivot(t)` (B, 2) at each stage's time when given."""
     n = chain.n
     x = np.concatenate([q, qd], axis=-1)
 
-    def f(x):
-        return np.concatenate([x[:, n:], chain.accelerations(x[:, :n], x[:, n:])], axis=-1)
+    def f(x, t):
+        p = None if pivot is None else pivot(t)
+        return np.concatenate([x[:, n:], chain.accelerations(x[:, :n], x[:, n:], pivot_acceleration=p)], axis=-1)
 
-    for _ in range(steps):
-        k1 = f(x)
-        k2 = f(0.5 * h * k1 + x)
-        k3 = f(0.5 * h * k2 + x)
-        k4 = f(h * k3 + x)
+    for k in range(steps):
+        t = k * h
+        k1 = f(x, t)
+        k2 = f(0.5 * h * k1 + x, t + 0.5 * h)
+        k3 = f(0.5 * h * k2 + x, t + 0.5 * h)
+        k4 = f(h * k3 + x, t + h)
         x = x + h / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
     return x[:, :n], x[:, n:]
 
@@ -59,6 +63,24 @@ def main():
     print(
         f"Chain.integrate(precision='float32'): {t_single * 1e3:.1f} ms ({t_ours / t_single:.2f}x float64), "
         f"largest difference {single_error:.1e} of the largest angle"
+    )
+    # Every state's pivot shaken vertically at its own frequency (a Kapitza map).
+    amplitude, omega = 0.01, np.linspace(50.0, 400.0, q.shape[0])
+    drive = pendulum.Harmonic(amplitude, omega)
+
+    def shaken(t):
+        return np.stack([np.zeros_like(omega), -amplitude * omega**2 * np.sin(omega * t)], axis=-1)
+
+    driven = chain.integrate(q, qd, h=h, steps=steps, drive=drive)
+    theirs = numpy_rk4(chain, q, qd, h, steps, pivot=shaken)
+    error = max(np.abs(driven[0] - theirs[0]).max(), np.abs(driven[1] - theirs[1]).max())
+    t_driven = best(lambda: chain.integrate(q, qd, h=h, steps=steps, drive=drive))
+    t_numpy = best(lambda: numpy_rk4(chain, q, qd, h, steps, pivot=shaken), repeats=3)
+    print(
+        f"Chain.integrate(drive=Harmonic(...)), one frequency per state: {t_driven * 1e3:.1f} ms "
+        f"({t_driven * per:.0f} ns per state-step, {t_driven / t_ours:.2f}x the held pivot's time); "
+        f"numpy RK4 around accelerations(pivot_acceleration=p(t)): {t_numpy * 1e3:.1f} ms, "
+        f"ratio {t_numpy / t_driven:.2f}x; largest difference {error:.1e}"
     )
 
 

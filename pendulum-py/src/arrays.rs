@@ -30,14 +30,7 @@ impl Rows {
     /// `what` as rows of `width`: an array (or anything numpy takes) whose last axis has
     /// `width` entries. Errors name `what` and say what was expected.
     pub fn read(what: &str, value: &Bound<'_, PyAny>, width: usize) -> PyResult<Self> {
-        let array: PyReadonlyArrayDyn<'_, f64> = value
-            .extract()
-            .or_else(|_| {
-                let np = value.py().import("numpy")?;
-                np.call_method1("asarray", (value, "float64"))?.extract()
-            })
-            .map_err(|_| invalid(format!("{what}: not an array of numbers")))?;
-        let shape = array.shape().to_vec();
+        let Numbers { shape, data } = Numbers::read_unchecked(what, value)?;
         let Some((&last, lead)) = shape.split_last() else {
             return Err(invalid(format!(
                 "{what}: a scalar, expected an array whose last axis has {width} entries"
@@ -46,15 +39,7 @@ impl Rows {
         if last != width {
             return Err(invalid(format!("{what}: the last axis has {last} entries, expected {width}")));
         }
-        // `as_slice` is memory order, which is the rows' order only for C order (a
-        // Fortran-ordered array is contiguous too); otherwise the logical order.
-        let data: Vec<f64> = match array.as_slice() {
-            Ok(contiguous) if array.is_c_contiguous() => contiguous.to_vec(),
-            _ => array.as_array().iter().copied().collect(),
-        };
-        if let Some(v) = data.iter().find(|v| !v.is_finite()) {
-            return Err(invalid(format!("{what}: {v} is not finite")));
-        }
+        finite(what, &data)?;
         Ok(Self { lead: lead.to_vec(), data, width })
     }
 
@@ -81,6 +66,78 @@ impl Rows {
             "{what}: the leading shape {:?} is not that of q, {:?} (give one row for all, or one per state)",
             rows.lead, like.lead
         )))
+    }
+}
+
+/// Finite numbers of any shape (one number: shape `()`), in C order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numbers {
+    pub shape: Vec<usize>,
+    pub data: Vec<f64>,
+}
+
+impl Numbers {
+    /// `what` as numpy reads it (`numpy.asarray(value, "float64")`); errors name `what`
+    /// and the first number that is not finite.
+    pub fn read(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let numbers = Self::read_unchecked(what, value)?;
+        finite(what, &numbers.data)?;
+        Ok(numbers)
+    }
+
+    /// [`read`](Self::read), the numbers not checked.
+    fn read_unchecked(what: &str, value: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let array: PyReadonlyArrayDyn<'_, f64> = value
+            .extract()
+            .or_else(|_| {
+                let np = value.py().import("numpy")?;
+                np.call_method1("asarray", (value, "float64"))?.extract()
+            })
+            .map_err(|_| invalid(format!("{what}: not an array of numbers")))?;
+        // `as_slice` is memory order, which is the rows' order only for C order (a
+        // Fortran-ordered array is contiguous too); otherwise the logical order.
+        let data: Vec<f64> = match array.as_slice() {
+            Ok(contiguous) if array.is_c_contiguous() => contiguous.to_vec(),
+            _ => array.as_array().iter().copied().collect(),
+        };
+        Ok(Self { shape: array.shape().to_vec(), data })
+    }
+
+    /// The numbers as an array of their shape.
+    pub fn to_array<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let (lead, tail) = self.shape.split_at(self.shape.len().saturating_sub(1));
+        match tail {
+            [] => Ok(self.data[0].into_pyobject(py)?.into_any()),
+            _ => Ok(array(py, self.data.clone(), lead, tail)?.into_any()),
+        }
+    }
+
+    /// One group of `width` numbers per state of the leading shape `lead` (`width = 1` for
+    /// one number a state): the same group for all (shape `(width,)`, or `()` when
+    /// `width = 1`), or one per state (shape `lead + (width,)`, or `lead` when `width = 1`).
+    /// Errors name `what` and the shapes.
+    pub fn per_state(&self, what: &str, width: usize, lead: &[usize]) -> PyResult<Vec<&[f64]>> {
+        let count: usize = lead.iter().product();
+        let group: &[usize] = if width == 1 { &[] } else { &[width] };
+        let each: Vec<usize> = lead.iter().chain(group).copied().collect();
+        if self.shape == group {
+            return Ok(vec![&self.data[..]; count]);
+        }
+        if self.shape == each {
+            return Ok(self.data.chunks_exact(width).collect());
+        }
+        Err(invalid(format!(
+            "{what}: shape {:?} is neither {group:?} (one for all) nor {each:?} (one per state)",
+            self.shape
+        )))
+    }
+}
+
+/// An error naming `what` and the first number of `data` that is not finite.
+fn finite(what: &str, data: &[f64]) -> PyResult<()> {
+    match data.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(invalid(format!("{what}: {v} is not finite"))),
+        None => Ok(()),
     }
 }
 

@@ -15,8 +15,9 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::arrays::{Rows, array, per_link};
 use crate::detach::maybe_detached;
 use crate::directions;
+use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error};
-use crate::planar_runs::{Plan, planar_run, run_in};
+use crate::planar_runs::{Plan, planar_rk4, planar_run, run_in};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
@@ -149,9 +150,8 @@ impl Chain {
         py: Python<'py>,
         [q]: [&Bound<'py, PyAny>; 1],
         [qd, torque, pivot]: [Option<&Bound<'py, PyAny>>; 3],
-        plan: Plan,
-        model: &str,
-        precision: &str,
+        (plan, drive): (Plan, Option<Given>),
+        (model, precision): (&str, &str),
     ) -> PyResult<Bound<'py, PyAny>> {
         let route = Route::of(model)?;
         if route == Route::Angles(Kind::Spatial) {
@@ -160,6 +160,17 @@ impl Chain {
         if !(plan.h.is_finite() && plan.h > 0.0) {
             return Err(invalid(format!("h: {} is not a positive time step (s)", plan.h)));
         }
+        if !plan.t0.is_finite() {
+            return Err(invalid(format!("t0: {} is not a finite time (s)", plan.t0)));
+        }
+        if drive.is_some() {
+            if pivot.is_some_and(|p| !p.is_none()) {
+                return Err(invalid("pivot_acceleration: a drive moves the pivot; give one or the other"));
+            }
+            if precision != "float64" {
+                return Err(invalid(format!("precision: '{precision}' — a driven run is 'float64' only")));
+            }
+        }
         if route == Route::Directions {
             if precision != "float64" {
                 return Err(invalid(format!(
@@ -167,10 +178,23 @@ impl Chain {
                 )));
             }
             let b = self.directions_rows(q, qd, torque, pivot)?;
-            return run_in(py, &self.inner, [b.q, b.qd, b.torque, b.pivot], plan, directions::rk4);
+            let drives = drive.map(|d| d.spatial(&b.q.lead)).transpose()?;
+            let rows = [b.q, b.qd, b.torque, b.pivot];
+            return run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
+                directions::rk4(c, rows, drives, plan, stop)
+            });
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
-        planar_run(py, &self.inner, [b.q, b.qd, b.torque, b.pivot], plan, precision)
+        let rows = [b.q, b.qd, b.torque, b.pivot];
+        match drive {
+            None => planar_run(py, &self.inner, rows, plan, precision),
+            Some(drive) => {
+                let drives = drive.planar(&rows[0].lead)?;
+                run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
+                    planar_rk4(c, rows, Some(&drives), plan, stop)
+                })
+            }
+        }
     }
 
     /// The states of `model="directions"`: `q` unit directions and `qd` their rates, rows
@@ -399,12 +423,15 @@ impl Chain {
     /// its joint torques (N·m) and pivot acceleration (m/s²) held over the call (none: the
     /// chain free; planar model): many states at once, four per SIMD register (eight with AVX-512) and on every
     /// core, each bit for bit what the chain alone would give (docs/ensembles.md).
+    /// `drive` (`pendulum.Harmonic`, or `pendulum.Circle` for directions) moves each
+    /// state's pivot within the call instead, its parameters one for all or one per state,
+    /// from the time `t0` (s; pass the end of one call as the start of the next).
     /// `model="directions"` steps the 3D chain in directions by RK4 with each rod put back
-    /// to unit length after every step (float64, no torques, the pivot acceleration held).
+    /// to unit length after every step (float64, no torques).
     /// `precision="float32"` steps eight states per register in single precision and
-    /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
+    /// returns float32 (its error against float64 in docs/ensembles.md; no drive). A state whose step
     /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64"))]
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn integrate<'py>(
         &self,
@@ -417,15 +444,17 @@ impl Chain {
         steps: i64,
         model: &str,
         precision: &str,
+        drive: Option<&Bound<'py, PyAny>>,
+        t0: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let plan = Plan { h, steps: count("steps", steps)?, every: None };
-        self.run(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
+        let plan = Plan { h, steps: count("steps", steps)?, every: None, t0 };
+        self.run(py, [q], [qd, torque, pivot_acceleration], (plan, Given::read(drive)?), (model, precision))
     }
 
     /// `(t, q, qd)`: `integrate`'s run sampled at the start, after every `every`-th step and
-    /// after the last: `t` (s) of shape `(samples,)`, `q` and `qd` of shape `(samples, ...)`
-    /// with the states' own shape after the first axis (the states' times start at 0).
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps, every = 1, model = "planar", precision = "float64"))]
+    /// after the last: `t` (s, from `t0`) of shape `(samples,)`, `q` and `qd` of shape
+    /// `(samples, ...)` with the states' own shape after the first axis.
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps, every = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn trajectory<'py>(
         &self,
@@ -439,13 +468,15 @@ impl Chain {
         every: i64,
         model: &str,
         precision: &str,
+        drive: Option<&Bound<'py, PyAny>>,
+        t0: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let every = match count("every", every)? {
             0 => return Err(invalid("every: 0 is not a number of steps (1 or more)")),
             every => every,
         };
-        let plan = Plan { h, steps: count("steps", steps)?, every: Some(every) };
-        self.run(py, [q], [qd, torque, pivot_acceleration], plan, model, precision)
+        let plan = Plan { h, steps: count("steps", steps)?, every: Some(every), t0 };
+        self.run(py, [q], [qd, torque, pivot_acceleration], (plan, Given::read(drive)?), (model, precision))
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians

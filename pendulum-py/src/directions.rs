@@ -6,7 +6,8 @@
 //!
 //! A state is `q = (u_1, …, u_n)`, each rod's unit direction `(x, y, z)` from mass `i − 1`
 //! to mass `i` (z up, the pivot mass 0), and `qd = (u̇_1, …, u̇_n)` (1/s); the pivot
-//! acceleration `p̈` (m/s², three components) is held constant over a call.
+//! acceleration `p̈` (m/s², three components) is held constant over a call, or a run's
+//! pivot moved by a drive (`drives`).
 
 use std::sync::atomic::AtomicBool;
 
@@ -19,6 +20,7 @@ use pyo3::prelude::*;
 
 use crate::arrays::Rows;
 use crate::detach::maybe_detached;
+use crate::drives::Pivot;
 use crate::errors::{core_error, invalid};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
 use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
@@ -204,23 +206,40 @@ pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core:
 }
 
 /// The projected RK4 run (`Projected<Rk4>`) of `plan` from each state, its pivot
-/// acceleration held: [`DirectionsBatch::integrate_rk4`] in chunks, the states sampled as
-/// `plan` says (the signature of the planar runs, the torques unused: the caller refuses
-/// them).
+/// acceleration held or, given `drives` (one per state), its pivot moved:
+/// [`DirectionsBatch::integrate_rk4`] in chunks, the states sampled as `plan` says (the
+/// signature of the planar runs, the torques unused: the caller refuses them).
 pub fn rk4(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, _torque, pivot]: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f64>> {
+    match drives {
+        None => rk4_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop),
+        Some(drives) => {
+            let one = Directions::<U3>::new(chain.clone());
+            let models = drives.into_iter().map(|d| one.clone().with_drive(d)).collect();
+            rk4_of(&DirectionsBatch::new(models).map_err(core)?, [q, qd], plan, stop)
+        }
+    }
+}
+
+/// [`rk4`] of the chains of `batch`, whatever drives their pivots.
+fn rk4_of<Dr: Drive<U3> + Sync>(
+    batch: &DirectionsBatch<U3, Dr>,
+    [q, qd]: [&Rows; 2],
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
     let half = q.width;
-    let batch = batch(chain, pivot).map_err(core)?;
     let mut states: Vec<State<Dyn>> = states(q, qd)
         .chunks_exact(2 * half.max(1))
-        .map(|x| State::new(0.0, DVector::from_column_slice(x)))
+        .map(|x| State::new(plan.t0, DVector::from_column_slice(x)))
         .collect();
     in_chunks(
-        (&q.lead, chain.links(), plan, stop),
+        (&q.lead, batch.model(0).links(), plan, stop),
         &mut states,
         |states, now| batch.integrate_rk4(states, plan.h, now),
         |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),

@@ -9,6 +9,7 @@ mod chain;
 mod claims;
 mod detach;
 mod directions;
+mod drives;
 mod errors;
 mod interrupt;
 mod page;
@@ -28,6 +29,8 @@ use pyo3::prelude::*;
 fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", pendulum_experiment::VERSION)?;
     m.add_class::<chain::Chain>()?;
+    m.add_class::<drives::Harmonic>()?;
+    m.add_class::<drives::Circle>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<run::RunResult>()?;
     m.add_class::<string::HeavyString>()?;

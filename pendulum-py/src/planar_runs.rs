@@ -6,8 +6,9 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use nalgebra::{DVector, Dyn};
+use nalgebra::{DVector, Dyn, U2};
 use numpy::PyArray1;
+use pendulum_core::Harmonic;
 use pendulum_core::batch::{Failure, PlanarBatch};
 use pendulum_core::integrate::State;
 use pendulum_experiment::Error;
@@ -21,13 +22,14 @@ use crate::interrupt::interruptible;
 /// (a few milliseconds each).
 const SOLVES_PER_CHUNK: usize = 1 << 20;
 
-/// The steps of a run: `steps` of `h` (s), the states sampled at the start, after every
-/// `every`-th step and after the last (`None`: only after the last).
+/// The steps of a run: `steps` of `h` (s) from the time `t0` (s), the states sampled at the
+/// start, after every `every`-th step and after the last (`None`: only after the last).
 #[derive(Debug, Clone, Copy)]
 pub struct Plan {
     pub h: f64,
     pub steps: usize,
     pub every: Option<usize>,
+    pub t0: f64,
 }
 
 impl Plan {
@@ -62,23 +64,29 @@ pub fn planar_run<'py>(
     precision: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     match precision {
-        "float64" => run_in(py, chain, rows, plan, planar_rk4),
+        "float64" => {
+            run_in(py, chain, rows, plan, |c, rows, plan, stop| planar_rk4(c, rows, None, plan, stop))
+        }
         "float32" => run_in(py, chain, rows, plan, planar_rk4_f32),
         _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
     }
 }
 
-/// [`planar_rk4`], [`planar_rk4_f32`] or the directions' run.
-pub type PlanarRun<T> =
-    fn(&pendulum_core::Chain<Dyn>, [&Rows; 4], Plan, &AtomicBool) -> pendulum_experiment::Result<Samples<T>>;
-
-/// [`planar_run`] in one precision's `run` (also the directions' runs).
+/// [`planar_run`] in one precision's `run` ([`planar_rk4`], [`planar_rk4_f32`], the
+/// driven runs, the directions' runs).
 pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [Rows; 4],
     plan: Plan,
-    run: PlanarRun<T>,
+    run: impl FnOnce(
+        &pendulum_core::Chain<Dyn>,
+        [&Rows; 4],
+        Plan,
+        &AtomicBool,
+    ) -> pendulum_experiment::Result<Samples<T>>
+    + Send
+    + 'static,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (lead, width, count) = (q.lead.clone(), q.width, q.count());
     let times = plan.samples();
@@ -102,17 +110,19 @@ pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
             .into_any());
     }
     let shape: Vec<usize> = std::iter::once(times.len()).chain(lead.iter().copied()).collect();
-    let t = PyArray1::from_vec(py, times.iter().map(|&k| k as f64 * plan.h).collect());
+    let t = PyArray1::from_vec(py, times.iter().map(|&k| plan.t0 + k as f64 * plan.h).collect());
     let (q, qd) = (array(py, q, &shape, &[width])?, array(py, qd, &shape, &[width])?);
     Ok((t, q, qd).into_pyobject(py)?.into_any())
 }
 
-/// `plan` for the planar chain from each state of `q`, `qd` with its torques and pivot
-/// acceleration held: [`PlanarBatch::integrate_rk4`] on every core, in chunks (the same
-/// bits as one call). A failed state is an error naming its index.
-fn planar_rk4(
+/// `plan` for the planar chain from each state of `q`, `qd` with its torques held and its
+/// pivot acceleration held ([`PlanarBatch::integrate_rk4`]) or, given `drives` (one per
+/// state), its pivot moved ([`PlanarBatch::integrate_rk4_driven`]): on every core, in
+/// chunks (the same bits as one call). A failed state is an error naming its index.
+pub fn planar_rk4(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
+    drives: Option<&[Harmonic<U2>]>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
@@ -122,12 +132,16 @@ fn planar_rk4(
         .data
         .chunks_exact(n)
         .zip(qd.data.chunks_exact(n))
-        .map(|(q, qd)| State::new(0.0, DVector::from_iterator(2 * n, q.iter().chain(qd).copied())))
+        .map(|(q, qd)| State::new(plan.t0, DVector::from_iterator(2 * n, q.iter().chain(qd).copied())))
         .collect();
+    let torque = Some(&torque.data[..]);
     in_chunks(
         (&q.lead, n, plan, stop),
         &mut states,
-        |states, now| batch.integrate_rk4(states, Some(&torque.data), Some(&pivot.data), plan.h, now),
+        |states, now| match drives {
+            Some(drives) => batch.integrate_rk4_driven(states, drives, torque, plan.h, now),
+            None => batch.integrate_rk4(states, torque, Some(&pivot.data), plan.h, now),
+        },
         |states, samples| split(n, states.iter().map(|s| s.x().as_slice()), samples),
     )
 }

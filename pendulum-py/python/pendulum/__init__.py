@@ -4,8 +4,10 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
 - ``Chain``: a chain's parameters and its models evaluated on arrays (accelerations,
   the terms of ``M q̈ + c + k + d = Q``, energies, analytic Jacobians), many states per
   call along leading axes; many states stepped by RK4 per call (``integrate``, sampled by
-  ``trajectory``, torques and pivot accelerations held); its normal modes and
-  linearisation.
+  ``trajectory``, torques and pivot accelerations held, or the pivot moved by a drive);
+  its normal modes and linearisation.
+- ``Harmonic``, ``Circle``: pivot drives for those runs (shaken along a line, or circling
+  about the vertical), their parameters one for all states or one per state.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).
@@ -33,7 +35,19 @@ SI units throughout, angles in radians. See ``docs/python.md`` in the repository
 
 from ._atlas import Atlas, atlas
 from ._claims import ClaimCheck, ClaimsReport, check_claims
-from ._pendulum import AtlasPlan, Chain, HeavyString, Run, RunResult, __version__, page, steady, whirls
+from ._pendulum import (
+    AtlasPlan,
+    Chain,
+    Circle,
+    Harmonic,
+    HeavyString,
+    Run,
+    RunResult,
+    __version__,
+    page,
+    steady,
+    whirls,
+)
 from ._sweep import SweepResult, sweep
 from ._plots import plot_ledger, plot_shape
 
@@ -42,9 +56,11 @@ __all__ = [
     "AtlasPlan",
     "atlas",
     "Chain",
+    "Circle",
     "ClaimCheck",
     "ClaimsReport",
     "check_claims",
+    "Harmonic",
     "HeavyString",
     "Run",
     "RunResult",

@@ -10,6 +10,8 @@ import numpy.typing as npt
 __all__ = [
     "AtlasPlan",
     "Chain",
+    "Circle",
+    "Harmonic",
     "HeavyString",
     "Run",
     "RunResult",
@@ -130,6 +132,8 @@ class Chain:
         steps: int = 1,
         model: str = "planar",
         precision: str = "float64",
+        drive: Union[Harmonic, Circle, None] = None,
+        t0: float = 0.0,
     ) -> tuple[_Array, _Array]: ...
     def trajectory(
         self,
@@ -143,6 +147,8 @@ class Chain:
         every: int = 1,
         model: str = "planar",
         precision: str = "float64",
+        drive: Union[Harmonic, Circle, None] = None,
+        t0: float = 0.0,
     ) -> tuple[_Array, _Array, _Array]: ...
     def jacobians(
         self,
@@ -177,6 +183,36 @@ class Chain:
         force: bool = False,
         tolerance: float = ...,
     ) -> dict[str, Any]: ...
+
+_PerState = Union[float, Sequence[float], npt.ArrayLike]
+
+@final
+class Harmonic:
+    def __new__(
+        cls,
+        amplitude: _PerState,
+        omega: _PerState,
+        phase: Optional[_PerState] = None,
+        direction: Optional[npt.ArrayLike] = None,
+    ) -> Harmonic: ...
+    @property
+    def amplitude(self) -> Union[float, _Array]: ...
+    @property
+    def omega(self) -> Union[float, _Array]: ...
+    @property
+    def phase(self) -> Union[float, _Array]: ...
+    @property
+    def direction(self) -> Optional[Union[float, _Array]]: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+
+@final
+class Circle:
+    def __new__(cls, radius: _PerState, omega: _PerState) -> Circle: ...
+    @property
+    def radius(self) -> Union[float, _Array]: ...
+    @property
+    def omega(self) -> Union[float, _Array]: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
 @final
 class Run:

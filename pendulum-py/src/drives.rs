@@ -1,0 +1,284 @@
+//! `pendulum.Harmonic` and `pendulum.Circle`: pivot drives for `Chain.integrate` and
+//! `Chain.trajectory`, their parameters one for all states or one per state, read into
+//! one core drive per state (`Harmonic`, `Circle`) that moves the pivot within a call.
+
+use nalgebra::{DimName, OVector, U2, U3, Vector3};
+use pendulum_core::Drive;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::arrays::Numbers;
+use crate::errors::{core_error, invalid};
+
+/// The pivot oscillating along a line: `p(t) = A sin(ωt + φ) d̂` (m), `d̂` the unit
+/// `direction` (default: the vertical, y up planar, z up in directions), amplitude
+/// `A ≥ 0` (m), angular frequency `ω ≥ 0` (rad/s), phase `φ` (rad). Each parameter is one
+/// number for all states or an array of the states' leading shape (`direction`: that
+/// shape plus one axis of 2 or 3 components): a Kapitza pendulum per state, each shaken
+/// at its own frequency, say.
+#[pyclass(module = "pendulum._pendulum", name = "Harmonic", frozen)]
+#[derive(Debug, Clone)]
+pub struct Harmonic {
+    amplitude: Numbers,
+    omega: Numbers,
+    phase: Numbers,
+    direction: Option<Numbers>,
+}
+
+/// The pivot on the horizontal circle `p(t) = R (cos ωt, sin ωt, 0)` (m) about the vertical
+/// (z up), radius `R ≥ 0` (m), angular frequency `ω` (rad/s, positive counter-clockwise
+/// seen from above), each one number for all states or an array of the states' leading
+/// shape: the whirled chain, `model="directions"` only.
+#[pyclass(module = "pendulum._pendulum", name = "Circle", frozen)]
+#[derive(Debug, Clone)]
+pub struct Circle {
+    radius: Numbers,
+    omega: Numbers,
+}
+
+/// `what`'s numbers, each checked by `valid` (a requirement in words when not).
+fn checked(
+    what: &str,
+    value: &Bound<'_, PyAny>,
+    valid: impl Fn(f64) -> Option<&'static str>,
+) -> PyResult<Numbers> {
+    let numbers = Numbers::read(what, value)?;
+    for &x in &numbers.data {
+        if let Some(requirement) = valid(x) {
+            return Err(invalid(format!("{what}: {x:?} is {requirement}")));
+        }
+    }
+    Ok(numbers)
+}
+
+/// `None` for a number `≥ 0`, else why not.
+fn non_negative(x: f64) -> Option<&'static str> {
+    (x < 0.0).then_some("negative")
+}
+
+#[pymethods]
+impl Harmonic {
+    #[new]
+    #[pyo3(signature = (amplitude, omega, phase = None, direction = None))]
+    fn new(
+        amplitude: &Bound<'_, PyAny>,
+        omega: &Bound<'_, PyAny>,
+        phase: Option<&Bound<'_, PyAny>>,
+        direction: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let phase = match phase.filter(|p| !p.is_none()) {
+            Some(p) => Numbers::read("phase", p)?,
+            None => Numbers { shape: vec![], data: vec![0.0] },
+        };
+        let direction = match direction.filter(|d| !d.is_none()) {
+            None => None,
+            Some(d) => {
+                let d = Numbers::read("direction", d)?;
+                let width = d.shape.last().copied().unwrap_or(0);
+                if !(2..=3).contains(&width) {
+                    return Err(invalid(format!(
+                        "direction: the last axis has {width} entries, expected 2 (planar) or 3 (directions)"
+                    )));
+                }
+                if let Some(zero) = d.data.chunks_exact(width).find(|v| v.iter().all(|x| *x == 0.0)) {
+                    return Err(invalid(format!("direction: {zero:?} has no direction")));
+                }
+                Some(d)
+            }
+        };
+        Ok(Self {
+            amplitude: checked("amplitude", amplitude, non_negative)?,
+            omega: checked("omega", omega, non_negative)?,
+            phase,
+            direction,
+        })
+    }
+
+    /// Amplitude `A` (m), as given.
+    #[getter]
+    fn amplitude<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.amplitude.to_array(py)
+    }
+
+    /// Angular frequency `ω` (rad/s), as given.
+    #[getter]
+    fn omega<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.omega.to_array(py)
+    }
+
+    /// Phase `φ` (rad), as given.
+    #[getter]
+    fn phase<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.phase.to_array(py)
+    }
+
+    /// The direction of oscillation as given (not normalised), `None` for the vertical.
+    #[getter]
+    fn direction<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.direction.as_ref().map(|d| d.to_array(py)).transpose()
+    }
+
+    fn __repr__(&self) -> String {
+        let direction = self.direction.as_ref().map_or("None".to_string(), describe);
+        format!(
+            "Harmonic(amplitude={}, omega={}, phase={}, direction={direction})",
+            describe(&self.amplitude),
+            describe(&self.omega),
+            describe(&self.phase)
+        )
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (py, me) = (slf.py(), slf.get());
+        let args = (me.amplitude(py)?, me.omega(py)?, me.phase(py)?, me.direction(py)?);
+        Ok((slf.get_type().into_any(), args.into_pyobject(py)?))
+    }
+}
+
+#[pymethods]
+impl Circle {
+    #[new]
+    fn new(radius: &Bound<'_, PyAny>, omega: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Ok(Self { radius: checked("radius", radius, non_negative)?, omega: Numbers::read("omega", omega)? })
+    }
+
+    /// Radius `R` (m), as given.
+    #[getter]
+    fn radius<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.radius.to_array(py)
+    }
+
+    /// Angular frequency `ω` (rad/s), as given.
+    #[getter]
+    fn omega<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.omega.to_array(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Circle(radius={}, omega={})", describe(&self.radius), describe(&self.omega))
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (py, me) = (slf.py(), slf.get());
+        Ok((slf.get_type().into_any(), (me.radius(py)?, me.omega(py)?).into_pyobject(py)?))
+    }
+}
+
+/// A number as itself, an array by its shape.
+fn describe(numbers: &Numbers) -> String {
+    match numbers.shape.as_slice() {
+        [] => format!("{:?}", numbers.data[0]),
+        shape => format!("<array of shape {shape:?}>"),
+    }
+}
+
+/// A drive given to a run: [`Harmonic`] or [`Circle`].
+#[derive(Debug, Clone)]
+pub enum Given {
+    Harmonic(Harmonic),
+    Circle(Circle),
+}
+
+impl Given {
+    /// `value` as a drive: `None` (or Python's `None`) for none.
+    pub fn read(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Self>> {
+        let Some(value) = value.filter(|v| !v.is_none()) else { return Ok(None) };
+        if let Ok(h) = value.cast::<Harmonic>() {
+            return Ok(Some(Self::Harmonic(h.get().clone())));
+        }
+        if let Ok(c) = value.cast::<Circle>() {
+            return Ok(Some(Self::Circle(c.get().clone())));
+        }
+        let kind = value.get_type().name().map_or_else(|_| "?".to_string(), |n| n.to_string());
+        Err(invalid(format!("drive: a {kind}, expected pendulum.Harmonic or pendulum.Circle")))
+    }
+
+    /// One planar drive per state of the leading shape `lead`.
+    pub fn planar(&self, lead: &[usize]) -> PyResult<Vec<pendulum_core::Harmonic<U2>>> {
+        match self {
+            Self::Harmonic(h) => h.drives(lead),
+            Self::Circle(_) => Err(invalid(
+                "drive: pendulum.Circle turns the pivot about the vertical, in 3D: model='directions' only",
+            )),
+        }
+    }
+
+    /// One drive of the chain in directions per state of the leading shape `lead`.
+    pub fn spatial(&self, lead: &[usize]) -> PyResult<Vec<Pivot>> {
+        Ok(match self {
+            Self::Harmonic(h) => h.drives(lead)?.into_iter().map(Pivot::Harmonic).collect(),
+            Self::Circle(c) => {
+                let (radius, omega) =
+                    (c.radius.per_state("radius", 1, lead)?, c.omega.per_state("omega", 1, lead)?);
+                let circle =
+                    |(r, w): (&&[f64], &&[f64])| pendulum_core::Circle::new(r[0], w[0]).map(Pivot::Circle);
+                radius.iter().zip(&omega).map(circle).collect::<Result<_, _>>().map_err(core_error)?
+            }
+        })
+    }
+}
+
+impl Harmonic {
+    /// One core drive in `S` per state of the leading shape `lead`.
+    fn drives<S: DimName>(&self, lead: &[usize]) -> PyResult<Vec<pendulum_core::Harmonic<S>>>
+    where
+        nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<S>,
+    {
+        let dim = S::DIM;
+        let count: usize = lead.iter().product();
+        let vertical: Vec<f64> = (0..dim).map(|k| if k + 1 == dim { 1.0 } else { 0.0 }).collect();
+        let directions = match &self.direction {
+            None => vec![&vertical[..]; count],
+            Some(d) if d.shape.last() != Some(&dim) => {
+                let model = if dim == 2 { "model='planar'" } else { "model='directions'" };
+                let given = d.shape.last().copied().unwrap_or(0);
+                return Err(invalid(format!("direction: {given} components, {model} takes {dim}")));
+            }
+            Some(d) => d.per_state("direction", dim, lead)?,
+        };
+        let amplitude = self.amplitude.per_state("amplitude", 1, lead)?;
+        let omega = self.omega.per_state("omega", 1, lead)?;
+        let phase = self.phase.per_state("phase", 1, lead)?;
+        (0..count)
+            .map(|k| {
+                let d = OVector::<f64, S>::from_column_slice(directions[k]);
+                pendulum_core::Harmonic::new(d, amplitude[k][0], omega[k][0], phase[k][0])
+            })
+            .collect::<Result<_, _>>()
+            .map_err(core_error)
+    }
+}
+
+/// The pivot drive of a chain in directions in a run.
+#[derive(Debug, Clone)]
+pub enum Pivot {
+    Harmonic(pendulum_core::Harmonic<U3>),
+    Circle(pendulum_core::Circle),
+}
+
+impl Drive<U3> for Pivot {
+    fn position(&self, t: f64) -> Vector3<f64> {
+        match self {
+            Self::Harmonic(d) => d.position(t),
+            Self::Circle(d) => d.position(t),
+        }
+    }
+    fn velocity(&self, t: f64) -> Vector3<f64> {
+        match self {
+            Self::Harmonic(d) => d.velocity(t),
+            Self::Circle(d) => d.velocity(t),
+        }
+    }
+    fn acceleration(&self, t: f64) -> Vector3<f64> {
+        match self {
+            Self::Harmonic(d) => d.acceleration(t),
+            Self::Circle(d) => d.acceleration(t),
+        }
+    }
+    fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        match self {
+            Self::Harmonic(d) => d.velocity_and_acceleration(t),
+            Self::Circle(d) => d.velocity_and_acceleration(t),
+        }
+    }
+}

@@ -1,0 +1,169 @@
+"""Runs whose pivot moves within a call (`drive=pendulum.Harmonic(...)` or
+`pendulum.Circle(...)`, parameters one for all or one per state): Kapitza's inverted
+pendulum against its threshold and slow frequency, a whirled rod on its steady cone,
+the directions against the planar model, drives per state and each state alone bit for
+bit, runs split in calls, and bad input."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import pendulum
+
+G = 9.81
+
+
+def test_kapitza_pendulum_stands_upright_above_its_threshold_at_its_slow_frequency():
+    # A rod of length l shaken vertically, p = A sin(ωt) ẑ, stands upright when
+    # A²ω² > 2 g l; it then sways about the top at Ω² = A²ω²/(2 l²) − g/l (Kapitza), with
+    # corrections of the order of (Ω/ω)². One call, one frequency per state.
+    amplitude, length, h = 0.02, 0.5, 2e-5
+    chain = pendulum.Chain(1.0, length)
+    omega = np.array([100.0, 300.0, 600.0])  # threshold: sqrt(2 g l) / A = 157 rad/s
+    q0 = np.full((3, 1), np.pi - 0.1)
+    t, q, _ = chain.trajectory(q0, h=h, steps=200_000, every=10, drive=pendulum.Harmonic(amplitude, omega))
+    away = q[:, :, 0] - np.pi
+    assert np.max(np.abs(away[:, 0])) > 2.0, "below the threshold the rod falls"
+    for k in (1, 2):
+        assert np.max(np.abs(away[:, k])) < 0.25, f"ω = {omega[k]}: the rod stands"
+        # Sign changes of the sway averaged over one period of the shaking.
+        window = int(round(2 * np.pi / omega[k] / (10 * h)))
+        slow = np.convolve(away[:, k], np.ones(window) / window, mode="valid")
+        crossings = t[np.nonzero(np.diff(np.sign(slow)))[0]]
+        measured = np.pi / np.mean(np.diff(crossings))
+        kapitza = np.sqrt((amplitude * omega[k]) ** 2 / (2 * length**2) - G / length)
+        assert abs(measured / kapitza - 1) < 0.03, (omega[k], measured, kapitza)
+
+
+def test_a_whirled_rod_started_on_its_steady_cone_stays_there():
+    # A rod of length l on a pivot circling at radius R and speed ω stands steady at the
+    # cone angle α with ω² (R + l sin α) = g tan α, its mass circling with the pivot.
+    radius, length, omega = 0.1, 0.5, 6.0
+    alpha = 0.0
+    for _ in range(200):  # fixed point of the steady balance (a contraction here)
+        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
+    chain = pendulum.Chain(1.0, length)
+    u = np.array([np.sin(alpha), 0.0, -np.cos(alpha)])
+    w = omega * np.cross([0.0, 0.0, 1.0], u)
+    t, q, _ = chain.trajectory(
+        u, w, h=1e-3, steps=2000, every=100, model="directions", drive=pendulum.Circle(radius, omega)
+    )
+    turned = np.stack([np.cos(omega * t), np.sin(omega * t)], 1)
+    horizontal = np.einsum("ij,ij->i", q[:, :2], turned)  # along the pivot's radius
+    assert np.max(np.abs(np.arctan2(horizontal, -q[:, 2]) - alpha)) < 1e-6
+    assert np.max(np.abs(turned[:, 1] * q[:, 0] - turned[:, 0] * q[:, 1])) < 1e-6
+
+
+def test_a_shaken_chain_in_a_vertical_plane_moves_as_the_planar_model_says():
+    # The same shaking along (1, 1) in the x–z plane, from the same state: the two models'
+    # RK4 runs agree to their truncation errors.
+    chain = pendulum.Chain([1.0, 0.5, 0.8], [0.4, 0.3, 0.5], damping=0.01)
+    theta, rate = np.array([0.3, -0.4, 0.9]), np.array([0.5, -1.0, 0.2])
+    steps, h = 2000, 2.5e-4
+    planar, _ = chain.integrate(
+        theta, rate, h=h, steps=steps, t0=0.3, drive=pendulum.Harmonic(0.05, 40.0, 0.5, direction=(1.0, 1.0))
+    )
+    zero = np.zeros(3)
+    u = np.stack([np.sin(theta), zero, -np.cos(theta)], 1).ravel()
+    w = (rate[:, None] * np.stack([np.cos(theta), zero, np.sin(theta)], 1)).ravel()
+    drive = pendulum.Harmonic(0.05, 40.0, 0.5, direction=(1.0, 0.0, 1.0))
+    q, _ = chain.integrate(u, w, h=h, steps=steps, t0=0.3, model="directions", drive=drive)
+    q = q.reshape(3, 3)
+    assert np.max(np.abs(np.arctan2(q[:, 0], -q[:, 2]) - planar)) < 1e-8
+
+
+@pytest.mark.parametrize("model", ["planar", "directions"])
+def test_drives_per_state_and_runs_in_calls_give_one_calls_numbers(model):
+    chain = pendulum.Chain([0.4, 0.3, 0.2, 0.5], [0.3, 0.2, 0.4, 0.3], damping=0.02)
+    r = np.random.default_rng(11)
+    if model == "planar":
+        q0, qd0 = r.uniform(-2, 2, (2, 3, 4)), r.uniform(-2, 2, (2, 3, 4))
+        direction = (0.3, 1.0)
+    else:
+        u = r.normal(size=(2, 3, 4, 3))
+        u /= np.linalg.norm(u, axis=-1, keepdims=True)
+        q0, qd0 = u.reshape(2, 3, 12), np.cross(u, r.normal(size=u.shape)).reshape(2, 3, 12)
+        direction = (0.3, 0.0, 1.0)
+    drive = pendulum.Harmonic(0.03, 70.0, 0.2, direction=direction)
+    kw = dict(h=1e-3, model=model, drive=drive)
+    q, qd = chain.integrate(q0, qd0, steps=30, t0=0.1, **kw)
+    # In two calls, the second from where the first ended: the same to round-off (a call
+    # starts its states' rounding compensation afresh).
+    qa, qda = chain.integrate(q0, qd0, steps=10, t0=0.1, **kw)
+    qb, qdb = chain.integrate(qa, qda, steps=20, t0=0.1 + 10 * 1e-3, **kw)
+    assert np.max(np.abs(qb - q)) < 1e-13 and np.max(np.abs(qdb - qd)) < 1e-12
+    # Started a step late, the drive's phase differs: the time is read.
+    late, _ = chain.integrate(qa, qda, steps=20, t0=0.1 + 11 * 1e-3, **kw)
+    assert np.max(np.abs(late - q)) > 1e-6
+    # The same parameters given once per state.
+    each = pendulum.Harmonic(
+        np.full((2, 3), 0.03), np.full((2, 3), 70.0), np.full((2, 3), 0.2), direction=np.tile(direction, (2, 3, 1))
+    )
+    qe, qde = chain.integrate(q0, qd0, steps=30, t0=0.1, h=1e-3, model=model, drive=each)
+    assert np.array_equal(q, qe) and np.array_equal(qd, qde)
+    # Each state alone.
+    for i in range(2):
+        for j in range(3):
+            alone = chain.integrate(q0[i, j], qd0[i, j], steps=30, t0=0.1, **kw)
+            assert np.array_equal(alone[0], q[i, j]) and np.array_equal(alone[1], qd[i, j])
+    # The states differ from the pivot at rest's: the drive moved them.
+    held, _ = chain.integrate(q0, qd0, steps=30, h=1e-3, model=model)
+    assert np.max(np.abs(held - q)) > 1e-3
+
+
+def test_a_drive_that_stands_still_is_the_pivot_at_rest_bit_for_bit():
+    chain = pendulum.Chain([0.4, 0.3], [0.3, 0.2])
+    q0, qd0 = np.array([[0.3, -0.2], [1.0, 2.0]]), np.array([[0.1, 0.0], [-1.0, 0.5]])
+    rest = chain.integrate(q0, qd0, h=1e-3, steps=50)
+    still = chain.integrate(q0, qd0, h=1e-3, steps=50, drive=pendulum.Harmonic([0.0, 0.0], 30.0))
+    assert all(np.array_equal(a, b) for a, b in zip(rest, still))
+    u = np.array([0.6, 0.0, -0.8, 0.0, 0.6, -0.8])
+    w = np.array([0.0, 0.8, 0.0, 1.0, 0.0, 0.0])
+    rest = chain.integrate(u, w, h=1e-3, steps=50, model="directions")
+    still = chain.integrate(u, w, h=1e-3, steps=50, model="directions", drive=pendulum.Circle(0.0, 5.0))
+    assert all(np.array_equal(a, b) for a, b in zip(rest, still))
+
+
+def test_trajectory_times_start_at_t0():
+    chain = pendulum.Chain(1.0, 1.0)
+    t, q, _ = chain.trajectory([0.2], h=0.01, steps=4, every=2, t0=5.0, drive=pendulum.Harmonic(0.01, 10.0))
+    assert np.allclose(t, [5.0, 5.02, 5.04]) and q.shape == (3, 1)
+
+
+def test_drives_print_and_pickle():
+    h = pendulum.Harmonic(0.02, np.linspace(100, 400, 4), direction=(0.0, 1.0))
+    assert repr(h) == "Harmonic(amplitude=0.02, omega=<array of shape [4]>, phase=0.0, direction=<array of shape [2]>)"
+    back = pickle.loads(pickle.dumps(h))
+    assert np.array_equal(back.omega, h.omega) and back.amplitude == 0.02 and back.phase == 0.0
+    assert np.array_equal(back.direction, [0.0, 1.0])
+    c = pickle.loads(pickle.dumps(pendulum.Circle(0.1, [3.0, 4.0])))
+    assert repr(c) == "Circle(radius=0.1, omega=<array of shape [2]>)"
+    assert pendulum.Harmonic(0.1, 2.0).direction is None
+
+
+def test_bad_drives_are_named():
+    chain = pendulum.Chain([1.0, 1.0], 0.5)
+    q = np.zeros((4, 2))
+    harmonic = pendulum.Harmonic(0.02, 200.0)
+    for kw, message in [
+        (dict(drive=harmonic, pivot_acceleration=[0.0, 1.0]), "pivot_acceleration: a drive moves the pivot"),
+        (dict(drive=pendulum.Circle(0.1, 3.0)), "model='directions' only"),
+        (dict(drive=3), "drive: a int, expected pendulum.Harmonic or pendulum.Circle"),
+        (dict(drive=harmonic, precision="float32"), "a driven run is 'float64' only"),
+        (dict(t0=float("nan")), "t0: NaN is not a finite time"),
+        (dict(drive=pendulum.Harmonic(0.1, [1.0, 2.0])), "omega: shape [2] is neither [] (one for all) nor [4]"),
+        (dict(drive=pendulum.Harmonic(0.1, 1.0, direction=(0, 0, 1))), "direction: 3 components, model='planar' takes 2"),
+    ]:
+        with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[")):
+            chain.integrate(q, h=1e-3, **kw)
+    for args, message in [
+        ((-1.0, 2.0), "amplitude: -1.0 is negative"),
+        ((1.0, np.inf), "omega: inf is not finite"),
+        ((1.0, 2.0, 0.0, (0.0, 0.0)), r"direction: \[0.0, 0.0\] has no direction"),
+        ((1.0, 2.0, 0.0, (1.0, 0.0, 0.0, 0.0)), "direction: the last axis has 4 entries"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            pendulum.Harmonic(*args)
+    with pytest.raises(ValueError, match="radius: -0.1 is negative"):
+        pendulum.Circle(-0.1, 2.0)
