@@ -390,6 +390,27 @@ fn planar_rk4(c: &mut Criterion) {
                     })
                 },
             );
+            // The same in single precision, eight chains a register.
+            let mut rows: Vec<f32> = start.iter().flat_map(|s| s.x().iter().map(|&v| v as f32)).collect();
+            let mut carry = vec![0.0f32; rows.len()];
+            group.bench_with_input(
+                BenchmarkId::new("planar_100_steps/batch_f32_1_thread_driven", n),
+                &n,
+                |b, _| {
+                    in_pool(b, &one, || {
+                        let failures = batch
+                            .integrate_rk4_driven_f32(
+                                (&mut rows, &mut carry),
+                                (0.0, &drives),
+                                None,
+                                1e-4,
+                                STEPS,
+                            )
+                            .expect("batch");
+                        assert!(failures.is_empty(), "{failures:?}");
+                    })
+                },
+            );
         }
         // Single precision, eight chains a register, the states as rows of (θ, θ̇).
         let mut rows: Vec<f32> = start.iter().flat_map(|s| s.x().iter().map(|&v| v as f32)).collect();

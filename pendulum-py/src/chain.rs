@@ -17,7 +17,7 @@ use crate::detach::maybe_detached;
 use crate::directions;
 use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error};
-use crate::planar_runs::{Plan, planar_rk4, planar_run, run_in};
+use crate::planar_runs::{Plan, planar_run, run_in};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
@@ -163,13 +163,8 @@ impl Chain {
         if !plan.t0.is_finite() {
             return Err(invalid(format!("t0: {} is not a finite time (s)", plan.t0)));
         }
-        if drive.is_some() {
-            if pivot.is_some_and(|p| !p.is_none()) {
-                return Err(invalid("pivot_acceleration: a drive moves the pivot; give one or the other"));
-            }
-            if precision != "float64" {
-                return Err(invalid(format!("precision: '{precision}' — a driven run is 'float64' only")));
-            }
+        if drive.is_some() && pivot.is_some_and(|p| !p.is_none()) {
+            return Err(invalid("pivot_acceleration: a drive moves the pivot; give one or the other"));
         }
         if route == Route::Directions {
             if precision != "float64" {
@@ -186,15 +181,8 @@ impl Chain {
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
         let rows = [b.q, b.qd, b.torque, b.pivot];
-        match drive {
-            None => planar_run(py, &self.inner, rows, plan, precision),
-            Some(drive) => {
-                let drives = drive.planar(&rows[0].lead)?;
-                run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
-                    planar_rk4(c, rows, Some(&drives), plan, stop)
-                })
-            }
-        }
+        let drives = drive.map(|d| d.planar(&rows[0].lead)).transpose()?;
+        planar_run(py, &self.inner, rows, (plan, drives), precision)
     }
 
     /// The states of `model="directions"`: `q` unit directions and `qd` their rates, rows
@@ -428,8 +416,8 @@ impl Chain {
     /// from the time `t0` (s; pass the end of one call as the start of the next).
     /// `model="directions"` steps the 3D chain in directions by RK4 with each rod put back
     /// to unit length after every step (float64, no torques).
-    /// `precision="float32"` steps eight states per register in single precision and
-    /// returns float32 (its error against float64 in docs/ensembles.md; no drive). A state whose step
+    /// `precision="float32"` steps eight planar states per register in single precision and
+    /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
     /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments

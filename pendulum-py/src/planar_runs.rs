@@ -54,20 +54,23 @@ pub struct Samples<T> {
 
 /// The run of `Chain.integrate` (`plan.every` `None`: `(q, qd)` shaped as `q`) or
 /// `Chain.trajectory` (`(t, q, qd)`, the samples along a first axis) of the states and
-/// inputs `rows` (`q`, `qd`, torques, pivot accelerations) in `precision`: here for a few
-/// milliseconds' work, on a thread of its own that Ctrl-C can stop otherwise.
+/// inputs `rows` (`q`, `qd`, torques, pivot accelerations) in `precision`, the pivots
+/// moved by `drives` (one per state) when given: here for a few milliseconds' work, on a
+/// thread of its own that Ctrl-C can stop otherwise.
 pub fn planar_run<'py>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     rows: [Rows; 4],
-    plan: Plan,
+    (plan, drives): (Plan, Option<Vec<Harmonic<U2>>>),
     precision: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     match precision {
-        "float64" => {
-            run_in(py, chain, rows, plan, |c, rows, plan, stop| planar_rk4(c, rows, None, plan, stop))
-        }
-        "float32" => run_in(py, chain, rows, plan, planar_rk4_f32),
+        "float64" => run_in(py, chain, rows, plan, move |c, rows, plan, stop| {
+            planar_rk4(c, rows, drives.as_deref(), plan, stop)
+        }),
+        "float32" => run_in(py, chain, rows, plan, move |c, rows, plan, stop| {
+            planar_rk4_f32(c, rows, drives.as_deref(), plan, stop)
+        }),
         _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
     }
 }
@@ -119,7 +122,7 @@ pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
 /// pivot acceleration held ([`PlanarBatch::integrate_rk4`]) or, given `drives` (one per
 /// state), its pivot moved ([`PlanarBatch::integrate_rk4_driven`]): on every core, in
 /// chunks (the same bits as one call). A failed state is an error naming its index.
-pub fn planar_rk4(
+fn planar_rk4(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
     drives: Option<&[Harmonic<U2>]>,
@@ -146,12 +149,14 @@ pub fn planar_rk4(
     )
 }
 
-/// [`planar_rk4`] in single precision ([`PlanarBatch::integrate_rk4_f32`]): the numbers
-/// rounded to `f32` (one past its range is an error), the rounding compensation kept from
-/// chunk to chunk (the same numbers as one call).
+/// [`planar_rk4`] in single precision ([`PlanarBatch::integrate_rk4_f32`], or
+/// [`PlanarBatch::integrate_rk4_driven_f32`] given `drives`): the numbers rounded to `f32`
+/// (one past its range is an error), the rounding compensation kept from chunk to chunk
+/// (the same numbers as one call when held; driven, each chunk starts from its own time).
 fn planar_rk4_f32(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
+    drives: Option<&[Harmonic<U2>]>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {
@@ -171,10 +176,20 @@ fn planar_rk4_f32(
     }
     let carry = vec![0.0f32; x.len()];
     let batch = PlanarBatch::repeated(chain.clone(), q.count()).map_err(core)?;
+    let mut done = 0;
     in_chunks(
         (&q.lead, n, plan, stop),
         &mut (x, carry),
-        |(x, carry), now| batch.integrate_rk4_f32((x, carry), Some(&torque), Some(&pivot), plan.h, now),
+        |(x, carry), now| {
+            let t = plan.t0 + done as f64 * plan.h;
+            done += now;
+            match drives {
+                Some(drives) => {
+                    batch.integrate_rk4_driven_f32((x, carry), (t, drives), Some(&torque), plan.h, now)
+                }
+                None => batch.integrate_rk4_f32((x, carry), Some(&torque), Some(&pivot), plan.h, now),
+            }
+        },
         |(x, _), samples| split(n, x.chunks_exact(2 * n), samples),
     )
 }

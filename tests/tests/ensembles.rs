@@ -1203,6 +1203,90 @@ fn single_precision_planar_runs_are_within_their_documented_error() {
 }
 
 #[test]
+fn single_precision_driven_planar_runs_follow_the_f64_ones_and_fail_by_chain() {
+    // Each chain's pivot shaken along its own line from t0 = 0.37 s (up to 0.01 m at up to
+    // 400 rad/s: 160 g): the f32 run against the f64 driven run (the bound of
+    // docs/ensembles.md; `--nocapture` prints it), a pivot that
+    // stands still against the held run bit for bit, one chain alone and thread counts bit
+    // for bit, a drive past f32's range failing its chain alone, and bad arguments.
+    let mut r = ChaCha8Rng::seed_from_u64(53);
+    let (chains, h, steps, t0) = (64, 1e-4, 100, 0.37);
+    let shake = |r: &mut ChaCha8Rng, k: usize| {
+        let direction =
+            nalgebra::Vector2::new(if k.is_multiple_of(2) { 0.0 } else { r.random_range(-1.0..1.0) }, 1.0);
+        let (a, w) = (r.random_range(0.0..0.01), r.random_range(10.0..400.0));
+        Harmonic::new(direction, a, w, r.random::<f64>()).expect("drive")
+    };
+    for n in [8, 20, 100] {
+        let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 0.3, &mut r)).collect();
+        let batch = PlanarBatch::new(list.clone()).expect("batch");
+        let drives: Vec<Harmonic<U2>> = (0..chains).map(|k| shake(&mut r, k)).collect();
+        let rows = planar_rows(chains, n, &mut r);
+        let mut states: Vec<State<Dyn>> =
+            rows.chunks_exact(2 * n).map(|x| State::new(t0, DVector::from_column_slice(x))).collect();
+        assert!(batch.integrate_rk4_driven(&mut states, &drives, None, h, steps).expect("f64").is_empty());
+        let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+        let start: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
+        let mut runs = Vec::new();
+        for pool in pools() {
+            let (mut x, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+            let run = pool.install(|| {
+                batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives), None, h, steps)
+            });
+            assert!(run.expect("f32").is_empty());
+            runs.push(x);
+        }
+        assert!(runs[0].iter().zip(&runs[1]).all(|(a, b)| a.to_bits() == b.to_bits()), "one thread or two");
+        let error = worst_relative_error(&f64s, &runs[0], 2 * n);
+        println!("driven planar run in f32, {steps} steps of {h} s, n = {n}: {error:.1e}");
+        assert!(error < 1e-4, "n = {n}: {error:e}");
+        let k = 37;
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let (mut x, mut carry) = (start[k * 2 * n..(k + 1) * 2 * n].to_vec(), vec![0.0; 2 * n]);
+        let run = alone.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives[k..=k]), None, h, steps);
+        assert!(run.expect("f32").is_empty());
+        assert!(
+            x.iter().zip(&runs[0][k * 2 * n..]).all(|(a, b)| a.to_bits() == b.to_bits()),
+            "chain {k} alone"
+        );
+        // No amplitude: the pivot at rest, as the held run has it.
+        let still: Vec<Harmonic<U2>> = (0..chains)
+            .map(|_| Harmonic::new(nalgebra::Vector2::new(0.3, 1.0), 0.0, 50.0, 0.1).expect("drive"))
+            .collect();
+        let (mut driven, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+        let run = batch.integrate_rk4_driven_f32((&mut driven, &mut carry), (t0, &still), None, h, steps);
+        assert!(run.expect("f32").is_empty());
+        let (mut held, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+        assert!(
+            batch.integrate_rk4_f32((&mut held, &mut carry), None, None, h, steps).expect("f32").is_empty()
+        );
+        assert!(driven.iter().zip(&held).all(|(a, b)| a.to_bits() == b.to_bits()), "n = {n}: at rest");
+    }
+    // A drive whose acceleration leaves f32's range (finite in f64) fails its chain alone at
+    // its first step; too few drives and a non-finite t0 are errors.
+    let batch = PlanarBatch::new((0..3).map(|_| spread_chain(4, 0.3, &mut r)).collect()).expect("batch");
+    let drives: Vec<Harmonic<U2>> = [1e30, 10.0, 10.0]
+        .into_iter()
+        .map(|w| Harmonic::new(nalgebra::Vector2::new(0.0, 1.0), 1.0, w, 0.3).expect("drive"))
+        .collect();
+    let (mut x, mut carry) = (vec![0.5f32; 24], vec![0.0f32; 24]);
+    let failures =
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives), None, 1e-3, 5).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [0]);
+    assert_eq!(failures[0].error, Error::NonFiniteState { t: t0, h: 1e-3 });
+    assert_eq!(&x[..8], &[0.5; 8], "the failed chain stays at its start");
+    assert!(x[8..].iter().any(|v| *v != 0.5));
+    assert!(matches!(
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives[..2]), None, 1e-3, 5),
+        Err(Error::LengthMismatch { what: "drives", expected: 3, got: 2 })
+    ));
+    assert!(matches!(
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (f64::NAN, &drives), None, 1e-3, 5),
+        Err(Error::NonFinite { what: "t0", .. })
+    ));
+}
+
+#[test]
 fn single_precision_planar_runs_fail_by_chain_and_change_with_no_thread_count_or_split() {
     let mut r = ChaCha8Rng::seed_from_u64(52);
     let (n, chains) = (6, 19);

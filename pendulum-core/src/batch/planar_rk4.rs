@@ -304,6 +304,51 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
+        self.runs_f32((x, carry), (torque, pivot), (h, steps), None)
+    }
+
+    /// [`integrate_rk4_f32`](Self::integrate_rk4_f32) with chain `k`'s pivot moved by
+    /// `drives[k]` from the time `t0` (s), as
+    /// [`integrate_rk4_driven`](Self::integrate_rk4_driven) moves it: its acceleration
+    /// computed in `f64` at each stage's time (`t`, `t + h/2`, `t + h`, with `t = t0 + j h`
+    /// at step `j`) and rounded to `f32`; the torques held. Not bit for bit anything: its
+    /// error against the `f64` driven run is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, as [`integrate_rk4_f32`](Self::integrate_rk4_f32)
+    /// does (a failed step's time counted from `t0`; a drive whose acceleration is not
+    /// finite in `f32` fails its chain at that step). Errors as there,
+    /// [`Error::LengthMismatch`] for a number of drives other than `B`, and
+    /// [`Error::NonFinite`] for a non-finite `t0`.
+    pub fn integrate_rk4_driven_f32<Dr: Drive<U2> + Sync>(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        (t0, drives): (f64, &[Dr]),
+        torque: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        if drives.len() != self.len() {
+            return Err(Error::LengthMismatch { what: "drives", expected: self.len(), got: drives.len() });
+        }
+        if !t0.is_finite() {
+            return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
+        }
+        let drive = |chain: usize, t: f64| {
+            let a = drives[chain].acceleration(t);
+            [a[0], a[1]]
+        };
+        self.runs_f32((x, carry), (torque, None), (h, steps), Some((t0, &drive)))
+    }
+
+    /// The `f32` runs in this batch's lanes, the pivots from `drive` (chain, time) from its
+    /// start time when given, else held; the arguments checked first.
+    fn runs_f32(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        (torque, pivot): Inputs<'_, f32>,
+        (h, steps): (f64, usize),
+        drive: Option<(f64, PivotAt<'_>)>,
+    ) -> Result<Vec<Failure>> {
         let (n, m) = (self.links, 2 * self.links);
         check_len("x", x, self.len(), m)?;
         check_len("carry", carry, self.len(), m)?;
@@ -323,13 +368,22 @@ impl PlanarBatch {
                 gather_rows(lanes.map(|k| &*block[k].0), m, Lanes32::flatten_mut(&mut s.x));
                 gather_rows(lanes.map(|k| &*block[k].1), m, Lanes32::flatten_mut(&mut s.carry));
                 let constants = one_of(&self.blocks_f32, b);
+                let t0 = drive.map_or(0.0, |(t0, _)| t0);
                 for step in 0..steps {
                     if alive == [0; WIDTH_F32] {
                         break;
                     }
+                    let t = t0 + step as f64 * h;
+                    if let Some((_, drive)) = drive {
+                        for (stage, pivot) in s.pivot.iter_mut().enumerate() {
+                            let at = [t, t + 0.5 * h, t + h][stage];
+                            let p: [[f64; 2]; WIDTH_F32] = std::array::from_fn(|k| drive(ids[k], at));
+                            *pivot = [0, 1].map(|c| Lanes32::rounded(std::array::from_fn(|k| p[k][c])));
+                        }
+                    }
                     let failed = self.rk4_step_simd(constants, h, alive, s);
                     for (k, _) in failed.iter().enumerate().filter(|(_, f)| **f != 0) {
-                        let error = Error::NonFiniteState { t: step as f64 * h, h };
+                        let error = Error::NonFiniteState { t, h };
                         failures.push(Failure { chain: ids[k], error });
                     }
                     alive = F32x8::and_not(alive, failed);
