@@ -9,13 +9,15 @@
 //!   links on one thread and on two;
 //! - `rk4/whirl_100`: one projected RK4 step of 1 ms of 64 whirls (3D, n = 100, each pivot on
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
-//!   (throughput in chain-steps per second), and 10 steps of the implicit rod midpoint
+//!   (throughput in chain-steps per second; also in `f32`, `integrate_rk4_f32`, on one
+//!   thread), and 10 steps of the implicit rod midpoint
 //!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
 //!   at n = 20 also each pivot shaken vertically, `FirstOrder::with_inputs(PlanarTension,
-//!   Driven)` alone against `integrate_rk4_driven` (`…/single_driven`, `…_driven`);
+//!   Driven)` alone against `integrate_rk4_driven` and `integrate_rk4_driven_f32`
+//!   (`…/single_driven`, `…_driven`);
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two (and in four lanes
 //!   instead of eight on a CPU with AVX-512), and in single precision on one;
@@ -294,6 +296,16 @@ fn rk4(c: &mut Criterion) {
             })
         });
     }
+    // The same in single precision, eight chains per AVX2 register, the time going on.
+    let (one, mut t) = (pool(1), 2.0);
+    let mut rows: Vec<f32> = start.iter().flat_map(|s| s.x().iter().map(|&v| v as f32)).collect();
+    group.bench_function("whirl_100/batch_f32_1_thread_100_steps", |b| {
+        in_pool(b, &one, || {
+            let failures = batch.integrate_rk4_f32(&mut rows, t, 1e-3, 100).expect("batch");
+            assert!(failures.is_empty(), "{failures:?}");
+            t += 0.1;
+        })
+    });
     // The implicit rod midpoint, 10 steps per call: each chain on its own, over the cores.
     group.throughput(Throughput::Elements(10 * CHAINS as u64));
     let mut states = start.clone();

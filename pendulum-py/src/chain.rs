@@ -16,7 +16,7 @@ use crate::arrays::{Rows, array, per_link};
 use crate::detach::maybe_detached;
 use crate::directions;
 use crate::drives::Given;
-use crate::errors::{core_error, invalid, run_error};
+use crate::errors::{core_error, invalid, run_error, unknown_precision};
 use crate::planar_runs::{Plan, planar_run, run_in};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use crate::states::{self, Batch};
@@ -167,17 +167,18 @@ impl Chain {
             return Err(invalid("pivot_acceleration: a drive moves the pivot; give one or the other"));
         }
         if route == Route::Directions {
-            if precision != "float64" {
-                return Err(invalid(format!(
-                    "precision: '{precision}' — model='directions' integrates in 'float64' only"
-                )));
-            }
             let b = self.directions_rows(q, qd, torque, pivot)?;
             let drives = drive.map(|d| d.spatial(&b.q.lead)).transpose()?;
             let rows = [b.q, b.qd, b.torque, b.pivot];
-            return run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
-                directions::rk4(c, rows, drives, plan, stop)
-            });
+            return match precision {
+                "float64" => run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
+                    directions::rk4(c, rows, drives, plan, stop)
+                }),
+                "float32" => run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
+                    directions::rk4_f32(c, rows, drives, plan, stop)
+                }),
+                _ => Err(unknown_precision(precision)),
+            };
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
         let rows = [b.q, b.qd, b.torque, b.pivot];
@@ -244,7 +245,7 @@ impl Chain {
                 let out = maybe_detached(py, numbers, || directions::accelerations_f32(&self.inner, rows));
                 Ok(array(py, out.map_err(core_error)?, lead, &width)?.into_any())
             }
-            _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+            _ => Err(unknown_precision(precision)),
         }
     }
 }
@@ -383,7 +384,7 @@ impl Chain {
         match precision {
             "float64" => {}
             "float32" => return self.accelerations_f32(py, kind, q, qd, torque, pivot_acceleration),
-            _ => return Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+            _ => return Err(unknown_precision(precision)),
         }
         if kind == Kind::Planar
             && torque.is_none()

@@ -22,7 +22,7 @@ use crate::arrays::Rows;
 use crate::detach::maybe_detached;
 use crate::drives::Pivot;
 use crate::errors::{core_error, invalid};
-use crate::planar_runs::{Plan, Samples, core, in_chunks, split};
+use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, split};
 use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
 use crate::states::Batch;
 
@@ -218,12 +218,32 @@ pub fn rk4(
 ) -> pendulum_experiment::Result<Samples<f64>> {
     match drives {
         None => rk4_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop),
-        Some(drives) => {
-            let one = Directions::<U3>::new(chain.clone());
-            let models = drives.into_iter().map(|d| one.clone().with_drive(d)).collect();
-            rk4_of(&DirectionsBatch::new(models).map_err(core)?, [q, qd], plan, stop)
-        }
+        Some(drives) => rk4_of(&driven(chain, drives)?, [q, qd], plan, stop),
     }
+}
+
+/// [`rk4`] in single precision ([`DirectionsBatch::integrate_rk4_f32`]): the numbers
+/// rounded to `f32` (one past its range is an error), each chunk from its own start time.
+pub fn rk4_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, _torque, pivot]: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f32>> {
+    match drives {
+        None => rk4_f32_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop),
+        Some(drives) => rk4_f32_of(&driven(chain, drives)?, [q, qd], plan, stop),
+    }
+}
+
+/// The batch of `chain` with one drive per state.
+fn driven(
+    chain: &pendulum_core::Chain<Dyn>,
+    drives: Vec<Pivot>,
+) -> pendulum_experiment::Result<DirectionsBatch<U3, Pivot>> {
+    let one = Directions::<U3>::new(chain.clone());
+    DirectionsBatch::new(drives.into_iter().map(|d| one.clone().with_drive(d)).collect()).map_err(core)
 }
 
 /// [`rk4`] of the chains of `batch`, whatever drives their pivots.
@@ -239,9 +259,31 @@ fn rk4_of<Dr: Drive<U3> + Sync>(
         .map(|x| State::new(plan.t0, DVector::from_column_slice(x)))
         .collect();
     in_chunks(
-        (&q.lead, batch.model(0).links(), plan, stop),
+        (&q.lead, batch.links(), plan, stop),
         &mut states,
         |states, now| batch.integrate_rk4(states, plan.h, now),
         |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),
+    )
+}
+
+/// [`rk4_f32`] of the chains of `batch`.
+fn rk4_f32_of<Dr: Drive<U3> + Sync>(
+    batch: &DirectionsBatch<U3, Dr>,
+    [q, qd]: [&Rows; 2],
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f32>> {
+    let half = q.width;
+    let mut x = narrow(&states(q, qd))?;
+    let mut done = 0;
+    in_chunks(
+        (&q.lead, batch.links(), plan, stop),
+        &mut x,
+        |x, now| {
+            let t = plan.t0 + done as f64 * plan.h;
+            done += now;
+            batch.integrate_rk4_f32(x, t, plan.h, now)
+        },
+        |x, samples| split(half, x.chunks_exact(2 * half.max(1)), samples),
     )
 }

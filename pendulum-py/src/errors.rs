@@ -24,3 +24,8 @@ pub fn core_error(e: pendulum_core::Error) -> PyErr {
 pub fn invalid(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }
+
+/// The error of a `precision` that is neither `"float64"` nor `"float32"`.
+pub fn unknown_precision(precision: &str) -> PyErr {
+    invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))
+}

@@ -15,7 +15,7 @@ use pendulum_experiment::Error;
 use pyo3::prelude::*;
 
 use crate::arrays::{Rows, array};
-use crate::errors::{invalid, run_error};
+use crate::errors::{run_error, unknown_precision};
 use crate::interrupt::interruptible;
 
 /// Rods' solves per chunk of a batched integration: Ctrl-C is looked at between chunks
@@ -71,7 +71,7 @@ pub fn planar_run<'py>(
         "float32" => run_in(py, chain, rows, plan, move |c, rows, plan, stop| {
             planar_rk4_f32(c, rows, drives.as_deref(), plan, stop)
         }),
-        _ => Err(invalid(format!("precision: '{precision}' is neither 'float64' nor 'float32'"))),
+        _ => Err(unknown_precision(precision)),
     }
 }
 
@@ -161,13 +161,6 @@ fn planar_rk4_f32(
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {
     let n = chain.links();
-    let narrow = |v: &[f64]| -> pendulum_experiment::Result<Vec<f32>> {
-        let out: Vec<f32> = v.iter().map(|&x| x as f32).collect();
-        match out.iter().all(|x| x.is_finite()) {
-            true => Ok(out),
-            false => Err(core(pendulum_core::Error::SinglePrecisionOverflow)),
-        }
-    };
     let (torque, pivot) = (narrow(&torque.data)?, narrow(&pivot.data)?);
     let mut x = Vec::with_capacity(2 * q.data.len());
     for (q, qd) in q.data.chunks_exact(n).zip(qd.data.chunks_exact(n)) {
@@ -235,6 +228,16 @@ pub fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, sa
     for row in rows {
         samples.q.extend_from_slice(&row[..n]);
         samples.qd.extend_from_slice(&row[n..2 * n]);
+    }
+}
+
+/// `v` rounded to `f32`; a number past its range is an error
+/// ([`SinglePrecisionOverflow`](pendulum_core::Error::SinglePrecisionOverflow)).
+pub fn narrow(v: &[f64]) -> pendulum_experiment::Result<Vec<f32>> {
+    let out: Vec<f32> = v.iter().map(|&x| x as f32).collect();
+    match out.iter().all(|x| x.is_finite()) {
+        true => Ok(out),
+        false => Err(core(pendulum_core::Error::SinglePrecisionOverflow)),
     }
 }
 

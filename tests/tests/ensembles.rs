@@ -1090,6 +1090,111 @@ fn single_precision_directions_fail_by_chain_and_change_with_no_thread_count_or_
     }
 }
 
+#[test]
+fn single_precision_direction_runs_follow_the_f64_ones_and_fail_by_chain() {
+    // Whirls of 10 g, 1 cm links spread by up to a factor of 2, each pivot circling at
+    // 0.5–5 cm and 1–10 rad/s, from random swinging states: steps of 0.1 ms from
+    // t0 = 1.3 s in f32 against `integrate_rk4` (the bounds of docs/ensembles.md;
+    // `--nocapture` prints the errors), the rods of unit length to f32's rounding, one
+    // thread or two and one chain alone the same bits.
+    let mut r = ChaCha8Rng::seed_from_u64(54);
+    let (chains, h, t0) = (64, 1e-4, 1.3);
+    for (steps, bound) in [(100, 5e-6), (1000, 3e-5)] {
+        for n in [8, 20, 100] {
+            let models: Vec<_> = (0..chains)
+                .map(|_| {
+                    let drive =
+                        Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
+                    Directions::<U3>::new(spread_chain(n, 0.3, &mut r)).with_drive(drive)
+                })
+                .collect();
+            let x: Vec<f64> = models
+                .iter()
+                .flat_map(|m| {
+                    let q: Vec<f64> = (0..2 * n)
+                        .map(|i| if i < n { r.random_range(0.1..3.0) } else { r.random_range(0.0..6.3) })
+                        .collect();
+                    let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-5.0..5.0)).collect();
+                    m.from_spherical(&q, &qd).expect("state").as_slice().to_vec()
+                })
+                .collect();
+            let m = 6 * n;
+            let batch = DirectionsBatch::new(models.clone()).expect("batch");
+            let mut states: Vec<State<Dyn>> =
+                x.chunks_exact(m).map(|x| State::new(t0, DVector::from_column_slice(x))).collect();
+            assert!(batch.integrate_rk4(&mut states, h, steps).expect("f64").is_empty());
+            let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+            let start: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+            let mut runs = Vec::new();
+            for pool in pools() {
+                let mut x32 = start.clone();
+                assert!(
+                    pool.install(|| batch.integrate_rk4_f32(&mut x32, t0, h, steps)).expect("f32").is_empty()
+                );
+                runs.push(x32);
+            }
+            assert!(
+                runs[0].iter().zip(&runs[1]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "one thread or two"
+            );
+            let error = worst_relative_error(&f64s, &runs[0], m);
+            let unit = runs[0]
+                .chunks_exact(m)
+                .flat_map(|x| x[..3 * n].chunks_exact(3))
+                .map(|u| (u.iter().map(|&v| f64::from(v) * f64::from(v)).sum::<f64>().sqrt() - 1.0).abs())
+                .fold(0.0, f64::max);
+            println!(
+                "directions run in f32, {steps} steps of {h} s, n = {n}: {error:.1e}, |u| − 1 ≤ {unit:.1e}"
+            );
+            assert!(error < bound, "{steps} steps, n = {n}: {error:e} ≥ {bound:e}");
+            assert!(unit < 1e-6, "n = {n}: |u| − 1 = {unit:e}");
+            let k = 29;
+            let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+            let mut x32 = start[k * m..(k + 1) * m].to_vec();
+            assert!(alone.integrate_rk4_f32(&mut x32, t0, h, steps).expect("f32").is_empty());
+            assert!(
+                x32.iter().zip(&runs[0][k * m..]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "chain {k} alone"
+            );
+        }
+    }
+    // A NaN state fails before any step, a pivot whose acceleration leaves f32's range at
+    // its first step; the others run on; bad arguments are errors.
+    let n = 5;
+    let models: Vec<_> = [0.02, 1e30, 0.02, 0.02]
+        .into_iter()
+        .map(|radius| {
+            let drive = Circle::new(radius, 3.0).expect("drive");
+            Directions::<U3>::new(spread_chain(n, 0.3, &mut r)).with_drive(drive)
+        })
+        .collect();
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let m = 6 * n;
+    let mut x: Vec<f32> =
+        (0..4).flat_map(|_| [[0.0, 0.6, -0.8]; 5].concat().into_iter().chain([0.1; 15])).collect();
+    x[2 * m + 4] = f32::NAN;
+    let before = x.clone();
+    let failures = batch.integrate_rk4_f32(&mut x, 0.5, 1e-3, 10).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 2]);
+    assert_eq!(failures[0].error, Error::NonFiniteState { t: 0.5, h: 1e-3 });
+    assert!(matches!(failures[1].error, Error::NonFinite { what: "x", index: 4, .. }));
+    for k in [1, 2] {
+        let same =
+            x[k * m..(k + 1) * m].iter().zip(&before[k * m..]).all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "chain {k} is left where it was");
+    }
+    assert!(x[..m] != before[..m] && x[3 * m..] != before[3 * m..]);
+    assert!(matches!(
+        batch.integrate_rk4_f32(&mut x[..m], 0.0, 1e-3, 1),
+        Err(Error::LengthMismatch { what: "x", .. })
+    ));
+    assert!(matches!(batch.integrate_rk4_f32(&mut x, 0.0, 0.0, 1), Err(Error::InvalidStepSize { .. })));
+    assert!(matches!(
+        batch.integrate_rk4_f32(&mut x, f64::INFINITY, 1e-3, 1),
+        Err(Error::NonFinite { what: "t0", .. })
+    ));
+}
+
 /// Chains of `n` links whose masses, lengths and damping are spread over `decades`
 /// decades around 10 g, 1 cm and 1e-4 N·m·s, with gravity 9.81 m/s².
 fn spread_chain(n: usize, decades: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {

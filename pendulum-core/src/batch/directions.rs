@@ -36,7 +36,7 @@ pub struct DirectionsBatch<S: DimName, Dr = Fixed> {
     count: usize,
     pub(super) blocks: Blocks<Block, Block<WIDTH_AVX512>>,
     /// Per block of [`WIDTH_F32`] chains, their rods and `−g` in single precision.
-    blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
+    pub(super) blocks_f32: Vec<(Rods<F32x8>, F32x8)>,
     links: usize,
     /// Whether the states carry the energy ledger of [`Accounted`].
     accounted: bool,
@@ -134,7 +134,7 @@ impl<T: Transpose + Into<f64>> States<'_, T> {
 type Lanes3<const C: usize, V> = (Solve<C, V>, Aligned<V>, Aligned<V>);
 
 impl<const C: usize, V: Lane> Solve<C, V> {
-    fn new(links: usize) -> Self {
+    pub(super) fn new(links: usize) -> Self {
         Self { rows: Rows::with_len(links), links }
     }
 
@@ -142,7 +142,14 @@ impl<const C: usize, V: Lane> Solve<C, V> {
     /// at directions and rates `x = (u, w)` (`2·C·n`), under gravity `g⃗` and pivot
     /// accelerations `p̈` (m/s²): [`Directions`]' tension solve, in lanes of any precision.
     #[inline(always)]
-    fn accelerations(&mut self, rods: &Rods<V>, gravity: [V; C], pivot: [V; C], x: &[V], out: &mut [V]) {
+    pub(super) fn accelerations(
+        &mut self,
+        rods: &Rods<V>,
+        gravity: [V; C],
+        pivot: [V; C],
+        x: &[V],
+        out: &mut [V],
+    ) {
         let half = C * self.links;
         let (directions, rates) = (&x[..half], &x[half..2 * half]);
         self.solve_loaded(rods, gravity, pivot, RateLoads { directions, rates, drag: rods.drag() }, out);
@@ -477,7 +484,7 @@ where
     /// `of(drive, t_k)` (the pivot's acceleration or velocity) of each lane's chain, as
     /// numbers of a lane type made by `lanes`.
     #[inline(always)]
-    fn pivot_lanes<const C: usize, const W: usize, V>(
+    pub(super) fn pivot_lanes<const C: usize, const W: usize, V>(
         &self,
         chains: [usize; W],
         t: [f64; W],
@@ -634,7 +641,7 @@ where
 
 /// Gravity `g⃗ = −g e_up` (m/s²) per lane, from `−g`: along the last axis.
 #[inline(always)]
-fn gravity<const C: usize, V: Lane>(down: V) -> [V; C] {
+pub(super) fn gravity<const C: usize, V: Lane>(down: V) -> [V; C] {
     let mut g = [V::splat(0.0); C];
     g[C - 1] = down;
     g

@@ -39,6 +39,7 @@ mod lane_states;
 mod planar;
 mod planar_rk4;
 mod rk4;
+mod rk4_f32;
 mod rod_midpoint;
 mod rooms;
 mod run;
