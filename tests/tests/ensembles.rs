@@ -1006,9 +1006,15 @@ fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_c
     }
 }
 
-/// `max |ü₃₂ − ü₆₄| / max |ü₆₄|` of each chain of whirls of `n` links whose masses, lengths
-/// and damping span `decades` decades, at random states: the worst of `chains`.
-fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8Rng) -> f64 {
+/// `chains` whirls of `n` links whose masses, lengths and damping span `decades` decades
+/// (`spread_chain`), each pivot on its own circle of 0.5–5 cm at 1–10 rad/s, and their
+/// states as rows of `(u, w)`: random tilts, azimuths and rates (±5 rad/s).
+fn spread_whirls(
+    n: usize,
+    decades: f64,
+    chains: usize,
+    r: &mut ChaCha8Rng,
+) -> (Vec<Directions<U3, Circle>>, Vec<f64>) {
     let models: Vec<_> = (0..chains)
         .map(|_| {
             let chain = spread_chain(n, decades, r);
@@ -1026,6 +1032,13 @@ fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8
             m.from_spherical(&q, &qd).expect("state").as_slice().to_vec()
         })
         .collect();
+    (models, x)
+}
+
+/// `max |ü₃₂ − ü₆₄| / max |ü₆₄|` of each chain of whirls of `n` links whose masses, lengths
+/// and damping span `decades` decades, at random states: the worst of `chains`.
+fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8Rng) -> f64 {
+    let (models, x) = spread_whirls(n, decades, chains, r);
     let batch = DirectionsBatch::new(models).expect("batch");
     let t = r.random_range(0.0..10.0);
     let (mut out64, mut out32) = (vec![0.0; chains * 3 * n], vec![0.0f32; chains * 3 * n]);
@@ -1101,23 +1114,7 @@ fn single_precision_direction_runs_follow_the_f64_ones_and_fail_by_chain() {
     let (chains, h, t0) = (64, 1e-4, 1.3);
     for (steps, bound) in [(100, 5e-6), (1000, 3e-5)] {
         for n in [8, 20, 100] {
-            let models: Vec<_> = (0..chains)
-                .map(|_| {
-                    let drive =
-                        Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
-                    Directions::<U3>::new(spread_chain(n, 0.3, &mut r)).with_drive(drive)
-                })
-                .collect();
-            let x: Vec<f64> = models
-                .iter()
-                .flat_map(|m| {
-                    let q: Vec<f64> = (0..2 * n)
-                        .map(|i| if i < n { r.random_range(0.1..3.0) } else { r.random_range(0.0..6.3) })
-                        .collect();
-                    let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-5.0..5.0)).collect();
-                    m.from_spherical(&q, &qd).expect("state").as_slice().to_vec()
-                })
-                .collect();
+            let (models, x) = spread_whirls(n, 0.3, chains, &mut r);
             let m = 6 * n;
             let batch = DirectionsBatch::new(models.clone()).expect("batch");
             let mut states: Vec<State<Dyn>> =

@@ -193,14 +193,23 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
+        let drive = self.pivots_of(drives)?;
+        self.runs_f64((states, (torque, None), (h, steps)), Some(&drive))
+    }
+
+    /// Chain `k`'s pivot acceleration `p̈(t)` (m/s²) from `drives[k]`, as `(k, t) ↦ p̈`.
+    /// Errors: [`Error::LengthMismatch`] for a number of drives other than `B`.
+    fn pivots_of<'a, Dr: Drive<U2> + Sync>(
+        &self,
+        drives: &'a [Dr],
+    ) -> Result<impl Fn(usize, f64) -> [f64; 2] + Sync + 'a> {
         if drives.len() != self.len() {
             return Err(Error::LengthMismatch { what: "drives", expected: self.len(), got: drives.len() });
         }
-        let drive = |chain: usize, t: f64| {
+        Ok(|chain: usize, t: f64| {
             let a = drives[chain].acceleration(t);
             [a[0], a[1]]
-        };
-        self.runs_f64((states, (torque, None), (h, steps)), Some(&drive))
+        })
     }
 
     /// The `f64` runs in this batch's lanes, the pivots from `drive` (chain, time) when
@@ -327,16 +336,10 @@ impl PlanarBatch {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        if drives.len() != self.len() {
-            return Err(Error::LengthMismatch { what: "drives", expected: self.len(), got: drives.len() });
-        }
+        let drive = self.pivots_of(drives)?;
         if !t0.is_finite() {
             return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
         }
-        let drive = |chain: usize, t: f64| {
-            let a = drives[chain].acceleration(t);
-            [a[0], a[1]]
-        };
         self.runs_f32((x, carry), (torque, None), (h, steps), Some((t0, &drive)))
     }
 
