@@ -2,6 +2,8 @@
 //! their shared fixtures, and its doctests run the README's examples.
 #![doc = include_str!("../../README.md")]
 
+pub mod batches;
+
 use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 use pendulum_core::{Inputs, Model, ModelAlloc};
 use rand::{Rng, SeedableRng};

@@ -1,0 +1,56 @@
+//! Fixtures of the batch tests (`ensembles.rs`, `single_precision.rs`): random chains and
+//! whirls, and thread pools of one and two threads.
+
+use nalgebra::{DVector, Dyn, U3};
+use pendulum_core::{Chain, Circle, Directions};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// A chain of `n` links with masses, lengths and damping log-uniform over two decades and
+/// gravity between 1 and 20 m/s².
+pub fn random_chain(n: usize, r: &mut ChaCha8Rng) -> Chain<Dyn> {
+    let mut decades = |lo: f64| (0..n).map(|_| 10f64.powf(lo + 2.0 * r.random::<f64>())).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (decades(-2.0), decades(-2.0), decades(-5.0));
+    let g = r.random_range(1.0..20.0);
+    Chain::new(&masses, &lengths, g).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// Chains of `n` links whose masses, lengths and damping are spread over `decades`
+/// decades around 10 g, 1 cm and 1e-4 N·m·s, with gravity 9.81 m/s².
+pub fn spread_chain(n: usize, decades: f64, r: &mut ChaCha8Rng) -> Chain<Dyn> {
+    let mut spread =
+        |lo: f64| (0..n).map(|_| 10f64.powf(lo + decades * r.random::<f64>())).collect::<Vec<_>>();
+    let (masses, lengths, damping) = (spread(-2.0), spread(-2.0), spread(-4.0));
+    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// A whirl-like 3D chain: uniform random links, its pivot on a circle of random radius and
+/// speed, from a tilted swinging state.
+pub fn whirl(n: usize, r: &mut ChaCha8Rng) -> (Directions<U3, Circle>, DVector<f64>) {
+    let chain = random_chain(n, r);
+    let drive = Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..10.0)).expect("drive");
+    let model = Directions::<U3>::new(chain).with_drive(drive);
+    let x = whirl_state(&model, n, r);
+    (model, x)
+}
+
+/// A state of `model` (a whirl of `n` links) at random spherical angles and rates.
+pub fn whirl_state(model: &Directions<U3, Circle>, n: usize, r: &mut ChaCha8Rng) -> DVector<f64> {
+    let q: Vec<f64> =
+        (0..2 * n).map(|i| if i < n { r.random_range(0.1..1.0) } else { r.random_range(0.0..6.0) }).collect();
+    let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-1.0..1.0)).collect();
+    model.from_spherical(&q, &qd).expect("state")
+}
+
+/// Thread pools of one and of two threads.
+pub fn pools() -> [rayon::ThreadPool; 2] {
+    [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
+}
+
+/// Every entry equal bit for bit (NaN only where NaN).
+pub fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
+    assert_eq!(batch.len(), single.len(), "{what}");
+    for (i, (a, b)) in batch.iter().zip(single).enumerate() {
+        assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
+    }
+}

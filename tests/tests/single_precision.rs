@@ -1,0 +1,430 @@
+//! Batches of chains in single precision (`pendulum_core::batch`'s `_f32` calls): their
+//! error against the `f64` calls, within the bounds `docs/ensembles.md` gives, and as in
+//! double precision a failing chain reported by its index while the others finish, the
+//! same numbers for any thread count and split.
+
+use nalgebra::{DVector, Dyn, U2, U3};
+use pendulum_core::batch::{DirectionsBatch, PlanarBatch};
+use pendulum_core::integrate::State;
+use pendulum_core::{Circle, Directions, Error, Harmonic};
+use pendulum_tests::batches::{pools, spread_chain, whirl};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `chains` whirls of `n` links whose masses, lengths and damping span `decades` decades
+/// (`spread_chain`), each pivot on its own circle of 0.5–5 cm at 1–10 rad/s, and their
+/// states as rows of `(u, w)`: random tilts, azimuths and rates (±5 rad/s).
+fn spread_whirls(
+    n: usize,
+    decades: f64,
+    chains: usize,
+    r: &mut ChaCha8Rng,
+) -> (Vec<Directions<U3, Circle>>, Vec<f64>) {
+    let models: Vec<_> = (0..chains)
+        .map(|_| {
+            let chain = spread_chain(n, decades, r);
+            let drive = Circle::new(r.random_range(0.005..0.05), r.random_range(1.0..10.0)).expect("drive");
+            Directions::<U3>::new(chain).with_drive(drive)
+        })
+        .collect();
+    let x: Vec<f64> = models
+        .iter()
+        .flat_map(|m| {
+            let q: Vec<f64> = (0..2 * n)
+                .map(|i| if i < n { r.random_range(0.1..3.0) } else { r.random_range(0.0..6.3) })
+                .collect();
+            let qd: Vec<f64> = (0..2 * n).map(|_| r.random_range(-5.0..5.0)).collect();
+            m.from_spherical(&q, &qd).expect("state").as_slice().to_vec()
+        })
+        .collect();
+    (models, x)
+}
+
+/// `max |ü₃₂ − ü₆₄| / max |ü₆₄|` of each chain of whirls of `n` links whose masses, lengths
+/// and damping span `decades` decades, at random states: the worst of `chains`.
+fn single_precision_error(n: usize, decades: f64, chains: usize, r: &mut ChaCha8Rng) -> f64 {
+    let (models, x) = spread_whirls(n, decades, chains, r);
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let t = r.random_range(0.0..10.0);
+    let (mut out64, mut out32) = (vec![0.0; chains * 3 * n], vec![0.0f32; chains * 3 * n]);
+    assert!(batch.accelerations(t, &x, &mut out64).expect("f64").is_empty());
+    let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+    assert!(batch.accelerations_f32(t, &x32, &mut out32).expect("f32").is_empty());
+    worst_relative_error(&out64, &out32, 3 * n)
+}
+
+#[test]
+fn single_precision_directions_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors.
+    let mut r = ChaCha8Rng::seed_from_u64(47);
+    for (decades, bound) in [(0.3, 5e-6), (1.0, 5e-6), (2.0, 1e-5), (3.0, 1e-4)] {
+        for n in [8, 20, 100] {
+            let error = single_precision_error(n, decades, 200, &mut r);
+            println!("spread 10^{decades}, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_directions_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(48);
+    let (n, chains) = (12, 19);
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+    let mut x: Vec<f32> = x.iter().flat_map(|x| x.iter().map(|&v| v as f32)).collect();
+    let m = 6 * n;
+    x[3 * m + 5] = f32::NAN;
+    // A rate whose square leaves f32: finite input, overflow in the solve.
+    x[11 * m + 3 * n + 1] = 3e19;
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let mut out = vec![0.0f32; chains * 3 * n];
+        let failures = pool.install(|| batch.accelerations_f32(1.5, &x, &mut out)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11]);
+        // NaN is not equal to itself: the error named by its fields.
+        assert!(matches!(failures[0].error, Error::NonFinite { what: "x", index: 5, .. }));
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, row) in out.chunks_exact(3 * n).enumerate() {
+            assert_eq!(row.iter().all(|v| v.is_nan()), k == 3 || k == 11, "chain {k}");
+        }
+        runs.push(out);
+    }
+    assert_eq!(
+        runs[0].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        runs[1].iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    // Each chain alone in a batch of its own: the same bits.
+    for k in [0, 7, 18] {
+        let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+        let mut out = vec![0.0f32; 3 * n];
+        assert!(alone.accelerations_f32(1.5, &x[k * m..(k + 1) * m], &mut out).expect("f32").is_empty());
+        let row = &runs[0][k * 3 * n..(k + 1) * 3 * n];
+        assert_eq!(
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            row.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "chain {k}"
+        );
+    }
+}
+
+#[test]
+fn single_precision_direction_runs_follow_the_f64_ones_and_fail_by_chain() {
+    // Whirls of 10 g, 1 cm links spread by up to a factor of 2, each pivot circling at
+    // 0.5–5 cm and 1–10 rad/s, from random swinging states: steps of 0.1 ms from
+    // t0 = 1.3 s in f32 against `integrate_rk4` (the bounds of docs/ensembles.md;
+    // `--nocapture` prints the errors), the rods of unit length to f32's rounding, one
+    // thread or two and one chain alone the same bits.
+    let mut r = ChaCha8Rng::seed_from_u64(54);
+    let (chains, h, t0) = (64, 1e-4, 1.3);
+    for (steps, bound) in [(100, 5e-6), (1000, 3e-5)] {
+        for n in [8, 20, 100] {
+            let (models, x) = spread_whirls(n, 0.3, chains, &mut r);
+            let m = 6 * n;
+            let batch = DirectionsBatch::new(models.clone()).expect("batch");
+            let mut states: Vec<State<Dyn>> =
+                x.chunks_exact(m).map(|x| State::new(t0, DVector::from_column_slice(x))).collect();
+            assert!(batch.integrate_rk4(&mut states, h, steps).expect("f64").is_empty());
+            let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+            let start: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+            let mut runs = Vec::new();
+            for pool in pools() {
+                let mut x32 = start.clone();
+                assert!(
+                    pool.install(|| batch.integrate_rk4_f32(&mut x32, t0, h, steps)).expect("f32").is_empty()
+                );
+                runs.push(x32);
+            }
+            assert!(
+                runs[0].iter().zip(&runs[1]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "one thread or two"
+            );
+            let error = worst_relative_error(&f64s, &runs[0], m);
+            let unit = runs[0]
+                .chunks_exact(m)
+                .flat_map(|x| x[..3 * n].chunks_exact(3))
+                .map(|u| (u.iter().map(|&v| f64::from(v) * f64::from(v)).sum::<f64>().sqrt() - 1.0).abs())
+                .fold(0.0, f64::max);
+            println!(
+                "directions run in f32, {steps} steps of {h} s, n = {n}: {error:.1e}, |u| − 1 ≤ {unit:.1e}"
+            );
+            assert!(error < bound, "{steps} steps, n = {n}: {error:e} ≥ {bound:e}");
+            assert!(unit < 1e-6, "n = {n}: |u| − 1 = {unit:e}");
+            let k = 29;
+            let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+            let mut x32 = start[k * m..(k + 1) * m].to_vec();
+            assert!(alone.integrate_rk4_f32(&mut x32, t0, h, steps).expect("f32").is_empty());
+            assert!(
+                x32.iter().zip(&runs[0][k * m..]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "chain {k} alone"
+            );
+        }
+    }
+    // A NaN state fails before any step, a pivot whose acceleration leaves f32's range at
+    // its first step; the others run on; bad arguments are errors.
+    let n = 5;
+    let models: Vec<_> = [0.02, 1e30, 0.02, 0.02]
+        .into_iter()
+        .map(|radius| {
+            let drive = Circle::new(radius, 3.0).expect("drive");
+            Directions::<U3>::new(spread_chain(n, 0.3, &mut r)).with_drive(drive)
+        })
+        .collect();
+    let batch = DirectionsBatch::new(models).expect("batch");
+    let m = 6 * n;
+    let mut x: Vec<f32> =
+        (0..4).flat_map(|_| [[0.0, 0.6, -0.8]; 5].concat().into_iter().chain([0.1; 15])).collect();
+    x[2 * m + 4] = f32::NAN;
+    let before = x.clone();
+    let failures = batch.integrate_rk4_f32(&mut x, 0.5, 1e-3, 10).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [1, 2]);
+    assert_eq!(failures[0].error, Error::NonFiniteState { t: 0.5, h: 1e-3 });
+    assert!(matches!(failures[1].error, Error::NonFinite { what: "x", index: 4, .. }));
+    for k in [1, 2] {
+        let same =
+            x[k * m..(k + 1) * m].iter().zip(&before[k * m..]).all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "chain {k} is left where it was");
+    }
+    assert!(x[..m] != before[..m] && x[3 * m..] != before[3 * m..]);
+    assert!(matches!(
+        batch.integrate_rk4_f32(&mut x[..m], 0.0, 1e-3, 1),
+        Err(Error::LengthMismatch { what: "x", .. })
+    ));
+    assert!(matches!(batch.integrate_rk4_f32(&mut x, 0.0, 0.0, 1), Err(Error::InvalidStepSize { .. })));
+    assert!(matches!(
+        batch.integrate_rk4_f32(&mut x, f64::INFINITY, 1e-3, 1),
+        Err(Error::NonFinite { what: "t0", .. })
+    ));
+}
+
+/// The worst over rows of `max |a₃₂ − a₆₄| / max |a₆₄|` (rows of `m`).
+fn worst_relative_error(f64s: &[f64], f32s: &[f32], m: usize) -> f64 {
+    f64s.chunks_exact(m)
+        .zip(f32s.chunks_exact(m))
+        .map(|(a, b)| {
+            let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            a.iter().zip(b).fold(0.0f64, |e, (a, &b)| e.max((a - f64::from(b)).abs())) / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn single_precision_planar_chains_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors.
+    let mut r = ChaCha8Rng::seed_from_u64(49);
+    let chains = 200;
+    for (decades, bound) in [(0.3, 1e-5), (1.0, 1e-5), (2.0, 5e-5)] {
+        for n in [8, 20, 100] {
+            let batch = PlanarBatch::new((0..chains).map(|_| spread_chain(n, decades, &mut r)).collect())
+                .expect("batch");
+            let q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+            let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+            let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+            let (mut out64, mut out32) = (vec![0.0; chains * n], vec![0.0f32; chains * n]);
+            assert!(batch.accelerations(&q, &qd, None, Some(&pivot), &mut out64).expect("f64").is_empty());
+            let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+            let (q, qd, pivot) = (narrow(&q), narrow(&qd), narrow(&pivot));
+            assert!(batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out32).expect("f32").is_empty());
+            let error = worst_relative_error(&out64, &out32, n);
+            println!("planar, spread 10^{decades}, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(50);
+    let (n, chains) = (10, 21);
+    let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 1.0, &mut r)).collect();
+    let mut q: Vec<f32> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+    let mut qd: Vec<f32> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+    q[4 * n + 2] = f32::INFINITY;
+    qd[13 * n + 7] = 3e19;
+    let batch = PlanarBatch::new(list.clone()).expect("batch");
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let mut out = vec![0.0f32; chains * n];
+        let failures = pool.install(|| batch.accelerations_f32(&q, &qd, None, &mut out)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [4, 13]);
+        assert_eq!(failures[0].error, Error::NonFinite { what: "q", index: 2, value: f64::INFINITY });
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, row) in out.chunks_exact(n).enumerate() {
+            assert_eq!(row.iter().all(|v| v.is_nan()), k == 4 || k == 13, "chain {k}");
+        }
+        runs.push(out.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    }
+    assert_eq!(runs[0], runs[1]);
+    for k in [0, 9, 20] {
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let mut out = vec![0.0f32; n];
+        let row = |v: &[f32]| v[k * n..(k + 1) * n].to_vec();
+        assert!(alone.accelerations_f32(&row(&q), &row(&qd), None, &mut out).expect("f32").is_empty());
+        assert_eq!(
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            runs[0][k * n..(k + 1) * n],
+            "chain {k}"
+        );
+    }
+}
+
+/// States of `chains` chains of `n` links as rows of `(θ, θ̇)`: angles within ±1 rad,
+/// rates within ±1 rad/s.
+fn planar_rows(chains: usize, n: usize, r: &mut ChaCha8Rng) -> Vec<f64> {
+    (0..chains * 2 * n).map(|_| r.random_range(-1.0..1.0)).collect()
+}
+
+#[test]
+fn single_precision_planar_runs_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"): 100 and 1000 RK4 steps of
+    // 0.1 ms from the same states, the f32 run against the f64 one; `--nocapture` prints them.
+    let mut r = ChaCha8Rng::seed_from_u64(51);
+    let (chains, h) = (64, 1e-4);
+    for (decades, steps, bound) in [(0.3, 100, 5e-6), (0.3, 1000, 3e-4), (1.0, 100, 5e-6), (2.0, 100, 1e-5)] {
+        for n in [8, 20, 100] {
+            let batch = PlanarBatch::new((0..chains).map(|_| spread_chain(n, decades, &mut r)).collect())
+                .expect("batch");
+            let rows = planar_rows(chains, n, &mut r);
+            let mut states: Vec<State<Dyn>> =
+                rows.chunks_exact(2 * n).map(|x| State::new(0.0, DVector::from_column_slice(x))).collect();
+            assert!(batch.integrate_rk4(&mut states, None, None, h, steps).expect("f64").is_empty());
+            let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+            let (mut f32s, mut carry): (Vec<f32>, _) =
+                (rows.iter().map(|&v| v as f32).collect(), vec![0.0; rows.len()]);
+            let run = batch.integrate_rk4_f32((&mut f32s, &mut carry), None, None, h, steps);
+            assert!(run.expect("f32").is_empty());
+            let error = worst_relative_error(&f64s, &f32s, 2 * n);
+            println!("planar run, spread 10^{decades}, {steps} steps of {h} s, n = {n}: {error:.1e}");
+            assert!(error < bound, "spread 10^{decades}, {steps} × {h} s, n = {n}: {error:e} ≥ {bound:e}");
+        }
+    }
+}
+
+#[test]
+fn single_precision_driven_planar_runs_follow_the_f64_ones_and_fail_by_chain() {
+    // Each chain's pivot shaken along its own line from t0 = 0.37 s (up to 0.01 m at up to
+    // 400 rad/s: 160 g): the f32 run against the f64 driven run (the bound of
+    // docs/ensembles.md; `--nocapture` prints it), a pivot that
+    // stands still against the held run bit for bit, one chain alone and thread counts bit
+    // for bit, a drive past f32's range failing its chain alone, and bad arguments.
+    let mut r = ChaCha8Rng::seed_from_u64(53);
+    let (chains, h, steps, t0) = (64, 1e-4, 100, 0.37);
+    let shake = |r: &mut ChaCha8Rng, k: usize| {
+        let direction =
+            nalgebra::Vector2::new(if k.is_multiple_of(2) { 0.0 } else { r.random_range(-1.0..1.0) }, 1.0);
+        let (a, w) = (r.random_range(0.0..0.01), r.random_range(10.0..400.0));
+        Harmonic::new(direction, a, w, r.random::<f64>()).expect("drive")
+    };
+    for n in [8, 20, 100] {
+        let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 0.3, &mut r)).collect();
+        let batch = PlanarBatch::new(list.clone()).expect("batch");
+        let drives: Vec<Harmonic<U2>> = (0..chains).map(|k| shake(&mut r, k)).collect();
+        let rows = planar_rows(chains, n, &mut r);
+        let mut states: Vec<State<Dyn>> =
+            rows.chunks_exact(2 * n).map(|x| State::new(t0, DVector::from_column_slice(x))).collect();
+        assert!(batch.integrate_rk4_driven(&mut states, &drives, None, h, steps).expect("f64").is_empty());
+        let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+        let start: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
+        let mut runs = Vec::new();
+        for pool in pools() {
+            let (mut x, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+            let run = pool.install(|| {
+                batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives), None, h, steps)
+            });
+            assert!(run.expect("f32").is_empty());
+            runs.push(x);
+        }
+        assert!(runs[0].iter().zip(&runs[1]).all(|(a, b)| a.to_bits() == b.to_bits()), "one thread or two");
+        let error = worst_relative_error(&f64s, &runs[0], 2 * n);
+        println!("driven planar run in f32, {steps} steps of {h} s, n = {n}: {error:.1e}");
+        assert!(error < 1e-4, "n = {n}: {error:e}");
+        let k = 37;
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let (mut x, mut carry) = (start[k * 2 * n..(k + 1) * 2 * n].to_vec(), vec![0.0; 2 * n]);
+        let run = alone.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives[k..=k]), None, h, steps);
+        assert!(run.expect("f32").is_empty());
+        assert!(
+            x.iter().zip(&runs[0][k * 2 * n..]).all(|(a, b)| a.to_bits() == b.to_bits()),
+            "chain {k} alone"
+        );
+        // No amplitude: the pivot at rest, as the held run has it.
+        let still: Vec<Harmonic<U2>> = (0..chains)
+            .map(|_| Harmonic::new(nalgebra::Vector2::new(0.3, 1.0), 0.0, 50.0, 0.1).expect("drive"))
+            .collect();
+        let (mut driven, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+        let run = batch.integrate_rk4_driven_f32((&mut driven, &mut carry), (t0, &still), None, h, steps);
+        assert!(run.expect("f32").is_empty());
+        let (mut held, mut carry) = (start.clone(), vec![0.0; rows.len()]);
+        assert!(
+            batch.integrate_rk4_f32((&mut held, &mut carry), None, None, h, steps).expect("f32").is_empty()
+        );
+        assert!(driven.iter().zip(&held).all(|(a, b)| a.to_bits() == b.to_bits()), "n = {n}: at rest");
+    }
+    // A drive whose acceleration leaves f32's range (finite in f64) fails its chain alone at
+    // its first step; too few drives and a non-finite t0 are errors.
+    let batch = PlanarBatch::new((0..3).map(|_| spread_chain(4, 0.3, &mut r)).collect()).expect("batch");
+    let drives: Vec<Harmonic<U2>> = [1e30, 10.0, 10.0]
+        .into_iter()
+        .map(|w| Harmonic::new(nalgebra::Vector2::new(0.0, 1.0), 1.0, w, 0.3).expect("drive"))
+        .collect();
+    let (mut x, mut carry) = (vec![0.5f32; 24], vec![0.0f32; 24]);
+    let failures =
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives), None, 1e-3, 5).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [0]);
+    assert_eq!(failures[0].error, Error::NonFiniteState { t: t0, h: 1e-3 });
+    assert_eq!(&x[..8], &[0.5; 8], "the failed chain stays at its start");
+    assert!(x[8..].iter().any(|v| *v != 0.5));
+    assert!(matches!(
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives[..2]), None, 1e-3, 5),
+        Err(Error::LengthMismatch { what: "drives", expected: 3, got: 2 })
+    ));
+    assert!(matches!(
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (f64::NAN, &drives), None, 1e-3, 5),
+        Err(Error::NonFinite { what: "t0", .. })
+    ));
+}
+
+#[test]
+fn single_precision_planar_runs_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(52);
+    let (n, chains) = (6, 19);
+    let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 1.0, &mut r)).collect();
+    let batch = PlanarBatch::new(list.clone()).expect("batch");
+    let mut start: Vec<f32> = planar_rows(chains, n, &mut r).iter().map(|&v| v as f32).collect();
+    let torque: Vec<f32> = (0..chains * n).map(|i| if (i / n) % 2 == 0 { 0.0 } else { 1e-3 }).collect();
+    start[3 * 2 * n + 1] = f32::NAN;
+    start[11 * 2 * n + n] = 1e30; // spins so fast that the first step overflows
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let (mut x, mut carry) = (start.clone(), vec![0.0; start.len()]);
+        let failures = pool
+            .install(|| batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), None, 1e-3, 20))
+            .expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11], "{failures:?}");
+        assert_eq!(failures[0].error.to_string(), "x[1] must be finite, got NaN");
+        assert_eq!(failures[1].error, Error::NonFiniteState { t: 0.0, h: 1e-3 });
+        for k in [3, 11] {
+            let row = k * 2 * n..(k + 1) * 2 * n;
+            let same = x[row.clone()].iter().zip(&start[row]).all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "chain {k} is left where it was");
+        }
+        runs.push(x.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        // Twenty calls of one step, the compensation kept: the same numbers.
+        let (mut y, mut carry) = (start.clone(), vec![0.0; start.len()]);
+        for _ in 0..20 {
+            pool.install(|| batch.integrate_rk4_f32((&mut y, &mut carry), Some(&torque), None, 1e-3, 1))
+                .expect("f32");
+        }
+        assert_eq!(y.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), runs[0], "one step per call");
+    }
+    assert_eq!(runs[0], runs[1], "one thread or two");
+    for k in [0, 8, 18] {
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let (mut x, mut carry) = (start[k * 2 * n..(k + 1) * 2 * n].to_vec(), vec![0.0; 2 * n]);
+        let t = &torque[k * n..(k + 1) * n];
+        let run = alone.integrate_rk4_f32((&mut x, &mut carry), Some(t), None, 1e-3, 20);
+        assert!(run.expect("f32").is_empty());
+        let bits: Vec<u32> = x.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(bits, runs[0][k * 2 * n..(k + 1) * 2 * n], "chain {k} alone");
+    }
+}
