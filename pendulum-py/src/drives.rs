@@ -25,15 +25,19 @@ pub struct Harmonic {
     direction: Option<Numbers>,
 }
 
-/// The pivot on the horizontal circle `p(t) = R (cos ωt, sin ωt, 0)` (m) about the vertical
-/// (z up), radius `R ≥ 0` (m), angular frequency `ω` (rad/s, positive counter-clockwise
-/// seen from above), each one number for all states or an array of the states' leading
-/// shape: the whirled chain, `model="directions"` only.
+/// The pivot on the horizontal circle `p(t) = R (cos φ, sin φ, 0)` (m) about the vertical
+/// (z up), radius `R ≥ 0` (m), at the angular speed `φ̇ = ω` (rad/s, positive
+/// counter-clockwise seen from above) or, given `ramp_time` `T` (s), ramped linearly from
+/// `ramp_from` (rad/s, default 0) at `t = 0` to `ω` at `t = T` and held there (the ramped
+/// whirl of `Run` and `whirls`); each parameter one number for all states or an array of
+/// the states' leading shape: the whirled chain, `model="directions"` only.
 #[pyclass(module = "pendulum._pendulum", name = "Circle", frozen)]
 #[derive(Debug, Clone)]
 pub struct Circle {
     radius: Numbers,
     omega: Numbers,
+    /// `T` and `ω0` of a ramp, if any.
+    ramp: Option<(Numbers, Numbers)>,
 }
 
 /// `what`'s numbers, each checked by `valid` (a requirement in words when not).
@@ -138,8 +142,43 @@ impl Harmonic {
 #[pymethods]
 impl Circle {
     #[new]
-    fn new(radius: &Bound<'_, PyAny>, omega: &Bound<'_, PyAny>) -> PyResult<Self> {
-        Ok(Self { radius: checked("radius", radius, non_negative)?, omega: Numbers::read("omega", omega)? })
+    #[pyo3(signature = (radius, omega, ramp_time = None, ramp_from = None))]
+    fn new(
+        radius: &Bound<'_, PyAny>,
+        omega: &Bound<'_, PyAny>,
+        ramp_time: Option<&Bound<'_, PyAny>>,
+        ramp_from: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let (ramp_time, ramp_from) = (ramp_time.filter(|v| !v.is_none()), ramp_from.filter(|v| !v.is_none()));
+        let ramp = match (ramp_time, ramp_from) {
+            (None, None) => None,
+            (None, Some(_)) => return Err(invalid("ramp_from: a ramp needs its ramp_time (s)")),
+            (Some(time), from) => {
+                let time = checked("ramp_time", time, |t| (t <= 0.0).then_some("not a positive time (s)"))?;
+                let from = match from {
+                    Some(from) => Numbers::read("ramp_from", from)?,
+                    None => Numbers { shape: vec![], data: vec![0.0] },
+                };
+                Some((time, from))
+            }
+        };
+        Ok(Self {
+            radius: checked("radius", radius, non_negative)?,
+            omega: Numbers::read("omega", omega)?,
+            ramp,
+        })
+    }
+
+    /// The ramp's duration `T` (s), as given; `None` for a steady speed.
+    #[getter]
+    fn ramp_time<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.ramp.as_ref().map(|(time, _)| time.to_array(py)).transpose()
+    }
+
+    /// The speed the ramp starts from `ω0` (rad/s), as given; `None` for a steady speed.
+    #[getter]
+    fn ramp_from<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.ramp.as_ref().map(|(_, from)| from.to_array(py)).transpose()
     }
 
     /// Radius `R` (m), as given.
@@ -155,12 +194,17 @@ impl Circle {
     }
 
     fn __repr__(&self) -> String {
-        format!("Circle(radius={}, omega={})", describe(&self.radius), describe(&self.omega))
+        let ramp = match &self.ramp {
+            None => String::new(),
+            Some((time, from)) => format!(", ramp_time={}, ramp_from={}", describe(time), describe(from)),
+        };
+        format!("Circle(radius={}, omega={}{ramp})", describe(&self.radius), describe(&self.omega))
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let (py, me) = (slf.py(), slf.get());
-        Ok((slf.get_type().into_any(), (me.radius(py)?, me.omega(py)?).into_pyobject(py)?))
+        let args = (me.radius(py)?, me.omega(py)?, me.ramp_time(py)?, me.ramp_from(py)?);
+        Ok((slf.get_type().into_any(), args.into_pyobject(py)?))
     }
 }
 
@@ -207,14 +251,33 @@ impl Given {
     pub fn spatial(&self, lead: &[usize]) -> PyResult<Vec<Pivot>> {
         Ok(match self {
             Self::Harmonic(h) => h.drives(lead)?.into_iter().map(Pivot::Harmonic).collect(),
-            Self::Circle(c) => {
-                let (radius, omega) =
-                    (c.radius.per_state("radius", 1, lead)?, c.omega.per_state("omega", 1, lead)?);
-                let circle =
-                    |(r, w): (&&[f64], &&[f64])| pendulum_core::Circle::new(r[0], w[0]).map(Pivot::Circle);
-                radius.iter().zip(&omega).map(circle).collect::<Result<_, _>>().map_err(core_error)?
-            }
+            Self::Circle(c) => c.drives(lead)?,
         })
+    }
+}
+
+impl Circle {
+    /// One core drive per state of the leading shape `lead`: [`pendulum_core::Circle`], or
+    /// [`pendulum_core::RampedCircle`] with a ramp.
+    fn drives(&self, lead: &[usize]) -> PyResult<Vec<Pivot>> {
+        let (radius, omega) =
+            (self.radius.per_state("radius", 1, lead)?, self.omega.per_state("omega", 1, lead)?);
+        let drives: Result<Vec<Pivot>, _> = match &self.ramp {
+            None => (0..radius.len())
+                .map(|k| pendulum_core::Circle::new(radius[k][0], omega[k][0]).map(Pivot::Circle))
+                .collect(),
+            Some((time, from)) => {
+                let (time, from) =
+                    (time.per_state("ramp_time", 1, lead)?, from.per_state("ramp_from", 1, lead)?);
+                (0..radius.len())
+                    .map(|k| {
+                        pendulum_core::RampedCircle::new(radius[k][0], from[k][0], omega[k][0], time[k][0])
+                            .map(Pivot::Ramped)
+                    })
+                    .collect()
+            }
+        };
+        drives.map_err(core_error)
     }
 }
 
@@ -254,6 +317,7 @@ impl Harmonic {
 pub enum Pivot {
     Harmonic(pendulum_core::Harmonic<U3>),
     Circle(pendulum_core::Circle),
+    Ramped(pendulum_core::RampedCircle),
 }
 
 impl Drive<U3> for Pivot {
@@ -261,24 +325,28 @@ impl Drive<U3> for Pivot {
         match self {
             Self::Harmonic(d) => d.position(t),
             Self::Circle(d) => d.position(t),
+            Self::Ramped(d) => d.position(t),
         }
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
         match self {
             Self::Harmonic(d) => d.velocity(t),
             Self::Circle(d) => d.velocity(t),
+            Self::Ramped(d) => d.velocity(t),
         }
     }
     fn acceleration(&self, t: f64) -> Vector3<f64> {
         match self {
             Self::Harmonic(d) => d.acceleration(t),
             Self::Circle(d) => d.acceleration(t),
+            Self::Ramped(d) => d.acceleration(t),
         }
     }
     fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         match self {
             Self::Harmonic(d) => d.velocity_and_acceleration(t),
             Self::Circle(d) => d.velocity_and_acceleration(t),
+            Self::Ramped(d) => d.velocity_and_acceleration(t),
         }
     }
 }

@@ -55,6 +55,38 @@ def test_a_whirled_rod_started_on_its_steady_cone_stays_there():
     assert np.max(np.abs(turned[:, 1] * q[:, 0] - turned[:, 0] * q[:, 1])) < 1e-6
 
 
+def test_a_whirl_ramped_slowly_follows_its_steady_cone():
+    # The rod above, undamped, from hanging at rest, the circle's speed ramped from 0 to ω
+    # over T (one T per state, one call): the slower the ramp, the closer the rod stays to
+    # its cone after it (adiabatic following: the sway left over falls as 1/T).
+    radius, length, omega = 0.1, 0.5, 4.0
+    alpha = 0.0
+    for _ in range(500):
+        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
+    ramp = np.array([15.0, 30.0, 60.0])
+    hanging, rest = np.tile([0.0, 0.0, -1.0], (3, 1)), np.zeros((3, 3))
+    h, every = 2e-3, 50
+    drive = pendulum.Circle(radius, omega, ramp_time=ramp)
+    t, q, _ = pendulum.Chain(1.0, length).trajectory(
+        hanging, rest, h=h, steps=int(65 / h), every=every, model="directions", drive=drive
+    )
+    sway = []
+    for k, time in enumerate(ramp):
+        phase = np.where(t < time, 0.5 * omega / time * t**2, omega * time / 2 + omega * (t - time))
+        turned = np.stack([np.cos(phase), np.sin(phase)], 1)
+        horizontal = np.einsum("ij,ij->i", q[:, k, :2], turned)
+        after = t > time
+        sway.append(np.max(np.abs(np.arctan2(horizontal, -q[:, k, 2]) - alpha)[after]))
+    assert sway[2] < 0.05 and 1.5 < sway[0] / sway[1] < 2.5 and 1.5 < sway[1] / sway[2] < 2.5, sway
+    # A ramp from ω to ω is the steady circle, bit for bit.
+    steady = pendulum.Circle(radius, omega)
+    flat = pendulum.Circle(radius, omega, ramp_time=2.0, ramp_from=omega)
+    u, w = np.array([0.6, 0.0, -0.8]), np.array([0.0, 1.0, 0.0])
+    a = pendulum.Chain(1.0, length).integrate(u, w, h=1e-3, steps=3000, model="directions", drive=steady)
+    b = pendulum.Chain(1.0, length).integrate(u, w, h=1e-3, steps=3000, model="directions", drive=flat)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
 def test_a_shaken_chain_in_a_vertical_plane_moves_as_the_planar_model_says():
     # The same shaking along (1, 1) in the x–z plane, from the same state: the two models'
     # RK4 runs agree to their truncation errors.
@@ -175,7 +207,10 @@ def test_drives_print_and_pickle():
     assert np.array_equal(back.omega, h.omega) and back.amplitude == 0.02 and back.phase == 0.0
     assert np.array_equal(back.direction, [0.0, 1.0])
     c = pickle.loads(pickle.dumps(pendulum.Circle(0.1, [3.0, 4.0])))
-    assert repr(c) == "Circle(radius=0.1, omega=<array of shape [2]>)"
+    assert repr(c) == "Circle(radius=0.1, omega=<array of shape [2]>)" and c.ramp_time is None
+    c = pickle.loads(pickle.dumps(pendulum.Circle(0.1, 3.0, ramp_time=[1.0, 2.0], ramp_from=0.5)))
+    assert repr(c) == "Circle(radius=0.1, omega=3.0, ramp_time=<array of shape [2]>, ramp_from=0.5)"
+    assert np.array_equal(c.ramp_time, [1.0, 2.0]) and c.ramp_from == 0.5
     assert pendulum.Harmonic(0.1, 2.0).direction is None
 
 
@@ -203,3 +238,10 @@ def test_bad_drives_are_named():
             pendulum.Harmonic(*args)
     with pytest.raises(ValueError, match="radius: -0.1 is negative"):
         pendulum.Circle(-0.1, 2.0)
+    with pytest.raises(ValueError, match=r"ramp_time: 0.0 is not a positive time \(s\)"):
+        pendulum.Circle(0.1, 2.0, ramp_time=[1.0, 0.0])
+    with pytest.raises(ValueError, match="ramp_from: a ramp needs its ramp_time"):
+        pendulum.Circle(0.1, 2.0, ramp_from=1.0)
+    with pytest.raises(ValueError, match=r"ramp_time: shape \[2\] is neither \[\] \(one for all\) nor \[3\]"):
+        u = np.tile([0.0, 0.0, -1.0], (3, 1))
+        pendulum.Chain(1.0, 1.0).integrate(u, h=1e-3, model="directions", drive=pendulum.Circle(0.1, 2.0, ramp_time=[1.0, 2.0]))
