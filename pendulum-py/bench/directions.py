@@ -5,8 +5,8 @@ angle model (one state at a time in Rust, on every core), from Python, in one ru
 
 10⁴ states of an 8-link 3D chain: accelerations in spherical angles (`model="spatial"`),
 in directions in float64, in float32 from float64 tables and from float32 tables, and
-100 projected RK4 steps of 1 ms of every state in directions, and the directions'
-Jacobians (`chain.jacobians(..., model="directions")`). Prints the best of 7 repeats, and how far the two models' `ü`
+100 projected RK4 steps of 1 ms of every state in directions (in float64, and in float32
+where the extension has it), and the directions' Jacobians (`chain.jacobians(..., model="directions")`). Prints the best of 7 repeats, and how far the two models' `ü`
 are apart (the chain rule of the angle model's `q̈`).
 """
 
@@ -50,6 +50,17 @@ calls = {
     ),
     "Jacobians, directions": (lambda: chain.jacobians(u, ud, model="directions"), 1),
 }
+
+
+def run32():
+    return chain.integrate(u32, ud32, h=1e-3, steps=100, model="directions", precision="float32")
+
+
+try:  # float32 runs came later: the script still runs against an extension without them
+    run32()
+    calls["100 RK4 steps, directions float32"] = (run32, 1)
+except ValueError:
+    pass
 best = {name: min(timeit.repeat(call, number=k, repeat=7)) / k for name, (call, k) in calls.items()}
 base = best["accelerations, spatial angles"]
 for name, seconds in best.items():
@@ -70,3 +81,8 @@ print(f"directions against the angle model (chain rule): worst relative differen
 single = chain.accelerations(u32, ud32, model="directions", precision="float32").reshape(count, n, 3)
 error = np.max(np.abs(single - got), axis=(1, 2)) / np.max(np.abs(got), axis=(1, 2))
 print(f"float32 against float64: worst relative difference {error.max():.1e}")
+if "100 RK4 steps, directions float32" in calls:
+    x64 = np.concatenate(chain.integrate(u, ud, h=1e-3, steps=100, model="directions"), 1)
+    x32 = np.concatenate(run32(), 1)
+    error = np.max(np.abs(x32 - x64), axis=1) / np.max(np.abs(x64), axis=1)
+    print(f"100 RK4 steps, float32 against float64: worst relative difference {error.max():.1e}")
