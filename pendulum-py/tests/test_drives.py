@@ -33,6 +33,7 @@ def test_kapitza_pendulum_stands_upright_above_its_threshold_at_its_slow_frequen
         crossings = t[np.nonzero(np.diff(np.sign(slow)))[0]]
         measured = np.pi / np.mean(np.diff(crossings))
         kapitza = np.sqrt((amplitude * omega[k]) ** 2 / (2 * length**2) - G / length)
+        print(f"ω = {omega[k]}: slow sway {measured:.3f} rad/s, Kapitza {kapitza:.3f} ({measured / kapitza - 1:+.1%})")
         assert abs(measured / kapitza - 1) < 0.03, (omega[k], measured, kapitza)
 
 
@@ -77,6 +78,7 @@ def test_a_whirl_ramped_slowly_follows_its_steady_cone():
         horizontal = np.einsum("ij,ij->i", q[:, k, :2], turned)
         after = t > time
         sway.append(np.max(np.abs(np.arctan2(horizontal, -q[:, k, 2]) - alpha)[after]))
+    print("sway about the cone after ramps of " + ", ".join(f"{T:.0f} s: {a:.3f} rad" for T, a in zip(ramp, sway)))
     assert sway[2] < 0.05 and 1.5 < sway[0] / sway[1] < 2.5 and 1.5 < sway[1] / sway[2] < 2.5, sway
     # A ramp from ω to ω is the steady circle, bit for bit.
     steady = pendulum.Circle(radius, omega)
