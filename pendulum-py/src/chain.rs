@@ -17,7 +17,7 @@ use crate::detach::maybe_detached;
 use crate::directions;
 use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error, unknown_precision};
-use crate::planar_runs::{Plan, planar_run, run_in};
+use crate::planar_runs::{Plan, planar_rk4, planar_rk4_f32, run_as};
 use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
 use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
@@ -170,20 +170,20 @@ impl Chain {
             let b = self.directions_rows(q, qd, torque, pivot)?;
             let drives = drive.map(|d| d.spatial(&b.q.lead)).transpose()?;
             let rows = [b.q, b.qd, b.torque, b.pivot];
-            return match precision {
-                "float64" => run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
-                    directions::rk4(c, rows, drives, plan, stop)
-                }),
-                "float32" => run_in(py, &self.inner, rows, plan, move |c, rows, plan, stop| {
-                    directions::rk4_f32(c, rows, drives, plan, stop)
-                }),
-                _ => Err(unknown_precision(precision)),
-            };
+            return run_as(
+                py,
+                &self.inner,
+                rows,
+                (plan, drives),
+                precision,
+                directions::rk4,
+                directions::rk4_f32,
+            );
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
+        let drives = drive.map(|d| d.planar(&b.q.lead)).transpose()?;
         let rows = [b.q, b.qd, b.torque, b.pivot];
-        let drives = drive.map(|d| d.planar(&rows[0].lead)).transpose()?;
-        planar_run(py, &self.inner, rows, (plan, drives), precision)
+        run_as(py, &self.inner, rows, (plan, drives), precision, planar_rk4, planar_rk4_f32)
     }
 
     /// The states of `model="directions"`: `q` unit directions and `qd` their rates, rows

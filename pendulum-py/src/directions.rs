@@ -261,7 +261,7 @@ fn rk4_of<Dr: Drive<U3> + Sync>(
     in_chunks(
         (&q.lead, batch.links(), plan, stop),
         &mut states,
-        |states, now| batch.integrate_rk4(states, plan.h, now),
+        |states, _, now| batch.integrate_rk4(states, plan.h, now),
         |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),
     )
 }
@@ -275,15 +275,10 @@ fn rk4_f32_of<Dr: Drive<U3> + Sync>(
 ) -> pendulum_experiment::Result<Samples<f32>> {
     let half = q.width;
     let mut x = narrow(&states(q, qd))?;
-    let mut done = 0;
     in_chunks(
         (&q.lead, batch.links(), plan, stop),
         &mut x,
-        |x, now| {
-            let t = plan.t0 + done as f64 * plan.h;
-            done += now;
-            batch.integrate_rk4_f32(x, t, plan.h, now)
-        },
+        |x, t, now| batch.integrate_rk4_f32(x, t, plan.h, now),
         |x, samples| split(half, x.chunks_exact(2 * half.max(1)), samples),
     )
 }

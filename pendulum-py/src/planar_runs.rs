@@ -2,7 +2,7 @@
 //! torques and pivot accelerations held (`PlanarBatch::integrate_rk4` in double precision,
 //! bit for bit each state alone; `integrate_rk4_f32` in single), in chunks of steps between
 //! which Ctrl-C is looked at, the states sampled every so many steps if asked. The chunks
-//! and samples (`run_in`, `in_chunks`) serve the directions' runs too.
+//! and samples (`run_as`, `in_chunks`) serve the directions' runs too.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -54,30 +54,42 @@ pub struct Samples<T> {
 
 /// The run of `Chain.integrate` (`plan.every` `None`: `(q, qd)` shaped as `q`) or
 /// `Chain.trajectory` (`(t, q, qd)`, the samples along a first axis) of the states and
-/// inputs `rows` (`q`, `qd`, torques, pivot accelerations) in `precision`, the pivots
-/// moved by `drives` (one per state) when given: here for a few milliseconds' work, on a
-/// thread of its own that Ctrl-C can stop otherwise.
-pub fn planar_run<'py>(
+/// inputs `rows` (`q`, `qd`, torques, pivot accelerations) in `precision`: `double` for
+/// `"float64"`, `single` for `"float32"`, each handed the `drives` (of the pivots, when
+/// given): here for a few milliseconds' work, on a thread of its own that Ctrl-C can stop
+/// otherwise. The planar runs are [`planar_rk4`] and [`planar_rk4_f32`].
+pub fn run_as<'py, D: Send + 'static>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     rows: [Rows; 4],
-    (plan, drives): (Plan, Option<Vec<Harmonic<U2>>>),
+    (plan, drives): (Plan, D),
     precision: &str,
+    double: RunOf<D, f64>,
+    single: RunOf<D, f32>,
 ) -> PyResult<Bound<'py, PyAny>> {
     match precision {
-        "float64" => run_in(py, chain, rows, plan, move |c, rows, plan, stop| {
-            planar_rk4(c, rows, drives.as_deref(), plan, stop)
-        }),
-        "float32" => run_in(py, chain, rows, plan, move |c, rows, plan, stop| {
-            planar_rk4_f32(c, rows, drives.as_deref(), plan, stop)
-        }),
+        "float64" => {
+            run_in(py, chain, rows, plan, move |c, rows, plan, stop| double(c, rows, drives, plan, stop))
+        }
+        "float32" => {
+            run_in(py, chain, rows, plan, move |c, rows, plan, stop| single(c, rows, drives, plan, stop))
+        }
         _ => Err(unknown_precision(precision)),
     }
 }
 
-/// [`planar_run`] in one precision's `run` ([`planar_rk4`], [`planar_rk4_f32`], the
-/// driven runs, the directions' runs).
-pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
+/// A run in one precision from the rows (`q`, `qd`, torques, pivot accelerations) with the
+/// drives `D`: [`planar_rk4`], [`planar_rk4_f32`], the directions' `rk4` and `rk4_f32`.
+pub type RunOf<D, T> = fn(
+    &pendulum_core::Chain<Dyn>,
+    [&Rows; 4],
+    D,
+    Plan,
+    &AtomicBool,
+) -> pendulum_experiment::Result<Samples<T>>;
+
+/// One precision's `run` of [`run_as`].
+fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
     py: Python<'py>,
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [Rows; 4],
@@ -122,10 +134,10 @@ pub fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
 /// pivot acceleration held ([`PlanarBatch::integrate_rk4`]) or, given `drives` (one per
 /// state), its pivot moved ([`PlanarBatch::integrate_rk4_driven`]): on every core, in
 /// chunks (the same bits as one call). A failed state is an error naming its index.
-fn planar_rk4(
+pub fn planar_rk4(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
-    drives: Option<&[Harmonic<U2>]>,
+    drives: Option<Vec<Harmonic<U2>>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
@@ -141,7 +153,7 @@ fn planar_rk4(
     in_chunks(
         (&q.lead, n, plan, stop),
         &mut states,
-        |states, now| match drives {
+        |states, _, now| match drives.as_deref() {
             Some(drives) => batch.integrate_rk4_driven(states, drives, torque, plan.h, now),
             None => batch.integrate_rk4(states, torque, Some(&pivot.data), plan.h, now),
         },
@@ -153,10 +165,10 @@ fn planar_rk4(
 /// [`PlanarBatch::integrate_rk4_driven_f32`] given `drives`): the numbers rounded to `f32`
 /// (one past its range is an error), the rounding compensation kept from chunk to chunk
 /// (the same numbers as one call when held; driven, each chunk starts from its own time).
-fn planar_rk4_f32(
+pub fn planar_rk4_f32(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
-    drives: Option<&[Harmonic<U2>]>,
+    drives: Option<Vec<Harmonic<U2>>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {
@@ -169,32 +181,28 @@ fn planar_rk4_f32(
     }
     let carry = vec![0.0f32; x.len()];
     let batch = PlanarBatch::repeated(chain.clone(), q.count()).map_err(core)?;
-    let mut done = 0;
     in_chunks(
         (&q.lead, n, plan, stop),
         &mut (x, carry),
-        |(x, carry), now| {
-            let t = plan.t0 + done as f64 * plan.h;
-            done += now;
-            match drives {
-                Some(drives) => {
-                    batch.integrate_rk4_driven_f32((x, carry), (t, drives), Some(&torque), plan.h, now)
-                }
-                None => batch.integrate_rk4_f32((x, carry), Some(&torque), Some(&pivot), plan.h, now),
+        |(x, carry), t, now| match drives.as_deref() {
+            Some(drives) => {
+                batch.integrate_rk4_driven_f32((x, carry), (t, drives), Some(&torque), plan.h, now)
             }
+            None => batch.integrate_rk4_f32((x, carry), Some(&torque), Some(&pivot), plan.h, now),
         },
         |(x, _), samples| split(n, x.chunks_exact(2 * n), samples),
     )
 }
 
-/// `run(states, k)` of `k` steps over the chunks of `plan` (about [`SOLVES_PER_CHUNK`] rods'
-/// solves each, ending at the samples), `stop` looked at before each, and
+/// `run(states, t, k)` of `k` steps from the time `t = t0 + j·h` (`j` steps before) over
+/// the chunks of `plan` (about [`SOLVES_PER_CHUNK`] rods' solves each, ending at the
+/// samples; the `f64` runs' states carry their own times), `stop` looked at before each, and
 /// `sample(states, samples)` at the plan's samples; the first failure as the error naming
 /// its state by its index in the leading shape `lead`.
 pub fn in_chunks<S, T>(
     (lead, n, plan, stop): (&[usize], usize, Plan, &AtomicBool),
     states: &mut S,
-    mut run: impl FnMut(&mut S, usize) -> pendulum_core::Result<Vec<Failure>>,
+    mut run: impl FnMut(&mut S, f64, usize) -> pendulum_core::Result<Vec<Failure>>,
     mut sample: impl FnMut(&S, &mut Samples<T>),
 ) -> pendulum_experiment::Result<Samples<T>> {
     let count: usize = lead.iter().product();
@@ -207,7 +215,7 @@ pub fn in_chunks<S, T>(
                 return Err(Error::interrupted("the integration was interrupted"));
             }
             let now = chunk.min(next - done);
-            let failures = run(states, now).map_err(core)?;
+            let failures = run(states, plan.t0 + done as f64 * plan.h, now).map_err(core)?;
             if let Some(first) = failures.first() {
                 let more = match failures.len() {
                     1 => String::new(),

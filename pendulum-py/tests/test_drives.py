@@ -37,23 +37,46 @@ def test_kapitza_pendulum_stands_upright_above_its_threshold_at_its_slow_frequen
         assert abs(measured / kapitza - 1) < 0.03, (omega[k], measured, kapitza)
 
 
+def cone_angle(radius, length, omega):
+    """The steady cone angle α (rad) of a rod of length l on a pivot circling at radius R
+    and speed ω, its mass circling with the pivot: ω² (R + l sin α) = g tan α, by its fixed
+    point (checked to have converged)."""
+    alpha = 0.0
+    for _ in range(500):
+        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
+    assert abs(G * np.tan(alpha) - omega**2 * (radius + length * np.sin(alpha))) < 1e-12
+    return alpha
+
+
+def on_the_cone(radius, length, omega):
+    """The rod's state `(u, w)` on its steady cone, in the plane of the pivot's radius at
+    t = 0, turning with it."""
+    alpha = cone_angle(radius, length, omega)
+    u = np.array([np.sin(alpha), 0.0, -np.cos(alpha)])
+    return u, omega * np.cross([0.0, 0.0, 1.0], u)
+
+
+def tilt(q, phase):
+    """The angle (rad) of rods `q` (rows of x, y, z) from the downward vertical, measured in
+    the plane of the pivot's radius at azimuth `phase` (one per row), and how far out of
+    that plane they point."""
+    turned = np.stack([np.cos(phase), np.sin(phase)], 1)
+    along = np.einsum("ij,ij->i", q[:, :2], turned)
+    across = turned[:, 0] * q[:, 1] - turned[:, 1] * q[:, 0]
+    return np.arctan2(along, -q[:, 2]), across
+
+
 def test_a_whirled_rod_started_on_its_steady_cone_stays_there():
     # A rod of length l on a pivot circling at radius R and speed ω stands steady at the
     # cone angle α with ω² (R + l sin α) = g tan α, its mass circling with the pivot.
     radius, length, omega = 0.1, 0.5, 6.0
-    alpha = 0.0
-    for _ in range(200):  # fixed point of the steady balance (a contraction here)
-        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
-    chain = pendulum.Chain(1.0, length)
-    u = np.array([np.sin(alpha), 0.0, -np.cos(alpha)])
-    w = omega * np.cross([0.0, 0.0, 1.0], u)
-    t, q, _ = chain.trajectory(
+    u, w = on_the_cone(radius, length, omega)
+    t, q, _ = pendulum.Chain(1.0, length).trajectory(
         u, w, h=1e-3, steps=2000, every=100, model="directions", drive=pendulum.Circle(radius, omega)
     )
-    turned = np.stack([np.cos(omega * t), np.sin(omega * t)], 1)
-    horizontal = np.einsum("ij,ij->i", q[:, :2], turned)  # along the pivot's radius
-    assert np.max(np.abs(np.arctan2(horizontal, -q[:, 2]) - alpha)) < 1e-6
-    assert np.max(np.abs(turned[:, 1] * q[:, 0] - turned[:, 0] * q[:, 1])) < 1e-6
+    angle, across = tilt(q, omega * t)
+    assert np.max(np.abs(angle - cone_angle(radius, length, omega))) < 1e-6
+    assert np.max(np.abs(across)) < 1e-6
 
 
 def test_a_whirl_ramped_slowly_follows_its_steady_cone():
@@ -61,9 +84,7 @@ def test_a_whirl_ramped_slowly_follows_its_steady_cone():
     # over T (one T per state, one call): the slower the ramp, the closer the rod stays to
     # its cone after it (adiabatic following: the sway left over falls as 1/T).
     radius, length, omega = 0.1, 0.5, 4.0
-    alpha = 0.0
-    for _ in range(500):
-        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
+    alpha = cone_angle(radius, length, omega)
     ramp = np.array([15.0, 30.0, 60.0])
     hanging, rest = np.tile([0.0, 0.0, -1.0], (3, 1)), np.zeros((3, 3))
     h, every = 2e-3, 50
@@ -74,10 +95,8 @@ def test_a_whirl_ramped_slowly_follows_its_steady_cone():
     sway = []
     for k, time in enumerate(ramp):
         phase = np.where(t < time, 0.5 * omega / time * t**2, omega * time / 2 + omega * (t - time))
-        turned = np.stack([np.cos(phase), np.sin(phase)], 1)
-        horizontal = np.einsum("ij,ij->i", q[:, k, :2], turned)
-        after = t > time
-        sway.append(np.max(np.abs(np.arctan2(horizontal, -q[:, k, 2]) - alpha)[after]))
+        angle, _ = tilt(q[:, k], phase)
+        sway.append(np.max(np.abs(angle - alpha)[t > time]))
     print("sway about the cone after ramps of " + ", ".join(f"{T:.0f} s: {a:.3f} rad" for T, a in zip(ramp, sway)))
     assert sway[2] < 0.05 and 1.5 < sway[0] / sway[1] < 2.5 and 1.5 < sway[1] / sway[2] < 2.5, sway
     # A ramp from ω to ω is the steady circle, bit for bit.
@@ -183,17 +202,11 @@ def test_driven_runs_in_float32_follow_float64():
         assert np.max(np.abs(qs[-1] - q32).max(axis=-1) / scale) < 1e-6
     # The whirled rod of the second test in float32: on its cone to f32's rounding.
     radius, length, omega = 0.1, 0.5, 6.0
-    alpha = 0.0
-    for _ in range(200):
-        alpha = np.arctan(omega**2 * (radius + length * np.sin(alpha)) / G)
-    u = np.array([np.sin(alpha), 0.0, -np.cos(alpha)])
-    w = omega * np.cross([0.0, 0.0, 1.0], u)
-    drive = pendulum.Circle(radius, omega)
-    kw = dict(h=1e-3, steps=2000, every=100, model="directions", drive=drive)
+    u, w = on_the_cone(radius, length, omega)
+    kw = dict(h=1e-3, steps=2000, every=100, model="directions", drive=pendulum.Circle(radius, omega))
     t, q, _ = pendulum.Chain(1.0, length).trajectory(u, w, precision="float32", **kw)
-    turned = np.stack([np.cos(omega * t), np.sin(omega * t)], 1)
-    horizontal = np.einsum("ij,ij->i", q[:, :2], turned)
-    assert np.max(np.abs(np.arctan2(horizontal, -q[:, 2]) - alpha)) < 1e-5
+    angle, _ = tilt(q.astype(np.float64), omega * t)
+    assert np.max(np.abs(angle - cone_angle(radius, length, omega))) < 1e-5
 
 
 def test_trajectory_times_start_at_t0():
