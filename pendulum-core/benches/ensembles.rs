@@ -24,8 +24,8 @@
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
 //!   lanes instead of eight too);
-//! - `jacobians/planar/…/20`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains of 20 links, one at a time
-//!   against `PlanarBatch::state_jacobians` on one thread and on two;
+//! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
+//!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two;
 //!   `jacobians/spatial/…/20` the same in 3D directions (`Directions::analytic_jacobian`
 //!   against `DirectionsBatch::state_jacobians`).
 //!
@@ -589,38 +589,51 @@ fn generated(c: &mut Criterion) {
     group.finish();
 }
 
-/// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` of 64 planar chains of 20 links: one chain at a time against the
-/// batch on one thread and on two (the chains over the cores, not in lanes).
+/// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` of 64 planar chains of 8, 20 and 100 links: one chain at a time
+/// against the batch on one thread (in four lanes too) and on two.
 fn jacobians(c: &mut Criterion) {
     const N: usize = 20;
     let mut group = c.benchmark_group("jacobians");
     group.warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1)).sample_size(30);
     group.throughput(Throughput::Elements(CHAINS as u64));
     let mut r = ChaCha8Rng::seed_from_u64(41);
-    let (chains, q, qd) = random_batch(CHAINS, N, &mut r);
-    let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
-    let inputs = Inputs::<Dyn, U2>::zeros(Dyn(N));
-    let mut out = Jacobians::zeros(&singles[0]);
-    group.bench_with_input(BenchmarkId::new("planar/single", N), &N, |b, _| {
-        b.iter(|| {
-            for (k, model) in singles.iter().enumerate() {
-                let row = k * N..(k + 1) * N;
-                let (q, qd) =
-                    (DVector::from_column_slice(&q[row.clone()]), DVector::from_column_slice(&qd[row]));
-                model.state_jacobians(&q, &qd, &inputs, &mut out).expect("single");
-                black_box(&out);
-            }
-        })
-    });
-    let batch = PlanarBatch::new(chains).expect("batch");
-    let (mut dq, mut dqd) = (vec![0.0; CHAINS * N * N], vec![0.0; CHAINS * N * N]);
-    for threads in [1, 2] {
-        let pool = pool(threads);
-        group.bench_with_input(BenchmarkId::new(format!("planar/batch_{threads}_threads"), N), &N, |b, _| {
-            in_pool(b, &pool, || {
-                batch.state_jacobians(&q, &qd, None, &mut dq, &mut dqd).expect("batch");
+    for n in [8, N, 100] {
+        let (chains, q, qd) = random_batch(CHAINS, n, &mut r);
+        let singles: Vec<_> = chains.iter().cloned().map(PlanarTension::new).collect();
+        let inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
+        let mut out = Jacobians::zeros(&singles[0]);
+        let (mut x, mut v) = (DVector::zeros(n), DVector::zeros(n));
+        group.bench_with_input(BenchmarkId::new("planar/single", n), &n, |b, _| {
+            b.iter(|| {
+                for (k, model) in singles.iter().enumerate() {
+                    x.copy_from_slice(&q[k * n..(k + 1) * n]);
+                    v.copy_from_slice(&qd[k * n..(k + 1) * n]);
+                    model.state_jacobians(&x, &v, &inputs, &mut out).expect("single");
+                    black_box(&out);
+                }
             })
         });
+        let batch = PlanarBatch::new(chains).expect("batch");
+        let (mut dq, mut dqd) = (vec![0.0; CHAINS * n * n], vec![0.0; CHAINS * n * n]);
+        let four = batch.clone().with_avx512(false);
+        let one = pool(1);
+        group.bench_with_input(BenchmarkId::new("planar/batch_1_threads_four_lanes", n), &n, |b, _| {
+            in_pool(b, &one, || {
+                four.state_jacobians(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
+            })
+        });
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            group.bench_with_input(
+                BenchmarkId::new(format!("planar/batch_{threads}_threads"), n),
+                &n,
+                |b, _| {
+                    in_pool(b, &pool, || {
+                        batch.state_jacobians(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
+                    })
+                },
+            );
+        }
     }
     // The same for 64 chains of 20 links in 3D directions: each chain's
     // `Directions::analytic_jacobian` (the whole first-order Jacobian, as a user calls it)

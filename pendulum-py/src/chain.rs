@@ -18,7 +18,9 @@ use crate::directions;
 use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error, unknown_precision};
 use crate::planar_runs::{Plan, planar_rk4, planar_rk4_f32, run_as};
-use crate::planar_states::{planar_batch, planar_batch_f32, planar_in_place, planar_table_f32};
+use crate::planar_states::{
+    planar_batch, planar_batch_f32, planar_in_place, planar_jacobians, planar_table_f32,
+};
 use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
 
@@ -470,7 +472,8 @@ impl Chain {
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians
     /// by the coordinates (1/s²) and the rates (1/s), entry `[..., a, b]` = ∂q̈_a/∂x_b; the
-    /// states as for `accelerations`. `model="directions"`: `ü` and its derivatives by the
+    /// states as for `accelerations`. Planar states go through the batch of chains, in SIMD
+    /// lanes (`qdd` is `accelerations`' q̈). `model="directions"`: `ü` and its derivatives by the
     /// directions' and the rates' three components each, the Jacobian of the first-order
     /// system `(u̇, ẇ) = (w, ü)` (the constraint `|u_i| = 1` not imposed).
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
@@ -492,6 +495,12 @@ impl Chain {
             }
         };
         let [qdd, dq, dqd] = maybe_detached(py, b.q.data.len() * b.q.width, || match route {
+            // Planar states, one or many: the SIMD batch (`accelerations`' numbers for q̈).
+            Route::Angles(Kind::Planar) if b.q.count() > 0 => planar_jacobians(
+                &self.inner,
+                b.q.count(),
+                [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data],
+            ),
             Route::Angles(kind) => with_model!(self, kind, |m| states::jacobians(m, &b)),
             Route::Directions => directions::jacobians(&self.inner, &b),
         })

@@ -26,6 +26,24 @@ pub fn planar_batch(
     Ok(out)
 }
 
+/// `θ̈`, `∂θ̈/∂θ` and `∂θ̈/∂θ̇` (row-major) of every planar state by the batch of chains, at
+/// the states of [`planar_batch`]: [`PlanarBatch::accelerations`] and
+/// [`PlanarBatch::state_jacobians`] (in SIMD lanes), each state's numbers bit for bit the
+/// model's alone, and the first failing row's error.
+pub fn planar_jacobians(
+    chain: &pendulum_core::Chain<Dyn>,
+    count: usize,
+    [q, qd, torque, pivot]: [&[f64]; 4],
+) -> pendulum_core::Result<[Vec<f64>; 3]> {
+    let n = chain.links();
+    let batch = PlanarBatch::repeated(chain.clone(), count)?;
+    let mut qdd = vec![0.0; q.len()];
+    first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut qdd)?)?;
+    let (mut dq, mut dqd) = (vec![0.0; count * n * n], vec![0.0; count * n * n]);
+    first_error(batch.state_jacobians(q, qd, Some(torque), Some(pivot), &mut dq, &mut dqd)?)?;
+    Ok([qdd, dq, dqd])
+}
+
 /// The first of a batch's `failures` as the error (the first failing row's).
 pub fn first_error(failures: Vec<Failure>) -> pendulum_core::Result<()> {
     failures.into_iter().next().map_or(Ok(()), |failure| Err(failure.error))

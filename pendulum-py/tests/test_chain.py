@@ -77,6 +77,16 @@ def test_a_batch_along_leading_axes_is_the_states_one_at_a_time():
             assert np.array_equal(batch[i, j], chain.accelerations(q[i, j], qd[i, j], torque[i, j]))
     qdd, dq, dqd = chain.jacobians(q, qd)
     assert (qdd.shape, dq.shape, dqd.shape) == ((3, 5, 8), (3, 5, 8, 8), (3, 5, 8, 8))
+    # The Jacobians go through the batch too (in SIMD lanes): each state's own, bit for bit,
+    # and q̈ is `accelerations`' q̈.
+    pivot = rng.normal(size=(3, 5, 2))
+    qdd, dq, dqd = chain.jacobians(q, qd, torque, pivot_acceleration=pivot)
+    assert np.array_equal(qdd, chain.accelerations(q, qd, torque, pivot_acceleration=pivot))
+    for i in range(3):
+        for j in range(5):
+            one = chain.jacobians(q[i, j], qd[i, j], torque[i, j], pivot_acceleration=pivot[i, j])
+            for many, alone in zip((qdd, dq, dqd), one):
+                assert np.array_equal(many[i, j], alone)
     # Pivots accelerating, and the same error for a bad state.
     pivot = rng.normal(size=(3, 5, 2))
     batch = chain.accelerations(q, qd, pivot_acceleration=pivot)

@@ -210,6 +210,11 @@ fn batches_need_chains_of_one_length_and_whole_rows() {
     let batch = PlanarBatch::new(vec![random_chain(4, &mut r); 3]).expect("batch");
     let err = batch.accelerations(&[0.0; 11], &[0.0; 12], None, None, &mut [0.0; 12]).unwrap_err();
     assert_eq!(err.to_string(), "q has 11 entries, expected 12");
+    let (q, mut dq, mut dqd) = ([0.0; 12], [0.0; 48], [0.0; 48]);
+    let err = batch.state_jacobians(&q, &q, Some(&[0.0; 13]), None, &mut dq, &mut dqd).unwrap_err();
+    assert_eq!(err.to_string(), "torque has 13 entries, expected 12");
+    let err = batch.state_jacobians(&q, &q, None, None, &mut dq[1..], &mut dqd).unwrap_err();
+    assert_eq!(err.to_string(), "dq has 47 entries, expected 48");
 }
 
 /// `steps` steps of RK4 of the planar chain alone with `inputs` held (none: free), from
@@ -472,13 +477,21 @@ fn a_planar_chain_that_fails_in(
 
 #[test]
 fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_chain() {
+    // In lanes up to 48 links, one chain at a time beyond. Chain 1 has masses of 1e-40 kg: its continuants (~1e40 a row)
+    // leave their range and it alone takes the classical pivots in its lanes.
     let mut r = ChaCha8Rng::seed_from_u64(77);
-    for (chains, n) in [(1, 1), (5, 8), (37, 20)] {
-        let chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+    for (chains, n) in [(1, 1), (5, 8), (37, 20), (11, 49)] {
+        let mut chain: Vec<_> = (0..chains).map(|_| random_chain(n, &mut r)).collect();
+        if chains > 1 {
+            chain[1] = Chain::new(&vec![1e-40; n], &vec![0.1; n], 9.81).expect("chain");
+        }
         let batch = PlanarBatch::new(chain.clone()).expect("batch");
         let mut q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-20.0..20.0)).collect();
         let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-10.0..10.0)).collect();
         let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+        // Joint torques on every chain but the first.
+        let mut torque: Vec<f64> = (0..chains * n).map(|_| r.random_range(-0.1..0.1)).collect();
+        torque[..n].fill(0.0);
         let bad = chains / 2;
         q[bad * n] = f64::NAN;
         let (mut single_q, mut single_qd) = (vec![0.0; chains * n * n], vec![0.0; chains * n * n]);
@@ -487,6 +500,7 @@ fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_
             let rows = k * n..(k + 1) * n;
             let mut inputs = Inputs::<Dyn, U2>::zeros(Dyn(n));
             inputs.pivot_acceleration = nalgebra::Vector2::new(pivot[2 * k], pivot[2 * k + 1]);
+            inputs.torque.copy_from_slice(&torque[k * n..(k + 1) * n]);
             let mut out = Jacobians::zeros(&model);
             let result = model.state_jacobians(
                 &DVector::from_column_slice(&q[rows.clone()]),
@@ -501,6 +515,7 @@ fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_
                 single_qd[block].fill(f64::NAN);
                 continue;
             }
+            assert!(out.q.iter().chain(out.qd.iter()).all(|v| v.is_finite()), "chain {k}");
             for a in 0..n {
                 for b in 0..n {
                     single_q[block.start + a * n + b] = out.q[(a, b)];
@@ -508,17 +523,43 @@ fn batched_jacobians_are_each_chains_own_bit_for_bit_and_a_failure_stays_in_its_
                 }
             }
         }
-        for pool in pools() {
+        for (batch, pool) in widths_and_pools(&batch) {
             let (mut dq, mut dqd) = (vec![0.0; chains * n * n], vec![0.0; chains * n * n]);
             let failures = pool
-                .install(|| batch.state_jacobians(&q, &qd, Some(&pivot), &mut dq, &mut dqd))
+                .install(|| batch.state_jacobians(&q, &qd, Some(&torque), Some(&pivot), &mut dq, &mut dqd))
                 .expect("batch");
-            let what = format!("{chains} chains of {n}, {} threads", pool.current_num_threads());
+            let what = format!(
+                "{chains} chains of {n}, {} threads, eight lanes {}",
+                pool.current_num_threads(),
+                batch.uses_avx512()
+            );
             assert_eq!(failures.len(), 1, "{what}");
             assert_eq!(failures[0].chain, bad, "{what}");
             assert_eq!(failures[0].error.to_string(), "q[0] must be finite, got NaN", "{what}");
             assert_bits(&dq, &single_q, &format!("{what}: ∂θ̈/∂θ"));
             assert_bits(&dqd, &single_qd, &format!("{what}: ∂θ̈/∂θ̇"));
         }
+        // Split into calls of 3 chains (the last shorter): the same numbers.
+        let (mut dq, mut dqd) = (vec![0.0; chains * n * n], vec![0.0; chains * n * n]);
+        for (part, start) in chain.chunks(3).zip((0..chains).step_by(3)) {
+            let batch = PlanarBatch::new(part.to_vec()).expect("part");
+            let (rows, squares) =
+                (start * n..(start + part.len()) * n, start * n * n..(start + part.len()) * n * n);
+            let pivot = &pivot[2 * start..2 * (start + part.len())];
+            let (dq, dqd) = (&mut dq[squares.clone()], &mut dqd[squares]);
+            let (q, qd, torque) = (&q[rows.clone()], &qd[rows.clone()], &torque[rows]);
+            batch.state_jacobians(q, qd, Some(torque), Some(pivot), dq, dqd).expect("part");
+        }
+        assert_bits(&dq, &single_q, &format!("{chains} chains of {n} in calls of 3: ∂θ̈/∂θ"));
+        assert_bits(&dqd, &single_qd, &format!("{chains} chains of {n} in calls of 3: ∂θ̈/∂θ̇"));
+        // No torques given is zero torques.
+        let zeros = vec![0.0; chains * n];
+        let mut with = [vec![0.0; chains * n * n], vec![0.0; chains * n * n]];
+        let mut without = with.clone();
+        let [a, b] = &mut with;
+        batch.state_jacobians(&q, &qd, Some(&zeros), Some(&pivot), a, b).expect("zeros");
+        let [a, b] = &mut without;
+        batch.state_jacobians(&q, &qd, None, Some(&pivot), a, b).expect("none");
+        assert_bits(&without.concat(), &with.concat(), &format!("{chains} chains of {n}, no torques"));
     }
 }

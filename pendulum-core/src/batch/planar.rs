@@ -16,7 +16,7 @@ use crate::lanes::{Aligned, Lane, Lanes, Lanes32};
 use crate::model::Model;
 use crate::models::PlanarTension;
 use crate::models::tension::{angle_acceleration, planar_load};
-use crate::rods::{Load, Loads, Rods, Rows, damping_pull, pull};
+use crate::rods::{Load, Loads, RodConstants, Rods, Rows, damping_pull, pull};
 
 /// `B` planar chains with the same number of links `n`, in absolute link angles (rad) as
 /// [`PlanarTension`]: each chain's own masses, lengths, damping and gravity, and per call
@@ -95,6 +95,12 @@ impl<V: Lane> Work<V> {
 pub(super) type Torques<'a, V> = (&'a [V], <V as Lane>::Mask);
 
 impl<V: Lane> Block<V> {
+    /// The block's chains' constants, and gravity `g` (m/s²) per lane.
+    #[inline(always)]
+    pub(super) fn constants(&self) -> (RodConstants<'_, V>, V) {
+        (self.rods.constants(), -self.down)
+    }
+
     /// `θ̈` (rad/s²) of the block's chains into `out`, from `[sin θ, cos θ, θ̇ (rad/s)]`, the
     /// joint torques and the pivot accelerations `pivot` (m/s²): [`PlanarTension`]'s
     /// tension solve, in lanes of any precision. The pull on rod `i` is

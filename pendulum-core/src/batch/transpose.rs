@@ -220,6 +220,34 @@ pub(crate) fn scatter<T: Transpose, const W: usize>(lanes: &[T], m: usize, out: 
     unsafe { scatter_into(lanes, m, starts) };
 }
 
+/// Row `i` of an `n × n` matrix per lane into the matrices of `out` (at most `W` of them:
+/// a block's, `n²` numbers each, row by row as numpy holds a `(B, n, n)` array): numbers
+/// `i·n … i·n + n − 1` of matrix `k` get lane `k` of the `n` groups of `W` in `lanes`.
+#[inline(always)]
+pub(crate) fn scatter_matrix_row<T: Transpose, const W: usize>(
+    lanes: &[T],
+    n: usize,
+    i: usize,
+    out: &mut [T],
+) {
+    if out.len() != W * n * n {
+        for (k, matrix) in out.chunks_exact_mut(n * n).enumerate() {
+            for (j, o) in matrix[i * n..(i + 1) * n].iter_mut().enumerate() {
+                *o = lanes[W * j + k];
+            }
+        }
+        return;
+    }
+    let mut starts = [out.as_mut_ptr(); W];
+    for (k, start) in starts.iter_mut().enumerate() {
+        // SAFETY: `out` holds `W` matrices of `n²`, and `i < n`.
+        *start = unsafe { start.add(n * n * k + n * i) };
+    }
+    // SAFETY: row `i` of each of the `W` matrices of `out`, `n` numbers each, apart from
+    // each other and from `lanes` (`out` is borrowed mutably).
+    unsafe { scatter_into(lanes, n, starts) };
+}
+
 /// [`scatter`] into `W` rows anywhere: `rows[k][j] = lanes[W·j + k]` for `j < m`.
 #[inline(always)]
 pub(crate) fn scatter_rows<T: Transpose, const W: usize>(lanes: &[T], m: usize, mut rows: [&mut [T]; W]) {

@@ -9,7 +9,8 @@
 use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
 use super::RodConstants;
-use super::angles::PlanarTangents;
+use super::angles::{Columns, PlanarTangents};
+use crate::lanes::Lane;
 
 impl<L: Dim> PlanarTangents<'_, L>
 where
@@ -35,76 +36,155 @@ where
     #[inline(always)]
     fn blocks(&self, dq: &mut [f64], dqd: &mut [f64], inputs: Option<(&mut [f64], &mut [f64])>) {
         let dim = self.links.shape_generic().0;
-        let n = dim.value();
-        if n == 0 {
-            return;
-        }
-        let RodConstants { length, inverse_length: il, drag, .. } = self.rods;
-        let (links, columns) = (self.links.as_slice(), self.columns());
-        // G = H A⁻¹, column-major: column j is row j of A⁻¹ Hᵀ, the solve of every output
-        // at once, each a row operation of the kept elimination.
         let mut green = OMatrix::<f64, L, L>::zeros_generic(dim, dim);
-        let green = green.as_mut_slice();
-        for j in 0..n {
-            if j >= 1 {
-                green[j * n + j - 1] = columns.coupling(j - 1)[1];
-            }
-            if j + 1 < n {
-                green[j * n + j + 1] = columns.coupling(j + 1)[0];
-            }
-        }
-        for j in 1..n {
-            let factor = links[j].factor;
-            let (above, here) = green.split_at_mut(j * n);
-            // Rows i > j + 1 of column j − 1 are still zero.
-            let end = (j + 1).min(n);
-            for (g, a) in here[..end].iter_mut().zip(&above[(j - 1) * n..(j - 1) * n + end]) {
-                *g -= factor * a;
-            }
-        }
-        let last = links[n - 1].inverse_pivot;
-        green[(n - 1) * n..].iter_mut().for_each(|g| *g *= last);
-        for j in (0..n - 1).rev() {
-            let (inverse_pivot, factor) = (links[j].inverse_pivot, links[j + 1].factor);
-            let (here, below) = green.split_at_mut((j + 1) * n);
-            for (g, b) in here[j * n..].iter_mut().zip(&below[..n]) {
-                *g = *g * inverse_pivot - factor * b;
-            }
-        }
-        let green = &*green;
-        let mix = |out: &mut [f64], x: usize, r: [f64; 3], h: [f64; 3]| mix(green, n, out, x, r, h);
-        for x in 0..n {
-            let (r, h) = columns.angle(x);
-            mix(&mut dq[x * n..(x + 1) * n], x, r, h);
-        }
-        // By θ̇_x (the pull's column scaled by −λ_x/l_x, and 2 l_x θ̇_x in b_x) and, if asked,
-        // by σ_x: the pull's column P_x into dqd's column x first, then ∂θ̈/∂σ_x = P_x/l_x
-        // and ∂θ̈/∂θ̇_x = −(λ_x/l_x) P_x + 2 l_x θ̇_x G[:, x].
-        let (mut dtorque, dpivot) = inputs.unzip();
-        for x in 0..n {
-            let (r, h) = columns.pull(x);
-            let column = &mut dqd[x * n..(x + 1) * n];
-            let (k, rate) = (-drag[x], 2.0 * length[x] * links[x].rate);
-            let Some(dtorque) = dtorque.as_deref_mut() else {
-                let mut r = r.map(|e| k * e);
-                r[1] += rate;
-                mix(column, x, r, h.map(|e| k * e));
-                continue;
-            };
+        blocks(self.columns(), green.as_mut_slice(), dq, dqd, inputs);
+    }
+}
+
+/// `∂θ̈/∂θ`, `∂θ̈/∂θ̇` and, if asked, `∂θ̈/∂σ` and `∂θ̈/∂p̈` of the kept solve `columns`,
+/// column-major (module docs), with `green` (`n²` zeros) as room for `G`. In lanes `V`, those
+/// of `W` chains side by side, each lane doing the operations of the chain alone in the
+/// same order.
+#[inline(always)]
+pub(crate) fn blocks<V: Lane>(
+    columns: Columns<'_, V>,
+    green: &mut [V],
+    dq: &mut [V],
+    dqd: &mut [V],
+    inputs: Option<(&mut [V], &mut [V])>,
+) {
+    let links = columns.links;
+    let n = links.len();
+    if n == 0 {
+        return;
+    }
+    let RodConstants { length, inverse_length: il, drag, .. } = columns.rods;
+    let green = green_of(columns, green);
+    let mix = |out: &mut [V], x: usize, r: [V; 3], h: [V; 3]| mix(green, n, out, x, r, h);
+    for x in 0..n {
+        let (r, h) = columns.angle(x);
+        mix(&mut dq[x * n..(x + 1) * n], x, r, h);
+    }
+    // By θ̇_x (the pull's column scaled by −λ_x/l_x, and 2 l_x θ̇_x in b_x) and, if asked,
+    // by σ_x: the pull's column P_x into dqd's column x first, then ∂θ̈/∂σ_x = P_x/l_x
+    // and ∂θ̈/∂θ̇_x = −(λ_x/l_x) P_x + 2 l_x θ̇_x G[:, x].
+    let (mut dtorque, dpivot) = inputs.unzip();
+    for x in 0..n {
+        let column = &mut dqd[x * n..(x + 1) * n];
+        let Some(dtorque) = dtorque.as_deref_mut() else {
+            let (r, h) = rate_weights(columns, x);
             mix(column, x, r, h);
-            for (t, p) in dtorque[x * n..(x + 1) * n].iter_mut().zip(&*column) {
-                *t = il[x] * p;
-            }
-            for (p, g) in column.iter_mut().zip(&green[x * n..(x + 1) * n]) {
-                *p = k * *p + rate * g;
-            }
+            continue;
+        };
+        let (r, h) = columns.pull(x);
+        let (k, rate) = (-drag[x], V::splat(2.0) * length[x] * links[x].rate);
+        mix(column, x, r, h);
+        for (t, &p) in dtorque[x * n..(x + 1) * n].iter_mut().zip(&*column) {
+            *t = il[x] * p;
         }
-        if let Some(dpivot) = dpivot {
-            for (k, (r, h)) in columns.pivot().into_iter().enumerate() {
-                mix(&mut dpivot[k * n..(k + 1) * n], 0, r, h);
-            }
+        for (p, &g) in column.iter_mut().zip(&green[x * n..(x + 1) * n]) {
+            *p = k * *p + rate * g;
         }
     }
+    if let Some(dpivot) = dpivot {
+        for (k, (r, h)) in columns.pivot().into_iter().enumerate() {
+            mix(&mut dpivot[k * n..(k + 1) * n], 0, r, h);
+        }
+    }
+}
+
+/// `∂θ̈/∂θ` and `∂θ̈/∂θ̇` of the kept solve `columns` row by row, for lanes, where a row
+/// costs what a column does and needs no room of `n²` for the result: `G` into `green`
+/// (`n²` zeros), the weights of every column into `weights` (`2n`), then
+/// `emit(i, row i of ∂θ̈/∂θ, row i of ∂θ̈/∂θ̇)` for `i = 0 … n − 1`, each row built in
+/// `rows` (`2n`). Every entry is the sum [`blocks`] forms (the same operations in the same
+/// order), so the same bits.
+#[inline(always)]
+pub(crate) fn state_rows<V: Lane>(
+    columns: Columns<'_, V>,
+    green: &mut [V],
+    weights: &mut [([V; 3], [V; 3])],
+    rows: &mut [V],
+    mut emit: impl FnMut(usize, &[V], &[V]),
+) {
+    let n = columns.links.len();
+    if n == 0 {
+        return;
+    }
+    let green = green_of(columns, green);
+    let (by_angle, by_rate) = weights[..2 * n].split_at_mut(n);
+    for x in 0..n {
+        by_angle[x] = columns.angle(x);
+        by_rate[x] = rate_weights(columns, x);
+    }
+    let (dq, dqd) = rows[..2 * n].split_at_mut(n);
+    for i in 0..n {
+        for (weights, row) in [(&*by_angle, &mut *dq), (&*by_rate, &mut *dqd)] {
+            for (x, (o, &(r, h))) in row.iter_mut().zip(weights).enumerate() {
+                let at = |j: usize| green[j * n + i];
+                let mut e = r[0] * at(x.saturating_sub(1)) + r[1] * at(x) + r[2] * at((x + 1).min(n - 1));
+                // Rows x − 1 … x + 1 of column x also change directly (`mix`).
+                if i + 1 == x {
+                    e += h[0];
+                } else if i == x {
+                    e += h[1];
+                } else if i == x + 1 {
+                    e += h[2];
+                }
+                *o = e;
+            }
+        }
+        emit(i, dq, dqd);
+    }
+}
+
+/// The weights of column `x` of `∂θ̈/∂θ̇` ([`mix`]): the pull's column scaled by
+/// `−λ_x/l_x`, and `2 l_x θ̇_x` in `b_x`.
+#[inline(always)]
+fn rate_weights<V: Lane>(columns: Columns<'_, V>, x: usize) -> ([V; 3], [V; 3]) {
+    let RodConstants { length, drag, .. } = columns.rods;
+    let (r, h) = columns.pull(x);
+    let (k, rate) = (-drag[x], V::splat(2.0) * length[x] * columns.links[x].rate);
+    // Written out: `array::map`'s closure was compiled apart from the lanes' kernels,
+    // without their target features.
+    ([k * r[0], k * r[1] + rate, k * r[2]], [k * h[0], k * h[1], k * h[2]])
+}
+
+/// `G = H A⁻¹` of the kept solve `columns` (module docs) into `green` (`n²` zeros),
+/// column-major: column j is row j of A⁻¹ Hᵀ, the solve of every output at once, each a
+/// row operation of the kept elimination.
+#[inline(always)]
+fn green_of<'g, V: Lane>(columns: Columns<'_, V>, green: &'g mut [V]) -> &'g [V] {
+    let links = columns.links;
+    let n = links.len();
+    let green = &mut green[..n * n];
+    for j in 0..n {
+        if j >= 1 {
+            green[j * n + j - 1] = columns.coupling(j - 1)[1];
+        }
+        if j + 1 < n {
+            green[j * n + j + 1] = columns.coupling(j + 1)[0];
+        }
+    }
+    for j in 1..n {
+        let factor = links[j].factor;
+        let (above, here) = green.split_at_mut(j * n);
+        // Rows i > j + 1 of column j − 1 are still zero.
+        let end = (j + 1).min(n);
+        for (g, &a) in here[..end].iter_mut().zip(&above[(j - 1) * n..(j - 1) * n + end]) {
+            *g -= factor * a;
+        }
+    }
+    let last = links[n - 1].inverse_pivot;
+    green[(n - 1) * n..].iter_mut().for_each(|g| *g = *g * last);
+    for j in (0..n - 1).rev() {
+        let (inverse_pivot, factor) = (links[j].inverse_pivot, links[j + 1].factor);
+        let (here, below) = green.split_at_mut((j + 1) * n);
+        for (g, &b) in here[j * n..].iter_mut().zip(&below[..n]) {
+            *g = *g * inverse_pivot - factor * b;
+        }
+    }
+    green
 }
 
 /// Column `x` of a Jacobian from `G`'s columns `x − 1`, `x`, `x + 1` (weights `r`, the
@@ -112,20 +192,26 @@ where
 /// rows; a weight outside the chain is zero (the joints there are), so its column may be
 /// any. Inlined so that a fixed `n` unrolls it.
 #[inline(always)]
-fn mix(green: &[f64], n: usize, out: &mut [f64], x: usize, r: [f64; 3], h: [f64; 3]) {
+fn mix<V: Lane>(green: &[V], n: usize, out: &mut [V], x: usize, r: [V; 3], h: [V; 3]) {
     let column = |j: usize| &green[j * n..(j + 1) * n];
     let (above, here, below) = (column(x.saturating_sub(1)), column(x), column((x + 1).min(n - 1)));
-    let entry = |i: usize| r[0] * above[i] + r[1] * here[i] + r[2] * below[i];
-    for (o, ((a, g), b)) in out[..n].iter_mut().zip(above.iter().zip(here).zip(below)) {
+    for (o, ((&a, &g), &b)) in out[..n].iter_mut().zip(above.iter().zip(here).zip(below)) {
         *o = r[0] * a + r[1] * g + r[2] * b;
     }
     // Rows x − 1 … x + 1 again from G, not read back from `out` (a load of a value just
     // stored by the vector loop stalls).
     if x >= 1 {
-        out[x - 1] = entry(x - 1) + h[0];
+        out[x - 1] = entry(r, [above, here, below], x - 1) + h[0];
     }
-    out[x] = entry(x) + h[1];
+    out[x] = entry(r, [above, here, below], x) + h[1];
     if x + 1 < n {
-        out[x + 1] = entry(x + 1) + h[2];
+        out[x + 1] = entry(r, [above, here, below], x + 1) + h[2];
     }
+}
+
+/// Row `i` of `G`'s columns `x − 1`, `x`, `x + 1` weighted by `r` ([`mix`]); a function, not
+/// a closure, so that it is inlined into the lanes' kernels with their target features.
+#[inline(always)]
+fn entry<V: Lane>(r: [V; 3], [above, here, below]: [&[V]; 3], i: usize) -> V {
+    r[0] * above[i] + r[1] * here[i] + r[2] * below[i]
 }

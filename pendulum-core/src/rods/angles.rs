@@ -29,6 +29,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, Dyn, OVector, U1, U2, allocator::Allocator};
 
+use crate::lanes::Lane;
 use crate::model::Inputs;
 
 use super::{Continuants, RodConstants, pull};
@@ -36,35 +37,66 @@ use crate::kinematics::trig::sin_cos_into;
 
 /// The joint above link `j` (between links `j − 1` and `j`, module docs): `C_j`, `S_j` and
 /// the derivatives of `r_{j−1}`, `r_j`, `h_{j−1}`, `h_j` by `φ_j = θ_j − θ_{j−1}`; zero for
-/// the joints outside the chain (above link 0, below the last).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct Joint {
-    pub cos: f64,
-    pub sin: f64,
-    pub r_above: f64,
-    pub r_below: f64,
-    pub h_above: f64,
-    pub h_below: f64,
+/// the joints outside the chain (above link 0, below the last). In lanes `V`, those of
+/// `W` chains side by side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Joint<V = f64> {
+    pub cos: V,
+    pub sin: V,
+    pub r_above: V,
+    pub r_below: V,
+    pub h_above: V,
+    pub h_below: V,
 }
 
-/// One link of the kept solve.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct Link {
-    pub sin: f64,
-    pub cos: f64,
+impl<V: Lane> Joint<V> {
+    /// A joint outside the chain.
+    #[inline(always)]
+    pub fn zero() -> Self {
+        let zero = V::splat(0.0);
+        Self { cos: zero, sin: zero, r_above: zero, r_below: zero, h_above: zero, h_below: zero }
+    }
+}
+
+/// One link of the kept solve (in lanes `V`, of `W` chains).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Link<V = f64> {
+    pub sin: V,
+    pub cos: V,
     /// `θ̇_i` (rad/s).
-    pub rate: f64,
+    pub rate: V,
     /// `f_i` (N).
-    pub pull: f64,
+    pub pull: V,
     /// The joint above this link.
-    pub joint: Joint,
+    pub joint: Joint<V>,
     /// `F_i = A_{i,i−1}/D_{i−1}` (0 for link 0) and `1/D_i` (kg).
-    pub factor: f64,
-    pub inverse_pivot: f64,
+    pub factor: V,
+    pub inverse_pivot: V,
     /// `T_i` (N).
-    pub tension: f64,
+    pub tension: V,
     /// `θ̈_i` (rad/s²).
-    pub acceleration: f64,
+    pub acceleration: V,
+}
+
+impl<V: Lane> Link<V> {
+    /// The link at `sin θ_i`, `cos θ_i`, `θ̇_i` (rad/s) with the pull `f_i` (N), the rest
+    /// for [`solve`] to fill.
+    #[inline(always)]
+    pub fn at(sin: V, cos: V, rate: V, pull: V) -> Self {
+        let zero = V::splat(0.0);
+        let joint = Joint::zero();
+        Self {
+            sin,
+            cos,
+            rate,
+            pull,
+            joint,
+            factor: zero,
+            inverse_pivot: zero,
+            tension: zero,
+            acceleration: zero,
+        }
+    }
 }
 
 /// `PlanarTension`'s solve at one state, kept for its tangents:
@@ -107,65 +139,16 @@ where
         DefaultAllocator: Allocator<U2>,
     {
         let dim = q.shape_generic().0;
-        let n = dim.value();
         let (q, qd, torque) = (q.as_slice(), qd.as_slice(), inputs.torque.as_slice());
         let pivot = [inputs.pivot_acceleration[0], inputs.pivot_acceleration[1]];
-        let RodConstants { inverse_mass: im, inverse_length: il, drag, .. } = rods;
+        let RodConstants { inverse_length: il, drag, .. } = rods;
         let mut trig = OVector::<[f64; 2], L>::from_element_generic(dim, U1, [0.0; 2]);
         sin_cos_into(q, trig.as_mut_slice());
         let mut links = OVector::<Link, L>::from_fn_generic(dim, U1, |i, _| {
             let [sin, cos] = trig[i];
-            Link { sin, cos, rate: qd[i], pull: pull(torque[i], il[i], drag[i], qd[i]), ..Link::default() }
+            Link::at(sin, cos, qd[i], pull(torque[i], il[i], drag[i], qd[i]))
         });
-        let ls = links.as_mut_slice();
-        for j in 1..n {
-            let (above, here) = (ls[j - 1], ls[j]);
-            ls[j].joint.cos = above.cos * here.cos + above.sin * here.sin;
-            ls[j].joint.sin = here.sin * above.cos - here.cos * above.sin;
-        }
-        // Down: b_i, eliminated as it comes, the pivots by continuants (the classical way
-        // should a continuant leave its range).
-        let mut continuants = Continuants::new();
-        eliminate(ls, rods, gravity, pivot, |i, diagonal, off| continuants.inverse_pivot(i, diagonal, off));
-        if !continuants.in_range() {
-            let mut inverse_pivot_above = 0.0;
-            eliminate(ls, rods, gravity, pivot, |_, diagonal, off| {
-                inverse_pivot_above = 1.0 / (diagonal - off * off * inverse_pivot_above);
-                inverse_pivot_above
-            });
-        }
-        // Up: T_i = e_i/D_i − F_{i+1} T_{i+1}.
-        let (mut factor_below, mut tension_below) = (0.0, 0.0);
-        for link in ls.iter_mut().rev() {
-            link.tension = link.tension * link.inverse_pivot - factor_below * tension_below;
-            (factor_below, tension_below) = (link.factor, link.tension);
-        }
-        // θ̈ and the joints' derivative terms.
-        for i in 0..n {
-            let here = ls[i];
-            let im_above = if i >= 1 { im[i - 1] } else { 0.0 };
-            let mut a = here.pull * (im[i] + im_above);
-            if i + 1 < n {
-                let b = ls[i + 1];
-                a += (b.tension * b.joint.sin - b.pull * b.joint.cos) * im[i];
-            }
-            if i >= 1 {
-                let (above, j) = (ls[i - 1], here.joint);
-                a -= (above.pull * j.cos + above.tension * j.sin) * im_above;
-                let w = im_above;
-                ls[i].joint = Joint {
-                    r_above: w * (here.pull * j.cos - j.sin * here.tension),
-                    r_below: w * (-above.pull * j.cos - j.sin * above.tension),
-                    h_above: il[i - 1] * w * (here.pull * j.sin + here.tension * j.cos),
-                    h_below: il[i] * w * (above.pull * j.sin - above.tension * j.cos),
-                    ..j
-                };
-            } else {
-                let [px, py] = pivot;
-                a -= here.cos * px + here.sin * (py + gravity);
-            }
-            ls[i].acceleration = a * il[i];
-        }
+        solve(links.as_mut_slice(), rods, gravity, pivot);
         let work = OVector::from_element_generic(dim, U1, 0.0);
         Self { rods, gravity, pivot, links, work }
     }
@@ -240,30 +223,94 @@ where
     }
 }
 
+/// The solve of [`PlanarTangents::new`] on `ls`, whose `sin`, `cos`, `rate` and `pull` are
+/// set ([`Link::at`]), for a chain of `rods` under gravity `g` (m/s²) with the pivot
+/// acceleration `p̈` (m/s²): the joints, the elimination (`F_i`, `1/D_i`), the tensions,
+/// `θ̈` and the joints' derivative terms. In lanes `V`, `W` chains at once, each lane doing
+/// the operations of the chain alone in the same order (so the same bits); a lane whose
+/// continuants leave their range redoes its pivots the classical way, the others keep
+/// theirs.
+#[inline(always)]
+pub(crate) fn solve<V: Lane>(ls: &mut [Link<V>], rods: RodConstants<'_, V>, gravity: V, pivot: [V; 2]) {
+    let n = ls.len();
+    let RodConstants { inverse_mass: im, inverse_length: il, .. } = rods;
+    let zero = V::splat(0.0);
+    for j in 1..n {
+        let (above, here) = (ls[j - 1], ls[j]);
+        ls[j].joint.cos = above.cos * here.cos + above.sin * here.sin;
+        ls[j].joint.sin = here.sin * above.cos - here.cos * above.sin;
+    }
+    // Down: b_i, eliminated as it comes, the pivots by continuants (the classical way in the
+    // lanes where a continuant left its range).
+    let mut continuants = Continuants::new();
+    eliminate(ls, rods, gravity, pivot, None, |i, diagonal, off| continuants.inverse_pivot(i, diagonal, off));
+    let outside = continuants.outside();
+    if V::any(outside) {
+        let mut inverse_pivot_above = zero;
+        eliminate(ls, rods, gravity, pivot, Some(outside), |_, diagonal, off| {
+            inverse_pivot_above = V::splat(1.0) / (diagonal - off * off * inverse_pivot_above);
+            inverse_pivot_above
+        });
+    }
+    // Up: T_i = e_i/D_i − F_{i+1} T_{i+1}.
+    let (mut factor_below, mut tension_below) = (zero, zero);
+    for link in ls.iter_mut().rev() {
+        link.tension = link.tension * link.inverse_pivot - factor_below * tension_below;
+        (factor_below, tension_below) = (link.factor, link.tension);
+    }
+    // θ̈ and the joints' derivative terms.
+    for i in 0..n {
+        let here = ls[i];
+        let im_above = if i >= 1 { im[i - 1] } else { zero };
+        let mut a = here.pull * (im[i] + im_above);
+        if i + 1 < n {
+            let b = ls[i + 1];
+            a += (b.tension * b.joint.sin - b.pull * b.joint.cos) * im[i];
+        }
+        if i >= 1 {
+            let (above, j) = (ls[i - 1], here.joint);
+            a -= (above.pull * j.cos + above.tension * j.sin) * im_above;
+            let w = im_above;
+            ls[i].joint = Joint {
+                r_above: w * (here.pull * j.cos - j.sin * here.tension),
+                r_below: w * (-above.pull * j.cos - j.sin * above.tension),
+                h_above: il[i - 1] * w * (here.pull * j.sin + here.tension * j.cos),
+                h_below: il[i] * w * (above.pull * j.sin - above.tension * j.cos),
+                ..j
+            };
+        } else {
+            let [px, py] = pivot;
+            a -= here.cos * px + here.sin * (py + gravity);
+        }
+        ls[i].acceleration = a * il[i];
+    }
+}
+
 /// How each input of `θ̈` moves `r` and `h` (module docs): a column changes rows
 /// `x − 1 … x + 1` only, given as `(∂r, ∂h)` in those rows, entries outside the chain zero.
 /// The one place these derivatives are written: the JVP gathers them, the full Jacobians
 /// (`jacobians`) mix `G`'s columns with them.
+/// In lanes `V`, the columns of `W` chains side by side.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Columns<'a> {
-    pub links: &'a [Link],
-    pub rods: RodConstants<'a>,
+pub(crate) struct Columns<'a, V = f64> {
+    pub links: &'a [Link<V>],
+    pub rods: RodConstants<'a, V>,
     /// `g` (m/s²) and `p̈` (m/s²).
-    pub gravity: f64,
-    pub pivot: [f64; 2],
+    pub gravity: V,
+    pub pivot: [V; 2],
 }
 
-impl Columns<'_> {
+impl<V: Lane> Columns<'_, V> {
     /// The joint above link `j` (zero outside the chain).
     #[inline(always)]
-    fn joint(&self, j: usize) -> Joint {
-        if j < self.links.len() { self.links[j].joint } else { Joint::default() }
+    fn joint(&self, j: usize) -> Joint<V> {
+        if j < self.links.len() { self.links[j].joint } else { Joint::zero() }
     }
 
     /// By `θ_x`: through `φ_x` (+1) and `φ_{x+1}` (−1); link 0 also through
     /// `u_0·(g⃗ − p̈)` in `b_0` and `−n_0·(p̈ − g⃗)/l_0` in `h_0`.
     #[inline(always)]
-    pub fn angle(&self, x: usize) -> ([f64; 3], [f64; 3]) {
+    pub fn angle(&self, x: usize) -> ([V; 3], [V; 3]) {
         let (a, b) = (self.joint(x), self.joint(x + 1));
         let mut r = [a.r_above, a.r_below - b.r_above, -b.r_below];
         let mut h = [a.h_above, a.h_below - b.h_above, -b.h_below];
@@ -279,12 +326,13 @@ impl Columns<'_> {
     /// By the pull `f_x` (N): `θ̇_x` enters as `−(λ_x/l_x) f_x` (and `2 l_x θ̇_x` in `b_x`),
     /// `σ_x` as `f_x/l_x`.
     #[inline(always)]
-    pub fn pull(&self, x: usize) -> ([f64; 3], [f64; 3]) {
+    pub fn pull(&self, x: usize) -> ([V; 3], [V; 3]) {
         let (im, il) = (self.rods.inverse_mass, self.rods.inverse_length);
         let (above, below) = (self.joint(x), self.joint(x + 1));
-        let (im_above, il_above) = if x >= 1 { (im[x - 1], il[x - 1]) } else { (0.0, 0.0) };
-        let il_below = il.get(x + 1).copied().unwrap_or(0.0);
-        let r = [im_above * above.sin, 0.0, -im[x] * below.sin];
+        let zero = V::splat(0.0);
+        let (im_above, il_above) = if x >= 1 { (im[x - 1], il[x - 1]) } else { (zero, zero) };
+        let il_below = il.get(x + 1).copied().unwrap_or(zero);
+        let r = [im_above * above.sin, zero, -im[x] * below.sin];
         let h = [-il_above * im_above * above.cos, il[x] * (im[x] + im_above), -il_below * im[x] * below.cos];
         (r, h)
     }
@@ -292,39 +340,44 @@ impl Columns<'_> {
     /// By `p̈_x` and `p̈_y`: through `u_0·(g⃗ − p̈)` in `b_0` and `−n_0·(p̈ − g⃗)/l_0` in `h_0`
     /// (columns of link 0).
     #[inline(always)]
-    pub fn pivot(&self) -> [([f64; 3], [f64; 3]); 2] {
+    pub fn pivot(&self) -> [([V; 3], [V; 3]); 2] {
         let (s0, c0, il) = (self.links[0].sin, self.links[0].cos, self.rods.inverse_length[0]);
-        [([0.0, -s0, 0.0], [0.0, -il * c0, 0.0]), ([0.0, c0, 0.0], [0.0, -il * s0, 0.0])]
+        let zero = V::splat(0.0);
+        [([zero, -s0, zero], [zero, -il * c0, zero]), ([zero, c0, zero], [zero, -il * s0, zero])]
     }
 
     /// Row `i` of `H = ∂h/∂T` (module docs): `[H_{i,i−1}, H_{i,i+1}] =
     /// [−S_i/(m_{i−1} l_i), S_{i+1}/(m_i l_i)]` (1/(kg·m)), zero outside the chain.
     #[inline(always)]
-    pub fn coupling(&self, i: usize) -> [f64; 2] {
+    pub fn coupling(&self, i: usize) -> [V; 2] {
         let (links, im, il) = (self.links, self.rods.inverse_mass, self.rods.inverse_length);
-        let above = if i >= 1 { -il[i] * im[i - 1] * links[i].joint.sin } else { 0.0 };
-        let below = if i + 1 < links.len() { il[i] * im[i] * links[i + 1].joint.sin } else { 0.0 };
+        let zero = V::splat(0.0);
+        let above = if i >= 1 { -il[i] * im[i - 1] * links[i].joint.sin } else { zero };
+        let below = if i + 1 < links.len() { il[i] * im[i] * links[i + 1].joint.sin } else { zero };
         [above, below]
     }
 }
 
-/// The down pass of [`PlanarTangents::new`]: `b_i` (module docs) and its elimination,
+/// The down pass of [`solve`]: `b_i` (module docs) and its elimination,
 /// `F_i = A_{i,i−1}/D_{i−1}` and `e_i = b_i − F_i e_{i−1}` (kept in `tension`), with the
-/// pivots `1/D_i` from `inverse_pivot(i, A_ii, A_{i,i−1})`.
+/// pivots `1/D_i` from `inverse_pivot(i, A_ii, A_{i,i−1})`; stored in every lane, or only
+/// in the lanes of `only`.
 #[inline(always)]
-fn eliminate(
-    ls: &mut [Link],
-    rods: RodConstants<'_>,
-    gravity: f64,
-    [px, py]: [f64; 2],
-    mut inverse_pivot: impl FnMut(usize, f64, f64) -> f64,
+fn eliminate<V: Lane>(
+    ls: &mut [Link<V>],
+    rods: RodConstants<'_, V>,
+    gravity: V,
+    [px, py]: [V; 2],
+    only: Option<V::Mask>,
+    mut inverse_pivot: impl FnMut(usize, V, V) -> V,
 ) {
     let n = ls.len();
     let RodConstants { inverse_mass: im, length, .. } = rods;
-    let (mut inverse_pivot_above, mut e_above) = (0.0, 0.0);
+    let zero = V::splat(0.0);
+    let (mut inverse_pivot_above, mut e_above) = (zero, zero);
     for i in 0..n {
         let here = ls[i];
-        let im_above = if i >= 1 { im[i - 1] } else { 0.0 };
+        let im_above = if i >= 1 { im[i - 1] } else { zero };
         let mut b = length[i] * here.rate * here.rate;
         if i == 0 {
             b += here.cos * (gravity + py) - here.sin * px;
@@ -338,7 +391,15 @@ fn eliminate(
         let ip = inverse_pivot(i, im[i] + im_above, off);
         let factor = off * inverse_pivot_above;
         let e = b - factor * e_above;
-        (ls[i].factor, ls[i].inverse_pivot, ls[i].tension) = (factor, ip, e);
+        let link = &mut ls[i];
+        match only {
+            None => (link.factor, link.inverse_pivot, link.tension) = (factor, ip, e),
+            Some(lanes) => {
+                link.factor = V::select(lanes, factor, link.factor);
+                link.inverse_pivot = V::select(lanes, ip, link.inverse_pivot);
+                link.tension = V::select(lanes, e, link.tension);
+            }
+        }
         (inverse_pivot_above, e_above) = (ip, e);
     }
 }

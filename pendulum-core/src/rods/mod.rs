@@ -50,7 +50,9 @@ mod green;
 mod solve;
 mod tangent;
 
+pub(crate) use angle_jacobians::state_rows;
 pub use angles::PlanarTangents;
+pub(crate) use angles::{Columns, Link, solve as solve_in_angles};
 pub(crate) use green::Column;
 pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
 
@@ -66,14 +68,24 @@ pub(crate) struct Rods<V: Lane = f64> {
 }
 
 /// A chain's per-link constants as the tension solve reads them, `n` entries each:
-/// `1/m_i` (1/kg), `l_i` (m), `1/l_i` (1/m) and the drag `λ_i/l_i` (N·s).
-#[derive(Debug, Clone, Copy)]
-pub struct RodConstants<'a> {
-    pub inverse_mass: &'a [f64],
-    pub length: &'a [f64],
-    pub inverse_length: &'a [f64],
-    pub drag: &'a [f64],
+/// `1/m_i` (1/kg), `l_i` (m), `1/l_i` (1/m) and the drag `λ_i/l_i` (N·s); with `V` =
+/// [`Lanes`](crate::lanes::Lanes), those of `W` chains side by side.
+#[derive(Debug)]
+pub struct RodConstants<'a, V = f64> {
+    pub inverse_mass: &'a [V],
+    pub length: &'a [V],
+    pub inverse_length: &'a [V],
+    pub drag: &'a [V],
 }
+
+// By hand: a derive would ask `V: Copy`, which the slices do not need.
+impl<V> Clone for RodConstants<'_, V> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<V> Copy for RodConstants<'_, V> {}
 
 /// The pull on planar rod `i` (N), `f_i = Q_i/l_i − (λ_i/l_i) θ̇_i`, from the joint torque
 /// `Q_i` (N·m), `1/l_i`, the drag `λ_i/l_i` (N·s) and the rate `θ̇_i` (rad/s); linear, so

@@ -21,16 +21,6 @@ impl Rods {
     pub fn len(&self) -> usize {
         self.length.len()
     }
-
-    /// The per-rod constants as one view.
-    pub fn constants(&self) -> RodConstants<'_> {
-        RodConstants {
-            inverse_mass: &self.inverse_mass,
-            length: &self.length,
-            inverse_length: &self.inverse_length,
-            drag: &self.drag,
-        }
-    }
 }
 
 impl Rods {
@@ -60,6 +50,16 @@ impl Rods {
 }
 
 impl<V: Lane> Rods<V> {
+    /// The per-rod constants as one view.
+    pub fn constants(&self) -> RodConstants<'_, V> {
+        RodConstants {
+            inverse_mass: &self.inverse_mass,
+            length: &self.length,
+            inverse_length: &self.inverse_length,
+            drag: &self.drag,
+        }
+    }
+
     /// `1 / l_i` (1/m) per rod.
     pub fn inverse_length(&self) -> &[V] {
         &self.inverse_length

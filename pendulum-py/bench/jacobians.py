@@ -1,0 +1,42 @@
+"""`Chain.jacobians` of many planar states from Python, in one run:
+
+    target/python/bin/python pendulum-py/bench/jacobians.py
+
+10⁴ states of planar chains of 8 and 20 links (with damping, joint torques and a pivot
+acceleration per state): `chain.jacobians(q, qd, torque, pivot_acceleration=p)`, which
+returns `q̈`, `∂q̈/∂q` and `∂q̈/∂q̇` of every state. Prints the best of 7 repeats, the time
+per state, and the largest difference of `∂q̈/∂q` from central differences of
+`chain.accelerations` (step 1e-6 rad), relative to the largest entry, as a check that the
+timed call does the work.
+"""
+
+import timeit
+
+import numpy as np
+
+import pendulum
+
+rng = np.random.default_rng(1)
+count = 10_000
+for n in (8, 20):
+    chain = pendulum.Chain(rng.uniform(0.05, 0.2, n), rng.uniform(0.1, 0.3, n), damping=1e-3)
+    q, qd = rng.uniform(-2, 2, (count, n)), rng.normal(size=(count, n))
+    torque, pivot = rng.normal(size=(count, n)) * 1e-2, rng.normal(size=(count, 2))
+
+    def call():
+        return chain.jacobians(q, qd, torque, pivot_acceleration=pivot)
+
+    seconds = min(timeit.repeat(call, number=1, repeat=7))
+    _, dq, _ = call()
+    eps, k = 1e-6, 0
+    step = np.zeros(n)
+    step[k] = eps
+    slope = (
+        chain.accelerations(q + step, qd, torque, pivot_acceleration=pivot)
+        - chain.accelerations(q - step, qd, torque, pivot_acceleration=pivot)
+    ) / (2 * eps)
+    error = np.abs(dq[:, :, k] - slope).max() / np.abs(dq).max()
+    print(
+        f"n = {n:2}: 10^4 states' Jacobians {seconds * 1e3:7.2f} ms"
+        f" ({seconds / count * 1e9:6.0f} ns a state); against central differences {error:.1e}"
+    )
