@@ -10,7 +10,7 @@ use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, U2, Vector2, allocator::
 use rayon::prelude::*;
 
 use super::lane_states::non_finite_lanes;
-use super::planar::Block;
+use super::planar::{Block, BlockStates};
 use super::rooms::Room;
 use super::transpose::{scatter_matrix_row, transpose_square};
 use super::{
@@ -19,7 +19,6 @@ use super::{
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::jacobians::{Derivatives, Jacobians};
-use crate::kinematics::trig::sin_cos_split;
 use crate::lanes::{Aligned, Lane, Lanes};
 use crate::model::Inputs;
 use crate::models::PlanarTension;
@@ -46,15 +45,11 @@ struct States<'a> {
     pivot: Option<&'a [f64]>,
 }
 
-/// A task's room for a block of chains in lanes `V`: the angles, sines, cosines, rates and
-/// joint torques in lane order, the kept solve's links, `G` (`n × n`), the columns' weights and a row of
+/// A task's room for a block of chains in lanes `V`: its states in lane order, the kept
+/// solve's links, `G` (`n × n`), the columns' weights and a row of
 /// each Jacobian (`rods::state_rows`).
 struct BlockRoom<V: Lane> {
-    angles: Aligned<V>,
-    sin: Aligned<V>,
-    cos: Aligned<V>,
-    rates: Aligned<V>,
-    torque: Aligned<V>,
+    states: BlockStates<V>,
     links: Aligned<Link<V>>,
     green: Aligned<V>,
     weights: Aligned<([V; 3], [V; 3])>,
@@ -64,14 +59,9 @@ struct BlockRoom<V: Lane> {
 impl<V: Lane> BlockRoom<V> {
     fn new(n: usize) -> Self {
         let zero = V::splat(0.0);
-        let lanes = || Aligned::filled(zero, n);
 
         Self {
-            angles: lanes(),
-            sin: lanes(),
-            cos: lanes(),
-            rates: lanes(),
-            torque: lanes(),
+            states: BlockStates::new(n),
             links: Aligned::filled(Link::at(zero, zero, zero, zero), n),
             green: Aligned::filled(zero, n * n),
             weights: Aligned::filled(([zero; 3], [zero; 3]), 2 * n),
@@ -180,26 +170,17 @@ impl PlanarBatch {
         ) -> [bool; W] {
             let (n, States { q, qd, torque, pivot }) = (self.links, states);
             let (rods, gravity) = one_of(blocks, b).constants();
-            gather(q, lanes, n, Lanes::flatten_mut(&mut room.angles));
-            sin_cos_split(
-                Lanes::flatten(&room.angles),
-                Lanes::flatten_mut(&mut room.sin),
-                Lanes::flatten_mut(&mut room.cos),
-            );
-            gather(qd, lanes, n, Lanes::flatten_mut(&mut room.rates));
+            let pivot = room.states.gather([q, qd], pivot, lanes, n);
             let zero = Lanes([0.0; W]);
-            let pivot = match pivot {
-                Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
-                None => [zero; 2],
-            };
             // The pulls as the chain alone forms them, from zero torques if none are given.
+            let t = &mut room.states;
             match torque {
-                Some(t) => gather(t, lanes, n, Lanes::flatten_mut(&mut room.torque)),
-                None => room.torque.fill(zero),
+                Some(torque) => gather(torque, lanes, n, Lanes::flatten_mut(&mut t.torque)),
+                None => t.torque.fill(zero),
             }
             for (i, link) in room.links.iter_mut().enumerate() {
-                let (rate, il, drag) = (room.rates[i], rods.inverse_length[i], rods.drag[i]);
-                *link = Link::at(room.sin[i], room.cos[i], rate, pull(room.torque[i], il, drag, rate));
+                let (rate, il, drag) = (t.rates[i], rods.inverse_length[i], rods.drag[i]);
+                *link = Link::at(t.sin[i], t.cos[i], rate, pull(t.torque[i], il, drag, rate));
             }
             solve_in_angles(&mut room.links, rods, gravity, pivot);
             for (a, link) in room.rows.iter_mut().zip(room.links.iter()) {

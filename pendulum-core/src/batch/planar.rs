@@ -52,30 +52,60 @@ pub(super) struct Block<V: Lane = F64x4> {
     down: V,
 }
 
-/// Per task: the block's angles, `sin θ` and `cos θ` in lane order, its rates and joint
-/// torques, the solve's room and the accelerations.
+/// A block's states in lane order: the angles, `sin θ` and `cos θ`, the rates and the
+/// joint torques.
+pub(super) struct BlockStates<V: Lane> {
+    pub angles: Aligned<V>,
+    pub sin: Aligned<V>,
+    pub cos: Aligned<V>,
+    pub rates: Aligned<V>,
+    pub torque: Aligned<V>,
+}
+
+impl<V: Lane> BlockStates<V> {
+    pub(super) fn new(links: usize) -> Self {
+        let lanes = || Aligned::filled(V::splat(0.0), links);
+        Self { angles: lanes(), sin: lanes(), cos: lanes(), rates: lanes(), torque: lanes() }
+    }
+}
+
+impl<const W: usize> BlockStates<Lanes<W>> {
+    /// `θ` and `θ̇` of the chains `lanes` (rows of `n` of `q` and `qd`) in lane order, and
+    /// `sin θ`, `cos θ` of all of them at once; returns their pivot accelerations (rows of
+    /// 2 of `pivot`; `None`: zero).
+    #[inline(always)]
+    pub(super) fn gather(
+        &mut self,
+        [q, qd]: [&[f64]; 2],
+        pivot: Option<&[f64]>,
+        lanes: [usize; W],
+        n: usize,
+    ) -> [Lanes<W>; 2] {
+        gather(q, lanes, n, Lanes::flatten_mut(&mut self.angles));
+        sin_cos_split(
+            Lanes::flatten(&self.angles),
+            Lanes::flatten_mut(&mut self.sin),
+            Lanes::flatten_mut(&mut self.cos),
+        );
+        gather(qd, lanes, n, Lanes::flatten_mut(&mut self.rates));
+        match pivot {
+            Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
+            None => [Lanes([0.0; W]); 2],
+        }
+    }
+}
+
+/// Per task: the block's states in lane order, the solve's room and the accelerations.
 struct Scratch<V: Lane = F64x4> {
-    angles: Aligned<V>,
-    sin: Aligned<V>,
-    cos: Aligned<V>,
-    rates: Aligned<V>,
-    torque: Aligned<V>,
+    states: BlockStates<V>,
     work: Work<V>,
     accelerations: Aligned<V>,
 }
 
 impl<V: Lane> Scratch<V> {
     fn new(links: usize) -> Self {
-        let lanes = || Aligned::filled(V::splat(0.0), links);
-        Self {
-            angles: lanes(),
-            sin: lanes(),
-            cos: lanes(),
-            rates: lanes(),
-            torque: lanes(),
-            work: Work::new(links),
-            accelerations: lanes(),
-        }
+        let accelerations = Aligned::filled(V::splat(0.0), links);
+        Self { states: BlockStates::new(links), work: Work::new(links), accelerations }
     }
 }
 
@@ -360,21 +390,21 @@ impl PlanarBatch {
             s: &mut Scratch<F32x8>,
             out: &mut [f32],
         ) -> [bool; WIDTH_F32] {
-            let n = self.links;
+            let (n, t) = (self.links, &mut s.states);
             let block = one_of(&self.blocks_f32, b);
-            gather(q, lanes, n, Lanes32::flatten_mut(&mut s.angles));
+            gather(q, lanes, n, Lanes32::flatten_mut(&mut t.angles));
             sin_cos_split_f32(
-                Lanes32::flatten(&s.angles),
-                Lanes32::flatten_mut(&mut s.sin),
-                Lanes32::flatten_mut(&mut s.cos),
+                Lanes32::flatten(&t.angles),
+                Lanes32::flatten_mut(&mut t.sin),
+                Lanes32::flatten_mut(&mut t.cos),
             );
-            gather(qd, lanes, n, Lanes32::flatten_mut(&mut s.rates));
+            gather(qd, lanes, n, Lanes32::flatten_mut(&mut t.rates));
             let pivot = match pivot {
                 Some(p) => [Lanes32::from_fn(|k| p[2 * lanes[k]]), Lanes32::from_fn(|k| p[2 * lanes[k] + 1])],
                 None => [Lanes32::splat(0.0); 2],
             };
-            let trig = [&s.sin[..], &s.cos, &s.rates];
-            block.accelerations(trig, (&s.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
+            let trig = [&t.sin[..], &t.cos, &t.rates];
+            block.accelerations(trig, (&t.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
             non_finite_lanes_f32(&s.accelerations).map(|flag| flag != 0)
         }
@@ -399,23 +429,13 @@ impl PlanarBatch {
         ) -> [bool; W] {
             let n = self.links;
             let block = one_of(blocks, b);
-            let torqued = torque.map_or(Lanes::<W>::none(), |t| {
-                gather_torques(t, lanes, n, Lanes::flatten_mut(&mut s.torque)).map(u64::from)
+            let t = &mut s.states;
+            let torqued = torque.map_or(Lanes::<W>::none(), |torque| {
+                gather_torques(torque, lanes, n, Lanes::flatten_mut(&mut t.torque)).map(u64::from)
             });
-            gather(q, lanes, n, Lanes::flatten_mut(&mut s.angles));
-            sin_cos_split(
-                Lanes::flatten(&s.angles),
-                Lanes::flatten_mut(&mut s.sin),
-                Lanes::flatten_mut(&mut s.cos),
-            );
-            gather(qd, lanes, n, Lanes::flatten_mut(&mut s.rates));
-            let zero = Lanes([0.0; W]);
-            let pivot = match pivot {
-                Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
-                None => [zero; 2],
-            };
-            let trig = [&s.sin[..], &s.cos, &s.rates];
-            block.accelerations(trig, (&s.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
+            let pivot = t.gather([q, qd], pivot, lanes, n);
+            let trig = [&t.sin[..], &t.cos, &t.rates];
+            block.accelerations(trig, (&t.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, W>(Lanes::flatten(&s.accelerations), n, out);
             non_finite_lanes(&s.accelerations).map(|flag| flag != 0)
         }
