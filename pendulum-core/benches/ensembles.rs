@@ -25,7 +25,8 @@
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
 //!   lanes instead of eight too);
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
-//!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two;
+//!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
+//!   `state_jacobians_f32`;
 //!   `jacobians/spatial/…/20` the same in 3D directions (`Directions::analytic_jacobian`
 //!   against `DirectionsBatch::state_jacobians`).
 //!
@@ -634,6 +635,20 @@ fn jacobians(c: &mut Criterion) {
                 },
             );
         }
+    }
+    // The same in single precision (eight lanes a register, at every length).
+    for n in [8, N, 100] {
+        let (chains, q, qd) = random_batch(CHAINS, n, &mut r);
+        let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+        let (q, qd) = (narrow(&q), narrow(&qd));
+        let batch = PlanarBatch::new(chains).expect("batch");
+        let (mut dq, mut dqd) = (vec![0.0f32; CHAINS * n * n], vec![0.0f32; CHAINS * n * n]);
+        let one = pool(1);
+        group.bench_with_input(BenchmarkId::new("planar/batch_f32_1_thread", n), &n, |b, _| {
+            in_pool(b, &one, || {
+                batch.state_jacobians_f32(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
+            })
+        });
     }
     // The same for 64 chains of 20 links in 3D directions: each chain's
     // `Directions::analytic_jacobian` (the whole first-order Jacobian, as a user calls it)

@@ -268,6 +268,86 @@ fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_
     }
 }
 
+#[test]
+fn single_precision_planar_jacobians_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors:
+    // the worst chain's largest difference in `∂θ̈/∂θ` and `∂θ̈/∂θ̇` over its largest entry.
+    let mut r = ChaCha8Rng::seed_from_u64(51);
+    let chains = 64;
+    for (decades, bound) in [(0.3, 5e-6), (1.0, 1e-5), (2.0, 3e-5)] {
+        for n in [8, 20, 100] {
+            let batch = PlanarBatch::new((0..chains).map(|_| spread_chain(n, decades, &mut r)).collect())
+                .expect("batch");
+            let q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+            let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+            let torque: Vec<f64> = (0..chains * n).map(|_| r.random_range(-1e-3..1e-3)).collect();
+            let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+            let squares = chains * n * n;
+            let (mut dq64, mut dqd64) = (vec![0.0; squares], vec![0.0; squares]);
+            let (mut dq32, mut dqd32) = (vec![0.0f32; squares], vec![0.0f32; squares]);
+            let (t, p) = (Some(&torque[..]), Some(&pivot[..]));
+            assert!(batch.state_jacobians(&q, &qd, t, p, &mut dq64, &mut dqd64).expect("f64").is_empty());
+            let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+            let (q, qd, torque, pivot) = (narrow(&q), narrow(&qd), narrow(&torque), narrow(&pivot));
+            let (t, p) = (Some(&torque[..]), Some(&pivot[..]));
+            assert!(batch.state_jacobians_f32(&q, &qd, t, p, &mut dq32, &mut dqd32).expect("f32").is_empty());
+            let by_q = worst_relative_error(&dq64, &dq32, n * n);
+            let by_qd = worst_relative_error(&dqd64, &dqd32, n * n);
+            println!(
+                "planar Jacobians, spread 10^{decades}, n = {n}: {by_q:.1e} (∂θ̈/∂θ), {by_qd:.1e} (∂θ̈/∂θ̇)"
+            );
+            for error in [by_q, by_qd] {
+                assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn single_precision_planar_jacobians_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(52);
+    let (n, chains) = (10, 21);
+    let list: Vec<_> = (0..chains).map(|_| spread_chain(n, 1.0, &mut r)).collect();
+    let mut q: Vec<f32> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
+    let mut qd: Vec<f32> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
+    let torque: Vec<f32> = (0..chains * n).map(|_| r.random_range(-1e-3..1e-3)).collect();
+    q[4 * n + 2] = f32::INFINITY;
+    qd[13 * n + 7] = 3e19;
+    let batch = PlanarBatch::new(list.clone()).expect("batch");
+    let squares = n * n;
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let (mut dq, mut dqd) = (vec![0.0f32; chains * squares], vec![0.0f32; chains * squares]);
+        let failures = pool
+            .install(|| batch.state_jacobians_f32(&q, &qd, Some(&torque), None, &mut dq, &mut dqd))
+            .expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [4, 13]);
+        assert_eq!(failures[0].error, Error::NonFinite { what: "q", index: 2, value: f64::INFINITY });
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, (a, b)) in dq.chunks_exact(squares).zip(dqd.chunks_exact(squares)).enumerate() {
+            let failed = k == 4 || k == 13;
+            assert_eq!(a.iter().chain(b).all(|v| v.is_nan()), failed, "chain {k}");
+            assert_eq!(a.iter().chain(b).all(|v| v.is_finite()), !failed, "chain {k}");
+        }
+        runs.push([dq, dqd].concat().iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    }
+    assert_eq!(runs[0], runs[1]);
+    for k in [0, 9, 20] {
+        let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
+        let (mut dq, mut dqd) = (vec![0.0f32; squares], vec![0.0f32; squares]);
+        let row = |v: &[f32]| v[k * n..(k + 1) * n].to_vec();
+        let failures =
+            alone.state_jacobians_f32(&row(&q), &row(&qd), Some(&row(&torque)), None, &mut dq, &mut dqd);
+        assert!(failures.expect("f32").is_empty());
+        let bits = |v: &[f32]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&dq), runs[0][k * squares..(k + 1) * squares], "chain {k}");
+        let offset = chains * squares;
+        assert_eq!(bits(&dqd), runs[0][offset + k * squares..offset + (k + 1) * squares], "chain {k}");
+    }
+    let err = batch.state_jacobians_f32(&q, &qd, None, None, &mut [0.0; 5], &mut [0.0; 5]).unwrap_err();
+    assert_eq!(err.to_string(), format!("dq has 5 entries, expected {}", chains * squares));
+}
+
 /// States of `chains` chains of `n` links as rows of `(θ, θ̇)`: angles within ±1 rad,
 /// rates within ±1 rad/s.
 fn planar_rows(chains: usize, n: usize, r: &mut ChaCha8Rng) -> Vec<f64> {

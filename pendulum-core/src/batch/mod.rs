@@ -37,6 +37,7 @@ mod directions;
 mod jacobians;
 mod lane_states;
 mod planar;
+mod planar_jacobians;
 mod planar_rk4;
 mod rk4;
 mod rk4_f32;
@@ -188,7 +189,7 @@ pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
 
 /// Whether every entry of `v` is finite (a loop without early exit, so that it vectorises).
 #[inline(always)]
-fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
+pub(crate) fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
     v.iter().fold(true, |finite, &x| finite & x.into().is_finite())
 }
 

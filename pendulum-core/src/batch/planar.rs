@@ -4,6 +4,7 @@
 use nalgebra::Dyn;
 
 use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
+use super::planar_rk4::RunLane;
 use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, F64x4, F64x8, Failure, Rooms, WIDTH, WIDTH_F32, block_chains, check_len, check_links,
@@ -11,7 +12,6 @@ use super::{
 };
 use crate::chain::Chain;
 use crate::error::{Error, Result};
-use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
 use crate::lanes::{Aligned, Lane, Lanes, Lanes32};
 use crate::model::Model;
 use crate::models::PlanarTension;
@@ -69,28 +69,24 @@ impl<V: Lane> BlockStates<V> {
     }
 }
 
-impl<const W: usize> BlockStates<Lanes<W>> {
-    /// `θ` and `θ̇` of the chains `lanes` (rows of `n` of `q` and `qd`) in lane order, and
-    /// `sin θ`, `cos θ` of all of them at once; returns their pivot accelerations (rows of
-    /// 2 of `pivot`; `None`: zero).
+impl<V: RunLane> BlockStates<V> {
+    /// `θ` and `θ̇` of the chains `lanes` (rows of `n` of `q` and `qd`; `W` is `V`'s
+    /// width) in lane order, and `sin θ`, `cos θ` of all of them at once by `V`'s sine
+    /// kernel; returns their pivot accelerations (rows of 2 of `pivot`; `None`: zero).
     #[inline(always)]
-    pub(super) fn gather(
+    pub(super) fn gather<const W: usize>(
         &mut self,
-        [q, qd]: [&[f64]; 2],
-        pivot: Option<&[f64]>,
+        [q, qd]: [&[V::Num]; 2],
+        pivot: Option<&[V::Num]>,
         lanes: [usize; W],
         n: usize,
-    ) -> [Lanes<W>; 2] {
-        gather(q, lanes, n, Lanes::flatten_mut(&mut self.angles));
-        sin_cos_split(
-            Lanes::flatten(&self.angles),
-            Lanes::flatten_mut(&mut self.sin),
-            Lanes::flatten_mut(&mut self.cos),
-        );
-        gather(qd, lanes, n, Lanes::flatten_mut(&mut self.rates));
+    ) -> [V; 2] {
+        gather(q, lanes, n, V::flatten_mut(&mut self.angles));
+        V::sin_cos(&self.angles, &mut self.sin, &mut self.cos);
+        gather(qd, lanes, n, V::flatten_mut(&mut self.rates));
         match pivot {
-            Some(p) => [Lanes::from_fn(|k| p[2 * lanes[k]]), Lanes::from_fn(|k| p[2 * lanes[k] + 1])],
-            None => [Lanes([0.0; W]); 2],
+            Some(p) => [V::from_nums(|k| p[2 * lanes[k]]), V::from_nums(|k| p[2 * lanes[k] + 1])],
+            None => [V::splat(0.0); 2],
         }
     }
 }
@@ -392,17 +388,7 @@ impl PlanarBatch {
         ) -> [bool; WIDTH_F32] {
             let (n, t) = (self.links, &mut s.states);
             let block = one_of(&self.blocks_f32, b);
-            gather(q, lanes, n, Lanes32::flatten_mut(&mut t.angles));
-            sin_cos_split_f32(
-                Lanes32::flatten(&t.angles),
-                Lanes32::flatten_mut(&mut t.sin),
-                Lanes32::flatten_mut(&mut t.cos),
-            );
-            gather(qd, lanes, n, Lanes32::flatten_mut(&mut t.rates));
-            let pivot = match pivot {
-                Some(p) => [Lanes32::from_fn(|k| p[2 * lanes[k]]), Lanes32::from_fn(|k| p[2 * lanes[k] + 1])],
-                None => [Lanes32::splat(0.0); 2],
-            };
+            let pivot = t.gather([q, qd], pivot, lanes, n);
             let trig = [&t.sin[..], &t.cos, &t.rates];
             block.accelerations(trig, (&t.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);

@@ -29,6 +29,8 @@ pub(super) trait RunLane: Lane + Send {
     /// The number type of one lane.
     type Num: Transpose + Into<f64> + Send + Sync;
     /// The lanes of `v` one after another.
+    fn flatten(v: &[Self]) -> &[Self::Num];
+    /// The same, to write.
     fn flatten_mut(v: &mut [Self]) -> &mut [Self::Num];
     /// `f(k)` in lane `k`.
     fn from_nums(f: impl Fn(usize) -> Self::Num) -> Self;
@@ -47,6 +49,10 @@ pub(super) trait RunLane: Lane + Send {
 
 impl<const W: usize> RunLane for Lanes<W> {
     type Num = f64;
+    #[inline(always)]
+    fn flatten(v: &[Self]) -> &[f64] {
+        Lanes::flatten(v)
+    }
     #[inline(always)]
     fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
         Lanes::flatten_mut(v)
@@ -79,6 +85,10 @@ impl<const W: usize> RunLane for Lanes<W> {
 
 impl RunLane for F32x8 {
     type Num = f32;
+    #[inline(always)]
+    fn flatten(v: &[Self]) -> &[f32] {
+        Lanes32::flatten(v)
+    }
     #[inline(always)]
     fn flatten_mut(v: &mut [Self]) -> &mut [f32] {
         Lanes32::flatten_mut(v)
