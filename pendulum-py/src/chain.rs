@@ -19,7 +19,7 @@ use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error, unknown_precision};
 use crate::planar_runs::{Plan, planar_rk4, planar_rk4_f32, run_as};
 use crate::planar_states::{
-    planar_batch, planar_batch_f32, planar_in_place, planar_jacobians, planar_table_f32,
+    planar_batch, planar_batch_f32, planar_in_place, planar_jacobians, planar_jacobians_f32, planar_table_f32,
 };
 use crate::states::{self, Batch};
 use pendulum_experiment::options::{expand, links};
@@ -92,6 +92,31 @@ impl Route {
 }
 
 impl Chain {
+    /// `Chain.jacobians(..., precision="float32")`: the planar model without torques in
+    /// single precision ([`planar_jacobians_f32`]).
+    fn jacobians_f32<'py>(
+        &self,
+        py: Python<'py>,
+        route: Route,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        torque: Option<&Bound<'py, PyAny>>,
+        pivot_acceleration: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        if !matches!(route, Route::Angles(Kind::Planar)) {
+            return Err(invalid("precision: 'float32' Jacobians serve model='planar' only"));
+        }
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
+        if b.torque.data.iter().any(|t| *t != 0.0) {
+            return Err(invalid("precision: 'float32' takes no torques"));
+        }
+        let out = maybe_detached(py, b.q.data.len() * b.q.width, || {
+            planar_jacobians_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
+        })
+        .map_err(core_error)?;
+        jacobian_arrays(py, out, &b)
+    }
+
     /// `Chain.accelerations(..., precision="float32")`: the planar model without torques in
     /// single precision ([`planar_batch_f32`]).
     fn accelerations_f32<'py>(
@@ -476,7 +501,11 @@ impl Chain {
     /// lanes (`qdd` is `accelerations`' q̈). `model="directions"`: `ü` and its derivatives by the
     /// directions' and the rates' three components each, the Jacobian of the first-order
     /// system `(u̇, ẇ) = (w, ü)` (the constraint `|u_i| = 1` not imposed).
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar"))]
+    /// `precision="float32"` (planar without torques) computes in single precision, eight
+    /// states per SIMD register, and returns float32: within a few parts per million of the
+    /// largest entry (docs/ensembles.md).
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", precision = "float64"))]
+    #[allow(clippy::too_many_arguments)]
     fn jacobians<'py>(
         &self,
         py: Python<'py>,
@@ -485,14 +514,17 @@ impl Chain {
         torque: Option<&Bound<'py, PyAny>>,
         pivot_acceleration: Option<&Bound<'py, PyAny>>,
         model: &str,
+        precision: &str,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let (b, route) = match Route::of(model)? {
-            Route::Angles(kind) => {
-                (self.batch(kind, q, qd, torque, pivot_acceleration)?, Route::Angles(kind))
-            }
-            Route::Directions => {
-                (self.directions_rows(q, qd, torque, pivot_acceleration)?, Route::Directions)
-            }
+        let route = Route::of(model)?;
+        match precision {
+            "float64" => {}
+            "float32" => return self.jacobians_f32(py, route, q, qd, torque, pivot_acceleration),
+            _ => return Err(unknown_precision(precision)),
+        }
+        let b = match route {
+            Route::Angles(kind) => self.batch(kind, q, qd, torque, pivot_acceleration)?,
+            Route::Directions => self.directions_rows(q, qd, torque, pivot_acceleration)?,
         };
         let [qdd, dq, dqd] = maybe_detached(py, b.q.data.len() * b.q.width, || match route {
             // Planar states, one or many: the SIMD batch (`accelerations`' numbers for q̈).
@@ -505,13 +537,7 @@ impl Chain {
             Route::Directions => directions::jacobians(&self.inner, &b),
         })
         .map_err(core_error)?;
-        let w = b.q.width;
-        let items = [
-            array(py, qdd, &b.q.lead, &[w])?,
-            array(py, dq, &b.q.lead, &[w, w])?,
-            array(py, dqd, &b.q.lead, &[w, w])?,
-        ];
-        PyTuple::new(py, items)
+        jacobian_arrays(py, [qdd, dq, dqd], &b)
     }
 
     /// Every term of `M q̈ + c + k + d = Q` at one state (the sympy reference's form), as
@@ -616,4 +642,19 @@ impl Chain {
 fn count(what: &str, value: i64) -> PyResult<usize> {
     usize::try_from(value)
         .map_err(|_| invalid(format!("{what}: {value} is not a number of steps (0 or more)")))
+}
+
+/// `(q̈, ∂q̈/∂q, ∂q̈/∂q̇)` as arrays shaped like the states of `b`: `(..., w)` and `(..., w, w)`.
+fn jacobian_arrays<'py, T: numpy::Element>(
+    py: Python<'py>,
+    [qdd, dq, dqd]: [Vec<T>; 3],
+    b: &Batch,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let w = b.q.width;
+    let items = [
+        array(py, qdd, &b.q.lead, &[w])?,
+        array(py, dq, &b.q.lead, &[w, w])?,
+        array(py, dqd, &b.q.lead, &[w, w])?,
+    ];
+    PyTuple::new(py, items)
 }

@@ -69,6 +69,29 @@ pub fn planar_batch_f32(
     }
 }
 
+/// [`planar_jacobians`] in single precision ([`PlanarBatch::accelerations_f32`] and
+/// [`PlanarBatch::state_jacobians_f32`]), without torques: the states and pivot
+/// accelerations rounded to `f32`, the results in `f32`.
+pub fn planar_jacobians_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    count: usize,
+    [q, qd, pivot]: [&[f64]; 3],
+) -> pendulum_core::Result<[Vec<f32>; 3]> {
+    let n = chain.links();
+    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
+    let batch = PlanarBatch::repeated(chain.clone(), count)?;
+    let (q, qd, pivot) = (narrow(q), narrow(qd), narrow(pivot));
+    let mut qdd = vec![0.0f32; q.len()];
+    let (mut dq, mut dqd) = (vec![0.0f32; count * n * n], vec![0.0f32; count * n * n]);
+    let mut failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut qdd)?;
+    failures.extend(batch.state_jacobians_f32(&q, &qd, None, Some(&pivot), &mut dq, &mut dqd)?);
+    // The inputs were checked finite in f64: a failure is single precision's range.
+    match failures.is_empty() {
+        true => Ok([qdd, dq, dqd]),
+        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
+    }
+}
+
 /// A C-contiguous `(B, n)` float64 array as its `B` and its numbers rounded to `f32`;
 /// `None` for any other array, or one with a number that is infinite in `f32`.
 fn table_f32(a: &Bound<'_, PyAny>, n: usize) -> Option<(usize, Vec<f32>)> {

@@ -160,6 +160,30 @@ def test_a_contiguous_table_of_planar_states_is_read_in_place_with_the_same_numb
         chain.accelerations(q[:, :5], qd[:, :5])
 
 
+def test_single_precision_jacobians_are_the_double_precision_ones_to_their_documented_error():
+    # precision="float32": the planar batch's Jacobians in f32 lanes, within a few parts per
+    # million of each state's largest entry (docs/ensembles.md), float32, shaped like q.
+    rng = np.random.default_rng(12)
+    n = 10
+    chain = pendulum.Chain(rng.uniform(0.01, 0.1, n), rng.uniform(0.01, 0.1, n), damping=rng.uniform(1e-4, 1e-3, n))
+    q, qd, pivot = rng.uniform(-3, 3, (4, 25, n)), rng.uniform(-5, 5, (4, 25, n)), rng.uniform(-30, 30, (4, 25, 2))
+    doubles = chain.jacobians(q, qd, pivot_acceleration=pivot)
+    singles = chain.jacobians(q, qd, pivot_acceleration=pivot, precision="float32")
+    for double, single, axes in zip(doubles, singles, [(-1,), (-2, -1), (-2, -1)]):
+        assert single.dtype == np.float32 and single.shape == double.shape
+        scale = np.abs(double).max(axis=axes, keepdims=True)
+        assert (np.abs(single - double) / scale).max() < 2e-5
+    one = chain.jacobians(q[1, 2], qd[1, 2], pivot_acceleration=pivot[1, 2], precision="float32")
+    for many, alone in zip(singles, one):
+        assert np.array_equal(many[1, 2], alone)
+    with pytest.raises(ValueError, match="takes no torques"):
+        chain.jacobians(q, qd, np.ones_like(q), precision="float32")
+    with pytest.raises(ValueError, match="serve model='planar' only"):
+        chain.jacobians(q[..., :n], precision="float32", model="spatial")
+    with pytest.raises(ValueError, match="float16"):
+        chain.jacobians(q, precision="float16")
+
+
 def test_the_analytic_jacobians_are_the_slopes_of_the_accelerations():
     rng = np.random.default_rng(2)
     chain = pendulum.Chain(rng.uniform(0.2, 1, 5), rng.uniform(0.2, 1, 5), damping=0.05)

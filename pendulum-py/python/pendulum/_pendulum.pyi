@@ -158,6 +158,7 @@ class Chain:
         pivot_acceleration: Optional[npt.ArrayLike] = None,
         *,
         model: str = "planar",
+        precision: str = "float64",
     ) -> tuple[_Array, _Array, _Array]: ...
     def terms(
         self,
