@@ -26,8 +26,9 @@ use crate::rods::{Columns, Link, pull, solve_in_angles, state_rows};
 /// The longest chains whose Jacobians a batch computes in lanes; longer ones go one at a
 /// time. Measured on one thread, 64 chains, lanes against one at a time in the same
 /// call: 1.6× as fast at n = 20, 1.05–1.1× at n = 32 and 48, 0.93× at n = 64 and 0.92× at
-/// n = 100, in eight lanes and in four alike (`docs/ensembles.md`). A block's `G` then
-/// outgrows the second-level cache, and writing the results dominates both ways.
+/// n = 100, in eight lanes and in four alike (`docs/ensembles.md`). Where it turns is
+/// measured, not explained: a block's `G` is `W · 8 · n²` bytes (262 kB at n = 64 in eight
+/// lanes), and writing the results (`2n²` numbers a chain) weighs on both ways.
 const LANES_UP_TO: usize = 48;
 
 /// A task's room for one chain at a time: the state's `θ`, `θ̇`, the inputs and the
@@ -46,8 +47,8 @@ struct States<'a, T = f64> {
 }
 
 /// A task's room for a block of chains in lanes `V`: its states in lane order, the kept
-/// solve's links, `G` (`n × n`), the columns' weights and a row of
-/// each Jacobian (`rods::state_rows`).
+/// solve's links, `G` (`n × n`), the columns' weights and a row of each Jacobian
+/// (`rods::state_rows`).
 struct BlockRoom<V: Lane> {
     states: BlockStates<V>,
     links: Aligned<Link<V>>,
@@ -59,7 +60,6 @@ struct BlockRoom<V: Lane> {
 impl<V: Lane> BlockRoom<V> {
     fn new(n: usize) -> Self {
         let zero = V::splat(0.0);
-
         Self {
             states: BlockStates::new(n),
             links: Aligned::filled(Link::at(zero, zero, zero, zero), n),
@@ -74,8 +74,9 @@ impl PlanarBatch {
     /// `∂θ̈/∂θ` (1/s²) and `∂θ̈/∂θ̇` (1/s) of every chain at angles `q` (rad) and rates `qd`
     /// (rad/s), `B` rows of `n`, with each chain's joint torques `Q_i` (N·m) from `torque`
     /// (`B` rows of `n`; `None`: none) and pivot acceleration from `pivot` (`B` rows of 2,
-    /// m/s²; `None`: at rest), as [`accelerations`](Self::accelerations) takes them: written into `dq` and `dqd` as `B` blocks of `n × n`,
-    /// row-major (`dq[k n² + a n + b] = ∂θ̈_a/∂θ_b` of chain `k`), exactly what
+    /// m/s²; `None`: at rest), as [`accelerations`](Self::accelerations) takes them:
+    /// written into `dq` and `dqd` as `B` blocks of `n × n`, row-major
+    /// (`dq[k n² + a n + b] = ∂θ̈_a/∂θ_b` of chain `k`), exactly what
     /// `PlanarTension::state_jacobians` gives for each chain alone. The kept solve and the
     /// Jacobians run in SIMD lanes for chains of up to 48 links, one chain at a time for
     /// longer ones (where lanes stopped paying); the blocks or chains over the current

@@ -4,7 +4,8 @@
 //! `∂θ̈/∂x = ∂h/∂x + G ∂r/∂x` with `G = H A⁻¹`. Every column `x` (an angle, rate or torque
 //! of link `x`, or the pivot) changes `r` and `h` in rows `x − 1 … x + 1` only, so after
 //! `G` (n solves with the kept factors of `A`, all outputs at once) each entry costs three
-//! multiply-adds.
+//! multiply-adds. Generic over [`Lane`]: the chain alone runs it with `f64`, a batch with
+//! `W` chains a lane group (`batch::planar_jacobians`), the same operations lane by lane.
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
@@ -42,11 +43,10 @@ where
 }
 
 /// `∂θ̈/∂θ`, `∂θ̈/∂θ̇` and, if asked, `∂θ̈/∂σ` and `∂θ̈/∂p̈` of the kept solve `columns`,
-/// column-major (module docs), with `green` (`n²` zeros) as room for `G`. In lanes `V`, those
-/// of `W` chains side by side, each lane doing the operations of the chain alone in the
-/// same order.
+/// column by column (module docs), with `green` (`n²` zeros) as room for `G`: the chain
+/// alone's order (a batch's lanes take [`state_rows`]).
 #[inline(always)]
-pub(crate) fn blocks<V: Lane>(
+fn blocks<V: Lane>(
     columns: Columns<'_, V>,
     green: &mut [V],
     dq: &mut [V],

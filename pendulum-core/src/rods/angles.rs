@@ -2,7 +2,8 @@
 //! own angles at one state and kept for its derivatives: `θ̈`, Jacobian-vector products in
 //! O(n) here, full Jacobians in O(n²) in `angle_jacobians`. Generic over the chain's
 //! dimension, so the generated models (`Const<N>`, stack arrays) and
-//! [`PlanarTension`](crate::PlanarTension) (`Dyn`) share it.
+//! [`PlanarTension`](crate::PlanarTension) (`Dyn`) share it; the solve ([`solve`]) and
+//! the columns' view are generic over [`Lane`] too, so a batch runs them in lanes.
 //!
 //! The system `A T = b` written in the links' frames (the planar substitution of
 //! [`PlanarTension`](crate::PlanarTension): `u_i = (sin θ_i, −cos θ_i)`, so
