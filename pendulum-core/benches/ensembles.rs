@@ -614,8 +614,23 @@ fn jacobians(c: &mut Criterion) {
                 }
             })
         });
-        let batch = PlanarBatch::new(chains).expect("batch");
+        // The same loop keeping every chain's result, copied out row by row into `(B, n, n)`
+        // arrays as the batch writes them.
         let (mut dq, mut dqd) = (vec![0.0; CHAINS * n * n], vec![0.0; CHAINS * n * n]);
+        group.bench_with_input(BenchmarkId::new("planar/single_kept", n), &n, |b, _| {
+            b.iter(|| {
+                for (k, model) in singles.iter().enumerate() {
+                    x.copy_from_slice(&q[k * n..(k + 1) * n]);
+                    v.copy_from_slice(&qd[k * n..(k + 1) * n]);
+                    model.state_jacobians(&x, &v, &inputs, &mut out).expect("single");
+                    let block = k * n * n..(k + 1) * n * n;
+                    dq[block.clone()].copy_from_slice(out.q.transpose().as_slice());
+                    dqd[block].copy_from_slice(out.qd.transpose().as_slice());
+                }
+                black_box((&dq, &dqd));
+            })
+        });
+        let batch = PlanarBatch::new(chains).expect("batch");
         let four = batch.clone().with_avx512(false);
         let one = pool(1);
         group.bench_with_input(BenchmarkId::new("planar/batch_1_threads_four_lanes", n), &n, |b, _| {
