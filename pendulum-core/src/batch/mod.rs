@@ -38,6 +38,7 @@ mod jacobians;
 mod lane_states;
 mod planar;
 mod planar_jacobians;
+mod planar_lanes;
 mod planar_rk4;
 mod rk4;
 mod rk4_f32;

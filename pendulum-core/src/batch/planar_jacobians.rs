@@ -9,7 +9,7 @@ use nalgebra::{DVector, Dyn, U2, Vector2};
 
 use super::jacobians::in_blocks;
 use super::planar::{Block, BlockStates};
-use super::planar_rk4::RunLane;
+use super::planar_lanes::RunLane;
 use super::rooms::Room;
 use super::transpose::{scatter_matrix_row, transpose_square};
 use super::{

@@ -9,9 +9,9 @@ use nalgebra::{Dyn, U2};
 
 #[cfg(target_arch = "x86_64")]
 use super::F64x8;
-use super::lane_states::{into_lanes, non_finite_lanes, non_finite_lanes_f32, out_of_lanes};
+use super::lane_states::{into_lanes, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
-use super::transpose::Transpose;
+use super::planar_lanes::RunLane;
 use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
     Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,
@@ -20,104 +20,7 @@ use super::{
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
 use crate::lanes::{Aligned, Lane, Lanes, Lanes32, one_row_at_a_time};
-
-/// The lanes a planar run steps in, with their precision's sine kernel: [`F64x4`] (or
-/// eight `f64` lanes) or [`F32x8`].
-pub(super) trait RunLane: Lane + Send {
-    /// The number type of one lane.
-    type Num: Transpose + Into<f64> + Send + Sync;
-    /// The lanes of `v` one after another.
-    fn flatten(v: &[Self]) -> &[Self::Num];
-    /// The same, to write.
-    fn flatten_mut(v: &mut [Self]) -> &mut [Self::Num];
-    /// `f(k)` in lane `k`.
-    fn from_nums(f: impl Fn(usize) -> Self::Num) -> Self;
-    /// The lanes `k` with `flag(k)`.
-    fn mask(flag: impl Fn(usize) -> bool) -> Self::Mask;
-    /// `sin`, `cos` of every lane of `angles` (inlined, so that it runs with its caller's
-    /// target features).
-    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
-    /// The lanes in which some entry of `v` is not finite.
-    fn non_finite(v: &[Self]) -> Self::Mask;
-    /// `a` and not `b`, lane by lane.
-    fn and_not(a: Self::Mask, b: Self::Mask) -> Self::Mask;
-    /// `a` and `b`, lane by lane.
-    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
-}
-
-impl<const W: usize> RunLane for Lanes<W> {
-    type Num = f64;
-    #[inline(always)]
-    fn flatten(v: &[Self]) -> &[f64] {
-        Lanes::flatten(v)
-    }
-    #[inline(always)]
-    fn flatten_mut(v: &mut [Self]) -> &mut [f64] {
-        Lanes::flatten_mut(v)
-    }
-    #[inline(always)]
-    fn from_nums(f: impl Fn(usize) -> f64) -> Self {
-        Lanes::from_fn(f)
-    }
-    #[inline(always)]
-    fn mask(flag: impl Fn(usize) -> bool) -> [u64; W] {
-        std::array::from_fn(|k| u64::from(flag(k)))
-    }
-    #[inline(always)]
-    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
-        sin_cos_split(Lanes::flatten(angles), Lanes::flatten_mut(sin), Lanes::flatten_mut(cos));
-    }
-    #[inline(always)]
-    fn non_finite(v: &[Self]) -> [u64; W] {
-        non_finite_lanes(v)
-    }
-    #[inline(always)]
-    fn and_not(a: [u64; W], b: [u64; W]) -> [u64; W] {
-        std::array::from_fn(|k| a[k] & !b[k])
-    }
-    #[inline(always)]
-    fn and(a: [u64; W], b: [u64; W]) -> [u64; W] {
-        std::array::from_fn(|k| a[k] & b[k])
-    }
-}
-
-impl RunLane for F32x8 {
-    type Num = f32;
-    #[inline(always)]
-    fn flatten(v: &[Self]) -> &[f32] {
-        Lanes32::flatten(v)
-    }
-    #[inline(always)]
-    fn flatten_mut(v: &mut [Self]) -> &mut [f32] {
-        Lanes32::flatten_mut(v)
-    }
-    #[inline(always)]
-    fn from_nums(f: impl Fn(usize) -> f32) -> Self {
-        Lanes32::from_fn(f)
-    }
-    #[inline(always)]
-    fn mask(flag: impl Fn(usize) -> bool) -> [u32; WIDTH_F32] {
-        std::array::from_fn(|k| u32::from(flag(k)))
-    }
-    #[inline(always)]
-    fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]) {
-        sin_cos_split_f32(Lanes32::flatten(angles), Lanes32::flatten_mut(sin), Lanes32::flatten_mut(cos));
-    }
-    #[inline(always)]
-    fn non_finite(v: &[Self]) -> [u32; WIDTH_F32] {
-        non_finite_lanes_f32(v)
-    }
-    #[inline(always)]
-    fn and_not(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
-        std::array::from_fn(|k| a[k] & !b[k])
-    }
-    #[inline(always)]
-    fn and(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
-        std::array::from_fn(|k| a[k] & b[k])
-    }
-}
 
 /// A block's run: `sin θ`, `cos θ` of a stage and the solve's room (`n` lanes), the joint
 /// torques, the lanes with torques and the pivot accelerations, the states and their
