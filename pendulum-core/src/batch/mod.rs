@@ -190,7 +190,7 @@ pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
 
 /// Whether every entry of `v` is finite (a loop without early exit, so that it vectorises).
 #[inline(always)]
-pub(crate) fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
+fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
     v.iter().fold(true, |finite, &x| finite & x.into().is_finite())
 }
 

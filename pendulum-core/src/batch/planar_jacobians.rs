@@ -13,8 +13,8 @@ use super::planar_lanes::RunLane;
 use super::rooms::Room;
 use super::transpose::{scatter_matrix_row, transpose_square};
 use super::{
-    Blocks, F32x8, Failure, PlanarBatch, WIDTH_F32, all_finite, block_chains, check_len, first_bad_input,
-    gather, one_of, simd_kernel,
+    Blocks, F32x8, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, first_bad_input, gather, one_of,
+    simd_kernel,
 };
 use crate::error::{Error, Result};
 use crate::jacobians::{Derivatives, Jacobians};
@@ -157,7 +157,7 @@ impl PlanarBatch {
             dqd: &mut [f64],
         ) -> [bool; W] {
             let block = one_of(blocks, b);
-            block_jacobians(self.links, block, lanes, states, room, dq, dqd).map(|flag| flag != 0)
+            block_jacobians(self.links, block, lanes, states, room, (dq, dqd), false).map(|flag| flag != 0)
         }
         dispatch fn jacobian_block_simd, jacobian_block_avx2, avx512 jacobian_block_avx512
     }
@@ -188,14 +188,12 @@ impl PlanarBatch {
             let flagged = self.jacobian_block_f32_simd(b, lanes, states, room, dq, dqd);
             let blocks = dq.chunks_exact_mut(n * n).zip(dqd.chunks_exact_mut(n * n));
             let mut failures = Vec::new();
-            for (k, (dq, dqd)) in blocks.enumerate() {
-                if flagged[k] || !all_finite(dq) || !all_finite(dqd) {
-                    dq.fill(f32::NAN);
-                    dqd.fill(f32::NAN);
-                    let chain = lanes[k];
-                    let error = first_bad_input(chain, n, [q, qd], torque, pivot);
-                    failures.push(Failure { chain, error: error.unwrap_or(Error::SinglePrecisionOverflow) });
-                }
+            for (k, (dq, dqd)) in blocks.enumerate().filter(|(k, _)| flagged[*k]) {
+                dq.fill(f32::NAN);
+                dqd.fill(f32::NAN);
+                let chain = lanes[k];
+                let error = first_bad_input(chain, n, [q, qd], torque, pivot);
+                failures.push(Failure { chain, error: error.unwrap_or(Error::SinglePrecisionOverflow) });
             }
             failures
         };
@@ -204,7 +202,7 @@ impl PlanarBatch {
 
     simd_kernel! {
         /// [`block_jacobians`] of block `b` in single precision, eight chains. Returns the
-        /// lanes whose `θ̈` is not finite.
+        /// lanes whose `θ̈` or a Jacobian entry is not finite.
         fn jacobian_block_f32(
             &self,
             b: usize,
@@ -215,7 +213,7 @@ impl PlanarBatch {
             dqd: &mut [f32],
         ) -> [bool; WIDTH_F32] {
             let block = one_of(&self.blocks_f32, b);
-            block_jacobians(self.links, block, lanes, states, room, dq, dqd).map(|flag| flag != 0)
+            block_jacobians(self.links, block, lanes, states, room, (dq, dqd), true).map(|flag| flag != 0)
         }
         dispatch fn jacobian_block_f32_simd, jacobian_block_f32_avx2
     }
@@ -291,7 +289,8 @@ impl PlanarBatch {
 /// One block of `W` chains of `n` links in lanes `V` (`W` its width), constants `block`:
 /// gather, `sin θ` and `cos θ` of all its angles at once, the kept solve and its Jacobians
 /// in lanes, each Jacobian's rows scattered into the block's `dq` and `dqd` as they come.
-/// Returns the lanes whose `θ̈` is not finite.
+/// Returns the lanes whose `θ̈` is not finite, and with `entries` also those with a
+/// Jacobian entry that is not finite (checked on each row while it is in the cache).
 #[inline(always)]
 fn block_jacobians<V: RunLane, const W: usize>(
     n: usize,
@@ -299,8 +298,8 @@ fn block_jacobians<V: RunLane, const W: usize>(
     lanes: [usize; W],
     States { q, qd, torque, pivot }: States<'_, V::Num>,
     room: &mut BlockRoom<V>,
-    dq: &mut [V::Num],
-    dqd: &mut [V::Num],
+    (dq, dqd): (&mut [V::Num], &mut [V::Num]),
+    entries: bool,
 ) -> V::Mask {
     let (rods, gravity) = block.constants();
     let zero = V::splat(0.0);
@@ -319,10 +318,13 @@ fn block_jacobians<V: RunLane, const W: usize>(
     for (a, link) in room.rows.iter_mut().zip(room.links.iter()) {
         *a = link.acceleration;
     }
-    let flagged = V::non_finite(&room.rows[..n]);
+    let mut flagged = V::non_finite(&room.rows[..n]);
     room.green.fill(zero);
     let columns = Columns { links: &room.links, rods, gravity, pivot };
     let emit = |i: usize, by_q: &[V], by_qd: &[V]| {
+        if entries {
+            flagged = V::or(flagged, V::or(V::non_finite(by_q), V::non_finite(by_qd)));
+        }
         scatter_matrix_row::<_, W>(V::flatten(by_q), n, i, dq);
         scatter_matrix_row::<_, W>(V::flatten(by_qd), n, i, dqd);
     };

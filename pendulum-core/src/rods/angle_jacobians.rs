@@ -120,18 +120,17 @@ pub(crate) fn state_rows<V: Lane>(
     let (dq, dqd) = rows[..2 * n].split_at_mut(n);
     for i in 0..n {
         for (weights, row) in [(&*by_angle, &mut *dq), (&*by_rate, &mut *dqd)] {
-            for (x, (o, &(r, h))) in row.iter_mut().zip(weights).enumerate() {
+            for (x, (o, &(r, _))) in row.iter_mut().zip(weights).enumerate() {
                 let at = |j: usize| green[j * n + i];
-                let mut e = r[0] * at(x.saturating_sub(1)) + r[1] * at(x) + r[2] * at((x + 1).min(n - 1));
-                // Rows x − 1 … x + 1 of column x also change directly (`mix`).
-                if i + 1 == x {
-                    e += h[0];
-                } else if i == x {
-                    e += h[1];
-                } else if i == x + 1 {
-                    e += h[2];
-                }
-                *o = e;
+                *o = r[0] * at(x.saturating_sub(1)) + r[1] * at(x) + r[2] * at((x + 1).min(n - 1));
+            }
+            // Row i is changed directly by columns i + 1, i and i − 1 (`mix`'s `h`).
+            if i >= 1 {
+                row[i - 1] += weights[i - 1].1[2];
+            }
+            row[i] += weights[i].1[1];
+            if i + 1 < n {
+                row[i + 1] += weights[i + 1].1[0];
             }
         }
         emit(i, dq, dqd);
