@@ -106,10 +106,7 @@ impl Chain {
         if !matches!(route, Route::Angles(Kind::Planar)) {
             return Err(invalid("precision: 'float32' Jacobians serve model='planar' only"));
         }
-        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
-        if b.torque.data.iter().any(|t| *t != 0.0) {
-            return Err(invalid("precision: 'float32' takes no torques"));
-        }
+        let b = self.batch_f32(q, qd, torque, pivot_acceleration)?;
         let out = maybe_detached(py, b.q.data.len() * b.q.width, || {
             planar_jacobians_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
         })
@@ -142,15 +139,28 @@ impl Chain {
                 return Ok(out);
             }
         }
-        let b = self.batch(kind, q, qd, torque, pivot_acceleration)?;
-        if b.torque.data.iter().any(|t| *t != 0.0) {
-            return Err(invalid("precision: 'float32' takes no torques"));
-        }
+        let b = self.batch_f32(q, qd, torque, pivot_acceleration)?;
         let out = maybe_detached(py, b.q.data.len(), || {
             planar_batch_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
         })
         .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
+    }
+
+    /// The planar states of a call in single precision: [`batch`](Self::batch), the torques
+    /// refused (the `f32` planar calls take none).
+    fn batch_f32(
+        &self,
+        q: &Bound<'_, PyAny>,
+        qd: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+        pivot: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Batch> {
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
+        if b.torque.data.iter().any(|t| *t != 0.0) {
+            return Err(invalid("precision: 'float32' takes no torques"));
+        }
+        Ok(b)
     }
 
     fn batch(
