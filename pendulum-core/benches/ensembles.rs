@@ -27,8 +27,9 @@
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
 //!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
 //!   `state_jacobians_f32`;
-//!   `jacobians/spatial/…/20` the same in 3D directions (`Directions::analytic_jacobian`
-//!   against `DirectionsBatch::state_jacobians`).
+//!   `jacobians/spatial/…/{8,20,100}` the same in 3D directions
+//!   (`Directions::analytic_jacobian`, and kept in `(B, h, h)` arrays, against
+//!   `DirectionsBatch::state_jacobians`).
 //!
 //! `cargo bench -p pendulum-core --bench ensembles`
 
@@ -658,35 +659,54 @@ fn jacobians(c: &mut Criterion) {
             })
         });
     }
-    // The same for 64 chains of 20 links in 3D directions: each chain's
-    // `Directions::analytic_jacobian` (the whole first-order Jacobian, as a user calls it)
-    // against `DirectionsBatch::state_jacobians` (its lower blocks, row-major).
-    let models: Vec<Directions<U3>> =
-        (0..CHAINS).map(|_| Directions::new(random_chain(N, 2.0, &mut r))).collect();
-    let x = spatial_states(&models, &mut r);
-    let mut jacobian = nalgebra::DMatrix::zeros(6 * N, 6 * N);
-    group.bench_with_input(BenchmarkId::new("spatial/single", N), &N, |b, _| {
-        b.iter(|| {
-            for (model, x) in models.iter().zip(&x) {
-                model.analytic_jacobian(0.0, x, &mut jacobian).expect("single");
-                black_box(&jacobian);
-            }
-        })
-    });
-    let batch = DirectionsBatch::new(models).expect("batch");
-    let joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
-    let (mut du, mut dw) = (vec![0.0; CHAINS * 9 * N * N], vec![0.0; CHAINS * 9 * N * N]);
-    for threads in [1, 2] {
-        let pool = pool(threads);
-        group.bench_with_input(
-            BenchmarkId::new(format!("spatial/batch_{threads}_threads"), N),
-            &N,
-            |b, _| {
-                in_pool(b, &pool, || {
-                    batch.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
+    // The same in 3D directions: each chain's `Directions::analytic_jacobian` (the whole
+    // first-order Jacobian, as a user calls it), and kept (its lower blocks copied into
+    // row-major `(B, h, h)` arrays, h = 3n, as the batch returns them), against
+    // `DirectionsBatch::state_jacobians`.
+    for n in [8, N, 100] {
+        let models: Vec<Directions<U3>> =
+            (0..CHAINS).map(|_| Directions::new(random_chain(n, 2.0, &mut r))).collect();
+        let x = spatial_states(&models, &mut r);
+        let h = 3 * n;
+        let mut jacobian = nalgebra::DMatrix::zeros(2 * h, 2 * h);
+        let (mut du, mut dw) = (vec![0.0; CHAINS * h * h], vec![0.0; CHAINS * h * h]);
+        for (name, keep) in [("spatial/single", false), ("spatial/single_kept", true)] {
+            group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                b.iter(|| {
+                    for (k, (model, x)) in models.iter().zip(&x).enumerate() {
+                        model.analytic_jacobian(0.0, x, &mut jacobian).expect("single");
+                        if keep {
+                            let lower = jacobian.rows(h, h);
+                            let block = k * h * h..(k + 1) * h * h;
+                            du[block.clone()].copy_from_slice(lower.columns(0, h).transpose().as_slice());
+                            dw[block].copy_from_slice(lower.columns(h, h).transpose().as_slice());
+                        }
+                        black_box(&jacobian);
+                    }
                 })
-            },
-        );
+            });
+        }
+        let batch = DirectionsBatch::new(models).expect("batch");
+        let joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
+        let four = batch.clone().with_avx512(false);
+        let one = pool(1);
+        group.bench_with_input(BenchmarkId::new("spatial/batch_1_threads_four_lanes", n), &n, |b, _| {
+            in_pool(b, &one, || {
+                four.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
+            })
+        });
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            group.bench_with_input(
+                BenchmarkId::new(format!("spatial/batch_{threads}_threads"), n),
+                &n,
+                |b, _| {
+                    in_pool(b, &pool, || {
+                        batch.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
+                    })
+                },
+            );
+        }
     }
     group.finish();
 }

@@ -57,6 +57,18 @@ pub(super) struct Block<const W: usize = WIDTH> {
     damping: Aligned<Lanes<W>>,
 }
 
+impl<const W: usize> Block<W> {
+    /// The chains' rods in lanes.
+    pub(super) fn rods(&self) -> &Rods<Lanes<W>> {
+        &self.rods
+    }
+
+    /// `−g` (m/s²) per lane.
+    pub(super) fn down(&self) -> Lanes<W> {
+        self.down
+    }
+}
+
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
 pub(super) struct Scratch<const C: usize, const W: usize> {
     pub solve: Solve<C, Lanes<W>>,
@@ -80,10 +92,17 @@ pub(super) struct Solve<const C: usize, V: Lane> {
 /// with drags `λ_i/l_i` (N·s): [`rate_load`], built where the solve reads it by a method
 /// inlined into the kernel (as a closure called from two places it was compiled apart,
 /// without the kernel's target features, and a pass of its own into an array was needed).
-struct RateLoads<'a, const C: usize, V> {
+pub(super) struct RateLoads<'a, const C: usize, V> {
     directions: &'a [V],
     rates: &'a [V],
     drag: &'a [V],
+}
+
+impl<'a, const C: usize, V> RateLoads<'a, C, V> {
+    /// The loads at directions `u` and rates `w` (`C·n` numbers each) with drags `λ_i/l_i`.
+    pub(super) fn new(directions: &'a [V], rates: &'a [V], drag: &'a [V]) -> Self {
+        Self { directions, rates, drag }
+    }
 }
 
 impl<const C: usize, V: Lane> Loads<C, V> for RateLoads<'_, C, V> {
@@ -98,7 +117,7 @@ impl<const C: usize, V: Lane> Loads<C, V> for RateLoads<'_, C, V> {
 /// A batch's states for one evaluation: `B` rows of `(u, w)` (`2·S·n` each), or the
 /// directions `u` and the rates `w` as two arrays of `B` rows of `S·n`.
 #[derive(Clone, Copy)]
-enum States<'a, T> {
+pub(super) enum States<'a, T> {
     Joined(&'a [T]),
     Split(&'a [T], &'a [T]),
 }
@@ -107,7 +126,7 @@ impl<T: Transpose + Into<f64>> States<'_, T> {
     /// The states of `chains` into lanes: `out` (flattened) as [`gather`] of the joined
     /// rows, `u` and then `w` (`half = S·n` numbers each).
     #[inline(always)]
-    fn gather<const W: usize>(self, chains: [usize; W], half: usize, out: &mut [T]) {
+    pub(super) fn gather<const W: usize>(self, chains: [usize; W], half: usize, out: &mut [T]) {
         match self {
             States::Joined(x) => gather(x, chains, 2 * half, out),
             States::Split(u, w) => {
@@ -119,7 +138,7 @@ impl<T: Transpose + Into<f64>> States<'_, T> {
     }
 
     /// Chain `c`'s first non-finite number, named by its array and index there.
-    fn non_finite(self, c: usize, half: usize) -> Option<Error> {
+    pub(super) fn non_finite(self, c: usize, half: usize) -> Option<Error> {
         match self {
             States::Joined(x) => non_finite("x", &x[2 * half * c..2 * half * (c + 1)]),
             States::Split(u, w) => {

@@ -1,15 +1,42 @@
-//! The Jacobians of a batch in directions: each chain's O(n²) Jacobian
-//! ([`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian)) chain by chain,
-//! the chains over the cores, every chain's own results bit for bit (the planar ones, in
-//! lanes: `planar_jacobians`); and the loop over blocks both use.
+//! The Jacobians of a batch in directions: each chain's kept O(n) solve and O(n²) Jacobian
+//! ([`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian)'s numbers) in
+//! SIMD lanes, mixed row by row (`Linearised::state_rows`) and scattered straight into
+//! numpy's `(B, h, h)` order, every chain's own results bit for bit; the blocks over the
+//! cores. And the loop over blocks the planar Jacobians use too.
 
-use nalgebra::{DVector, DefaultAllocator, DimName, allocator::Allocator};
+use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 use rayon::prelude::*;
 
-use super::transpose::transpose_square;
-use super::{DirectionsBatch, Failure, check_len};
+use super::directions::{Block, RateLoads, States, gravity};
+use super::lane_states::non_finite_sum;
+use super::transpose::scatter_matrix_row;
+use super::{
+    Blocks, DirectionsBatch, Failure, WIDTH, WIDTH_AVX512, block_chains, check_len, one_of, simd_kernel,
+};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
+use crate::lanes::{Aligned, Lanes};
+use crate::models::directions::state_column;
+use crate::rods::{Linearised, RowsRoom};
+
+/// A task's room for a block of `W` chains in `C` dimensions: their states in lanes, the
+/// kept solve, and the Jacobians' windows and rows.
+struct Room<const C: usize, const W: usize> {
+    x: Aligned<Lanes<W>>,
+    solve: Linearised<C, Lanes<W>>,
+    rows: RowsRoom<C, Lanes<W>>,
+}
+
+impl<const C: usize, const W: usize> Room<C, W> {
+    fn new(n: usize) -> Self {
+        let h = C * n;
+        Self {
+            x: Aligned::filled(Lanes([0.0; W]), 2 * h),
+            solve: Linearised::with_len(n),
+            rows: RowsRoom::new(n, 2 * h),
+        }
+    }
+}
 
 impl<S: DimName, Dr: Drive<S> + Sync> DirectionsBatch<S, Dr>
 where
@@ -21,8 +48,9 @@ where
     /// are the lower blocks of each chain's
     /// [`Directions::analytic_jacobian`](crate::Directions::analytic_jacobian), bit for bit:
     /// the Jacobian of the first-order system in the directions' own `S` components each
-    /// (the constraint `|u_i| = 1` not imposed), one O(n²) pass a chain. The chains go over
-    /// the current rayon pool, each on its own (not in lanes).
+    /// (the constraint `|u_i| = 1` not imposed), O(n²) a chain. The kept solve and the
+    /// Jacobians run in SIMD lanes (four or eight chains, as
+    /// [`accelerations`](Self::accelerations)), the blocks over the current rayon pool.
     ///
     /// Returns the chains that failed, in order, with their errors (a non-finite state as
     /// the chain alone names it; a non-finite result as
@@ -33,12 +61,12 @@ where
     pub fn state_jacobians(&self, t: f64, x: &[f64], du: &mut [f64], dw: &mut [f64]) -> Result<Vec<Failure>> {
         let half = S::DIM * self.links();
         check_len("x", x, self.len(), 2 * half)?;
-        self.jacobians_of(t, |k, state| state.copy_from_slice(&x[2 * half * k..2 * half * (k + 1)]), du, dw)
+        self.jacobians_of(t, States::Joined(x), du, dw)
     }
 
     /// [`state_jacobians`](Self::state_jacobians) of the states given as two arrays, the
     /// directions `u` and the rates `w`, `B` rows of `S·n` each (as numpy holds `q` and
-    /// `qd`): the same numbers.
+    /// `qd`): the same numbers; a non-finite state is named by its array, `u` or `w`.
     ///
     /// Errors: [`Error::LengthMismatch`](crate::Error::LengthMismatch) when an array does
     /// not hold `B` rows or blocks.
@@ -53,50 +81,126 @@ where
         let half = S::DIM * self.links();
         check_len("u", u, self.len(), half)?;
         check_len("w", w, self.len(), half)?;
-        let state = |k: usize, state: &mut DVector<f64>| {
-            let rows = half * k..half * (k + 1);
-            state.as_mut_slice()[..half].copy_from_slice(&u[rows.clone()]);
-            state.as_mut_slice()[half..].copy_from_slice(&w[rows]);
-        };
-        self.jacobians_of(t, state, du, dw)
+        self.jacobians_of(t, States::Split(u, w), du, dw)
     }
 
-    /// The Jacobians of every chain at the state `state(k, x)` writes into `x`.
     fn jacobians_of(
         &self,
         t: f64,
-        state: impl Fn(usize, &mut DVector<f64>) + Sync + Send,
+        x: States<'_, f64>,
         du: &mut [f64],
         dw: &mut [f64],
     ) -> Result<Vec<Failure>> {
         let half = S::DIM * self.links();
-        let block = half * half;
-        check_len("du", du, self.len(), block)?;
-        check_len("dw", dw, self.len(), block)?;
-        // Per task: the state and the lower blocks, column-major, reused from chain to chain.
-        let scratch = || (DVector::zeros(2 * half), vec![0.0; 2 * block]);
-        let one = |(x, lower): &mut (DVector<f64>, Vec<f64>), k: usize, du: &mut [f64], dw: &mut [f64]| {
-            state(k, x);
-            let model = self.model(k);
-            let error = match model.check_state(x) {
-                Err(error) => Some(error),
-                Ok(()) => {
-                    model.lower_jacobian_of_valid(t, x.as_slice(), lower);
-                    let finite = lower.iter().fold(true, |all, v| all & v.is_finite());
-                    (!finite).then_some(Error::NotPositiveDefinite)
-                }
-            };
-            if let Some(error) = error {
-                du.fill(f64::NAN);
-                dw.fill(f64::NAN);
-                return Some(Failure { chain: k, error });
+        check_len("du", du, self.len(), half * half)?;
+        check_len("dw", dw, self.len(), half * half)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_in::<2>(t, x, du, dw),
+            _ => self.jacobians_in::<3>(t, x, du, dw),
+        })
+    }
+
+    fn jacobians_in<const C: usize>(
+        &self,
+        t: f64,
+        x: States<'_, f64>,
+        du: &mut [f64],
+        dw: &mut [f64],
+    ) -> Vec<Failure> {
+        match &self.blocks {
+            Blocks::Four(blocks) => self.jacobian_blocks::<C, WIDTH>(x, du, dw, |b, chains, room, du, dw| {
+                self.jacobian_block_simd::<C, WIDTH>(one_of(blocks, b), chains, t, x, room, du, dw)
+            }),
+            #[cfg(target_arch = "x86_64")]
+            Blocks::Eight(blocks) => {
+                self.jacobian_blocks::<C, WIDTH_AVX512>(x, du, dw, |b, chains, room, du, dw| {
+                    // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
+                    unsafe {
+                        self.jacobian_block_avx512::<C, WIDTH_AVX512>(
+                            one_of(blocks, b),
+                            chains,
+                            t,
+                            x,
+                            room,
+                            du,
+                            dw,
+                        )
+                    }
+                })
             }
-            // Row-major: the transposes of the column-major blocks.
-            transpose_square(&lower[..block], half, du);
-            transpose_square(&lower[block..], half, dw);
-            None
-        };
-        Ok(in_blocks(du, dw, block, scratch, one))
+            #[cfg(not(target_arch = "x86_64"))]
+            Blocks::Never(_) => unreachable!("eight lanes only with AVX-512"),
+        }
+    }
+
+    /// Runs `kernel(b, chains, room, du, dw)` for every block of `W` chains with its blocks
+    /// of `du` and `dw`, and reports each chain with a non-finite state (named by its entry)
+    /// or a lane the kernel flags (a result not finite), its blocks set to NaN.
+    fn jacobian_blocks<const C: usize, const W: usize>(
+        &self,
+        x: States<'_, f64>,
+        du: &mut [f64],
+        dw: &mut [f64],
+        kernel: impl Fn(usize, [usize; W], &mut Room<C, W>, &mut [f64], &mut [f64]) -> [bool; W] + Sync + Send,
+    ) -> Vec<Failure> {
+        let (chains, h) = (self.len(), C * self.links());
+        let block = h * h;
+        let room = || self.rooms.take(|| Room::<C, W>::new(self.links()));
+        let one =
+            |room: &mut super::rooms::Room<'_, Room<C, W>>, b: usize, du: &mut [f64], dw: &mut [f64]| {
+                let lanes = block_chains::<W>(b, chains);
+                let flagged = kernel(b, lanes, room, du, dw);
+                let blocks = du.chunks_exact_mut(block).zip(dw.chunks_exact_mut(block));
+                let mut failures = Vec::new();
+                for (k, (du, dw)) in blocks.enumerate() {
+                    let chain = lanes[k];
+                    let error =
+                        x.non_finite(chain, h).or_else(|| flagged[k].then_some(Error::NotPositiveDefinite));
+                    if let Some(error) = error {
+                        du.fill(f64::NAN);
+                        dw.fill(f64::NAN);
+                        failures.push(Failure { chain, error });
+                    }
+                }
+                failures
+            };
+        in_blocks(du, dw, W * block, room, one)
+    }
+
+    simd_kernel! {
+        /// The Jacobians of block `b` of `W` chains (`chains`, constants `block`) into its
+        /// blocks of `du` and `dw`: the states gathered into lanes, the kept solve, every
+        /// column's window, then row by row, each row scattered as it comes. Returns the
+        /// lanes with an entry not finite.
+        fn jacobian_block<const C: usize, const W: usize>(
+            &self,
+            block: &Block<W>,
+            chains: [usize; W],
+            t: f64,
+            x: States<'_, f64>,
+            room: &mut Room<C, W>,
+            du: &mut [f64],
+            dw: &mut [f64],
+        ) -> [bool; W] {
+            let (n, h) = (self.links(), C * self.links());
+            let Room { x: states, solve, rows } = room;
+            x.gather(chains, h, Lanes::flatten_mut(states));
+            let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
+            let rods = block.rods();
+            let (directions, rates) = states.split_at(h);
+            solve.solve(rods, gravity(block.down()), pivot, RateLoads::new(directions, rates, rods.drag()));
+            for b in 0..2 * h {
+                solve.keep_column(rods, b, &state_column::<C, _>(b, n, rates, rods.drag()), rows);
+            }
+            let mut flags = Lanes([0.0; W]);
+            solve.state_rows(rods, rows, |a, row| {
+                flags += non_finite_sum(row);
+                scatter_matrix_row::<_, W>(Lanes::flatten(&row[..h]), h, a, du);
+                scatter_matrix_row::<_, W>(Lanes::flatten(&row[h..]), h, a, dw);
+            });
+            flags.0.map(f64::is_nan)
+        }
+        dispatch fn jacobian_block_simd, jacobian_block_avx2, avx512 jacobian_block_avx512
     }
 }
 

@@ -17,6 +17,8 @@ use crate::rods::{Load, Rods, with_scratch};
 
 mod tangents;
 
+pub(crate) use tangents::state_column;
+
 /// A chain of `n` point masses on rigid rods in the plane (`S = U2`, y up) or in space
 /// (`S = U3`, z up), described by the unit direction `u_i` of each rod (from mass `i−1` to
 /// mass `i`, mass 0 the pivot) and its rate `w_i = u̇_i` (1/s), with the pivot moved by

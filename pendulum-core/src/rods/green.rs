@@ -17,64 +17,75 @@
 
 use super::tangent::{Linearised, LoadTangent};
 use super::{Rods, dot};
+use crate::lanes::{Aligned, Lane, one_row_at_a_time};
 
 /// One column's load change: `load` on rod `rod` (the pivot's acceleration unchanged).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Column<const S: usize> {
+pub(crate) struct Column<const S: usize, V: Lane = f64> {
     pub rod: usize,
-    pub load: LoadTangent<S>,
+    pub load: LoadTangent<S, V>,
 }
 
 /// The sparse parts of one column (module docs): `r` in rows `x − 1, x, x + 1` and the
 /// local `δü` on rods `x − 1, x, x + 1` (entries outside the chain are zero).
-struct Window<const S: usize> {
-    rhs: [f64; 3],
-    local: [[f64; S]; 3],
+struct Window<const S: usize, V: Lane> {
+    rhs: [V; 3],
+    local: [[V; S]; 3],
 }
 
-impl<const S: usize> Linearised<S> {
+/// `e_k`, the unit vector along axis `k`.
+#[inline(always)]
+pub(crate) fn unit<const S: usize, V: Lane>(k: usize) -> [V; S] {
+    let mut e = [V::splat(0.0); S];
+    e[k] = V::splat(1.0);
+    e
+}
+
+impl<const S: usize, V: Lane> Linearised<S, V> {
     /// The window of one column.
-    fn window(&self, rods: &Rods, c: &Column<S>) -> Window<S> {
+    #[inline(always)]
+    fn window(&self, rods: &Rods<V>, c: &Column<S, V>) -> Window<S, V> {
         let n = self.len();
         let x = c.rod;
-        let im = |i: usize| rods.inverse_mass[i];
-        let im_above = if x > 0 { im(x - 1) } else { 0.0 };
+        let zero = V::splat(0.0);
+        let im = &rods.inverse_mass;
+        let im_above = if x > 0 { im[x - 1] } else { zero };
         let (du, dpair) = (c.load.direction, c.load.pair);
         // δa° at masses x − 1 (none above rod 0: the pivot's is unchanged) and x.
-        let mut dfree_above = [0.0; S];
-        let mut dfree = [0.0; S];
+        let mut dfree_above = [zero; S];
+        let mut dfree = [zero; S];
         for k in 0..S {
-            dfree[k] = dpair[k] * im(x);
-            dfree_above[k] = if x > 0 { -dpair[k] * im_above } else { 0.0 };
+            dfree[k] = dpair[k] * im[x];
+            dfree_above[k] = if x > 0 { -dpair[k] * im_above } else { zero };
         }
-        let u = |i: usize| self.direction(i);
-        let t = |i: usize| self.tension(i);
-        let free = |i: isize| if i < 0 { self.pivot() } else { self.free(i as usize) };
-        let mut rhs = [0.0; 3];
+        let mut rhs = [zero; 3];
         // Row x.
-        let (ux, fx, fa) = (u(x), free(x as isize), free(x as isize - 1));
+        let (ux, fx, tx) = (self.direction(x), self.free(x), self.tension(x));
+        let fa = if x > 0 { self.free(x - 1) } else { self.pivot() };
         let mut r = rods.length[x] * c.load.rate_squared;
         for k in 0..S {
             r += du[k] * (fx[k] - fa[k]) + ux[k] * (dfree[k] - dfree_above[k]);
         }
-        r -= 2.0 * (im(x) + im_above) * dot(&ux, &du) * t(x);
+        r -= V::splat(2.0) * (im[x] + im_above) * dot(&ux, &du) * tx;
         if x > 0 {
-            let doff = -dot(&u(x - 1), &du) * im_above;
-            r -= doff * t(x - 1);
+            let u_above = self.direction(x - 1);
+            let doff = -dot(&u_above, &du) * im_above;
+            r -= doff * self.tension(x - 1);
             // Row x − 1: u_{x−1}·(δa°_{x−1} − 0) − δc_x T_x.
-            let mut r_above = -doff * t(x);
+            let mut r_above = -doff * tx;
             for k in 0..S {
-                r_above += u(x - 1)[k] * dfree_above[k];
+                r_above += u_above[k] * dfree_above[k];
             }
             rhs[0] = r_above;
         }
         if x + 1 < n {
-            let doff = -dot(&du, &u(x + 1)) * im(x);
-            r -= doff * t(x + 1);
+            let u_below = self.direction(x + 1);
+            let doff = -dot(&du, &u_below) * im[x];
+            r -= doff * self.tension(x + 1);
             // Row x + 1: u_{x+1}·(0 − δa°_x) − δc_{x+1} T_x.
-            let mut r_below = -doff * t(x);
+            let mut r_below = -doff * tx;
             for k in 0..S {
-                r_below -= u(x + 1)[k] * dfree[k];
+                r_below -= u_below[k] * dfree[k];
             }
             rhs[2] = r_below;
         }
@@ -84,34 +95,37 @@ impl<const S: usize> Linearised<S> {
         let mut a_x = dfree;
         let mut a_above = dfree_above;
         for k in 0..S {
-            a_x[k] -= t(x) * du[k] * im(x);
+            a_x[k] -= tx * du[k] * im[x];
             if x > 0 {
-                a_above[k] += t(x) * du[k] * im_above;
+                a_above[k] += tx * du[k] * im_above;
             }
         }
-        let mut local = [[0.0; S]; 3];
+        let il = &rods.inverse_length;
+        let mut local = [[zero; S]; 3];
         for k in 0..S {
             if x > 0 {
                 // Rod x − 1: local_a_{x−1} − local_a_{x−2}, the latter zero.
-                local[0][k] = a_above[k] * rods.inverse_length[x - 1];
-                local[1][k] = (a_x[k] - a_above[k]) * rods.inverse_length[x];
+                local[0][k] = a_above[k] * il[x - 1];
+                local[1][k] = (a_x[k] - a_above[k]) * il[x];
             } else {
-                local[1][k] = a_x[k] * rods.inverse_length[0];
+                local[1][k] = a_x[k] * il[0];
             }
             if x + 1 < n {
-                local[2][k] = -a_x[k] * rods.inverse_length[x + 1];
+                local[2][k] = -a_x[k] * il[x + 1];
             }
         }
         Window { rhs, local }
     }
 
     /// `(w·V_i)_j` for `j = i − 1, i, i + 1` (module docs).
-    fn v_row(&self, rods: &Rods, i: usize, w: &[f64; S]) -> [f64; 3] {
+    #[inline(always)]
+    fn v_row(&self, rods: &Rods<V>, i: usize, w: &[V; S]) -> [V; 3] {
         let n = self.len();
+        let zero = V::splat(0.0);
         let il = rods.inverse_length[i];
         let im = rods.inverse_mass[i];
-        let im_above = if i > 0 { rods.inverse_mass[i - 1] } else { 0.0 };
-        let mut v = [0.0; 3];
+        let im_above = if i > 0 { rods.inverse_mass[i - 1] } else { zero };
+        let mut v = [zero; 3];
         if i > 0 {
             v[0] = dot(w, &self.direction(i - 1)) * im_above * il;
         }
@@ -121,7 +135,124 @@ impl<const S: usize> Linearised<S> {
         }
         v
     }
+}
 
+/// A room for [`Linearised::state_rows`]: the columns' windows, the `G` of one rod's `S`
+/// outputs and their rows.
+pub(crate) struct RowsRoom<const S: usize, V: Lane> {
+    /// Per column, `r` in rows `x − 1, x, x + 1` and the local `δü` on rods `x − 1 … x + 1`.
+    rhs: Aligned<[V; 3]>,
+    local: Aligned<[[V; S]; 3]>,
+    /// `(f_j, 1/D_j)` per rod, read by every output's solve.
+    pivots: Aligned<[V; 2]>,
+    /// `G` of the `S` outputs of one rod, `n + 2` entries with a zero at each end (the
+    /// rods `−1` and `n` outside the chain).
+    green: Aligned<[V; S]>,
+    /// Their rows, `S` of `columns` entries.
+    rows: Aligned<V>,
+}
+
+impl<const S: usize, V: Lane> RowsRoom<S, V> {
+    /// Room for chains of `n` rods and Jacobians of `columns` columns.
+    pub fn new(n: usize, columns: usize) -> Self {
+        let zero = V::splat(0.0);
+        Self {
+            rhs: Aligned::filled([zero; 3], columns),
+            local: Aligned::filled([[zero; S]; 3], columns),
+            pivots: Aligned::filled([zero; 2], n),
+            green: Aligned::filled([zero; S], n + 2),
+            rows: Aligned::filled(zero, S * columns),
+        }
+    }
+}
+
+impl<const S: usize, V: Lane> Linearised<S, V> {
+    /// Keeps column `b`'s window (module docs) for [`state_rows`](Self::state_rows).
+    #[inline(always)]
+    pub fn keep_column(&self, rods: &Rods<V>, b: usize, column: &Column<S, V>, room: &mut RowsRoom<S, V>) {
+        let Window { rhs, local } = self.window(rods, column);
+        (room.rhs[b], room.local[b]) = (rhs, local);
+    }
+
+    /// The Jacobian of `ü` row by row, each output `e_k·δü_i` in turn (`i` rod by rod, `k`
+    /// axis by axis): `emit(S·i + k, row)` with its entries over the columns kept in
+    /// `room` ([`keep_column`](Self::keep_column)), where column `b` moves rod
+    /// `(b / S) mod n` (the state's layout: `S` numbers a rod, in blocks of `n` rods). The
+    /// numbers of [`green`](Linearised::green) and [`columns`](Linearised::columns)
+    /// with the unit outputs `(i, e_k)` in that order, bit for bit: `G` of the `S` outputs of
+    /// a rod at once (one O(n) solve each, their serial chains side by side), then three
+    /// multiply-adds an entry, then the local part on rods `i − 1 … i + 1`.
+    #[inline(always)]
+    pub fn state_rows(&self, rods: &Rods<V>, room: &mut RowsRoom<S, V>, mut emit: impl FnMut(usize, &[V])) {
+        let n = self.len();
+        let zero = V::splat(0.0);
+        let RowsRoom { rhs, local, pivots, green, rows } = room;
+        let m = rhs.len();
+        for (j, p) in pivots.iter_mut().enumerate() {
+            *p = [self.factor(j), self.inverse_pivot(j)];
+        }
+        for i in 0..n {
+            // G's right-hand sides: (w·V_i)_j at j = i − 1, i, i + 1, zeros elsewhere.
+            green.fill([zero; S]);
+            for k in 0..S {
+                let v = self.v_row(rods, i, &unit(k));
+                for (slot, &vs) in v.iter().enumerate() {
+                    if let Some(j) = (i + slot).checked_sub(1).filter(|&j| j < n) {
+                        green[j + 1][k] = vs;
+                    }
+                }
+            }
+            // Down from rod i − 1 (above it every e_j is zero, as in `green`'s groups),
+            // then up: e_j = v_j − f_j e_{j−1}, g_j = e_j/D_j − f_{j+1} g_{j+1}.
+            let mut e = [zero; S];
+            for j in i.saturating_sub(1)..n {
+                let f = pivots[j][0];
+                for k in 0..S {
+                    e[k] = green[j + 1][k] - f * e[k];
+                }
+                green[j + 1] = e;
+            }
+            let mut g = [zero; S];
+            for j in (0..n).rev() {
+                let below = if j + 1 < n { pivots[j + 1][0] } else { zero };
+                let inverse_pivot = pivots[j][1];
+                for k in 0..S {
+                    g[k] = green[j + 1][k] * inverse_pivot - below * g[k];
+                }
+                green[j + 1] = g;
+            }
+            // Σ_slot G[:, x − 1 + slot] r_slot, G padded with zeros outside the chain; by
+            // iterators over each row's blocks of `n` rods (indexed, each entry's bounds checks
+            // and a division per rod were a third of the loop).
+            for (k, row) in rows.chunks_exact_mut(m).enumerate() {
+                for (row, rhs) in row.chunks_exact_mut(S * n).zip(rhs.chunks_exact(S * n)) {
+                    let rods = row.chunks_exact_mut(S).zip(rhs.chunks_exact(S));
+                    for ((out, rhs), g) in rods.zip(green.windows(3)) {
+                        let (g0, g1, g2) = (g[0][k], g[1][k], g[2][k]);
+                        for (out, r) in out.iter_mut().zip(rhs) {
+                            *out = g0 * r[0] + g1 * r[1] + g2 * r[2];
+                        }
+                        one_row_at_a_time();
+                    }
+                }
+            }
+            // The local part: the columns of rods i − 1, i, i + 1 (slot i − x + 1).
+            for x in i.saturating_sub(1)..(i + 2).min(n) {
+                let slot = i + 1 - x;
+                for b in (S * x..m).step_by(S * n).flat_map(|first| first..first + S) {
+                    for k in 0..S {
+                        rows[k * m + b] += dot(&unit(k), &local[b][slot]);
+                    }
+                }
+            }
+            for k in 0..S {
+                emit(S * i + k, &rows[k * m..(k + 1) * m]);
+            }
+        }
+    }
+}
+
+impl<const S: usize> Linearised<S> {
     /// `G_w` for the outputs `rows` (`(i, w)`: the output `w·δü_i`, sorted by `i`),
     /// column-major (`rows.len()` × n): one O(n) solve per output, eight outputs at a time
     /// so that their serial chains overlap.

@@ -53,7 +53,7 @@ mod tangent;
 pub(crate) use angle_jacobians::state_rows;
 pub use angles::PlanarTangents;
 pub(crate) use angles::{Columns, Link, solve as solve_in_angles};
-pub(crate) use green::Column;
+pub(crate) use green::{Column, RowsRoom, unit};
 pub(crate) use tangent::{Linearised, LoadTangent, TangentRow};
 
 /// Per-chain constants of the solve: reciprocal masses and lengths, and the drag
@@ -282,10 +282,5 @@ impl<V: Lane> Continuants<V> {
     /// at some row so far.
     pub fn outside(&self) -> V::Mask {
         self.out_of_range
-    }
-
-    /// Whether every continuant so far stayed inside its precision's range (in every lane).
-    pub fn in_range(&self) -> bool {
-        !V::any(self.out_of_range)
     }
 }

@@ -12,113 +12,122 @@
 //! δa_i  = δa°_i + (δT_{i+1} u_{i+1} + T_{i+1} δu_{i+1} − δT_i u_i − T_i δu_i)/m_i
 //! δü_i  = (δa_i − δa_{i−1})/l_i
 //! ```
-//! The primal pass ([`Linearised::new`]) is Gaussian elimination (`D_i = A_ii − f_i
-//! A_{i,i−1}`, `f_i = A_{i,i−1}/D_{i−1}`, the pivots as ratios of continuants like the
-//! solve's, the classical way should one leave its range), keeping per rod what the
-//! tangents need; each [`Linearised::tangent`] is then one down and one up pass over the
-//! load changes in its rows, allocation-free.
+//! The primal pass ([`Linearised::solve`], also in lanes of chains) is Gaussian elimination
+//! (`D_i = A_ii − f_i A_{i,i−1}`, `f_i = A_{i,i−1}/D_{i−1}`, the pivots as ratios of
+//! continuants like the solve's, the classical way should one leave its range), keeping
+//! per rod what the tangents need; each [`Linearised::tangent`] is then one down and one up
+//! pass over the load changes in its rows, allocation-free.
 
-// The per-component loops read and write several `[f64; S]` at one index, like the solve's.
+// The per-component loops read and write several `[V; S]` at one index, like the solve's.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Continuants, Load, Rods, dot, entries};
+use super::{Continuants, Load, Loads, Rods, dot, entries};
+use crate::lanes::{Aligned, Lane};
 
-/// The change of one rod's [`Load`] along a direction.
+/// The change of one rod's [`Load`] along a direction (in lanes `V`, of `W` chains).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct LoadTangent<const S: usize> {
+pub(crate) struct LoadTangent<const S: usize, V: Lane = f64> {
     /// `δu_i`.
-    pub direction: [f64; S],
+    pub direction: [V; S],
     /// `δ|u̇_i|²` (1/s²).
-    pub rate_squared: f64,
+    pub rate_squared: V,
     /// `δF_i` (N).
-    pub pair: [f64; S],
+    pub pair: [V; S],
 }
 
 /// One rod of a solve kept for its tangents.
 #[derive(Debug, Clone, Copy)]
-struct Kept<const S: usize> {
-    load: Load<S>,
+struct Kept<const S: usize, V: Lane> {
+    load: Load<S, V>,
     /// `a°_i`.
-    free: [f64; S],
+    free: [V; S],
     /// `b_i`, kept for [`Linearised::eliminate_by_pivots`].
-    rhs: f64,
+    rhs: V,
     /// `f_i = A_{i,i−1}/D_{i−1}` and `1/D_i`.
-    factor: f64,
-    inverse_pivot: f64,
+    factor: V,
+    inverse_pivot: V,
     /// `T_i` (N); `e_i = b_i − f_i e_{i−1}` until [`Linearised::substitute`].
-    tension: f64,
-    /// `ü_i`.
-    acceleration: [f64; S],
+    tension: V,
 }
 
-/// A tension solve at one state, kept for its tangents (module docs).
+/// A tension solve at one state, kept for its tangents (module docs); in lanes `V`, the
+/// solves of `W` chains side by side, each lane doing its chain's operations in the same
+/// order (so the same bits).
 #[derive(Debug, Clone)]
-pub(crate) struct Linearised<const S: usize> {
-    rods: Vec<Kept<S>>,
-    pivot: [f64; S],
+pub(crate) struct Linearised<const S: usize, V: Lane = f64> {
+    rods: Aligned<Kept<S, V>>,
+    pivot: [V; S],
 }
 
-impl<const S: usize> Linearised<S> {
-    /// The solve of `rods` with these loads, gravity `g⃗` and pivot acceleration `p̈`: the
-    /// pivots by continuants ([`Continuants`]), the classical way should one leave its
-    /// range.
-    pub fn new(rods: &Rods, gravity: [f64; S], pivot: [f64; S], load: impl Fn(usize) -> Load<S>) -> Self {
-        let n = rods.len();
-        let mut kept = Vec::with_capacity(n);
+impl<const S: usize, V: Lane> Linearised<S, V> {
+    /// Room for the solves of chains of `n` rods ([`solve`](Self::solve)).
+    pub fn with_len(n: usize) -> Self {
+        let zero = V::splat(0.0);
+        let load = Load { direction: [zero; S], rate_squared: zero, pair: [zero; S] };
+        let kept =
+            Kept { load, free: [zero; S], rhs: zero, factor: zero, inverse_pivot: zero, tension: zero };
+        Self { rods: Aligned::filled(kept, n), pivot: [zero; S] }
+    }
+
+    /// The solve of `rods` (as many as this room's) with the loads `load`, gravity `g⃗` and
+    /// pivot acceleration `p̈`: the pivots by continuants ([`Continuants`]), the classical
+    /// way in the lanes where one leaves its range.
+    #[inline(always)]
+    pub fn solve(&mut self, rods: &Rods<V>, gravity: [V; S], pivot: [V; S], mut load: impl Loads<S, V>) {
+        let n = self.rods.len();
+        debug_assert_eq!(n, rods.length.len(), "a room for {n} rods");
+        let zero = V::splat(0.0);
         let mut continuants = Continuants::new();
-        let (mut free_above, mut im_above, mut u_above) = (pivot, 0.0, [0.0; S]);
-        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
-        let mut below = (n > 0).then(|| load(0));
+        let (mut free_above, mut im_above, mut u_above) = (pivot, zero, [zero; S]);
+        let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
+        let none = Load { direction: [zero; S], rate_squared: zero, pair: [zero; S] };
+        // No `Option` of a lane load: it fell apart into scalars.
+        let mut below = if n > 0 { load.load(0) } else { none };
         for i in 0..n {
-            let here = below.expect("rod i");
-            below = (i + 1 < n).then(|| load(i + 1));
-            let pair_below = below.map_or([0.0; S], |b| b.pair);
+            let here = below;
+            below = if i + 1 < n { load.load(i + 1) } else { none };
             let im = rods.inverse_mass[i];
             let mut a = gravity;
             let mut rhs = rods.length[i] * here.rate_squared;
             for k in 0..S {
-                a[k] += (here.pair[k] - pair_below[k]) * im;
+                a[k] += (here.pair[k] - below.pair[k]) * im;
                 rhs += here.direction[k] * (a[k] - free_above[k]);
             }
             let (diagonal, off) = entries(im, im_above, &u_above, &here.direction);
             let inverse_pivot = continuants.inverse_pivot(i, diagonal, off);
             let factor = off * inverse_pivot_above;
             let eliminated = rhs - factor * eliminated_above;
-            kept.push(Kept {
-                load: here,
-                free: a,
-                rhs,
-                factor,
-                inverse_pivot,
-                tension: eliminated,
-                acceleration: [0.0; S],
-            });
+            self.rods[i] = Kept { load: here, free: a, rhs, factor, inverse_pivot, tension: eliminated };
             (free_above, im_above, u_above) = (a, im, here.direction);
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
         }
-        let mut out = Self { rods: kept, pivot };
-        if !continuants.in_range() {
-            out.eliminate_by_pivots(rods);
+        self.pivot = pivot;
+        let outside = continuants.outside();
+        if V::any(outside) {
+            self.eliminate_by_pivots(rods, outside);
         }
-        out.substitute(rods);
-        out
+        self.substitute();
     }
 
     /// The elimination again with the pivots `D_i = A_ii − f_i A_{i,i−1}` (a division on
-    /// the serial chain), for the solves whose continuants left their range.
+    /// the serial chain) in the lanes `only`, whose continuants left their range.
     #[cold]
     #[inline(never)]
-    fn eliminate_by_pivots(&mut self, rods: &Rods) {
-        let (mut im_above, mut u_above) = (0.0, [0.0; S]);
-        let (mut inverse_pivot_above, mut eliminated_above) = (0.0, 0.0);
+    fn eliminate_by_pivots(&mut self, rods: &Rods<V>, only: V::Mask) {
+        let zero = V::splat(0.0);
+        let (mut im_above, mut u_above) = (zero, [zero; S]);
+        let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
         for (i, kept) in self.rods.iter_mut().enumerate() {
             let (im, u) = (rods.inverse_mass[i], kept.load.direction);
             let (diagonal, off) = entries(im, im_above, &u_above, &u);
-            kept.factor = off * inverse_pivot_above;
-            kept.inverse_pivot = 1.0 / (diagonal - kept.factor * off);
-            kept.tension = kept.rhs - kept.factor * eliminated_above;
+            let factor = off * inverse_pivot_above;
+            let inverse_pivot = V::splat(1.0) / (diagonal - factor * off);
+            let tension = kept.rhs - factor * eliminated_above;
+            kept.factor = V::select(only, factor, kept.factor);
+            kept.inverse_pivot = V::select(only, inverse_pivot, kept.inverse_pivot);
+            kept.tension = V::select(only, tension, kept.tension);
             (im_above, u_above) = (im, u);
-            (inverse_pivot_above, eliminated_above) = (kept.inverse_pivot, kept.tension);
+            (inverse_pivot_above, eliminated_above) = (inverse_pivot, tension);
         }
     }
 
@@ -128,66 +137,56 @@ impl<const S: usize> Linearised<S> {
     }
 
     /// `u_i`.
-    pub(super) fn direction(&self, i: usize) -> [f64; S] {
+    pub(super) fn direction(&self, i: usize) -> [V; S] {
         self.rods[i].load.direction
     }
 
     /// `T_i` (N).
-    pub(crate) fn tension(&self, i: usize) -> f64 {
+    pub(crate) fn tension(&self, i: usize) -> V {
         self.rods[i].tension
     }
 
     /// `a°_i` (m/s²).
-    pub(super) fn free(&self, i: usize) -> [f64; S] {
+    pub(super) fn free(&self, i: usize) -> [V; S] {
         self.rods[i].free
     }
 
     /// `p̈` (m/s²).
-    pub(crate) fn pivot(&self) -> [f64; S] {
+    pub(crate) fn pivot(&self) -> [V; S] {
         self.pivot
     }
 
     /// `f_i = A_{i,i−1}/D_{i−1}`.
-    pub(crate) fn factor(&self, i: usize) -> f64 {
+    pub(crate) fn factor(&self, i: usize) -> V {
         self.rods[i].factor
     }
 
     /// `1/D_i`.
-    pub(crate) fn inverse_pivot(&self, i: usize) -> f64 {
+    pub(crate) fn inverse_pivot(&self, i: usize) -> V {
         self.rods[i].inverse_pivot
     }
 
-    /// The primal back substitution: `T_i = e_i/D_i − f_{i+1} T_{i+1}`, then
-    /// `a_i = a°_i + (T_{i+1} u_{i+1} − T_i u_i)/m_i` and `ü_i = (a_i − a_{i−1})/l_i`.
-    fn substitute(&mut self, rods: &Rods) {
+    /// The primal back substitution of the tensions: `T_i = e_i/D_i − f_{i+1} T_{i+1}`.
+    #[inline(always)]
+    fn substitute(&mut self) {
         let n = self.rods.len();
-        let mut tension_below = 0.0;
+        let mut tension_below = V::splat(0.0);
         for i in (0..n).rev() {
-            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { 0.0 };
+            let below_factor = if i + 1 < n { self.rods[i + 1].factor } else { V::splat(0.0) };
             let t = self.rods[i].tension * self.rods[i].inverse_pivot - below_factor * tension_below;
             self.rods[i].tension = t;
             tension_below = t;
         }
-        let mut a_above = self.pivot;
-        for i in 0..n {
-            let im = rods.inverse_mass[i];
-            let here = self.rods[i];
-            let mut a = here.free;
-            for k in 0..S {
-                a[k] -= here.tension * here.load.direction[k] * im;
-            }
-            if i + 1 < n {
-                let below = &self.rods[i + 1];
-                for k in 0..S {
-                    a[k] += below.tension * below.load.direction[k] * im;
-                }
-            }
-            let il = rods.inverse_length[i];
-            for k in 0..S {
-                self.rods[i].acceleration[k] = (a[k] - a_above[k]) * il;
-            }
-            a_above = a;
-        }
+    }
+}
+
+impl<const S: usize> Linearised<S> {
+    /// The solve of `rods` with these loads, gravity `g⃗` and pivot acceleration `p̈`
+    /// ([`solve`](Self::solve)).
+    pub fn new(rods: &Rods, gravity: [f64; S], pivot: [f64; S], load: impl Loads<S, f64>) -> Self {
+        let mut out = Self::with_len(rods.len());
+        out.solve(rods, gravity, pivot, load);
+        out
     }
 
     /// `δü_i` (1/s²) along the load tangents in `work` (one [`TangentRow`] per rod) and

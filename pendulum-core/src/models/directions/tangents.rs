@@ -10,9 +10,11 @@
 use nalgebra::{DMatrix, DVector, DefaultAllocator, DimName, allocator::Allocator};
 
 use super::Directions;
+use super::rate_load;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
-use crate::rods::{Column, Linearised, Load, LoadTangent, TangentRow};
+use crate::lanes::Lane;
+use crate::rods::{Column, Linearised, LoadTangent, TangentRow, unit};
 
 impl<S: DimName, Dr: Drive<S>> Directions<S, Dr>
 where
@@ -28,15 +30,7 @@ where
         let pivot: [f64; C] = std::array::from_fn(|k| p[k]);
         let (directions, rates) = x.split_at(C * n);
         let (directions, rates) = (directions.as_chunks::<C>().0, rates.as_chunks::<C>().0);
-        Linearised::new(&self.rods, gravity, pivot, |i| {
-            let (u, w) = (directions[i], &rates[i]);
-            let mut load = Load { direction: u, rate_squared: 0.0, pair: [0.0; C] };
-            for (pair, w) in load.pair.iter_mut().zip(w) {
-                load.rate_squared += w * w;
-                *pair = -drag[i] * w;
-            }
-            load
-        })
+        Linearised::new(&self.rods, gravity, pivot, |i| rate_load(directions[i], rates[i], drag[i]))
     }
 
     /// `δü = (∂ü/∂u) δu + (∂ü/∂w) δw` (1/s²) at `(t, x)` along `dx = (δu, δw)`, written
@@ -126,23 +120,34 @@ where
         let solve = self.linearised::<C>(t, x);
         let drag = self.rods.drag();
         let rates = &x[half..];
-        let unit = |k: usize| std::array::from_fn::<f64, C, _>(|m| if m == k { 1.0 } else { 0.0 });
         let rows: Vec<(usize, [f64; C])> = (0..half).map(|r| (r / C, unit(r % C))).collect();
-        let zero = [0.0; C];
-        let mut columns = Vec::with_capacity(2 * half);
-        for j in 0..half {
-            let load = LoadTangent { direction: unit(j % C), rate_squared: 0.0, pair: zero };
-            columns.push(Column { rod: j / C, load });
-        }
-        for (j, &rate) in rates.iter().enumerate().take(half) {
-            let (rod, k) = (j / C, j % C);
-            let pair = std::array::from_fn(|m| if m == k { -drag[rod] } else { 0.0 });
-            let load = LoadTangent { direction: zero, rate_squared: 2.0 * rate, pair };
-            columns.push(Column { rod, load });
-        }
+        let columns: Vec<_> = (0..2 * half).map(|b| state_column(b, n, rates, drag)).collect();
         let green = solve.green(&self.rods, &rows);
         solve.columns(&self.rods, &rows, &green, &columns, lower);
     }
+}
+
+/// Column `b` of `∂ü/∂x` as a load change of chains of `n` rods at rates `w` (`C·n`
+/// numbers) with drags `λ_i/l_i` (module docs): for `b < C·n` the direction `u_i` (`i =
+/// b / C`) moving along axis `k = b mod C`, beyond it the rate `w_i` (`b − C·n`), which
+/// moves `|u̇_i|²` by `2 w_ik` and the pair by `−λ_i/l_i` along `k`. In lanes `V` too.
+#[inline(always)]
+pub(crate) fn state_column<const C: usize, V: Lane>(
+    b: usize,
+    n: usize,
+    rates: &[V],
+    drag: &[V],
+) -> Column<C, V> {
+    let zero = V::splat(0.0);
+    let (rod, k) = ((b % (C * n)) / C, b % C);
+    let load = if b < C * n {
+        LoadTangent { direction: unit(k), rate_squared: zero, pair: [zero; C] }
+    } else {
+        let mut pair = [zero; C];
+        pair[k] = -drag[rod];
+        LoadTangent { direction: [zero; C], rate_squared: V::splat(2.0) * rates[b - C * n], pair }
+    };
+    Column { rod, load }
 }
 
 #[cfg(test)]
