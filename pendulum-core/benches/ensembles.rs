@@ -29,7 +29,7 @@
 //!   `state_jacobians_f32`;
 //!   `jacobians/spatial/…/{8,20,100}` the same in 3D directions
 //!   (`Directions::analytic_jacobian`, and kept in `(B, h, h)` arrays, against
-//!   `DirectionsBatch::state_jacobians`).
+//!   `DirectionsBatch::state_jacobians`, and `state_jacobians_f32`).
 //!
 //! `cargo bench -p pendulum-core --bench ensembles`
 
@@ -707,6 +707,13 @@ fn jacobians(c: &mut Criterion) {
                 },
             );
         }
+        let narrow: Vec<f32> = joined.iter().map(|&v| v as f32).collect();
+        let (mut du32, mut dw32) = (vec![0.0f32; CHAINS * h * h], vec![0.0f32; CHAINS * h * h]);
+        group.bench_with_input(BenchmarkId::new("spatial/batch_f32_1_thread", n), &n, |b, _| {
+            in_pool(b, &one, || {
+                batch.state_jacobians_f32(0.0, &narrow, &mut du32, &mut dw32).expect("batch");
+            })
+        });
     }
     group.finish();
 }

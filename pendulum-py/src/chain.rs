@@ -92,8 +92,9 @@ impl Route {
 }
 
 impl Chain {
-    /// `Chain.jacobians(..., precision="float32")`: the planar model without torques in
-    /// single precision ([`planar_jacobians_f32`]).
+    /// `Chain.jacobians(..., precision="float32")`: the planar model without torques
+    /// ([`planar_jacobians_f32`]) or the directions ([`directions::jacobians_f32`]) in single
+    /// precision.
     fn jacobians_f32<'py>(
         &self,
         py: Python<'py>,
@@ -103,8 +104,15 @@ impl Chain {
         torque: Option<&Bound<'py, PyAny>>,
         pivot_acceleration: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        if !matches!(route, Route::Angles(Kind::Planar)) {
-            return Err(invalid("precision: 'float32' Jacobians serve model='planar' only"));
+        if route == Route::Directions {
+            let b = self.directions_rows(q, qd, torque, pivot_acceleration)?;
+            let out =
+                maybe_detached(py, b.q.data.len() * b.q.width, || directions::jacobians_f32(&self.inner, &b))
+                    .map_err(core_error)?;
+            return jacobian_arrays(py, out, &b);
+        }
+        if route != Route::Angles(Kind::Planar) {
+            return Err(invalid("precision: 'float32' Jacobians serve model='planar' and 'directions' only"));
         }
         let b = self.batch_f32(q, qd, torque, pivot_acceleration)?;
         let out = maybe_detached(py, b.q.data.len() * b.q.width, || {
@@ -511,9 +519,9 @@ impl Chain {
     /// lanes (`qdd` is `accelerations`' q̈). `model="directions"`: `ü` and its derivatives by the
     /// directions' and the rates' three components each, the Jacobian of the first-order
     /// system `(u̇, ẇ) = (w, ü)` (the constraint `|u_i| = 1` not imposed).
-    /// `precision="float32"` (planar without torques) computes in single precision, eight
-    /// states per SIMD register, and returns float32: within a few parts per million of the
-    /// largest entry (docs/ensembles.md).
+    /// `precision="float32"` (planar without torques, or directions) computes in single
+    /// precision, eight states per SIMD register, and returns float32: within a few parts
+    /// per million of the largest entry (docs/ensembles.md).
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", precision = "float64"))]
     #[allow(clippy::too_many_arguments)]
     fn jacobians<'py>(

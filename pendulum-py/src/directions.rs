@@ -165,14 +165,37 @@ pub fn accelerations_f32(
     if q.count() == 0 {
         return Ok(out);
     }
+    let (u, w) = in_single(&q.data, &qd.data)?;
+    first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
+    Ok(out)
+}
+
+/// `ü`, `∂ü/∂u` and `∂ü/∂u̇` of every state in single precision:
+/// [`DirectionsBatch::accelerations_split_f32`] and
+/// [`DirectionsBatch::state_jacobians_split_f32`], the states rounded to `f32` (one past
+/// its range is an error).
+pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f32>; 3]> {
+    let (count, dof) = (b.q.count(), b.q.width);
+    let mut udd = vec![0.0f32; count * dof];
+    let (mut du, mut dw) = (vec![0.0f32; count * dof * dof], vec![0.0f32; count * dof * dof]);
+    if count > 0 {
+        let (u, w) = in_single(&b.q.data, &b.qd.data)?;
+        let batch = batch(chain, &b.pivot)?;
+        first_error(batch.accelerations_split_f32(0.0, &u, &w, &mut udd)?)?;
+        first_error(batch.state_jacobians_split_f32(0.0, &u, &w, &mut du, &mut dw)?)?;
+    }
+    Ok([udd, du, dw])
+}
+
+/// The directions and rates rounded to `f32`: finite in `f64` (checked when read), an
+/// infinity here is past `f32`'s range, [`pendulum_core::Error::SinglePrecisionOverflow`].
+fn in_single(u: &[f64], w: &[f64]) -> pendulum_core::Result<(Vec<f32>, Vec<f32>)> {
     let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<_>>();
-    let (u, w) = (narrow(&q.data), narrow(&qd.data));
-    // Finite in f64 (checked when read): an infinity here is past f32's range.
+    let (u, w) = (narrow(u), narrow(w));
     if u.iter().chain(&w).any(|v| !v.is_finite()) {
         return Err(pendulum_core::Error::SinglePrecisionOverflow);
     }
-    first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
-    Ok(out)
+    Ok((u, w))
 }
 
 /// `(T, U)` (J) of every state relative to the pivot ([`Directions::kinetic_energy`],

@@ -178,7 +178,7 @@ def test_single_precision_jacobians_are_the_double_precision_ones_to_their_docum
         assert np.array_equal(many[1, 2], alone)
     with pytest.raises(ValueError, match="takes no torques"):
         chain.jacobians(q, qd, np.ones_like(q), precision="float32")
-    with pytest.raises(ValueError, match="serve model='planar' only"):
+    with pytest.raises(ValueError, match="serve model='planar' and 'directions' only"):
         chain.jacobians(q[..., :n], precision="float32", model="spatial")
     with pytest.raises(ValueError, match="float16"):
         chain.jacobians(q, precision="float16")

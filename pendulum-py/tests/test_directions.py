@@ -192,6 +192,26 @@ def test_jacobians_match_central_differences_and_batches_match_one_state():
     print(f"jacobians against central differences: worst {worst:.1e} of the largest entries")
 
 
+def test_float32_jacobians_are_within_a_few_parts_per_million_and_each_state_is_its_own():
+    # precision="float32": eight states per SIMD register in f32, within 2e-5 of each
+    # state's largest entry (docs/ensembles.md), shaped like the float64 ones, float32.
+    chain = pendulum.Chain([0.02, 0.01, 0.03] * 3, [0.02, 0.01, 0.015] * 3, damping=1e-4)
+    r = np.random.default_rng(4)
+    u, w = random_states(r, (3, 11), 9)
+    pivot = r.uniform(-3, 3, (3, 11, 3))
+    doubles = chain.jacobians(u, w, pivot_acceleration=pivot, model="directions")
+    singles = chain.jacobians(u, w, pivot_acceleration=pivot, model="directions", precision="float32")
+    for double, single, axes in zip(doubles, singles, [(-1,), (-2, -1), (-2, -1)]):
+        assert single.dtype == np.float32 and single.shape == double.shape
+        scale = np.abs(double).max(axis=axes, keepdims=True)
+        assert (np.abs(single - double) / scale).max() < 2e-5
+    one = chain.jacobians(u[2, 5], w[2, 5], pivot_acceleration=pivot[2, 5], model="directions", precision="float32")
+    for many, alone in zip(singles, one):
+        assert np.array_equal(many[2, 5], alone)
+    with pytest.raises(ValueError, match="not finite in single precision"):
+        chain.jacobians(u[0], w[0] * 1e39, model="directions", precision="float32")
+
+
 def test_the_projected_run_keeps_rods_rigid_and_conserves_energy():
     chain = pendulum.Chain([0.3, 0.2, 0.25, 0.1], [0.4, 0.3, 0.35, 0.2])
     r = np.random.default_rng(5)

@@ -109,6 +109,82 @@ fn single_precision_directions_fail_by_chain_and_change_with_no_thread_count_or_
 }
 
 #[test]
+fn single_precision_direction_jacobians_are_within_their_documented_error() {
+    // The bounds of docs/ensembles.md ("Single precision"); `--nocapture` prints the errors:
+    // the worst chain's largest difference in `∂ü/∂u` and `∂ü/∂w` over its largest entry.
+    let mut r = ChaCha8Rng::seed_from_u64(53);
+    let chains = 64;
+    for (decades, bound) in [(0.3, 5e-6), (1.0, 5e-6), (2.0, 1e-5), (3.0, 5e-5)] {
+        for n in [8, 20, 100] {
+            let (models, x) = spread_whirls(n, decades, chains, &mut r);
+            let batch = DirectionsBatch::new(models).expect("batch");
+            let (t, h) = (r.random_range(0.0..10.0), 3 * n);
+            let (mut du64, mut dw64) = (vec![0.0; chains * h * h], vec![0.0; chains * h * h]);
+            let (mut du32, mut dw32) = (vec![0.0f32; chains * h * h], vec![0.0f32; chains * h * h]);
+            assert!(batch.state_jacobians(t, &x, &mut du64, &mut dw64).expect("f64").is_empty());
+            let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+            assert!(batch.state_jacobians_f32(t, &x32, &mut du32, &mut dw32).expect("f32").is_empty());
+            let by_u = worst_relative_error(&du64, &du32, h * h);
+            let by_w = worst_relative_error(&dw64, &dw32, h * h);
+            println!("3D Jacobians, spread 10^{decades}, n = {n}: {by_u:.1e} (∂ü/∂u), {by_w:.1e} (∂ü/∂w)");
+            for error in [by_u, by_w] {
+                assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn single_precision_direction_jacobians_fail_by_chain_and_change_with_no_thread_count_or_split() {
+    let mut r = ChaCha8Rng::seed_from_u64(54);
+    let (n, chains) = (7, 19);
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+    let mut x: Vec<f32> = x.iter().flat_map(|x| x.iter().map(|&v| v as f32)).collect();
+    let (m, h) = (6 * n, 3 * n);
+    x[3 * m + 5] = f32::NAN;
+    // A rate whose square leaves f32: finite input, overflow in the solve.
+    x[11 * m + 3 * n + 1] = 3e19;
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let squares = h * h;
+    let mut runs = Vec::new();
+    for pool in pools() {
+        let (mut du, mut dw) = (vec![0.0f32; chains * squares], vec![0.0f32; chains * squares]);
+        let failures = pool.install(|| batch.state_jacobians_f32(1.5, &x, &mut du, &mut dw)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11]);
+        assert!(matches!(failures[0].error, Error::NonFinite { what: "x", index: 5, .. }));
+        assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        for (k, (a, b)) in du.chunks_exact(squares).zip(dw.chunks_exact(squares)).enumerate() {
+            let failed = k == 3 || k == 11;
+            assert_eq!(a.iter().chain(b).all(|v| v.is_nan()), failed, "chain {k}");
+            assert_eq!(a.iter().chain(b).all(|v| v.is_finite()), !failed, "chain {k}");
+        }
+        // From the directions and rates apart: the same bits.
+        let u: Vec<f32> = x.chunks_exact(m).flat_map(|x| x[..h].to_vec()).collect();
+        let w: Vec<f32> = x.chunks_exact(m).flat_map(|x| x[h..].to_vec()).collect();
+        let (mut du2, mut dw2) = (vec![0.0f32; chains * squares], vec![0.0f32; chains * squares]);
+        let split = pool.install(|| batch.state_jacobians_split_f32(1.5, &u, &w, &mut du2, &mut dw2));
+        assert_eq!(split.expect("split").iter().map(|f| f.chain).collect::<Vec<_>>(), [3, 11]);
+        let bits = |v: &[f32]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&[du2, dw2].concat()), bits(&[du.clone(), dw.clone()].concat()));
+        runs.push(bits(&[du, dw].concat()));
+    }
+    assert_eq!(runs[0], runs[1]);
+    for k in [0, 8, 18] {
+        let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+        let (mut du, mut dw) = (vec![0.0f32; squares], vec![0.0f32; squares]);
+        assert!(
+            alone.state_jacobians_f32(1.5, &x[k * m..(k + 1) * m], &mut du, &mut dw).expect("f32").is_empty()
+        );
+        let bits = |v: &[f32]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&du), runs[0][k * squares..(k + 1) * squares], "chain {k}");
+        let offset = chains * squares;
+        assert_eq!(bits(&dw), runs[0][offset + k * squares..offset + (k + 1) * squares], "chain {k}");
+    }
+    let err = batch.state_jacobians_f32(1.5, &x, &mut [0.0; 5], &mut [0.0; 5]).unwrap_err();
+    assert_eq!(err.to_string(), format!("du has 5 entries, expected {}", chains * squares));
+}
+
+#[test]
 fn single_precision_direction_runs_follow_the_f64_ones_and_fail_by_chain() {
     // Whirls of 10 g, 1 cm links spread by up to a factor of 2, each pivot circling at
     // 0.5–5 cm and 1–10 rad/s, from random swinging states: steps of 0.1 ms from

@@ -8,30 +8,32 @@ use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 use rayon::prelude::*;
 
 use super::directions::{Block, RateLoads, States, gravity};
-use super::lane_states::non_finite_sum;
+use super::rooms::Room as Kept;
+use super::run_lanes::RunLane;
 use super::transpose::scatter_matrix_row;
 use super::{
-    Blocks, DirectionsBatch, Failure, WIDTH, WIDTH_AVX512, block_chains, check_len, one_of, simd_kernel,
+    Blocks, DirectionsBatch, F32x8, Failure, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, one_of,
+    simd_kernel,
 };
 use crate::drive::Drive;
 use crate::error::{Error, Result};
-use crate::lanes::{Aligned, Lanes};
+use crate::lanes::{Aligned, FlushSubnormals, Lane, Lanes, Lanes32};
 use crate::models::directions::state_column;
-use crate::rods::{Linearised, RowsRoom};
+use crate::rods::{Linearised, Rods, RowsRoom};
 
-/// A task's room for a block of `W` chains in `C` dimensions: their states in lanes, the
-/// kept solve, and the Jacobians' windows and rows.
-struct Room<const C: usize, const W: usize> {
-    x: Aligned<Lanes<W>>,
-    solve: Linearised<C, Lanes<W>>,
-    rows: RowsRoom<C, Lanes<W>>,
+/// A task's room for a block of chains in lanes `V`, `C` dimensions: their states in lanes,
+/// the kept solve, and the Jacobians' windows and rows.
+struct Room<const C: usize, V: Lane> {
+    x: Aligned<V>,
+    solve: Linearised<C, V>,
+    rows: RowsRoom<C, V>,
 }
 
-impl<const C: usize, const W: usize> Room<C, W> {
+impl<const C: usize, V: Lane> Room<C, V> {
     fn new(n: usize) -> Self {
         let h = C * n;
         Self {
-            x: Aligned::filled(Lanes([0.0; W]), 2 * h),
+            x: Aligned::filled(V::splat(0.0), 2 * h),
             solve: Linearised::with_len(n),
             rows: RowsRoom::new(n, 2 * h),
         }
@@ -59,9 +61,11 @@ where
     /// [`Error::LengthMismatch`](crate::Error::LengthMismatch) when an array does not hold
     /// `B` rows or blocks.
     pub fn state_jacobians(&self, t: f64, x: &[f64], du: &mut [f64], dw: &mut [f64]) -> Result<Vec<Failure>> {
-        let half = S::DIM * self.links();
-        check_len("x", x, self.len(), 2 * half)?;
-        self.jacobians_of(t, States::Joined(x), du, dw)
+        self.check_jacobian_args(States::Joined(x), du, dw)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_in::<2>(t, States::Joined(x), du, dw),
+            _ => self.jacobians_in::<3>(t, States::Joined(x), du, dw),
+        })
     }
 
     /// [`state_jacobians`](Self::state_jacobians) of the states given as two arrays, the
@@ -78,26 +82,68 @@ where
         du: &mut [f64],
         dw: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        let half = S::DIM * self.links();
-        check_len("u", u, self.len(), half)?;
-        check_len("w", w, self.len(), half)?;
-        self.jacobians_of(t, States::Split(u, w), du, dw)
+        self.check_jacobian_args(States::Split(u, w), du, dw)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_in::<2>(t, States::Split(u, w), du, dw),
+            _ => self.jacobians_in::<3>(t, States::Split(u, w), du, dw),
+        })
     }
 
-    fn jacobians_of(
+    /// [`state_jacobians`](Self::state_jacobians) in single precision: arrays in `f32`,
+    /// eight chains per AVX2 register, each chain's constants rounded to `f32` and its pivot
+    /// acceleration computed in `f64` and then rounded. Not bit for bit anything: its error
+    /// against the `f64` call is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, in order: a non-finite state as the `f64` call names
+    /// it, otherwise (a number past `f32`'s range) [`Error::SinglePrecisionOverflow`]; their
+    /// blocks are NaN. Errors: [`Error::LengthMismatch`] when an array does not hold `B`
+    /// rows or blocks.
+    pub fn state_jacobians_f32(
         &self,
         t: f64,
-        x: States<'_, f64>,
-        du: &mut [f64],
-        dw: &mut [f64],
+        x: &[f32],
+        du: &mut [f32],
+        dw: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        let half = S::DIM * self.links();
-        check_len("du", du, self.len(), half * half)?;
-        check_len("dw", dw, self.len(), half * half)?;
+        self.check_jacobian_args(States::Joined(x), du, dw)?;
         Ok(match S::DIM {
-            2 => self.jacobians_in::<2>(t, x, du, dw),
-            _ => self.jacobians_in::<3>(t, x, du, dw),
+            2 => self.jacobians_f32_in::<2>(t, States::Joined(x), du, dw),
+            _ => self.jacobians_f32_in::<3>(t, States::Joined(x), du, dw),
         })
+    }
+
+    /// [`state_jacobians_f32`](Self::state_jacobians_f32) of the states given as two
+    /// arrays, as [`state_jacobians_split`](Self::state_jacobians_split) takes them.
+    ///
+    /// Errors: [`Error::LengthMismatch`] when an array does not hold `B` rows or blocks.
+    pub fn state_jacobians_split_f32(
+        &self,
+        t: f64,
+        u: &[f32],
+        w: &[f32],
+        du: &mut [f32],
+        dw: &mut [f32],
+    ) -> Result<Vec<Failure>> {
+        self.check_jacobian_args(States::Split(u, w), du, dw)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_f32_in::<2>(t, States::Split(u, w), du, dw),
+            _ => self.jacobians_f32_in::<3>(t, States::Split(u, w), du, dw),
+        })
+    }
+
+    /// Checks that the states hold `B` rows (`2·S·n` joined, `S·n` each apart) and `du`
+    /// and `dw` `B` blocks of `(S·n)²`.
+    fn check_jacobian_args<T>(&self, x: States<'_, T>, du: &[T], dw: &[T]) -> Result<()> {
+        let (chains, half) = (self.len(), S::DIM * self.links());
+        match x {
+            States::Joined(x) => check_len("x", x, chains, 2 * half)?,
+            States::Split(u, w) => {
+                check_len("u", u, chains, half)?;
+                check_len("w", w, chains, half)?;
+            }
+        }
+        check_len("du", du, chains, half * half)?;
+        check_len("dw", dw, chains, half * half)
     }
 
     fn jacobians_in<const C: usize>(
@@ -107,13 +153,16 @@ where
         du: &mut [f64],
         dw: &mut [f64],
     ) -> Vec<Failure> {
+        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
         match &self.blocks {
-            Blocks::Four(blocks) => self.jacobian_blocks::<C, WIDTH>(x, du, dw, |b, chains, room, du, dw| {
-                self.jacobian_block_simd::<C, WIDTH>(one_of(blocks, b), chains, t, x, room, du, dw)
-            }),
+            Blocks::Four(blocks) => {
+                self.jacobian_blocks::<C, WIDTH, _>(x, du, dw, otherwise, |b, chains, room, du, dw| {
+                    self.jacobian_block_simd::<C, WIDTH>(one_of(blocks, b), chains, t, x, room, du, dw)
+                })
+            }
             #[cfg(target_arch = "x86_64")]
             Blocks::Eight(blocks) => {
-                self.jacobian_blocks::<C, WIDTH_AVX512>(x, du, dw, |b, chains, room, du, dw| {
+                self.jacobian_blocks::<C, WIDTH_AVX512, _>(x, du, dw, otherwise, |b, chains, room, du, dw| {
                     // SAFETY: eight-lane blocks exist only where the CPU has AVX-512.
                     unsafe {
                         self.jacobian_block_avx512::<C, WIDTH_AVX512>(
@@ -133,75 +182,126 @@ where
         }
     }
 
+    fn jacobians_f32_in<const C: usize>(
+        &self,
+        t: f64,
+        x: States<'_, f32>,
+        du: &mut [f32],
+        dw: &mut [f32],
+    ) -> Vec<Failure> {
+        let otherwise = (f32::NAN, Error::SinglePrecisionOverflow);
+        self.jacobian_blocks::<C, WIDTH_F32, F32x8>(x, du, dw, otherwise, |b, chains, room, du, dw| {
+            self.jacobian_block_f32_simd::<C>(b, chains, t, x, room, du, dw)
+        })
+    }
+
     /// Runs `kernel(b, chains, room, du, dw)` for every block of `W` chains with its blocks
     /// of `du` and `dw`, and reports each chain with a non-finite state (named by its entry)
-    /// or a lane the kernel flags (a result not finite), its blocks set to NaN.
-    fn jacobian_blocks<const C: usize, const W: usize>(
+    /// or a lane the kernel flags (a result not finite, reported as `otherwise`), its blocks
+    /// set to `nan`.
+    fn jacobian_blocks<const C: usize, const W: usize, V: RunLane>(
         &self,
-        x: States<'_, f64>,
-        du: &mut [f64],
-        dw: &mut [f64],
-        kernel: impl Fn(usize, [usize; W], &mut Room<C, W>, &mut [f64], &mut [f64]) -> [bool; W] + Sync + Send,
+        x: States<'_, V::Num>,
+        du: &mut [V::Num],
+        dw: &mut [V::Num],
+        (nan, otherwise): (V::Num, Error),
+        kernel: impl Fn(usize, [usize; W], &mut Room<C, V>, &mut [V::Num], &mut [V::Num]) -> [bool; W]
+        + Sync
+        + Send,
     ) -> Vec<Failure> {
         let (chains, h) = (self.len(), C * self.links());
         let block = h * h;
-        let room = || self.rooms.take(|| Room::<C, W>::new(self.links()));
-        let one =
-            |room: &mut super::rooms::Room<'_, Room<C, W>>, b: usize, du: &mut [f64], dw: &mut [f64]| {
-                let lanes = block_chains::<W>(b, chains);
-                let flagged = kernel(b, lanes, room, du, dw);
-                let blocks = du.chunks_exact_mut(block).zip(dw.chunks_exact_mut(block));
-                let mut failures = Vec::new();
-                for (k, (du, dw)) in blocks.enumerate() {
-                    let chain = lanes[k];
-                    let error =
-                        x.non_finite(chain, h).or_else(|| flagged[k].then_some(Error::NotPositiveDefinite));
-                    if let Some(error) = error {
-                        du.fill(f64::NAN);
-                        dw.fill(f64::NAN);
-                        failures.push(Failure { chain, error });
-                    }
+        let room = || self.rooms.take(|| Room::<C, V>::new(self.links()));
+        let one = |room: &mut Kept<'_, Room<C, V>>, b: usize, du: &mut [V::Num], dw: &mut [V::Num]| {
+            let lanes = block_chains::<W>(b, chains);
+            let flagged = kernel(b, lanes, room, du, dw);
+            let blocks = du.chunks_exact_mut(block).zip(dw.chunks_exact_mut(block));
+            let mut failures = Vec::new();
+            for (k, (du, dw)) in blocks.enumerate() {
+                let chain = lanes[k];
+                let error = x.non_finite(chain, h).or_else(|| flagged[k].then(|| otherwise.clone()));
+                if let Some(error) = error {
+                    du.fill(nan);
+                    dw.fill(nan);
+                    failures.push(Failure { chain, error });
                 }
-                failures
-            };
+            }
+            failures
+        };
         in_blocks(du, dw, W * block, room, one)
     }
 
     simd_kernel! {
-        /// The Jacobians of block `b` of `W` chains (`chains`, constants `block`) into its
-        /// blocks of `du` and `dw`: the states gathered into lanes, the kept solve, every
-        /// column's window, then row by row, each row scattered as it comes. Returns the
-        /// lanes with an entry not finite.
+        /// [`block_jacobians`] of block `b` of `W` chains (`chains`, constants `block`).
+        /// Returns the lanes with an entry not finite.
         fn jacobian_block<const C: usize, const W: usize>(
             &self,
             block: &Block<W>,
             chains: [usize; W],
             t: f64,
             x: States<'_, f64>,
-            room: &mut Room<C, W>,
+            room: &mut Room<C, Lanes<W>>,
             du: &mut [f64],
             dw: &mut [f64],
         ) -> [bool; W] {
-            let (n, h) = (self.links(), C * self.links());
-            let Room { x: states, solve, rows } = room;
-            x.gather(chains, h, Lanes::flatten_mut(states));
             let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
-            let rods = block.rods();
-            let (directions, rates) = states.split_at(h);
-            solve.solve(rods, gravity(block.down()), pivot, RateLoads::new(directions, rates, rods.drag()));
-            for b in 0..2 * h {
-                solve.keep_column(rods, b, &state_column::<C, _>(b, n, rates, rods.drag()), rows);
-            }
-            let mut flags = Lanes([0.0; W]);
-            solve.state_rows(rods, rows, |a, row| {
-                flags += non_finite_sum(row);
-                scatter_matrix_row::<_, W>(Lanes::flatten(&row[..h]), h, a, du);
-                scatter_matrix_row::<_, W>(Lanes::flatten(&row[h..]), h, a, dw);
-            });
-            flags.0.map(f64::is_nan)
+            let constants = (self.links(), block.rods(), block.down());
+            block_jacobians(constants, pivot, (x, chains), room, (du, dw)).map(|flag| flag != 0)
         }
         dispatch fn jacobian_block_simd, jacobian_block_avx2, avx512 jacobian_block_avx512
     }
+
+    simd_kernel! {
+        /// [`block_jacobians`] of the single-precision block `b` (chains `chains`). Returns
+        /// the lanes with an entry not finite.
+        fn jacobian_block_f32<const C: usize>(
+            &self,
+            b: usize,
+            chains: [usize; WIDTH_F32],
+            t: f64,
+            x: States<'_, f32>,
+            room: &mut Room<C, F32x8>,
+            du: &mut [f32],
+            dw: &mut [f32],
+        ) -> [bool; WIDTH_F32] {
+            // `G` decays along a chain into `f32`'s subnormals (`lanes::FlushSubnormals`).
+            let _flush = FlushSubnormals::new();
+            let (rods, down) = one_of(&self.blocks_f32, b);
+            let pivot = self.pivot_lanes::<C, WIDTH_F32, _>(chains, [t; WIDTH_F32], Dr::acceleration, Lanes32::rounded);
+            block_jacobians((self.links(), rods, *down), pivot, (x, chains), room, (du, dw)).map(|flag| flag != 0)
+        }
+        dispatch fn jacobian_block_f32_simd, jacobian_block_f32_avx2
+    }
+}
+
+/// The Jacobians of one block of `W` chains of `n` links in lanes `V` (constants `rods`,
+/// `−g` per lane `down`, pivot accelerations `pivot`) at the states `x` of `chains` into
+/// the block's `du` and `dw`: the states gathered into lanes, the kept solve, every
+/// column's window, then row by row, each row scattered as it comes. Returns the lanes
+/// with an entry not finite.
+#[inline(always)]
+fn block_jacobians<const C: usize, V: RunLane, const W: usize>(
+    (n, rods, down): (usize, &Rods<V>, V),
+    pivot: [V; C],
+    (x, chains): (States<'_, V::Num>, [usize; W]),
+    room: &mut Room<C, V>,
+    (du, dw): (&mut [V::Num], &mut [V::Num]),
+) -> V::Mask {
+    let h = C * n;
+    let Room { x: states, solve, rows } = room;
+    x.gather(chains, h, V::flatten_mut(states));
+    let (directions, rates) = states.split_at(h);
+    solve.solve(rods, gravity(down), pivot, RateLoads::new(directions, rates, rods.drag()));
+    for b in 0..2 * h {
+        solve.keep_column(rods, b, &state_column::<C, _>(b, n, rates, rods.drag()), rows);
+    }
+    let mut flags = V::none();
+    solve.state_rows(rods, rows, |a, row| {
+        flags = V::or(flags, V::non_finite(row));
+        scatter_matrix_row::<_, W>(V::flatten(&row[..h]), h, a, du);
+        scatter_matrix_row::<_, W>(V::flatten(&row[h..]), h, a, dw);
+    });
+    flags
 }
 
 /// Runs `one(scratch, k, a_k, b_k)` for every block `k` of `a` and `b` (`len` numbers each,

@@ -38,13 +38,13 @@ mod jacobians;
 mod lane_states;
 mod planar;
 mod planar_jacobians;
-mod planar_lanes;
 mod planar_rk4;
 mod rk4;
 mod rk4_f32;
 mod rod_midpoint;
 mod rooms;
 mod run;
+mod run_lanes;
 pub(crate) mod transpose;
 mod unrolled;
 

@@ -4,7 +4,7 @@
 use nalgebra::Dyn;
 
 use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
-use super::planar_lanes::RunLane;
+use super::run_lanes::RunLane;
 use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, F64x4, F64x8, Failure, Rooms, WIDTH, WIDTH_F32, block_chains, check_len, check_links,

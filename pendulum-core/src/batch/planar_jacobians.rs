@@ -9,8 +9,8 @@ use nalgebra::{DVector, Dyn, U2, Vector2};
 
 use super::jacobians::in_blocks;
 use super::planar::{Block, BlockStates};
-use super::planar_lanes::RunLane;
 use super::rooms::Room;
+use super::run_lanes::RunLane;
 use super::transpose::{scatter_matrix_row, transpose_square};
 use super::{
     Blocks, F32x8, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, first_bad_input, gather, one_of,
@@ -18,7 +18,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::jacobians::{Derivatives, Jacobians};
-use crate::lanes::{Aligned, Lane, Lanes};
+use crate::lanes::{Aligned, FlushSubnormals, Lane, Lanes};
 use crate::model::Inputs;
 use crate::models::PlanarTension;
 use crate::rods::{Columns, Link, pull, solve_in_angles, state_rows};
@@ -212,6 +212,8 @@ impl PlanarBatch {
             dq: &mut [f32],
             dqd: &mut [f32],
         ) -> [bool; WIDTH_F32] {
+            // `G` decays along a chain into `f32`'s subnormals (`lanes::FlushSubnormals`).
+            let _flush = FlushSubnormals::new();
             let block = one_of(&self.blocks_f32, b);
             block_jacobians(self.links, block, lanes, states, room, (dq, dqd), true).map(|flag| flag != 0)
         }

@@ -11,7 +11,7 @@ use nalgebra::{Dyn, U2};
 use super::F64x8;
 use super::lane_states::{into_lanes, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
-use super::planar_lanes::RunLane;
+use super::run_lanes::RunLane;
 use super::transpose::{gather_rows, scatter_some_rows};
 use super::{
     Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,

@@ -14,10 +14,12 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssi
 mod aligned;
 #[cfg(target_arch = "x86_64")]
 mod registers;
+mod subnormals;
 
 pub(crate) use aligned::Aligned;
 #[cfg(target_arch = "x86_64")]
 pub(crate) use registers::{Avx4, Avx8, AvxF32};
+pub(crate) use subnormals::FlushSubnormals;
 
 /// Whether the lanes can run as AVX2 registers on this CPU (checked once, then cached by
 /// std).

@@ -1,6 +1,7 @@
-//! [`RunLane`]: the lanes a planar batch computes in, `f64` ([`Lanes`]) or `f32`
-//! ([`F32x8`]), with their precision's sine kernel and flags: what the runs, the
-//! accelerations and the Jacobians of `PlanarBatch` are written against once.
+//! [`RunLane`]: the lanes a batch computes in, `f64` ([`Lanes`]) or `f32` ([`F32x8`]),
+//! with their precision's sine kernel and flags: what the runs, the accelerations and the
+//! Jacobians of `PlanarBatch`, and the Jacobians of `DirectionsBatch`, are written against
+//! once.
 
 use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
 use super::transpose::Transpose;
@@ -8,8 +9,8 @@ use super::{F32x8, WIDTH_F32};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
 use crate::lanes::{Lane, Lanes, Lanes32};
 
-/// The lanes a planar batch steps and differentiates in, with their precision's sine
-/// kernel: four or eight `f64` lanes ([`Lanes`]) or [`F32x8`].
+/// The lanes a batch steps and differentiates in, with their precision's sine kernel: four
+/// or eight `f64` lanes ([`Lanes`]) or [`F32x8`].
 pub(super) trait RunLane: Lane + Send {
     /// The number type of one lane.
     type Num: Transpose + Into<f64> + Send + Sync;
