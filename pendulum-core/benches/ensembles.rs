@@ -165,18 +165,9 @@ fn accelerations(c: &mut Criterion) {
             })
         });
         let batch = PlanarBatch::new(chains.clone()).expect("batch");
-        for threads in [1, 2] {
-            let pool = pool(threads);
-            group.bench_with_input(
-                BenchmarkId::new(format!("planar/batch_{threads}_threads"), n),
-                &n,
-                |b, _| {
-                    in_pool(b, &pool, || {
-                        batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
-                    })
-                },
-            );
-        }
+        thread_rows(&mut group, ("planar", n), || {
+            batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+        });
         // What `with_avx512(false)` trades, on a CPU with AVX-512: four lanes instead of eight.
         let four = batch.clone().with_avx512(false);
         for threads in [1, 2].into_iter().filter(|_| n == 100 && batch.uses_avx512()) {
@@ -211,18 +202,9 @@ fn accelerations(c: &mut Criterion) {
         let batch = DirectionsBatch::new(models).expect("batch");
         let flat: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
         let mut out = vec![0.0; CHAINS * 3 * n];
-        for threads in [1, 2] {
-            let pool = pool(threads);
-            group.bench_with_input(
-                BenchmarkId::new(format!("spatial/batch_{threads}_threads"), n),
-                &n,
-                |b, _| {
-                    in_pool(b, &pool, || {
-                        batch.accelerations(0.0, &flat, &mut out).expect("batch");
-                    })
-                },
-            );
-        }
+        thread_rows(&mut group, ("spatial", n), || {
+            batch.accelerations(0.0, &flat, &mut out).expect("batch");
+        });
         let four = batch.clone().with_avx512(false);
         for threads in [1, 2].into_iter().filter(|_| n == 100 && batch.uses_avx512()) {
             let pool = pool(threads);
@@ -627,24 +609,9 @@ fn jacobians(c: &mut Criterion) {
         }
         let batch = PlanarBatch::new(chains).expect("batch");
         let four = batch.clone().with_avx512(false);
-        let one = pool(1);
-        group.bench_with_input(BenchmarkId::new("planar/batch_1_threads_four_lanes", n), &n, |b, _| {
-            in_pool(b, &one, || {
-                four.state_jacobians(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
-            })
+        batch_rows(&mut group, ("planar", n), [&four, &batch], |batch| {
+            batch.state_jacobians(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
         });
-        for threads in [1, 2] {
-            let pool = pool(threads);
-            group.bench_with_input(
-                BenchmarkId::new(format!("planar/batch_{threads}_threads"), n),
-                &n,
-                |b, _| {
-                    in_pool(b, &pool, || {
-                        batch.state_jacobians(&q, &qd, None, None, &mut dq, &mut dqd).expect("batch");
-                    })
-                },
-            );
-        }
     }
     // The same in single precision (eight lanes a register, at every length).
     for n in [8, N, 100] {
@@ -689,24 +656,10 @@ fn jacobians(c: &mut Criterion) {
         let batch = DirectionsBatch::new(models).expect("batch");
         let joined: Vec<f64> = x.iter().flat_map(|x| x.iter().copied()).collect();
         let four = batch.clone().with_avx512(false);
-        let one = pool(1);
-        group.bench_with_input(BenchmarkId::new("spatial/batch_1_threads_four_lanes", n), &n, |b, _| {
-            in_pool(b, &one, || {
-                four.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
-            })
+        batch_rows(&mut group, ("spatial", n), [&four, &batch], |batch| {
+            batch.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
         });
-        for threads in [1, 2] {
-            let pool = pool(threads);
-            group.bench_with_input(
-                BenchmarkId::new(format!("spatial/batch_{threads}_threads"), n),
-                &n,
-                |b, _| {
-                    in_pool(b, &pool, || {
-                        batch.state_jacobians(0.0, &joined, &mut du, &mut dw).expect("batch");
-                    })
-                },
-            );
-        }
+        let one = pool(1);
         let narrow: Vec<f32> = joined.iter().map(|&v| v as f32).collect();
         let (mut du32, mut dw32) = (vec![0.0f32; CHAINS * h * h], vec![0.0f32; CHAINS * h * h]);
         group.bench_with_input(BenchmarkId::new("spatial/batch_f32_1_thread", n), &n, |b, _| {
@@ -716,6 +669,38 @@ fn jacobians(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// The rows `{family}/batch_1_threads_four_lanes/n`, `…/batch_1_threads/n` and
+/// `…/batch_2_threads/n`: `call` of the batch in four lanes on one thread, then of the
+/// batch (in eight lanes where the CPU has AVX-512) on one thread and on two.
+fn batch_rows<B: Sync>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    (family, n): (&str, usize),
+    [four, batch]: [&B; 2],
+    mut call: impl FnMut(&B) + Send,
+) {
+    let one = pool(1);
+    let id = BenchmarkId::new(format!("{family}/batch_1_threads_four_lanes"), n);
+    group.bench_with_input(id, &n, |b, _| in_pool(b, &one, || call(four)));
+    thread_rows(group, (family, n), || call(batch));
+}
+
+/// The rows `{family}/batch_1_threads/n` and `…/batch_2_threads/n`: `call` timed from
+/// inside a pool of one thread and of two.
+fn thread_rows(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    (family, n): (&str, usize),
+    mut call: impl FnMut() + Send,
+) {
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        group.bench_with_input(
+            BenchmarkId::new(format!("{family}/batch_{threads}_threads"), n),
+            &n,
+            |b, _| in_pool(b, &pool, &mut call),
+        );
+    }
 }
 
 criterion_group!(benches, accelerations, large_batches, rk4, planar_rk4, generated, jacobians);

@@ -61,11 +61,7 @@ where
     /// [`Error::LengthMismatch`](crate::Error::LengthMismatch) when an array does not hold
     /// `B` rows or blocks.
     pub fn state_jacobians(&self, t: f64, x: &[f64], du: &mut [f64], dw: &mut [f64]) -> Result<Vec<Failure>> {
-        self.check_jacobian_args(States::Joined(x), du, dw)?;
-        Ok(match S::DIM {
-            2 => self.jacobians_in::<2>(t, States::Joined(x), du, dw),
-            _ => self.jacobians_in::<3>(t, States::Joined(x), du, dw),
-        })
+        self.jacobians_f64(t, States::Joined(x), du, dw)
     }
 
     /// [`state_jacobians`](Self::state_jacobians) of the states given as two arrays, the
@@ -82,11 +78,7 @@ where
         du: &mut [f64],
         dw: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        self.check_jacobian_args(States::Split(u, w), du, dw)?;
-        Ok(match S::DIM {
-            2 => self.jacobians_in::<2>(t, States::Split(u, w), du, dw),
-            _ => self.jacobians_in::<3>(t, States::Split(u, w), du, dw),
-        })
+        self.jacobians_f64(t, States::Split(u, w), du, dw)
     }
 
     /// [`state_jacobians`](Self::state_jacobians) in single precision: arrays in `f32`,
@@ -105,11 +97,7 @@ where
         du: &mut [f32],
         dw: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        self.check_jacobian_args(States::Joined(x), du, dw)?;
-        Ok(match S::DIM {
-            2 => self.jacobians_f32_in::<2>(t, States::Joined(x), du, dw),
-            _ => self.jacobians_f32_in::<3>(t, States::Joined(x), du, dw),
-        })
+        self.jacobians_f32(t, States::Joined(x), du, dw)
     }
 
     /// [`state_jacobians_f32`](Self::state_jacobians_f32) of the states given as two
@@ -124,11 +112,7 @@ where
         du: &mut [f32],
         dw: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        self.check_jacobian_args(States::Split(u, w), du, dw)?;
-        Ok(match S::DIM {
-            2 => self.jacobians_f32_in::<2>(t, States::Split(u, w), du, dw),
-            _ => self.jacobians_f32_in::<3>(t, States::Split(u, w), du, dw),
-        })
+        self.jacobians_f32(t, States::Split(u, w), du, dw)
     }
 
     /// Checks that the states hold `B` rows (`2·S·n` joined, `S·n` each apart) and `du`
@@ -144,6 +128,36 @@ where
         }
         check_len("du", du, chains, half * half)?;
         check_len("dw", dw, chains, half * half)
+    }
+
+    /// The checked call in `f64`, in `S` dimensions.
+    fn jacobians_f64(
+        &self,
+        t: f64,
+        x: States<'_, f64>,
+        du: &mut [f64],
+        dw: &mut [f64],
+    ) -> Result<Vec<Failure>> {
+        self.check_jacobian_args(x, du, dw)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_in::<2>(t, x, du, dw),
+            _ => self.jacobians_in::<3>(t, x, du, dw),
+        })
+    }
+
+    /// The checked call in `f32`, in `S` dimensions.
+    fn jacobians_f32(
+        &self,
+        t: f64,
+        x: States<'_, f32>,
+        du: &mut [f32],
+        dw: &mut [f32],
+    ) -> Result<Vec<Failure>> {
+        self.check_jacobian_args(x, du, dw)?;
+        Ok(match S::DIM {
+            2 => self.jacobians_f32_in::<2>(t, x, du, dw),
+            _ => self.jacobians_f32_in::<3>(t, x, du, dw),
+        })
     }
 
     fn jacobians_in<const C: usize>(
