@@ -24,6 +24,7 @@ use crate::drives::Pivot;
 use crate::errors::{core_error, invalid};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, split};
 use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
+use crate::results;
 use crate::states::Batch;
 
 /// How far `|u_i|` may be from 1 in a state's directions: the rounding of directions made
@@ -177,7 +178,7 @@ pub fn accelerations_f32(
 pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f32>; 3]> {
     let (count, dof) = (b.q.count(), b.q.width);
     let mut udd = vec![0.0f32; count * dof];
-    let (mut du, mut dw) = (vec![0.0f32; count * dof * dof], vec![0.0f32; count * dof * dof]);
+    let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));
     if count > 0 {
         let (u, w) = in_single(&b.q.data, &b.qd.data)?;
         let batch = batch(chain, &b.pivot)?;
@@ -219,7 +220,7 @@ pub fn energies(chain: &pendulum_core::Chain<Dyn>, [q, qd]: [&Rows; 2]) -> (Vec<
 pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f64>; 3]> {
     let (count, dof) = (b.q.count(), b.q.width);
     let mut udd = vec![0.0; count * dof];
-    let (mut du, mut dw) = (vec![0.0; count * dof * dof], vec![0.0; count * dof * dof]);
+    let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));
     if count > 0 {
         let batch = batch(chain, &b.pivot)?;
         first_error(batch.accelerations_split(0.0, &b.q.data, &b.qd.data, &mut udd)?)?;

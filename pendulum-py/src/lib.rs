@@ -15,6 +15,7 @@ mod interrupt;
 mod page;
 mod planar_runs;
 mod planar_states;
+mod results;
 mod run;
 mod states;
 mod steady;

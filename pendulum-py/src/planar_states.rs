@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 
 use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
+use crate::results;
 
 /// `θ̈` of every planar state by the batch of chains ([`PlanarBatch::repeated`]) at the
 /// `count` states `q`, `qd`, joint torques `torque` and pivot accelerations `pivot`, rows of
@@ -39,7 +40,7 @@ pub fn planar_jacobians(
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut qdd = vec![0.0; q.len()];
     first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut qdd)?)?;
-    let (mut dq, mut dqd) = (vec![0.0; count * n * n], vec![0.0; count * n * n]);
+    let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
     first_error(batch.state_jacobians(q, qd, Some(torque), Some(pivot), &mut dq, &mut dqd)?)?;
     Ok([qdd, dq, dqd])
 }
@@ -82,7 +83,7 @@ pub fn planar_jacobians_f32(
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let (q, qd, pivot) = (narrow(q), narrow(qd), narrow(pivot));
     let mut qdd = vec![0.0f32; q.len()];
-    let (mut dq, mut dqd) = (vec![0.0f32; count * n * n], vec![0.0f32; count * n * n]);
+    let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
     let mut failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut qdd)?;
     failures.extend(batch.state_jacobians_f32(&q, &qd, None, Some(&pivot), &mut dq, &mut dqd)?);
     // The inputs were checked finite in f64: a failure is single precision's range.
