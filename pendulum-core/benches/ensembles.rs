@@ -184,7 +184,7 @@ fn accelerations(c: &mut Criterion) {
         let pool1 = pool(1);
         group.bench_with_input(BenchmarkId::new("planar/batch_f32_1_thread", n), &n, |b, _| {
             in_pool(b, &pool1, || {
-                batch.accelerations_f32(&q32, &qd32, None, &mut out32).expect("batch");
+                batch.accelerations_f32(&q32, &qd32, None, None, &mut out32).expect("batch");
             })
         });
 

@@ -92,7 +92,7 @@ impl Route {
 }
 
 impl Chain {
-    /// `Chain.jacobians(..., precision="float32")`: the planar model without torques
+    /// `Chain.jacobians(..., precision="float32")`: the planar model
     /// ([`planar_jacobians_f32`]) or the directions ([`directions::jacobians_f32`]) in single
     /// precision.
     fn jacobians_f32<'py>(
@@ -114,16 +114,20 @@ impl Chain {
         if route != Route::Angles(Kind::Planar) {
             return Err(invalid("precision: 'float32' Jacobians serve model='planar' and 'directions' only"));
         }
-        let b = self.batch_f32(q, qd, torque, pivot_acceleration)?;
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
         let out = maybe_detached(py, b.q.data.len() * b.q.width, || {
-            planar_jacobians_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
+            planar_jacobians_f32(
+                &self.inner,
+                b.q.count(),
+                [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data],
+            )
         })
         .map_err(core_error)?;
         jacobian_arrays(py, out, &b)
     }
 
-    /// `Chain.accelerations(..., precision="float32")`: the planar model without torques in
-    /// single precision ([`planar_batch_f32`]).
+    /// `Chain.accelerations(..., precision="float32")`: the planar model in single
+    /// precision ([`planar_batch_f32`]).
     fn accelerations_f32<'py>(
         &self,
         py: Python<'py>,
@@ -138,7 +142,7 @@ impl Chain {
         }
         if torque.is_none() && pivot_acceleration.is_none() {
             let single = |b: &PlanarBatch, q: &[f32], qd: &[f32], out: &mut [f32]| {
-                b.accelerations_f32(q, qd, None, out)
+                b.accelerations_f32(q, qd, None, None, out)
             };
             if let Some(out) = planar_in_place(py, &self.inner, q, qd, single)? {
                 return Ok(out);
@@ -147,28 +151,12 @@ impl Chain {
                 return Ok(out);
             }
         }
-        let b = self.batch_f32(q, qd, torque, pivot_acceleration)?;
+        let b = self.batch(Kind::Planar, q, qd, torque, pivot_acceleration)?;
         let out = maybe_detached(py, b.q.data.len(), || {
-            planar_batch_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.pivot.data])
+            planar_batch_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data])
         })
         .map_err(core_error)?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
-    }
-
-    /// The planar states of a call in single precision: [`batch`](Self::batch), the torques
-    /// refused (the `f32` planar calls take none).
-    fn batch_f32(
-        &self,
-        q: &Bound<'_, PyAny>,
-        qd: Option<&Bound<'_, PyAny>>,
-        torque: Option<&Bound<'_, PyAny>>,
-        pivot: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Batch> {
-        let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
-        if b.torque.data.iter().any(|t| *t != 0.0) {
-            return Err(invalid("precision: 'float32' takes no torques"));
-        }
-        Ok(b)
     }
 
     fn batch(
@@ -403,7 +391,7 @@ impl Chain {
     /// by `model` ("planar", "spatial" or "directions"). `q` may hold many states along
     /// leading axes, shape `(..., dof)`; `qd`, `torque` (default zeros) are one row for
     /// all or one per state, likewise `pivot_acceleration`. Returns an array shaped like
-    /// `q`. `precision="float32"` (planar without torques, or directions) computes in
+    /// `q`. `precision="float32"` (planar, or directions) computes in
     /// single precision, eight states per SIMD register, and returns float32: within about
     /// 1e-5 of the largest acceleration (docs/ensembles.md). `model="directions"`: `q` the
     /// rods' unit directions (dof = 3n, each within 1e-6 of length 1), `qd` their rates,
@@ -519,7 +507,7 @@ impl Chain {
     /// lanes (`qdd` is `accelerations`' q̈). `model="directions"`: `ü` and its derivatives by the
     /// directions' and the rates' three components each, the Jacobian of the first-order
     /// system `(u̇, ẇ) = (w, ü)` (the constraint `|u_i| = 1` not imposed).
-    /// `precision="float32"` (planar without torques, or directions) computes in single
+    /// `precision="float32"` (planar, or directions) computes in single
     /// precision, eight states per SIMD register, and returns float32: within a few parts
     /// per million of the largest entry (docs/ensembles.md).
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, model = "planar", precision = "float64"))]

@@ -50,18 +50,18 @@ pub fn first_error(failures: Vec<Failure>) -> pendulum_core::Result<()> {
     failures.into_iter().next().map_or(Ok(()), |failure| Err(failure.error))
 }
 
-/// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states
-/// and pivot accelerations rounded to `f32`, the result in `f32`.
+/// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states,
+/// torques and pivot accelerations rounded to `f32`, the result in `f32`.
 pub fn planar_batch_f32(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
-    [q, qd, pivot]: [&[f64]; 3],
+    [q, qd, torque, pivot]: [&[f64]; 4],
 ) -> pendulum_core::Result<Vec<f32>> {
     let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0f32; q.len()];
-    let (q, qd, pivot) = (narrow(q), narrow(qd), narrow(pivot));
-    let failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out)?;
+    let (q, qd, torque, pivot) = (narrow(q), narrow(qd), narrow(torque), narrow(pivot));
+    let failures = batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?;
     // The inputs were checked finite in f64: a failure is single precision's range (an
     // input past f32's, or the solve's numbers).
     match failures.is_empty() {
@@ -71,21 +71,22 @@ pub fn planar_batch_f32(
 }
 
 /// [`planar_jacobians`] in single precision ([`PlanarBatch::accelerations_f32`] and
-/// [`PlanarBatch::state_jacobians_f32`]), without torques: the states and pivot
-/// accelerations rounded to `f32`, the results in `f32`.
+/// [`PlanarBatch::state_jacobians_f32`]): the states, torques and pivot accelerations
+/// rounded to `f32`, the results in `f32`.
 pub fn planar_jacobians_f32(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
-    [q, qd, pivot]: [&[f64]; 3],
+    [q, qd, torque, pivot]: [&[f64]; 4],
 ) -> pendulum_core::Result<[Vec<f32>; 3]> {
     let n = chain.links();
     let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
-    let (q, qd, pivot) = (narrow(q), narrow(qd), narrow(pivot));
+    let (q, qd, torque, pivot) = (narrow(q), narrow(qd), narrow(torque), narrow(pivot));
+    let (torque, pivot) = (Some(&torque[..]), Some(&pivot[..]));
     let mut qdd = vec![0.0f32; q.len()];
     let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
-    let mut failures = batch.accelerations_f32(&q, &qd, Some(&pivot), &mut qdd)?;
-    failures.extend(batch.state_jacobians_f32(&q, &qd, None, Some(&pivot), &mut dq, &mut dqd)?);
+    let mut failures = batch.accelerations_f32(&q, &qd, torque, pivot, &mut qdd)?;
+    failures.extend(batch.state_jacobians_f32(&q, &qd, torque, pivot, &mut dq, &mut dqd)?);
     // The inputs were checked finite in f64: a failure is single precision's range.
     match failures.is_empty() {
         true => Ok([qdd, dq, dqd]),
@@ -117,7 +118,7 @@ pub fn planar_table_f32<'py>(
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     tables_f32(py, q, qd, chain.links(), |qs, qds, out| {
         let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
-        let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, out))
+        let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, None, out))
             .map_err(core_error)?;
         first_failure(failures, qs, qds, |_| core_error(pendulum_core::Error::SinglePrecisionOverflow))
     })

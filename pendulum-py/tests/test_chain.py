@@ -122,10 +122,18 @@ def test_single_precision_is_the_double_precision_batch_to_its_documented_error(
     narrow = chain.accelerations(q[0].astype(np.float32), qd[0].astype(np.float32), precision="float32")
     general = chain.accelerations(q[0], qd[0], pivot_acceleration=np.zeros(2), precision="float32")
     assert table.dtype == np.float32 and np.array_equal(table, narrow) and np.array_equal(table, general)
+    # Joint torques too, as float64 takes them.
+    torque = rng.uniform(-1e-3, 1e-3, (4, 25, n))
+    double = chain.accelerations(q, qd, torque, pivot_acceleration=pivot)
+    single = chain.accelerations(q, qd, torque, pivot_acceleration=pivot, precision="float32")
+    error = np.max(np.abs(single - double), axis=-1) / np.max(np.abs(double), axis=-1)
+    assert 0 < error.max() < 1e-5
+    one = chain.accelerations(q[3, 7], qd[3, 7], torque[3, 7], pivot_acceleration=pivot[3, 7], precision="float32")
+    assert np.array_equal(one, single[3, 7])
     for call, message in [
         (lambda: chain.accelerations(q, qd, precision="float16"), "precision: 'float16' is neither"),
         (lambda: chain.accelerations(np.zeros(2 * n), precision="float32", model="spatial"), "model='planar' only"),
-        (lambda: chain.accelerations(q[0], qd[0], np.ones(n), precision="float32"), "takes no torques"),
+        (lambda: chain.accelerations(q[0], qd[0], np.ones((3, n)), precision="float32"), "torque"),
         (lambda: chain.accelerations(q[0], qd[0] * 1e20, precision="float32"), "not finite in single precision"),
         (lambda: chain.accelerations(q[0] * 1e40, precision="float32"), "not finite in single precision"),
         (lambda: chain.accelerations(np.full((3, n), np.inf, np.float32), precision="float32"), "q: inf is not finite"),
@@ -167,17 +175,18 @@ def test_single_precision_jacobians_are_the_double_precision_ones_to_their_docum
     n = 10
     chain = pendulum.Chain(rng.uniform(0.01, 0.1, n), rng.uniform(0.01, 0.1, n), damping=rng.uniform(1e-4, 1e-3, n))
     q, qd, pivot = rng.uniform(-3, 3, (4, 25, n)), rng.uniform(-5, 5, (4, 25, n)), rng.uniform(-30, 30, (4, 25, 2))
-    doubles = chain.jacobians(q, qd, pivot_acceleration=pivot)
-    singles = chain.jacobians(q, qd, pivot_acceleration=pivot, precision="float32")
-    for double, single, axes in zip(doubles, singles, [(-1,), (-2, -1), (-2, -1)]):
-        assert single.dtype == np.float32 and single.shape == double.shape
-        scale = np.abs(double).max(axis=axes, keepdims=True)
-        assert (np.abs(single - double) / scale).max() < 2e-5
-    one = chain.jacobians(q[1, 2], qd[1, 2], pivot_acceleration=pivot[1, 2], precision="float32")
-    for many, alone in zip(singles, one):
-        assert np.array_equal(many[1, 2], alone)
-    with pytest.raises(ValueError, match="takes no torques"):
-        chain.jacobians(q, qd, np.ones_like(q), precision="float32")
+    torque = rng.uniform(-1e-3, 1e-3, (4, 25, n))
+    for tau in (None, torque):
+        doubles = chain.jacobians(q, qd, tau, pivot_acceleration=pivot)
+        singles = chain.jacobians(q, qd, tau, pivot_acceleration=pivot, precision="float32")
+        for double, single, axes in zip(doubles, singles, [(-1,), (-2, -1), (-2, -1)]):
+            assert single.dtype == np.float32 and single.shape == double.shape
+            scale = np.abs(double).max(axis=axes, keepdims=True)
+            assert (np.abs(single - double) / scale).max() < 2e-5
+        tau_one = None if tau is None else tau[1, 2]
+        one = chain.jacobians(q[1, 2], qd[1, 2], tau_one, pivot_acceleration=pivot[1, 2], precision="float32")
+        for many, alone in zip(singles, one):
+            assert np.array_equal(many[1, 2], alone)
     with pytest.raises(ValueError, match="serve model='planar' and 'directions' only"):
         chain.jacobians(q[..., :n], precision="float32", model="spatial")
     with pytest.raises(ValueError, match="float16"):

@@ -143,9 +143,9 @@ fn the_scratch_a_batch_keeps_between_calls_changes_no_result() {
     let (q1, qd1, q2, qd2) = (single(&q1), single(&qd1), single(&q2), single(&qd2));
     let (mut out, mut new) = (vec![0.0f32; chains * n], vec![0.0f32; chains * n]);
     let batch = fresh.clone();
-    assert_eq!(batch.accelerations_f32(&q1, &qd1, None, &mut out).expect("first").len(), 1);
-    assert!(batch.accelerations_f32(&q2, &qd2, None, &mut out).expect("second").is_empty());
-    assert!(fresh.clone().accelerations_f32(&q2, &qd2, None, &mut new).expect("new").is_empty());
+    assert_eq!(batch.accelerations_f32(&q1, &qd1, None, None, &mut out).expect("first").len(), 1);
+    assert!(batch.accelerations_f32(&q2, &qd2, None, None, &mut out).expect("second").is_empty());
+    assert!(fresh.clone().accelerations_f32(&q2, &qd2, None, None, &mut new).expect("new").is_empty());
     assert_eq!(
         out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
         new.iter().map(|v| v.to_bits()).collect::<Vec<_>>()

@@ -296,11 +296,17 @@ fn single_precision_planar_chains_are_within_their_documented_error() {
             let q: Vec<f64> = (0..chains * n).map(|_| r.random_range(-3.0..3.0)).collect();
             let qd: Vec<f64> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
             let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-30.0..30.0)).collect();
+            // Joint torques on two chains in three: blocks of chains with and without them.
+            let torque: Vec<f64> = (0..chains * n)
+                .map(|i| if (i / n) % 3 == 0 { 0.0 } else { r.random_range(-1e-3..1e-3) })
+                .collect();
             let (mut out64, mut out32) = (vec![0.0; chains * n], vec![0.0f32; chains * n]);
-            assert!(batch.accelerations(&q, &qd, None, Some(&pivot), &mut out64).expect("f64").is_empty());
+            let (t, p) = (Some(&torque[..]), Some(&pivot[..]));
+            assert!(batch.accelerations(&q, &qd, t, p, &mut out64).expect("f64").is_empty());
             let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
-            let (q, qd, pivot) = (narrow(&q), narrow(&qd), narrow(&pivot));
-            assert!(batch.accelerations_f32(&q, &qd, Some(&pivot), &mut out32).expect("f32").is_empty());
+            let (q, qd, torque, pivot) = (narrow(&q), narrow(&qd), narrow(&torque), narrow(&pivot));
+            let (t, p) = (Some(&torque[..]), Some(&pivot[..]));
+            assert!(batch.accelerations_f32(&q, &qd, t, p, &mut out32).expect("f32").is_empty());
             let error = worst_relative_error(&out64, &out32, n);
             println!("planar, spread 10^{decades}, n = {n}: {error:.1e}");
             assert!(error < bound, "spread 10^{decades}, n = {n}: {error:e} ≥ {bound:e}");
@@ -317,16 +323,25 @@ fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_
     let mut qd: Vec<f32> = (0..chains * n).map(|_| r.random_range(-5.0..5.0)).collect();
     q[4 * n + 2] = f32::INFINITY;
     qd[13 * n + 7] = 3e19;
+    // Joint torques on every other chain, one of them not finite.
+    let mut torque: Vec<f32> =
+        (0..chains * n).map(|i| if (i / n) % 2 == 0 { 0.0 } else { r.random_range(-1e-3..1e-3) }).collect();
+    torque[17 * n + 3] = f32::NEG_INFINITY;
     let batch = PlanarBatch::new(list.clone()).expect("batch");
     let mut runs = Vec::new();
     for pool in pools() {
         let mut out = vec![0.0f32; chains * n];
-        let failures = pool.install(|| batch.accelerations_f32(&q, &qd, None, &mut out)).expect("f32");
-        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [4, 13]);
+        let failures =
+            pool.install(|| batch.accelerations_f32(&q, &qd, Some(&torque), None, &mut out)).expect("f32");
+        assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [4, 13, 17]);
         assert_eq!(failures[0].error, Error::NonFinite { what: "q", index: 2, value: f64::INFINITY });
         assert_eq!(failures[1].error, Error::SinglePrecisionOverflow);
+        assert_eq!(
+            failures[2].error,
+            Error::NonFinite { what: "torque", index: 3, value: f64::NEG_INFINITY }
+        );
         for (k, row) in out.chunks_exact(n).enumerate() {
-            assert_eq!(row.iter().all(|v| v.is_nan()), k == 4 || k == 13, "chain {k}");
+            assert_eq!(row.iter().all(|v| v.is_nan()), [4, 13, 17].contains(&k), "chain {k}");
         }
         runs.push(out.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
     }
@@ -335,7 +350,10 @@ fn single_precision_planar_chains_fail_by_chain_and_change_with_no_thread_count_
         let alone = PlanarBatch::new(vec![list[k].clone()]).expect("batch");
         let mut out = vec![0.0f32; n];
         let row = |v: &[f32]| v[k * n..(k + 1) * n].to_vec();
-        assert!(alone.accelerations_f32(&row(&q), &row(&qd), None, &mut out).expect("f32").is_empty());
+        let t = row(&torque);
+        assert!(
+            alone.accelerations_f32(&row(&q), &row(&qd), Some(&t), None, &mut out).expect("f32").is_empty()
+        );
         assert_eq!(
             out.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             runs[0][k * n..(k + 1) * n],

@@ -307,10 +307,11 @@ impl PlanarBatch {
         })
     }
 
-    /// [`accelerations`](Self::accelerations) in single precision: arrays in `f32`, eight
-    /// chains per AVX2 register, each chain's constants rounded to `f32`, the sines from
-    /// the single-precision kernel (Cephes' `sinf`). Not bit for bit anything: its error
-    /// against the `f64` call is measured in `docs/ensembles.md`.
+    /// [`accelerations`](Self::accelerations) in single precision, joint torques (`None`:
+    /// none) and pivot accelerations as it takes them: arrays in `f32`, eight chains per
+    /// AVX2 register, each chain's constants rounded to `f32`, the sines from the
+    /// single-precision kernel (Cephes' `sinf`). Not bit for bit anything: its error against
+    /// the `f64` call is measured in `docs/ensembles.md`.
     ///
     /// Returns the chains that failed, in order: a non-finite input as the `f64` call names
     /// it, otherwise [`Error::SinglePrecisionOverflow`]; their rows of `out` are NaN.
@@ -319,17 +320,21 @@ impl PlanarBatch {
         &self,
         q: &[f32],
         qd: &[f32],
+        torque: Option<&[f32]>,
         pivot: Option<&[f32]>,
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
         self.check_rows(q, qd, pivot, out)?;
+        if let Some(torque) = torque {
+            check_len("torque", torque, self.len(), self.links)?;
+        }
         Ok(self.in_blocks(
             [q, qd],
-            None,
+            torque,
             pivot,
             out,
             (f32::NAN, Error::SinglePrecisionOverflow),
-            |b, lanes, s, out| self.block_f32_simd(b, lanes, q, qd, pivot, s, out),
+            |b, lanes, s, out| self.block_f32_simd(b, lanes, q, qd, torque, pivot, s, out),
         ))
     }
 
@@ -382,15 +387,20 @@ impl PlanarBatch {
             lanes: [usize; WIDTH_F32],
             q: &[f32],
             qd: &[f32],
+            torque: Option<&[f32]>,
             pivot: Option<&[f32]>,
             s: &mut Scratch<F32x8>,
             out: &mut [f32],
         ) -> [bool; WIDTH_F32] {
             let (n, t) = (self.links, &mut s.states);
             let block = one_of(&self.blocks_f32, b);
+            let torqued = match torque {
+                Some(torque) => gather_torques(torque, lanes, n, Lanes32::flatten_mut(&mut t.torque)).map(u32::from),
+                None => F32x8::none(),
+            };
             let pivot = t.gather([q, qd], pivot, lanes, n);
             let trig = [&t.sin[..], &t.cos, &t.rates];
-            block.accelerations(trig, (&t.torque, F32x8::none()), pivot, &mut s.work, &mut s.accelerations);
+            block.accelerations(trig, (&t.torque, torqued), pivot, &mut s.work, &mut s.accelerations);
             scatter::<_, WIDTH_F32>(Lanes32::flatten(&s.accelerations), n, out);
             non_finite_lanes_f32(&s.accelerations).map(|flag| flag != 0)
         }
