@@ -17,6 +17,7 @@ use pyo3::prelude::*;
 use crate::arrays::{Rows, array};
 use crate::errors::{run_error, unknown_precision};
 use crate::interrupt::interruptible;
+use crate::results;
 
 /// Rods' solves per chunk of a batched integration: Ctrl-C is looked at between chunks
 /// (a few milliseconds each).
@@ -209,7 +210,8 @@ pub fn in_chunks<S, T>(
     let chunk = (SOLVES_PER_CHUNK / (4 * n * count).max(1)).max(1);
     let mut samples = Samples { q: Vec::new(), qd: Vec::new() };
     let mut done = 0;
-    for next in plan.samples() {
+    let times = plan.samples();
+    for (k, &next) in times.iter().enumerate() {
         while done < next {
             if stop.load(Ordering::Relaxed) {
                 return Err(Error::interrupted("the integration was interrupted"));
@@ -227,6 +229,11 @@ pub fn in_chunks<S, T>(
             done += now;
         }
         sample(states, &mut samples);
+        if k == 0 {
+            // Room for every sample at once, as large results are kept (`results`).
+            results::reserve_times(&mut samples.q, times.len());
+            results::reserve_times(&mut samples.qd, times.len());
+        }
     }
     Ok(samples)
 }

@@ -20,6 +20,16 @@ pub fn zeros<T: Copy + Default>(len: usize) -> Vec<T> {
     v
 }
 
+/// Room in `v` for `times` times the values it holds, in pages the kernel may make huge
+/// where that is large (the samples of a long run, appended as they come).
+pub fn reserve_times<T>(v: &mut Vec<T>, times: usize) {
+    v.reserve_exact(v.len() * times.saturating_sub(1));
+    let bytes = v.capacity() * std::mem::size_of::<T>();
+    if bytes >= HUGE_FROM {
+        advise_huge(v.as_ptr().cast(), bytes);
+    }
+}
+
 /// Asks the kernel for huge pages over the whole pages of `bytes` bytes from `start`
 /// (advice only: where it is refused, or not Linux, the pages stay as they are).
 #[cfg(target_os = "linux")]
