@@ -1,7 +1,8 @@
 """`Chain.integrate` against the RK4 a user would write around `Chain.accelerations` in
 numpy, in single precision, and with every pivot shaken at its own frequency
 (`drive=pendulum.Harmonic`): 10⁴ states of an 8-link planar chain, 100 steps of 1 ms
-(docs/ensembles.md).
+(docs/ensembles.md); and `Chain.trajectory` of the same states, 400 steps sampled every
+second one.
 
     target/python/bin/python pendulum-py/bench/integrate.py
 """
@@ -81,6 +82,14 @@ def main():
         f"({t_driven * per:.0f} ns per state-step, {t_driven / t_ours:.2f}x the held pivot's time); "
         f"numpy RK4 around accelerations(pivot_acceleration=p(t)): {t_numpy * 1e3:.1f} ms, "
         f"ratio {t_numpy / t_driven:.2f}x; largest difference {error:.1e}"
+    )
+    # A trajectory: 400 steps sampled every 2nd, 201 samples of every state (257 MB of them).
+    t_trajectory = best(lambda: chain.trajectory(q, qd, h=h, steps=400, every=2))
+    _, qs, qds = chain.trajectory(q, qd, h=h, steps=400, every=2)
+    same = np.array_equal(qs[-1], chain.integrate(q, qd, h=h, steps=400)[0])
+    print(
+        f"Chain.trajectory, 400 steps every 2nd: {t_trajectory * 1e3:.1f} ms "
+        f"({(qs.nbytes + qds.nbytes) / 1e6:.0f} MB of samples; last sample = integrate: {same})"
     )
 
 
