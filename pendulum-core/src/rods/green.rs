@@ -222,8 +222,9 @@ impl<const S: usize, V: Lane> Linearised<S, V> {
                 green[j + 1] = g;
             }
             // Σ_slot G[:, x − 1 + slot] r_slot, G padded with zeros outside the chain; by
-            // iterators over each row's blocks of `n` rods (indexed, each entry's bounds checks
-            // and a division per rod were a third of the loop).
+            // iterators over each row's blocks of `n` rods (no division to find a column's
+            // rod), each rod's body closed by a fence: without it LLVM vectorised a rod's
+            // columns with gathers, 1.6× slower (`docs/ensembles.md`).
             for (k, row) in rows.chunks_exact_mut(m).enumerate() {
                 for (row, rhs) in row.chunks_exact_mut(S * n).zip(rhs.chunks_exact(S * n)) {
                     let rods = row.chunks_exact_mut(S).zip(rhs.chunks_exact(S));
