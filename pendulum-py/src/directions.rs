@@ -22,7 +22,7 @@ use crate::arrays::Rows;
 use crate::detach::maybe_detached;
 use crate::drives::Pivot;
 use crate::errors::{core_error, invalid};
-use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, split};
+use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, rounded, split};
 use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
 use crate::results;
 use crate::states::Batch;
@@ -166,7 +166,7 @@ pub fn accelerations_f32(
     if q.count() == 0 {
         return Ok(out);
     }
-    let (u, w) = in_single(&q.data, &qd.data)?;
+    let (u, w) = (rounded(&q.data)?, rounded(&qd.data)?);
     first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
     Ok(out)
 }
@@ -180,23 +180,12 @@ pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_c
     let mut udd = vec![0.0f32; count * dof];
     let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));
     if count > 0 {
-        let (u, w) = in_single(&b.q.data, &b.qd.data)?;
+        let (u, w) = (rounded(&b.q.data)?, rounded(&b.qd.data)?);
         let batch = batch(chain, &b.pivot)?;
         first_error(batch.accelerations_split_f32(0.0, &u, &w, &mut udd)?)?;
         first_error(batch.state_jacobians_split_f32(0.0, &u, &w, &mut du, &mut dw)?)?;
     }
     Ok([udd, du, dw])
-}
-
-/// The directions and rates rounded to `f32`: finite in `f64` (checked when read), an
-/// infinity here is past `f32`'s range, [`pendulum_core::Error::SinglePrecisionOverflow`].
-fn in_single(u: &[f64], w: &[f64]) -> pendulum_core::Result<(Vec<f32>, Vec<f32>)> {
-    let narrow = |v: &[f64]| v.iter().map(|&v| v as f32).collect::<Vec<_>>();
-    let (u, w) = (narrow(u), narrow(w));
-    if u.iter().chain(&w).any(|v| !v.is_finite()) {
-        return Err(pendulum_core::Error::SinglePrecisionOverflow);
-    }
-    Ok((u, w))
 }
 
 /// `(T, U)` (J) of every state relative to the pivot ([`Directions::kinetic_energy`],

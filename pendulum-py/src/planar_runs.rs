@@ -249,10 +249,15 @@ pub fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, sa
 /// `v` rounded to `f32`; a number past its range is an error
 /// ([`SinglePrecisionOverflow`](pendulum_core::Error::SinglePrecisionOverflow)).
 pub fn narrow(v: &[f64]) -> pendulum_experiment::Result<Vec<f32>> {
+    rounded(v).map_err(core)
+}
+
+/// [`narrow`] with the core's error: the one rounding of every `f32` call.
+pub fn rounded(v: &[f64]) -> pendulum_core::Result<Vec<f32>> {
     let out: Vec<f32> = v.iter().map(|&x| x as f32).collect();
     match out.iter().all(|x| x.is_finite()) {
         true => Ok(out),
-        false => Err(core(pendulum_core::Error::SinglePrecisionOverflow)),
+        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
     }
 }
 

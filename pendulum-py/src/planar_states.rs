@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 
 use crate::detach::maybe_detached;
 use crate::errors::{core_error, invalid};
+use crate::planar_runs::rounded;
 use crate::results;
 
 /// `θ̈` of every planar state by the batch of chains ([`PlanarBatch::repeated`]) at the
@@ -57,10 +58,9 @@ pub fn planar_batch_f32(
     count: usize,
     [q, qd, torque, pivot]: [&[f64]; 4],
 ) -> pendulum_core::Result<Vec<f32>> {
-    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0f32; q.len()];
-    let (q, qd, torque, pivot) = (narrow(q), narrow(qd), narrow(torque), narrow(pivot));
+    let (q, qd, torque, pivot) = (rounded(q)?, rounded(qd)?, rounded(torque)?, rounded(pivot)?);
     let failures = batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?;
     // The inputs were checked finite in f64: a failure is single precision's range (an
     // input past f32's, or the solve's numbers).
@@ -79,9 +79,8 @@ pub fn planar_jacobians_f32(
     [q, qd, torque, pivot]: [&[f64]; 4],
 ) -> pendulum_core::Result<[Vec<f32>; 3]> {
     let n = chain.links();
-    let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
-    let (q, qd, torque, pivot) = (narrow(q), narrow(qd), narrow(torque), narrow(pivot));
+    let (q, qd, torque, pivot) = (rounded(q)?, rounded(qd)?, rounded(torque)?, rounded(pivot)?);
     let (torque, pivot) = (Some(&torque[..]), Some(&pivot[..]));
     let mut qdd = vec![0.0f32; q.len()];
     let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
