@@ -11,7 +11,8 @@
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
 //!   (throughput in chain-steps per second; also in `f32`, `integrate_rk4_f32`, on one
 //!   thread), and 10 steps of the implicit rod midpoint
-//!   chain by chain against `integrate_rod_midpoint` on one thread and on two;
+//!   chain by chain against `integrate_rod_midpoint` (in four lanes) on one thread and on
+//!   two;
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
@@ -290,11 +291,14 @@ fn rk4(c: &mut Criterion) {
             t += 0.1;
         })
     });
-    // The implicit rod midpoint, 10 steps per call: each chain on its own, over the cores.
+    // The implicit rod midpoint, 10 steps per call, every call from the same states (a run
+    // of them went on into a whirl whose steps cost more): each chain on its own, against
+    // the batch.
     group.throughput(Throughput::Elements(10 * CHAINS as u64));
     let mut states = start.clone();
     group.bench_function("whirl_100/rod_midpoint_single_10_steps", |b| {
         b.iter(|| {
+            states.clone_from(&start);
             for (k, state) in states.iter_mut().enumerate() {
                 let model = batch.model(k);
                 let mut step = RodMidpoint::new();
@@ -309,10 +313,12 @@ fn rk4(c: &mut Criterion) {
         let mut states = start.clone();
         group.bench_function(format!("whirl_100/rod_midpoint_batch_{threads}_threads_10_steps"), |b| {
             in_pool(b, &pool, || {
+                states.clone_from(&start);
                 batch.integrate_rod_midpoint(&mut states, 1e-3, 10).expect("batch");
             })
         });
     }
+
     group.finish();
 }
 

@@ -10,7 +10,7 @@ use nalgebra::{DVector, Dyn, U2, U3};
 use pendulum_core::RodMidpoint;
 use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
-use pendulum_core::{Accounted, Circle, Directions, Error, trajectory};
+use pendulum_core::{Accounted, Circle, Directions, Error, Harmonic, trajectory};
 use pendulum_tests::batches::{assert_bits, pools, random_chain, whirl, whirl_state};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -414,6 +414,166 @@ fn batched_direction_jacobians_are_each_models_own_bit_for_bit_and_failures_stay
         batch.state_jacobians(0.0, &x[1..], &mut du, &mut dw),
         Err(Error::LengthMismatch { what: "x", .. })
     ));
+}
+
+/// The rod midpoint helpers for chains in `$dim` dimensions driven by `$drive`s.
+macro_rules! midpoint_helpers {
+    ($alone:ident, $as_alone:ident, $dim:ty, $drive:ty) => {
+        /// `steps` rod midpoint steps of `h` of each state alone, with the ledger when
+        /// `accounted`: the states after them, the first error of each, and how many steps each
+        /// took halved (by the step's own stats).
+        fn $alone(
+            models: &[Directions<$dim, $drive>],
+            start: &[State<Dyn>],
+            accounted: bool,
+            (h, steps): (f64, usize),
+        ) -> (Vec<State<Dyn>>, Vec<Option<Error>>, Vec<u64>) {
+            let mut states = start.to_vec();
+            let mut errors = Vec::new();
+            let mut halved = Vec::new();
+            for (model, state) in models.iter().zip(&mut states) {
+                let mut step = RodMidpoint::new();
+                let error = if accounted {
+                    let system = Accounted::of(model.clone());
+                    (0..steps).find_map(|_| step.step(&system, state, h).err())
+                } else {
+                    (0..steps).find_map(|_| step.step(model, state, h).err())
+                };
+                errors.push(error);
+                halved.push(step.stats().halved_steps);
+            }
+            (states, errors, halved)
+        }
+
+        /// The batch's rod midpoint steps of `start` equal each chain's own, bit for bit, in eight
+        /// lanes and in four, on one thread and two, whole and split in two batches; the failures
+        /// are the chains' own errors.
+        fn $as_alone(
+            models: &[Directions<$dim, $drive>],
+            start: &[State<Dyn>],
+            accounted: bool,
+            (h, steps): (f64, usize),
+        ) -> Vec<u64> {
+            let (single, errors, halved) = $alone(models, start, accounted, (h, steps));
+            let expected: Vec<(usize, String)> = errors
+                .iter()
+                .enumerate()
+                .filter_map(|(k, e)| e.as_ref().map(|e| (k, e.to_string())))
+                .collect();
+            let batch_of = |models: &[Directions<$dim, $drive>]| {
+                let batch = if accounted {
+                    DirectionsBatch::accounted(models.to_vec())
+                } else {
+                    DirectionsBatch::new(models.to_vec())
+                };
+                batch.expect("batch")
+            };
+            let cut = models.len() / 3;
+            for avx512 in [true, false] {
+                for pool in pools() {
+                    let what = format!(
+                        "accounted {accounted}, AVX-512 {avx512}, {} threads",
+                        pool.current_num_threads()
+                    );
+                    let mut states = start.to_vec();
+                    let batch = batch_of(models).with_avx512(avx512);
+                    let failures =
+                        pool.install(|| batch.integrate_rod_midpoint(&mut states, h, steps)).expect("batch");
+                    let failed: Vec<(usize, String)> =
+                        failures.iter().map(|f| (f.chain, f.error.to_string())).collect();
+                    assert_eq!(failed, expected, "{what}");
+                    // Split in two batches at `cut`.
+                    let mut parts = start.to_vec();
+                    let (front, back) = parts.split_at_mut(cut);
+                    let (first, second) = (batch_of(&models[..cut]), batch_of(&models[cut..]));
+                    pool.install(|| first.with_avx512(avx512).integrate_rod_midpoint(front, h, steps))
+                        .expect("front");
+                    pool.install(|| second.with_avx512(avx512).integrate_rod_midpoint(back, h, steps))
+                        .expect("back");
+                    for (k, ((a, b), c)) in states.iter().zip(&single).zip(&parts).enumerate() {
+                        for (state, whose) in [(a, "batch"), (c, "split")] {
+                            let what = format!("{what}: chain {k}, {whose}");
+                            assert_eq!(state.t().to_bits(), b.t().to_bits(), "{what}: t");
+                            assert_bits(state.x().as_slice(), b.x().as_slice(), &what);
+                            assert_bits(state.compensation().as_slice(), b.compensation().as_slice(), &what);
+                        }
+                    }
+                }
+            }
+            halved
+        }
+    };
+}
+
+midpoint_helpers!(midpoint_alone_3d, midpoint_as_alone_3d, U3, Circle);
+midpoint_helpers!(midpoint_alone_2d, midpoint_as_alone_2d, U2, Harmonic<U2>);
+
+#[test]
+fn rod_midpoint_steps_in_lanes_are_each_chains_own_even_where_some_chains_halve_or_fail() {
+    let mut r = ChaCha8Rng::seed_from_u64(23);
+    // 3D whirls of 12 links: three blocks of eight, the last one short. A step of 20 ms
+    // is halved for the chains that spin fastest and taken whole in lanes for the others.
+    let (models, x): (Vec<_>, Vec<_>) = (0..19).map(|_| whirl(12, &mut r)).unzip();
+    for accounted in [false, true] {
+        let mut start: Vec<State<Dyn>> = if accounted {
+            accounted_states(&models, &x)
+        } else {
+            x.iter().map(|x| State::new(0.0, x.clone())).collect()
+        };
+        // Chains 2, 7, 13 and 17 turn by 0.95 rad in the first step, just below the most
+        // a step may turn before it is halved untried: their Newton iterations fail in
+        // lanes, and the chains' own integrators halve the step.
+        for k in [2, 7, 13, 17] {
+            let mut x = start[k].x().clone();
+            let rates = 36..72;
+            let fastest = x.as_slice()[rates.clone()]
+                .chunks(3)
+                .map(|w| w.iter().map(|v| v * v).sum::<f64>())
+                .fold(0.0, f64::max);
+            x.as_mut_slice()[rates].iter_mut().for_each(|w| *w *= 0.95 / (0.02 * fastest.sqrt()));
+            start[k] = State::new(0.0, x);
+        }
+        // Chain 5 starts from a NaN; chain 11 from rates that overflow.
+        let mut bad = start[5].x().clone();
+        bad[7] = f64::NAN;
+        start[5] = State::new(0.25, bad);
+        let mut fast = start[11].x().clone();
+        let half = fast.len() / 2 - if accounted { 1 } else { 0 };
+        fast[half + 4] = 1e200;
+        start[11] = State::new(0.5, fast);
+        let halved = midpoint_as_alone_3d(&models, &start, accounted, (0.02, 6));
+        let halving = halved.iter().filter(|&&h| h > 0).count();
+        assert!((4..14).contains(&halving), "chains halving: {halved:?}");
+    }
+    // Planar chains in directions, shaken along random directions and swinging, at a
+    // step of 1 ms.
+    let planar: Vec<Directions<U2, Harmonic<U2>>> = (0..11)
+        .map(|_| {
+            let along = nalgebra::Vector2::new(r.random_range(-1.0..1.0), r.random_range(0.1..1.0));
+            let (amplitude, frequency) = (r.random_range(0.0..0.05), r.random_range(1.0..10.0));
+            let drive = Harmonic::new(along, amplitude, frequency, r.random_range(0.0..6.0)).expect("drive");
+            Directions::<U2>::new(random_chain(7, &mut r)).with_drive(drive)
+        })
+        .collect();
+    let start: Vec<State<Dyn>> = planar
+        .iter()
+        .map(|m| {
+            let q: Vec<f64> = (0..7).map(|_| r.random_range(-1.0..1.0)).collect();
+            let qd: Vec<f64> = (0..7).map(|_| r.random_range(-3.0..3.0)).collect();
+            State::new(r.random_range(0.0..1.0), m.from_angles(&q, &qd).expect("state"))
+        })
+        .collect();
+    for accounted in [false, true] {
+        let start: Vec<State<Dyn>> = if accounted {
+            let ledger = |(m, s): (&Directions<U2, Harmonic<U2>>, &State<Dyn>)| {
+                State::new(s.t(), Accounted::of(m.clone()).state(s.x()).expect("state"))
+            };
+            planar.iter().zip(&start).map(ledger).collect()
+        } else {
+            start.clone()
+        };
+        midpoint_as_alone_2d(&planar, &start, accounted, (1e-3, 8));
+    }
 }
 
 #[test]

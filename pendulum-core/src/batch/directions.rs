@@ -67,6 +67,11 @@ impl<const W: usize> Block<W> {
     pub(super) fn down(&self) -> Lanes<W> {
         self.down
     }
+
+    /// Per link, the rods' lengths (m) and damping `λ` (N·m·s) in lanes.
+    pub(super) fn lengths_and_damping(&self) -> (&[Lanes<W>], &[Lanes<W>]) {
+        (&self.lengths, &self.damping)
+    }
 }
 
 /// Per task: the rows of the solve and, for the steps, the stage vectors in lane order.
@@ -220,6 +225,22 @@ impl<const C: usize, V: Lane> Solve<C, V> {
             RateLoads { directions, rates, drag: rods.drag() },
             accelerations,
         );
+    }
+
+    /// The rod tensions `T_i` (N) into `out` (`n`) of the solve
+    /// [`accelerations`](Self::accelerations) does.
+    #[inline(always)]
+    pub(super) fn tensions(
+        &mut self,
+        rods: &Rods<V>,
+        gravity: [V; C],
+        pivot: [V; C],
+        x: &[V],
+        out: &mut [V],
+    ) {
+        let half = C * self.links;
+        let loads = RateLoads::new(&x[..half], &x[half..2 * half], rods.drag());
+        rods.solve(gravity, pivot, &mut self.rows, loads, |i, _, _, t| out[i] = t);
     }
 
     /// The tension solve of `loads`: `ü` into `out` (`C·n`).

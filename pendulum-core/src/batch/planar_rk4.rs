@@ -20,7 +20,7 @@ use super::{
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
-use crate::lanes::{Aligned, Lane, Lanes, Lanes32, one_row_at_a_time};
+use crate::lanes::{Aligned, Lane, Lanes, Lanes32, Masked, one_row_at_a_time};
 
 /// A block's run: `sin θ`, `cos θ` of a stage and the solve's room (`n` lanes), the joint
 /// torques, the lanes with torques and the pivot accelerations, the states and their

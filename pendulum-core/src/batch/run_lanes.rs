@@ -7,11 +7,11 @@ use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
 use super::transpose::Transpose;
 use super::{F32x8, WIDTH_F32};
 use crate::kinematics::{trig::sin_cos_split, trig32::sin_cos_split_f32};
-use crate::lanes::{Lane, Lanes, Lanes32};
+use crate::lanes::{Lanes, Lanes32, Masked};
 
 /// The lanes a batch steps and differentiates in, with their precision's sine kernel: four
 /// or eight `f64` lanes ([`Lanes`]) or [`F32x8`].
-pub(super) trait RunLane: Lane + Send {
+pub(super) trait RunLane: Masked + Send {
     /// The number type of one lane.
     type Num: Transpose + Into<f64> + Send + Sync;
     /// The lanes of `v` one after another.
@@ -27,10 +27,6 @@ pub(super) trait RunLane: Lane + Send {
     fn sin_cos(angles: &[Self], sin: &mut [Self], cos: &mut [Self]);
     /// The lanes in which some entry of `v` is not finite.
     fn non_finite(v: &[Self]) -> Self::Mask;
-    /// `a` and not `b`, lane by lane.
-    fn and_not(a: Self::Mask, b: Self::Mask) -> Self::Mask;
-    /// `a` and `b`, lane by lane.
-    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
 }
 
 impl<const W: usize> RunLane for Lanes<W> {
@@ -59,14 +55,6 @@ impl<const W: usize> RunLane for Lanes<W> {
     fn non_finite(v: &[Self]) -> [u64; W] {
         non_finite_lanes(v)
     }
-    #[inline(always)]
-    fn and_not(a: [u64; W], b: [u64; W]) -> [u64; W] {
-        std::array::from_fn(|k| a[k] & !b[k])
-    }
-    #[inline(always)]
-    fn and(a: [u64; W], b: [u64; W]) -> [u64; W] {
-        std::array::from_fn(|k| a[k] & b[k])
-    }
 }
 
 impl RunLane for F32x8 {
@@ -94,13 +82,5 @@ impl RunLane for F32x8 {
     #[inline(always)]
     fn non_finite(v: &[Self]) -> [u32; WIDTH_F32] {
         non_finite_lanes_f32(v)
-    }
-    #[inline(always)]
-    fn and_not(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
-        std::array::from_fn(|k| a[k] & !b[k])
-    }
-    #[inline(always)]
-    fn and(a: [u32; WIDTH_F32], b: [u32; WIDTH_F32]) -> [u32; WIDTH_F32] {
-        std::array::from_fn(|k| a[k] & b[k])
     }
 }

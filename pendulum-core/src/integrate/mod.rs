@@ -137,9 +137,16 @@ where
 
     /// `t += h`, `x += increment` with compensated (Kahan) summation.
     pub(crate) fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
+        self.advance_by(h, |i, _| increment[i]);
+    }
+
+    /// [`advance`](Self::advance) by the increments `increment(i, x_i)`, asked in order.
+    pub(crate) fn advance_by(&mut self, h: f64, mut increment: impl FnMut(usize, f64) -> f64) {
         (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
-        for i in 0..self.x.len() {
-            (self.x[i], self.x_carry[i]) = kahan_add(self.x[i], self.x_carry[i], increment[i]);
+        let (x, carry) = (self.x.as_mut_slice(), self.x_carry.as_mut_slice());
+        assert_eq!(x.len(), carry.len(), "a compensation per entry");
+        for i in 0..x.len() {
+            (x[i], carry[i]) = kahan_add(x[i], carry[i], increment(i, x[i]));
         }
     }
 }

@@ -120,6 +120,29 @@ pub trait Lane:
     }
 }
 
+/// The comparisons and the flags' logic that control flow in lanes needs (a lane that
+/// converged or failed is masked while the others go on), on lanes held as arrays.
+pub trait Masked: Lane {
+    /// The flags of both.
+    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// The flags of `a` that are not in `b`.
+    fn and_not(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// `|x|`, lane by lane.
+    fn abs(self) -> Self;
+    /// `other` where it is larger, else `self`, lane by lane: `f64::max` for a `self` that
+    /// is not NaN (a NaN `other` loses). A compare and a select, which stay in vector
+    /// registers (`f64::max` on arrays of eight lanes was computed one lane at a time).
+    fn max(self, other: Self) -> Self;
+    /// The lanes that are infinite or NaN.
+    fn not_finite(self) -> Self::Mask;
+    /// The lanes that are `±0`.
+    fn is_zero(self) -> Self::Mask;
+    /// The lanes with `self ≤ bound` (never a NaN lane).
+    fn at_most(self, bound: Self) -> Self::Mask;
+    /// The lanes with `self > bound` (never a NaN lane).
+    fn above(self, bound: Self) -> Self::Mask;
+}
+
 impl Lane for f64 {
     type Mask = bool;
     const WIDTH: usize = 1;
@@ -160,6 +183,41 @@ impl Lane for f64 {
     fn normalizer(self) -> Self {
         let biased = (self.to_bits() >> 52) & 0x7ff;
         f64::from_bits(((2046 - biased as i64) as u64 & 0x7ff) << 52)
+    }
+}
+
+impl Masked for f64 {
+    #[inline(always)]
+    fn and(a: bool, b: bool) -> bool {
+        a & b
+    }
+    #[inline(always)]
+    fn and_not(a: bool, b: bool) -> bool {
+        a & !b
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        if other > self { other } else { self }
+    }
+    #[inline(always)]
+    fn not_finite(self) -> bool {
+        !self.is_finite()
+    }
+    #[inline(always)]
+    fn is_zero(self) -> bool {
+        self == 0.0
+    }
+    #[inline(always)]
+    fn at_most(self, bound: Self) -> bool {
+        self <= bound
+    }
+    #[inline(always)]
+    fn above(self, bound: Self) -> bool {
+        self > bound
     }
 }
 
@@ -270,6 +328,75 @@ macro_rules! lane_op {
 
 lane_array!(Lanes, f64);
 lane_array!(Lanes32, f32);
+
+/// The comparisons and masks of [`Lane`] for a lane array type of `$t` with masks
+/// `[$m; W]` (1 in a flagged lane).
+macro_rules! lane_masks {
+    ($t:ty, $m:ty) => {
+        #[inline(always)]
+        fn and(a: [$m; W], b: [$m; W]) -> [$m; W] {
+            let mut out = a;
+            for k in 0..W {
+                out[k] &= b[k];
+            }
+            out
+        }
+        #[inline(always)]
+        fn and_not(a: [$m; W], b: [$m; W]) -> [$m; W] {
+            let mut out = a;
+            for k in 0..W {
+                out[k] &= !b[k];
+            }
+            out
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            self.map(<$t>::abs)
+        }
+        #[inline(always)]
+        fn max(self, other: Self) -> Self {
+            let mut out = self.0;
+            for k in 0..W {
+                if other.0[k] > out[k] {
+                    out[k] = other.0[k];
+                }
+            }
+            Self(out)
+        }
+        #[inline(always)]
+        fn not_finite(self) -> [$m; W] {
+            let mut out = [0; W];
+            for k in 0..W {
+                out[k] = <$m>::from(!self.0[k].is_finite());
+            }
+            out
+        }
+        #[inline(always)]
+        fn is_zero(self) -> [$m; W] {
+            let mut out = [0; W];
+            for k in 0..W {
+                out[k] = <$m>::from(self.0[k] == 0.0);
+            }
+            out
+        }
+        #[inline(always)]
+        fn at_most(self, bound: Self) -> [$m; W] {
+            let mut out = [0; W];
+            for k in 0..W {
+                out[k] = <$m>::from(self.0[k] <= bound.0[k]);
+            }
+            out
+        }
+        #[inline(always)]
+        fn above(self, bound: Self) -> [$m; W] {
+            let mut out = [0; W];
+            for k in 0..W {
+                out[k] = <$m>::from(self.0[k] > bound.0[k]);
+            }
+            out
+        }
+    };
+}
 
 /// The flags of either mask, lane by lane.
 #[inline(always)]
@@ -430,6 +557,14 @@ impl<const W: usize> Lane for Lanes<W> {
     fn normalizer(self) -> Self {
         self.map(f64::normalizer)
     }
+}
+
+impl<const W: usize> Masked for Lanes32<W> {
+    lane_masks!(f32, u32);
+}
+
+impl<const W: usize> Masked for Lanes<W> {
+    lane_masks!(f64, u64);
 }
 
 #[cfg(test)]

@@ -8,17 +8,18 @@
 //! drive and damping ledger exactly, so it can step over those modes; it does not resolve
 //! them (their frequencies come out too low), and it is of order 2.
 
-use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
+use nalgebra::{DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
-use crate::chain::Chain;
 use crate::drive::Drive;
 use crate::energy::Accounted;
 use crate::energy::ledger::LEDGER_LEN;
 use crate::error::{Error, Result};
 use crate::integrate::{Integrator, State, Stats};
+use crate::lanes::{Lane, Masked};
 use crate::models::directions::Directions;
-use newton::{LinkRow, Pivot};
+use iteration::{Chains, Iterated, Limits, Work};
 
+pub(crate) mod iteration;
 mod newton;
 
 /// The energy-conserving midpoint step of a chain of point masses on rigid rods
@@ -56,16 +57,8 @@ pub struct RodMidpoint {
     stats: Stats,
     tolerance: f64,
     max_iterations: usize,
-    planar: Work<2>,
-    spatial: Work<3>,
-}
-
-/// The Newton matrix's rows and its elimination's pivots, in `C` dimensions: buffers kept
-/// from step to step.
-#[derive(Debug, Clone, Default)]
-struct Work<const C: usize> {
-    rows: Vec<LinkRow<C>>,
-    pivots: Vec<Pivot<C>>,
+    planar: Work<2, f64>,
+    spatial: Work<3, f64>,
 }
 
 impl Default for RodMidpoint {
@@ -157,36 +150,39 @@ impl RodMidpoint {
     where
         DefaultAllocator: Allocator<S>,
     {
-        let n = chain.links();
         // A link turning by more than MAX_TURN in the step: halve it without trying.
-        let fastest = motion[S::DIM * n..]
-            .chunks_exact(S::DIM)
-            .map(|w| w.iter().map(|v| v * v).sum::<f64>())
-            .fold(0.0, f64::max)
-            .sqrt();
-        if depth < MAX_HALVINGS && h.abs() * fastest > MAX_TURN {
+        if depth < MAX_HALVINGS && turns_too_far(&motion[S::DIM * chain.links()..], S::DIM, h) {
             return self.halves(chain, t, motion, h, out, depth);
         }
         let drive = chain.drive();
         let ends = [drive.position(t), drive.position(t + h), drive.velocity(t), drive.velocity(t + h)];
         let limits = self.limits();
         // The multipliers' start: the tensions at t (the accelerations come with them).
+        let n = chain.links();
         let mut start = vec![0.0; (S::DIM + 1) * n];
         let (accelerations, tensions) = start.split_at_mut(S::DIM * n);
         if chain.accelerations_of_valid(t, motion, accelerations, Some(tensions)).is_err() {
             return Err(0);
         }
-        let start = Start { tensions };
-        let result = match S::DIM {
+        let links = chain.chain();
+        let chains = Chains {
+            masses: links.masses().as_slice(),
+            lengths: links.lengths().as_slice(),
+            damping: links.damping().as_slice(),
+            down: -links.gravity(),
+        };
+        let data = (motion, h, &mut *out);
+        let Iterated { failed, iterations, drive, damped } = match S::DIM {
             2 => {
                 let ends = ends.map(|v| [v[0], v[1]]);
-                newton::<2>(&mut self.planar, &start, chain.chain(), ends, motion, h, out, &limits)
+                iteration::iterate(&mut self.planar, &chains, tensions, ends, data, true, &limits)
             }
             _ => {
                 let ends = ends.map(|v| [v[0], v[1], v[2]]);
-                newton::<3>(&mut self.spatial, &start, chain.chain(), ends, motion, h, out, &limits)
+                iteration::iterate(&mut self.spatial, &chains, tensions, ends, data, true, &limits)
             }
         };
+        let result = if failed { Err(iterations) } else { Ok((StepWork { drive, damped }, iterations)) };
         // One tension solve for the start; one factorisation per Newton iteration.
         let iterations = match &result {
             Ok((_, i)) | Err(i) => *i,
@@ -221,179 +217,47 @@ impl RodMidpoint {
         Ok(StepWork { drive: first.drive + second.drive, damped: first.damped + second.damped })
     }
 
-    fn limits(&self) -> Limits {
+    /// The stopping rule of the Newton iteration.
+    pub(crate) fn limits(&self) -> Limits {
         Limits { tolerance: self.tolerance, max_iterations: self.max_iterations }
     }
 }
 
-/// The rod tensions `T_i` at the start of a step.
-struct Start<'a> {
-    tensions: &'a [f64],
-}
-
-struct Limits {
-    tolerance: f64,
-    max_iterations: usize,
-}
-
-/// `a − b`, `a·b` and the `i`-th `C`-vector of a flat slice.
-fn sub<const C: usize>(a: [f64; C], b: [f64; C]) -> [f64; C] {
-    std::array::from_fn(|k| a[k] - b[k])
-}
-fn dot<const C: usize>(a: [f64; C], b: [f64; C]) -> f64 {
-    (0..C).map(|k| a[k] * b[k]).sum()
-}
-fn at<const C: usize>(v: &[f64], i: usize) -> [f64; C] {
-    std::array::from_fn(|k| v[i * C + k])
-}
-
-/// The Newton iteration of one step in `C` dimensions. `ends`:
-/// pivot position at `t` and `t + h`, velocity at `t` and `t + h`. Returns the step's
-/// work and its Newton iterations (each one factorisation), or the iterations spent when
-/// it did not converge.
-#[allow(clippy::too_many_arguments)] // One step's data, all of it needed.
-fn newton<const C: usize>(
-    work: &mut Work<C>,
-    start: &Start,
-    chain: &Chain<nalgebra::Dyn>,
-    ends: [[f64; C]; 4],
-    motion: &[f64],
-    h: f64,
-    out: &mut [f64],
-    limits: &Limits,
-) -> std::result::Result<(StepWork, usize), usize> {
-    let [p0, p1, pv0, pv1] = ends;
-    let n = chain.links();
-    let (m, l, lambda) = (chain.masses(), chain.lengths(), chain.damping());
-    let mut gravity = [0.0; C];
-    gravity[C - 1] = -chain.gravity();
-    let reach: f64 = l.iter().sum::<f64>() + p0.iter().chain(&p1).fold(0.0_f64, |a, b| a.max(b.abs()));
-    let (u, w) = motion.split_at(C * n);
-
-    // Positions and velocities at t; the start of the iteration: each rod turned by h w_i
-    // (with h²/2 ü_i too it took more iterations), the multipliers μ_i = T_i / l_i at t.
-    let mut x0 = vec![0.0; C * n];
-    let mut v0 = vec![0.0; C * n];
-    let mut x1 = vec![0.0; C * n];
-    let (mut r0, mut rv, mut r1) = (p0, pv0, p1);
-    for i in 0..n {
-        let (ui, wi) = (at::<C>(u, i), at::<C>(w, i));
-        let turned: [f64; C] = std::array::from_fn(|k| ui[k] + h * wi[k]);
-        let norm = dot(turned, turned).sqrt();
-        for k in 0..C {
-            r0[k] += l[i] * ui[k];
-            rv[k] += l[i] * wi[k];
-            r1[k] += l[i] * turned[k] / norm;
-            x0[i * C + k] = r0[k];
-            v0[i * C + k] = rv[k];
-            x1[i * C + k] = r1[k];
+/// The lanes in which a link would turn by more than [`MAX_TURN`] in a step of `h` (s):
+/// `|h| max_i |w_i| > MAX_TURN`, from the rates `w` of a state (`dims` numbers each, 1/s).
+#[inline(always)]
+pub(crate) fn turns_too_far<V: Masked>(rates: &[V], dims: usize, h: f64) -> V::Mask {
+    let mut fastest = V::splat(0.0);
+    for w in rates.chunks_exact(dims) {
+        let mut squared = w[0] * w[0];
+        for &v in &w[1..] {
+            squared += v * v;
         }
+        fastest = fastest.max(squared);
     }
-    let mut mu: Vec<f64> = (0..n).map(|i| start.tensions[i] / l[i]).collect();
-    // Rod i's damping pair per unit change of the rod vector, λ_i/(l_i² h), and mass i's
-    // inertia term 2 m_i/h².
-    let damping = |i: usize| lambda[i] / (l[i] * l[i] * h);
-    let inertia = |i: usize| 2.0 * m[i] / (h * h);
-    let pivot_step = sub(p1, p0);
+    (V::splat(h.abs()) * fastest.sqrt()).above(V::splat(MAX_TURN))
+}
 
-    // Rod i's vectors: endpoint e_i, midpoint d_i, change of the rod vector s_i.
-    let rod = |x1: &[f64], i: usize| -> ([f64; C], [f64; C], [f64; C]) {
-        let (a0, a1) = if i == 0 { (p0, p1) } else { (at::<C>(&x0, i - 1), at::<C>(x1, i - 1)) };
-        let (b0, b1) = (at::<C>(&x0, i), at::<C>(x1, i));
-        let e = sub(b1, a1);
-        let d = std::array::from_fn(|k| 0.5 * (b0[k] + b1[k] - a0[k] - a1[k]));
-        let s = std::array::from_fn(|k| (b1[k] - b0[k]) - (a1[k] - a0[k]));
-        (e, d, s)
-    };
+/// Entry `j` of a step's increment of a state whose entry is `x`: `next_j − x` for the
+/// motion (`j < next.len()`), then the step's `work` for the ledger's `W_drive` and
+/// `E_damped` (J) when given, and `x − x` (zero, or NaN as the entry) for its other entry.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` on purpose: zero, or NaN as the entry.
+pub(crate) fn increment<V: Lane>(j: usize, x: V, next: &[V], work: Option<(V, V)>) -> V {
+    let len = next.len();
+    match work {
+        _ if j < len => next[j] - x,
+        Some((drive, _)) if j == len => drive,
+        Some((_, damped)) if j == len + 2 => damped,
+        _ => x - x,
+    }
+}
 
-    // Newton's method, the matrix refactored at every iteration (a frozen matrix, tried,
-    // took several times the iterations once the free end whips).
-    let mut iterations = 0;
-    let mut previous = f64::INFINITY;
-    loop {
-        if iterations == limits.max_iterations {
-            return Err(iterations);
-        }
-        iterations += 1;
-        // Residuals and the Newton matrix, link by link (`newton` module docs).
-        let Work { rows, pivots } = &mut *work;
-        rows.clear();
-        let mut next = rod(&x1, 0);
-        for i in 0..n {
-            let (e, d, s) = next;
-            let has_next = i + 1 < n;
-            if has_next {
-                next = rod(&x1, i + 1);
-            }
-            let (_, d_next, s_next) = next;
-            let (mu_i, mu_next) = (mu[i], if has_next { mu[i + 1] } else { 0.0 });
-            let (c_i, c_next) = (damping(i), if has_next { damping(i + 1) } else { 0.0 });
-            let xi = at::<C>(&x1, i);
-            let x0i = at::<C>(&x0, i);
-            let v0i = at::<C>(&v0, i);
-            let force: [f64; C] = std::array::from_fn(|k| {
-                let mut r =
-                    inertia(i) * (xi[k] - x0i[k] - h * v0i[k]) - m[i] * gravity[k] + c_i * s[k] + mu_i * d[k];
-                if has_next {
-                    r -= c_next * s_next[k] + mu_next * d_next[k];
-                }
-                -r
-            });
-            rows.push(LinkRow {
-                stiffness: inertia(i) + c_i + c_next + 0.5 * (mu_i + mu_next),
-                coupling: c_i + 0.5 * mu_i,
-                midpoint: d,
-                end: e,
-                force,
-                constraint: -0.5 * (dot(e, e) - l[i] * l[i]),
-            });
-        }
-        if !newton::solve(rows, pivots) {
-            return Err(iterations);
-        }
-        let mut largest: f64 = 0.0;
-        for (i, row) in rows.iter().enumerate() {
-            for k in 0..C {
-                x1[i * C + k] += row.force[k];
-                largest = largest.max(row.force[k].abs());
-            }
-            mu[i] += row.constraint;
-        }
-        if !largest.is_finite() {
-            return Err(iterations);
-        }
-        // Newton converges quadratically: the error left after this correction is about
-        // δ_k²/δ_{k−1} (or less), so stop once that is below the tolerance.
-        if largest <= limits.tolerance * reach
-            || (previous.is_finite() && largest * largest / previous <= limits.tolerance * reach)
-        {
-            break;
-        }
-        previous = largest;
-    }
-
-    // The new state and the step's work.
-    let (u_out, w_out) = out.split_at_mut(C * n);
-    let mut previous_velocity = pv1;
-    let (_, d_first, s_first) = rod(&x1, 0);
-    let pair_first: [f64; C] = std::array::from_fn(|k| -damping(0) * s_first[k]);
-    let drive: f64 = (0..C).map(|k| (pair_first[k] - mu[0] * d_first[k]) * pivot_step[k]).sum();
-    let mut damped = 0.0;
-    for i in 0..n {
-        let (e, _, s) = rod(&x1, i);
-        damped += damping(i) * dot(s, s);
-        let velocity: [f64; C] =
-            std::array::from_fn(|k| 2.0 * (x1[i * C + k] - x0[i * C + k]) / h - v0[i * C + k]);
-        for k in 0..C {
-            u_out[i * C + k] = e[k] / l[i];
-            w_out[i * C + k] = (velocity[k] - previous_velocity[k]) / l[i];
-        }
-        previous_velocity = velocity;
-    }
-    if !out.iter().all(|v| v.is_finite()) {
-        return Err(iterations);
-    }
-    Ok((StepWork { drive, damped }, iterations))
+/// Moves `state` by a step of `h` (s) to its new motion `next` (the state's first
+/// entries), adding the step's `work` to the ledger after them when given.
+fn take_step(state: &mut State<Dyn>, h: f64, next: &[f64], work: Option<&StepWork>) {
+    let work = work.map(|w| (w.drive, w.damped));
+    state.advance_by(h, |j, x| increment(j, x, next, work));
 }
 
 impl<S: DimName, Dr: Drive<S>> Integrator<Directions<S, Dr>> for RodMidpoint
@@ -403,8 +267,7 @@ where
     fn step(&mut self, system: &Directions<S, Dr>, state: &mut State<nalgebra::Dyn>, h: f64) -> Result<()> {
         let mut next = state.x().clone();
         self.advance(system, state.t(), state.x().as_slice(), h, next.as_mut_slice())?;
-        let increment = next - state.x();
-        state.advance(h, &increment);
+        take_step(state, h, next.as_slice(), None);
         Ok(())
     }
 
@@ -438,10 +301,7 @@ where
             h,
             &mut next.as_mut_slice()[..len],
         )?;
-        let mut increment = next - x;
-        increment[len] = work.drive;
-        increment[len + 2] = work.damped;
-        state.advance(h, &increment);
+        take_step(state, h, &next.as_slice()[..len], Some(&work));
         Ok(())
     }
 
@@ -455,6 +315,7 @@ mod tests {
     use nalgebra::{DVector, U2, U3};
 
     use super::*;
+    use crate::chain::Chain;
     use crate::integrate::{Projected, Rk4};
 
     fn twisted(model: &Directions<U3, impl Drive<U3>>, n: usize, tilt: f64) -> DVector<f64> {

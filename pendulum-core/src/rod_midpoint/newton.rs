@@ -19,50 +19,104 @@
 //! of 1.25 ms (`cargo bench -p pendulum-core --bench large_chains -- step/free_1000` at
 //! each commit, one run each).
 
-/// Link `i`'s row of the Newton matrix and its right-hand side.
+use crate::lanes::Masked;
+
+/// Link `i`'s row of the Newton matrix and its right-hand side, in lanes `V` (one chain's
+/// numbers in each; `f64` for one chain).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct LinkRow<const C: usize> {
+pub(crate) struct LinkRow<const C: usize, V = f64> {
     /// `k_i`, the position block's diagonal.
-    pub stiffness: f64,
+    pub stiffness: V,
     /// `a_i`: the coupling of `x_i` to `x_{i−1}` is `−a_i I` (both ways).
-    pub coupling: f64,
+    pub coupling: V,
     /// `d_i`: the multiplier's column.
-    pub midpoint: [f64; C],
+    pub midpoint: [V; C],
     /// `e_i`: the constraint's row.
-    pub end: [f64; C],
+    pub end: [V; C],
     /// `r_i`; the solution's `δx_i` after [`solve`].
-    pub force: [f64; C],
+    pub force: [V; C],
     /// `q_i`; the solution's `δμ_i` after [`solve`].
-    pub constraint: f64,
+    pub constraint: V,
 }
 
 /// What the elimination keeps of link `i`: the inverse of its pivot (`C + 1` rows, of
 /// which the first `C` columns are needed going back) and its part of the solution.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Pivot<const C: usize> {
+pub(crate) struct Pivot<const C: usize, V = f64> {
     /// Columns `0..C` of `D'⁻¹_i`: rows `0..C` in `top`, row `C` in `bottom`.
-    top: [[f64; C]; C],
-    bottom: [f64; C],
+    top: [[V; C]; C],
+    bottom: [V; C],
     /// `D'⁻¹_i y_i`: the solution before the back substitution.
-    position: [f64; C],
-    multiplier: f64,
+    position: [V; C],
+    multiplier: V,
 }
 
-/// Solves the system in place (see the module docs). Returns `false` when a pivot is
-/// singular or not finite.
-pub(crate) fn solve<const C: usize>(rows: &mut [LinkRow<C>], pivots: &mut Vec<Pivot<C>>) -> bool {
-    pivots.clear();
-    for &row in rows.iter() {
-        let mut p = [[0.0; C]; C];
+impl<const C: usize, V: Masked> Pivot<C, V> {
+    /// A pivot of zeros, to size the buffers with.
+    pub(crate) fn zero() -> Self {
+        let zero = V::splat(0.0);
+        Self { top: [[zero; C]; C], bottom: [zero; C], position: [zero; C], multiplier: zero }
+    }
+}
+
+/// `Σ_k a_k b_k`, summed in order `k = 0, 1, …` (as `Iterator::sum` adds them).
+#[inline(always)]
+pub(super) fn dot<const C: usize, V: Masked>(a: [V; C], b: [V; C]) -> V {
+    let mut sum = a[0] * b[0];
+    for k in 1..C {
+        sum += a[k] * b[k];
+    }
+    sum
+}
+
+/// `M b`.
+#[inline(always)]
+fn times<const C: usize, V: Masked>(m: &[[V; C]; C], b: [V; C]) -> [V; C] {
+    let mut out = b;
+    for (o, line) in out.iter_mut().zip(m) {
+        *o = dot(*line, b);
+    }
+    out
+}
+
+/// `Mᵀ b`.
+#[inline(always)]
+fn times_transposed<const C: usize, V: Masked>(m: &[[V; C]; C], b: [V; C]) -> [V; C] {
+    let mut out = b;
+    for (j, o) in out.iter_mut().enumerate() {
+        let mut sum = m[0][j] * b[0];
+        for k in 1..C {
+            sum += m[k][j] * b[k];
+        }
+        *o = sum;
+    }
+    out
+}
+
+/// Solves the system in place (see the module docs), lane by lane, with `pivots` (as many
+/// as `rows`) for the elimination's. Returns the lanes in which a pivot is singular or not
+/// finite (their numbers are then meaningless).
+#[inline(always)]
+pub(crate) fn solve<const C: usize, V: Masked>(
+    rows: &mut [LinkRow<C, V>],
+    pivots: &mut [Pivot<C, V>],
+) -> V::Mask {
+    assert_eq!(rows.len(), pivots.len(), "a pivot per row");
+    let zero = V::splat(0.0);
+    let mut singular = V::none();
+    for i in 0..rows.len() {
+        let row = rows[i];
+        let mut p = [[zero; C]; C];
         for (k, line) in p.iter_mut().enumerate() {
             line[k] = row.stiffness;
         }
-        let (mut b, mut c, mut s) = (row.midpoint, row.end, 0.0);
+        let (mut b, mut c, mut s) = (row.midpoint, row.end, zero);
         let (mut y, mut yq) = (row.force, row.constraint);
-        if let Some(before) = pivots.last() {
+        if i > 0 {
+            let before = &pivots[i - 1];
             let (a, w, e, d) = (row.coupling, &before.top, row.end, row.midpoint);
-            let wd: [f64; C] = std::array::from_fn(|j| (0..C).map(|k| w[j][k] * d[k]).sum());
-            let wte: [f64; C] = std::array::from_fn(|j| (0..C).map(|k| w[k][j] * e[k]).sum());
+            let wd = times(w, d);
+            let wte = times_transposed(w, e);
             for j in 0..C {
                 for k in 0..C {
                     p[j][k] -= a * a * w[j][k];
@@ -74,85 +128,88 @@ pub(crate) fn solve<const C: usize>(rows: &mut [LinkRow<C>], pivots: &mut Vec<Pi
                 yq += e[j] * before.position[j];
             }
         }
-        let Some(pi) = invert(p) else { return false };
+        let (pi, bad) = invert(p);
         // D'⁻¹ = [P⁻¹ + u vᵀ/σ, −u/σ; −vᵀ/σ, 1/σ], u = P⁻¹ b, vᵀ = cᵀ P⁻¹, σ = s − cᵀ u.
-        let u: [f64; C] = std::array::from_fn(|j| (0..C).map(|k| pi[j][k] * b[k]).sum());
-        let v: [f64; C] = std::array::from_fn(|j| (0..C).map(|k| c[k] * pi[k][j]).sum());
-        let sigma = s - (0..C).map(|k| c[k] * u[k]).sum::<f64>();
-        if !(sigma.is_finite() && sigma != 0.0) {
-            return false;
+        let u = times(&pi, b);
+        let v = times_transposed(&pi, c);
+        let sigma = s - dot(c, u);
+        let mut top = pi;
+        for j in 0..C {
+            for k in 0..C {
+                top[j][k] = pi[j][k] + u[j] * v[k] / sigma;
+            }
         }
-        let top: [[f64; C]; C] =
-            std::array::from_fn(|j| std::array::from_fn(|k| pi[j][k] + u[j] * v[k] / sigma));
-        let bottom: [f64; C] = std::array::from_fn(|k| -v[k] / sigma);
-        let (vy, top_y): (f64, [f64; C]) = (
-            (0..C).map(|k| v[k] * y[k]).sum(),
-            std::array::from_fn(|j| (0..C).map(|k| top[j][k] * y[k]).sum()),
-        );
-        let position: [f64; C] = std::array::from_fn(|j| top_y[j] - u[j] / sigma * yq);
+        let mut bottom = v;
+        for b in &mut bottom {
+            *b = -*b / sigma;
+        }
+        let (vy, top_y) = (dot(v, y), times(&top, y));
+        let mut position = top_y;
+        let mut unusable = V::or(bad, V::or(sigma.not_finite(), sigma.is_zero()));
+        for j in 0..C {
+            position[j] = top_y[j] - u[j] / sigma * yq;
+            unusable = V::or(unusable, position[j].not_finite());
+        }
         let multiplier = (yq - vy) / sigma;
-        if !(multiplier.is_finite() && position.iter().all(|v| v.is_finite())) {
-            return false;
+        singular = V::or(singular, V::or(unusable, multiplier.not_finite()));
+        if V::all(singular) {
+            return singular;
         }
-        pivots.push(Pivot { top, bottom, position, multiplier });
+        pivots[i] = Pivot { top, bottom, position, multiplier };
     }
     // Back: δz_i = D'⁻¹_i y_i + D'⁻¹_i [a_{i+1} δx_{i+1} + d_{i+1} δμ_{i+1}; 0].
-    let mut next: Option<([f64; C], f64)> = None;
     for i in (0..rows.len()).rev() {
         let pivot = &pivots[i];
         let (mut x, mut mu) = (pivot.position, pivot.multiplier);
-        if let Some((dx, dmu)) = next {
-            let after = &rows[i + 1];
-            let g: [f64; C] = std::array::from_fn(|k| after.coupling * dx[k] + after.midpoint[k] * dmu);
-            for (xj, top) in x.iter_mut().zip(&pivot.top) {
-                *xj += (0..C).map(|k| top[k] * g[k]).sum::<f64>();
+        if let Some(after) = rows.get(i + 1) {
+            let (dx, dmu) = (after.force, after.constraint);
+            let mut g = dx;
+            for k in 0..C {
+                g[k] = after.coupling * dx[k] + after.midpoint[k] * dmu;
             }
-            mu += (0..C).map(|k| pivot.bottom[k] * g[k]).sum::<f64>();
+            let moved = times(&pivot.top, g);
+            for j in 0..C {
+                x[j] += moved[j];
+            }
+            mu += dot(pivot.bottom, g);
         }
         rows[i].force = x;
         rows[i].constraint = mu;
-        next = Some((x, mu));
     }
-    true
+    singular
 }
 
-/// The inverse of a 2 × 2 or 3 × 3 matrix by its adjugate; `None` when singular or not
-/// finite. No pivoting: the position blocks are near `k_i I`, far from singular.
-fn invert<const C: usize>(a: [[f64; C]; C]) -> Option<[[f64; C]; C]> {
-    let mut inverse = [[0.0; C]; C];
-    let det = match C {
-        2 => {
-            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-            inverse[0][0] = a[1][1];
-            inverse[0][1] = -a[0][1];
-            inverse[1][0] = -a[1][0];
-            inverse[1][1] = a[0][0];
-            det
-        }
-        3 => {
-            let cofactor = |i: usize, j: usize| {
-                let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
-                let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
-                a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
-            };
-            for (i, line) in inverse.iter_mut().enumerate() {
-                for (j, v) in line.iter_mut().enumerate() {
-                    *v = cofactor(j, i);
-                }
+/// The inverse of a 2 × 2 or 3 × 3 matrix by its adjugate, lane by lane, and the lanes in
+/// which it is singular or not finite. No pivoting: the position blocks are near `k_i I`,
+/// far from singular.
+#[inline(always)]
+fn invert<const C: usize, V: Masked>(a: [[V; C]; C]) -> ([[V; C]; C], V::Mask) {
+    let mut inverse = a;
+    let det = if C == 2 {
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        inverse[0][0] = a[1][1];
+        inverse[0][1] = -a[0][1];
+        inverse[1][0] = -a[1][0];
+        inverse[1][1] = a[0][0];
+        det
+    } else {
+        debug_assert_eq!(C, 3, "2 or 3 dimensions");
+        for (i, line) in inverse.iter_mut().enumerate() {
+            for (j, v) in line.iter_mut().enumerate() {
+                // The cofactor of entry (j, i).
+                let (r0, r1) = ((j + 1) % 3, (j + 2) % 3);
+                let (c0, c1) = ((i + 1) % 3, (i + 2) % 3);
+                *v = a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0];
             }
-            (0..3).map(|j| a[0][j] * inverse[j][0]).sum()
         }
-        _ => return None,
+        a[0][0] * inverse[0][0] + a[0][1] * inverse[1][0] + a[0][2] * inverse[2][0]
     };
-    if !(det.is_finite() && det != 0.0) {
-        return None;
-    }
     for line in inverse.iter_mut() {
         for v in line.iter_mut() {
-            *v /= det;
+            *v = *v / det;
         }
     }
-    Some(inverse)
+    (inverse, V::or(det.not_finite(), det.is_zero()))
 }
 
 #[cfg(test)]
@@ -199,7 +256,7 @@ mod tests {
         }
         let expected = dense.lu().solve(&rhs).unwrap();
         let mut solved = rows.clone();
-        assert!(solve(&mut solved, &mut Vec::new()));
+        assert!(!solve(&mut solved, &mut vec![Pivot::zero(); n]));
         for (i, r) in solved.iter().enumerate() {
             for k in 0..C {
                 assert!((r.force[k] - expected[i * b + k]).abs() < 1e-12, "{i} {k}");
@@ -208,10 +265,55 @@ mod tests {
         }
     }
 
+    /// In lanes, each lane solves its own system, bit for bit as alone, and a lane with a
+    /// singular pivot is flagged without touching the others.
+    #[test]
+    fn in_lanes_each_lane_is_its_own_system() {
+        use crate::lanes::Lanes;
+        const C: usize = 3;
+        let n = 7;
+        let value = |i: usize, k: usize, lane: usize| ((i * 13 + k * 7 + lane * 31) as f64 * 0.61).sin();
+        let row = |i: usize, lane: usize| LinkRow::<C> {
+            // Lane 2's third link is singular.
+            stiffness: if lane == 2 && i == 3 { 0.0 } else { 50.0 + value(i, 0, lane) },
+            coupling: if lane == 2 && i == 3 { 0.0 } else { 3.0 + value(i, 1, lane) },
+            midpoint: std::array::from_fn(|k| value(i, k + 2, lane)),
+            end: std::array::from_fn(|k| value(i, k + 5, lane)),
+            force: std::array::from_fn(|k| value(i, k + 8, lane)),
+            constraint: value(i, 11, lane),
+        };
+        let lanes = |f: &dyn Fn(usize) -> f64| Lanes::<4>(std::array::from_fn(f));
+        let mut rows: Vec<LinkRow<C, Lanes<4>>> = (0..n)
+            .map(|i| LinkRow {
+                stiffness: lanes(&|l| row(i, l).stiffness),
+                coupling: lanes(&|l| row(i, l).coupling),
+                midpoint: std::array::from_fn(|k| lanes(&|l| row(i, l).midpoint[k])),
+                end: std::array::from_fn(|k| lanes(&|l| row(i, l).end[k])),
+                force: std::array::from_fn(|k| lanes(&|l| row(i, l).force[k])),
+                constraint: lanes(&|l| row(i, l).constraint),
+            })
+            .collect();
+        let singular = solve(&mut rows, &mut vec![Pivot::zero(); n]);
+        assert_eq!(singular, [0, 0, 1, 0]);
+        for lane in [0, 1, 3] {
+            let mut alone: Vec<LinkRow<C>> = (0..n).map(|i| row(i, lane)).collect();
+            assert!(!solve(&mut alone, &mut vec![Pivot::zero(); n]));
+            for (a, b) in alone.iter().zip(&rows) {
+                for k in 0..C {
+                    assert_eq!(a.force[k].to_bits(), b.force[k].0[lane].to_bits(), "lane {lane}");
+                }
+                assert_eq!(a.constraint.to_bits(), b.constraint.0[lane].to_bits(), "lane {lane}");
+            }
+        }
+        let mut alone: Vec<LinkRow<C>> = (0..n).map(|i| row(i, 2)).collect();
+        assert!(solve(&mut alone, &mut vec![Pivot::zero(); n]));
+    }
+
     #[test]
     fn small_inverses_are_inverses() {
         let a = [[4.0, 1.0, -2.0], [0.5, 3.0, 1.0], [-1.0, 2.0, 5.0]];
-        let b = invert(a).unwrap();
+        let (b, singular) = invert(a);
+        assert!(!singular);
         let product = |i: usize, j: usize| (0..3).map(|k| a[i][k] * b[k][j]).sum::<f64>();
         for i in 0..3 {
             for j in 0..3 {
@@ -219,9 +321,9 @@ mod tests {
                 assert!((p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14, "{i} {j} {p}");
             }
         }
-        let b = invert([[2.0, 1.0], [3.0, 4.0]]).unwrap();
-        assert_eq!(b, [[0.8, -0.2], [-0.6, 0.4]]);
-        assert!(invert([[1.0, 2.0], [2.0, 4.0]]).is_none());
+        let (b, singular) = invert([[2.0, 1.0], [3.0, 4.0]]);
+        assert_eq!((b, singular), ([[0.8, -0.2], [-0.6, 0.4]], false));
+        assert!(invert([[1.0, 2.0], [2.0, 4.0]]).1);
     }
 
     #[test]
@@ -234,6 +336,6 @@ mod tests {
             force: [1.0; 2],
             constraint: 1.0,
         };
-        assert!(!solve(&mut [row], &mut Vec::new()));
+        assert!(solve(&mut [row], &mut [Pivot::zero()]));
     }
 }
