@@ -184,12 +184,25 @@ impl Chain {
         [q]: [&Bound<'py, PyAny>; 1],
         [qd, torque, pivot]: [Option<&Bound<'py, PyAny>>; 3],
         (plan, drive): (Plan, Option<Given>),
-        (model, precision): (&str, &str),
+        (model, precision, method): (&str, &str, &str),
     ) -> PyResult<Bound<'py, PyAny>> {
         let route = Route::of(model)?;
         if route == Route::Angles(Kind::Spatial) {
             return Err(invalid("integrate: serves model='planar' and model='directions'"));
         }
+        let implicit = match method {
+            "rk4" => false,
+            "rod_midpoint" if route != Route::Directions => {
+                return Err(invalid("method: 'rod_midpoint' steps model='directions' (planar runs are RK4)"));
+            }
+            "rod_midpoint" if precision != "float64" => {
+                return Err(invalid(format!(
+                    "precision: {precision:?} with method='rod_midpoint' (float64 only)"
+                )));
+            }
+            "rod_midpoint" => true,
+            _ => return Err(invalid(format!("method: {method:?} is not 'rk4' or 'rod_midpoint'"))),
+        };
         if !(plan.h.is_finite() && plan.h > 0.0) {
             return Err(invalid(format!("h: {} is not a positive time step (s)", plan.h)));
         }
@@ -203,15 +216,8 @@ impl Chain {
             let b = self.directions_rows(q, qd, torque, pivot)?;
             let drives = drive.map(|d| d.spatial(&b.q.lead)).transpose()?;
             let rows = [b.q, b.qd, b.torque, b.pivot];
-            return run_as(
-                py,
-                &self.inner,
-                rows,
-                (plan, drives),
-                precision,
-                directions::rk4,
-                directions::rk4_f32,
-            );
+            let double = if implicit { directions::rod_midpoint } else { directions::rk4 };
+            return run_as(py, &self.inner, rows, (plan, drives), precision, double, directions::rk4_f32);
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
         let drives = drive.map(|d| d.planar(&b.q.lead)).transpose()?;
@@ -449,11 +455,14 @@ impl Chain {
     /// state's pivot within the call instead, its parameters one for all or one per state,
     /// from the time `t0` (s; pass the end of one call as the start of the next).
     /// `model="directions"` steps the 3D chain in directions by RK4 with each rod put back
-    /// to unit length after every step (float64, no torques).
+    /// to unit length after every step (float64, no torques), or, with
+    /// `method="rod_midpoint"`, by the implicit rod midpoint step: stable at any `h`, the
+    /// rods exactly rigid, a free chain's energy kept to the Newton tolerance
+    /// (docs/integrators.md), its Newton iterations four or eight states per SIMD register.
     /// `precision="float32"` steps eight planar states per register in single precision and
     /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
     /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0))]
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0, method = "rk4"))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn integrate<'py>(
         &self,
@@ -468,15 +477,17 @@ impl Chain {
         precision: &str,
         drive: Option<&Bound<'py, PyAny>>,
         t0: f64,
+        method: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let plan = Plan { h, steps: count("steps", steps)?, every: None, t0 };
-        self.run(py, [q], [qd, torque, pivot_acceleration], (plan, Given::read(drive)?), (model, precision))
+        let given = (plan, Given::read(drive)?);
+        self.run(py, [q], [qd, torque, pivot_acceleration], given, (model, precision, method))
     }
 
     /// `(t, q, qd)`: `integrate`'s run sampled at the start, after every `every`-th step and
     /// after the last: `t` (s, from `t0`) of shape `(samples,)`, `q` and `qd` of shape
     /// `(samples, ...)` with the states' own shape after the first axis.
-    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps, every = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0))]
+    #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps, every = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0, method = "rk4"))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn trajectory<'py>(
         &self,
@@ -492,13 +503,15 @@ impl Chain {
         precision: &str,
         drive: Option<&Bound<'py, PyAny>>,
         t0: f64,
+        method: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let every = match count("every", every)? {
             0 => return Err(invalid("every: 0 is not a number of steps (1 or more)")),
             every => every,
         };
         let plan = Plan { h, steps: count("steps", steps)?, every: Some(every), t0 };
-        self.run(py, [q], [qd, torque, pivot_acceleration], (plan, Given::read(drive)?), (model, precision))
+        let given = (plan, Given::read(drive)?);
+        self.run(py, [q], [qd, torque, pivot_acceleration], given, (model, precision, method))
     }
 
     /// `(qdd, dqdd_dq, dqdd_dqd)`: the accelerations (rad/s²) and their analytic Jacobians

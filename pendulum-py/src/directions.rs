@@ -13,7 +13,7 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::Directions;
-use pendulum_core::batch::DirectionsBatch;
+use pendulum_core::batch::{DirectionsBatch, Failure};
 use pendulum_core::drive::Drive;
 use pendulum_core::integrate::State;
 use pyo3::prelude::*;
@@ -230,8 +230,31 @@ pub fn rk4(
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
     match drives {
-        None => rk4_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop),
-        Some(drives) => rk4_of(&driven(chain, drives)?, [q, qd], plan, stop),
+        None => {
+            run_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop, DirectionsBatch::integrate_rk4)
+        }
+        Some(drives) => run_of(&driven(chain, drives)?, [q, qd], plan, stop, DirectionsBatch::integrate_rk4),
+    }
+}
+
+/// [`rk4`] by the implicit rod midpoint step instead ([`DirectionsBatch::integrate_rod_midpoint`]:
+/// `RodMidpoint`, its Newton iterations in SIMD lanes, each state's numbers bit for bit
+/// its own).
+pub fn rod_midpoint(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, _torque, pivot]: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f64>> {
+    match drives {
+        None => {
+            let batch = batch(chain, pivot).map_err(core)?;
+            run_of(&batch, [q, qd], plan, stop, DirectionsBatch::integrate_rod_midpoint)
+        }
+        Some(drives) => {
+            run_of(&driven(chain, drives)?, [q, qd], plan, stop, DirectionsBatch::integrate_rod_midpoint)
+        }
     }
 }
 
@@ -259,12 +282,19 @@ fn driven(
     DirectionsBatch::new(drives.into_iter().map(|d| one.clone().with_drive(d)).collect()).map_err(core)
 }
 
-/// [`rk4`] of the chains of `batch`, whatever drives their pivots.
-fn rk4_of<Dr: Drive<U3> + Sync>(
+/// `steps` steps of `h` (s) of a batch's states: its RK4 or rod midpoint runs.
+type Steps<Dr> =
+    fn(&DirectionsBatch<U3, Dr>, &mut [State<Dyn>], f64, usize) -> pendulum_core::Result<Vec<Failure>>;
+
+/// The run of the chains of `batch`, whatever drives their pivots, by `step(batch, states,
+/// h, steps)` ([`DirectionsBatch::integrate_rk4`] or
+/// [`DirectionsBatch::integrate_rod_midpoint`]).
+fn run_of<Dr: Drive<U3> + Sync>(
     batch: &DirectionsBatch<U3, Dr>,
     [q, qd]: [&Rows; 2],
     plan: Plan,
     stop: &AtomicBool,
+    step: Steps<Dr>,
 ) -> pendulum_experiment::Result<Samples<f64>> {
     let half = q.width;
     let mut states: Vec<State<Dyn>> = states(q, qd)
@@ -274,7 +304,7 @@ fn rk4_of<Dr: Drive<U3> + Sync>(
     in_chunks(
         (&q.lead, batch.links(), plan, stop),
         &mut states,
-        |states, _, now| batch.integrate_rk4(states, plan.h, now),
+        |states, _, now| step(batch, states, plan.h, now),
         |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),
     )
 }

@@ -250,6 +250,54 @@ def test_float32_runs_follow_float64_and_keep_rods_rigid():
     assert np.array_equal(alone[0], q32[4]) and np.array_equal(alone[1], qd32[4])
 
 
+def test_the_rod_midpoint_keeps_a_free_chains_energy_at_a_long_step_and_each_state_is_its_own():
+    # method="rod_midpoint": the implicit step, stable far past RK4's limit, keeps a free
+    # undamped chain's energy to the Newton tolerance and its rods rigid exactly; many
+    # states in SIMD lanes, each bit for bit itself alone, also where a state's step is
+    # halved (a link turning by more than a radian).
+    chain = pendulum.Chain([0.3, 0.2, 0.25, 0.1, 0.2, 0.15], [0.4, 0.3, 0.35, 0.2, 0.25, 0.3])
+    r = np.random.default_rng(7)
+    u, w = random_states(r, (3, 5), 6)
+    w[1, 3] *= 100.0  # h |w_i| near 2 rad: its steps are halved
+    e0 = sum(chain.energy(u, w, model="directions"))
+    q, qd = chain.integrate(u, w, h=0.02, steps=200, model="directions", method="rod_midpoint")
+    e1 = sum(chain.energy(q, qd, model="directions"))
+    drift = np.max(np.abs(e1 - e0) / np.abs(e0))
+    print(f"energy after 200 rod midpoint steps of 20 ms: {drift:.1e} relative")
+    assert drift < 1e-10
+    links = q.reshape(3, 5, 6, 3)
+    assert np.max(np.abs(np.linalg.norm(links, axis=-1) - 1)) < 1e-13
+    for k in [(0, 0), (1, 3), (2, 4)]:
+        alone = chain.integrate(u[k], w[k], h=0.02, steps=200, model="directions", method="rod_midpoint")
+        assert np.array_equal(alone[0], q[k]) and np.array_equal(alone[1], qd[k])
+    # Driven, it converges to projected RK4's motion at order 2; the trajectory's samples
+    # are integrate's states.
+    circle = pendulum.Circle(radius=0.05, omega=4.0)
+    exact, _ = chain.integrate(u[0], w[0], h=1e-4, steps=4000, model="directions", drive=circle)
+    errors = []
+    for steps in [400, 800]:
+        t, qs, _ = chain.trajectory(u[0], w[0], h=0.4 / steps, steps=steps, every=steps // 2, model="directions", method="rod_midpoint", drive=circle)
+        errors.append(np.max(np.abs(qs[2] - exact)))
+    order = np.log2(errors[0] / errors[1])
+    print(f"rod midpoint errors at 1 and 0.5 ms after 0.4 s: {errors[0]:.1e}, {errors[1]:.1e}; order {order:.2f}")
+    assert 1.8 < order < 2.3 and errors[1] < 1e-4
+    half, _ = chain.integrate(u[0], w[0], h=5e-4, steps=400, model="directions", method="rod_midpoint", drive=circle)
+    assert np.allclose(t, [0.0, 0.2, 0.4]) and np.array_equal(qs[1], half)
+
+
+def test_the_rod_midpoint_refuses_what_it_does_not_serve():
+    chain = pendulum.Chain([1.0, 1.0], [1.0, 1.0])
+    u = np.array([0.0, 0.0, -1.0, 0.6, 0.0, -0.8])
+    with pytest.raises(ValueError, match="'rod_midpoint' steps model='directions'"):
+        chain.integrate([0.1, 0.2], h=0.01, method="rod_midpoint")
+    with pytest.raises(ValueError, match=r"precision: \"float32\" with method='rod_midpoint'"):
+        chain.integrate(u, h=0.01, model="directions", precision="float32", method="rod_midpoint")
+    with pytest.raises(ValueError, match=r"method: \"euler\" is not 'rk4' or 'rod_midpoint'"):
+        chain.integrate(u, h=0.01, model="directions", method="euler")
+    with pytest.raises(ValueError, match="h: 0 is not a positive time step"):
+        chain.integrate(u, h=0.0, model="directions", method="rod_midpoint")
+
+
 def test_bad_input_is_named():
     chain = pendulum.Chain([1.0, 1.0], [1.0, 1.0])
     u = np.array([0.0, 0.0, -1.0, 0.6, 0.0, -0.8])

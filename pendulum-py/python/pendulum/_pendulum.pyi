@@ -134,6 +134,7 @@ class Chain:
         precision: str = "float64",
         drive: Union[Harmonic, Circle, None] = None,
         t0: float = 0.0,
+        method: str = "rk4",
     ) -> tuple[_Array, _Array]: ...
     def trajectory(
         self,
@@ -149,6 +150,7 @@ class Chain:
         precision: str = "float64",
         drive: Union[Harmonic, Circle, None] = None,
         t0: float = 0.0,
+        method: str = "rk4",
     ) -> tuple[_Array, _Array, _Array]: ...
     def jacobians(
         self,
