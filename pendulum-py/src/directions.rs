@@ -13,7 +13,7 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DVector, Dyn, U3, Vector3};
 use pendulum_core::Directions;
-use pendulum_core::batch::{DirectionsBatch, Failure};
+use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::drive::Drive;
 use pendulum_core::integrate::State;
 use pyo3::prelude::*;
@@ -224,17 +224,12 @@ pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core:
 /// signature of the planar runs, the torques unused: the caller refuses them).
 pub fn rk4(
     chain: &pendulum_core::Chain<Dyn>,
-    [q, qd, _torque, pivot]: [&Rows; 4],
+    rows: [&Rows; 4],
     drives: Option<Vec<Pivot>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
-    match drives {
-        None => {
-            run_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop, DirectionsBatch::integrate_rk4)
-        }
-        Some(drives) => run_of(&driven(chain, drives)?, [q, qd], plan, stop, DirectionsBatch::integrate_rk4),
-    }
+    runs(chain, rows, drives, (plan, Method::Rk4), stop)
 }
 
 /// [`rk4`] by the implicit rod midpoint step instead ([`DirectionsBatch::integrate_rod_midpoint`]:
@@ -242,19 +237,33 @@ pub fn rk4(
 /// its own).
 pub fn rod_midpoint(
     chain: &pendulum_core::Chain<Dyn>,
-    [q, qd, _torque, pivot]: [&Rows; 4],
+    rows: [&Rows; 4],
     drives: Option<Vec<Pivot>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
+    runs(chain, rows, drives, (plan, Method::RodMidpoint), stop)
+}
+
+/// How a run in float64 steps: [`rk4`] or [`rod_midpoint`].
+#[derive(Debug, Clone, Copy)]
+enum Method {
+    Rk4,
+    RodMidpoint,
+}
+
+/// The run of `plan` by `method`, each pivot's acceleration held or, given `drives`, each
+/// pivot moved.
+fn runs(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, _torque, pivot]: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    run: (Plan, Method),
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f64>> {
     match drives {
-        None => {
-            let batch = batch(chain, pivot).map_err(core)?;
-            run_of(&batch, [q, qd], plan, stop, DirectionsBatch::integrate_rod_midpoint)
-        }
-        Some(drives) => {
-            run_of(&driven(chain, drives)?, [q, qd], plan, stop, DirectionsBatch::integrate_rod_midpoint)
-        }
+        None => run_of(&batch(chain, pivot).map_err(core)?, [q, qd], run, stop),
+        Some(drives) => run_of(&driven(chain, drives)?, [q, qd], run, stop),
     }
 }
 
@@ -282,19 +291,12 @@ fn driven(
     DirectionsBatch::new(drives.into_iter().map(|d| one.clone().with_drive(d)).collect()).map_err(core)
 }
 
-/// `steps` steps of `h` (s) of a batch's states: its RK4 or rod midpoint runs.
-type Steps<Dr> =
-    fn(&DirectionsBatch<U3, Dr>, &mut [State<Dyn>], f64, usize) -> pendulum_core::Result<Vec<Failure>>;
-
-/// The run of the chains of `batch`, whatever drives their pivots, by `step(batch, states,
-/// h, steps)` ([`DirectionsBatch::integrate_rk4`] or
-/// [`DirectionsBatch::integrate_rod_midpoint`]).
-fn run_of<Dr: Drive<U3> + Sync>(
+/// The run of the chains of `batch`, whatever drives their pivots, by `method`.
+fn run_of<Dr: Drive<U3> + Clone + Sync>(
     batch: &DirectionsBatch<U3, Dr>,
     [q, qd]: [&Rows; 2],
-    plan: Plan,
+    (plan, method): (Plan, Method),
     stop: &AtomicBool,
-    step: Steps<Dr>,
 ) -> pendulum_experiment::Result<Samples<f64>> {
     let half = q.width;
     let mut states: Vec<State<Dyn>> = states(q, qd)
@@ -304,7 +306,10 @@ fn run_of<Dr: Drive<U3> + Sync>(
     in_chunks(
         (&q.lead, batch.links(), plan, stop),
         &mut states,
-        |states, _, now| step(batch, states, plan.h, now),
+        |states, _, now| match method {
+            Method::Rk4 => batch.integrate_rk4(states, plan.h, now),
+            Method::RodMidpoint => batch.integrate_rod_midpoint(states, plan.h, now),
+        },
         |states, samples| split(half, states.iter().map(|s| s.x().as_slice()), samples),
     )
 }

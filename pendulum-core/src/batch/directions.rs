@@ -174,9 +174,14 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         x: &[V],
         out: &mut [V],
     ) {
+        self.solve_loaded(rods, gravity, pivot, self.loads(rods, x), out);
+    }
+
+    /// The loads of the states `x = (u, w)` (`2·C·n`) on rods `rods`.
+    #[inline(always)]
+    fn loads<'a>(&self, rods: &'a Rods<V>, x: &'a [V]) -> RateLoads<'a, C, V> {
         let half = C * self.links;
-        let (directions, rates) = (&x[..half], &x[half..2 * half]);
-        self.solve_loaded(rods, gravity, pivot, RateLoads { directions, rates, drag: rods.drag() }, out);
+        RateLoads::new(&x[..half], &x[half..2 * half], rods.drag())
     }
 
     /// [`accelerations`](Self::accelerations) at a Runge–Kutta stage `y = x + a·k`, formed
@@ -238,8 +243,7 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         x: &[V],
         out: &mut [V],
     ) {
-        let half = C * self.links;
-        let loads = RateLoads::new(&x[..half], &x[half..2 * half], rods.drag());
+        let loads = self.loads(rods, x);
         rods.solve(gravity, pivot, &mut self.rows, loads, |i, _, _, t| out[i] = t);
     }
 
