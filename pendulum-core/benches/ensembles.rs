@@ -11,8 +11,8 @@
 //!   its own circle) chain by chain against the batch, and 100 steps per batch call
 //!   (throughput in chain-steps per second; also in `f32`, `integrate_rk4_f32`, on one
 //!   thread), and 10 steps of the implicit rod midpoint
-//!   chain by chain against `integrate_rod_midpoint` (in four lanes) on one thread and on
-//!   two;
+//!   chain by chain against `integrate_rod_midpoint` (in lanes) on one thread and on two,
+//!   at steps of 1 ms and of 10 ms (where some chains' steps are halved);
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
@@ -293,30 +293,52 @@ fn rk4(c: &mut Criterion) {
     });
     // The implicit rod midpoint, 10 steps per call, every call from the same states (a run
     // of them went on into a whirl whose steps cost more): each chain on its own, against
-    // the batch.
+    // the batch. At 1 ms, and at 50 ms, where the chains take more Newton iterations and
+    // unequal numbers of them (a block of lanes iterates until its last lane converges):
+    // the iterations and halvings of the chains alone are printed.
     group.throughput(Throughput::Elements(10 * CHAINS as u64));
-    let mut states = start.clone();
-    group.bench_function("whirl_100/rod_midpoint_single_10_steps", |b| {
-        b.iter(|| {
-            states.clone_from(&start);
+    for (h, name) in [(1e-3, ""), (5e-2, "_of_50ms")] {
+        let single = |states: &mut [State<Dyn>]| {
+            let mut stats = Vec::new();
             for (k, state) in states.iter_mut().enumerate() {
                 let model = batch.model(k);
                 let mut step = RodMidpoint::new();
                 for _ in 0..10 {
-                    step.step(model, state, 1e-3).expect("single");
+                    step.step(model, state, h).expect("single");
                 }
+                stats.push(*step.stats());
             }
-        })
-    });
-    for threads in [1, 2] {
-        let pool = pool(threads);
+            stats
+        };
+        let stats = single(&mut start.clone());
+        let iterations: Vec<u64> = stats.iter().map(|s| s.newton_iterations).collect();
+        let halved: u64 = stats.iter().map(|s| s.halved_steps).sum();
+        let (fewest, most) = (iterations.iter().min().unwrap_or(&0), iterations.iter().max().unwrap_or(&0));
+        eprintln!(
+            "rod midpoint steps of {h} s: {fewest} to {most} Newton iterations in 10 steps per chain, \
+             {halved} halvings in {} chain-steps",
+            10 * CHAINS
+        );
         let mut states = start.clone();
-        group.bench_function(format!("whirl_100/rod_midpoint_batch_{threads}_threads_10_steps"), |b| {
-            in_pool(b, &pool, || {
+        group.bench_function(format!("whirl_100/rod_midpoint_single_10_steps{name}"), |b| {
+            b.iter(|| {
                 states.clone_from(&start);
-                batch.integrate_rod_midpoint(&mut states, 1e-3, 10).expect("batch");
+                single(&mut states)
             })
         });
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            let mut states = start.clone();
+            group.bench_function(
+                format!("whirl_100/rod_midpoint_batch_{threads}_threads_10_steps{name}"),
+                |b| {
+                    in_pool(b, &pool, || {
+                        states.clone_from(&start);
+                        batch.integrate_rod_midpoint(&mut states, h, 10).expect("batch");
+                    })
+                },
+            );
+        }
     }
 
     group.finish();
