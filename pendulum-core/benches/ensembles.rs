@@ -22,6 +22,8 @@
 //! - `generated/planar/…/n`: `model!`'s planar models (n = 4, 8, 16) called in a loop against
 //!   the same models in lanes (`UnrolledBatch`), on one thread and on two (and in four lanes
 //!   instead of eight on a CPU with AVX-512), and in single precision on one;
+//!   `generated/spatial/…/n`: `model!`'s spatial models (n = 4, 8, in spherical angles)
+//!   the same way (`UnrolledSpatialBatch`);
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
 //!   lanes instead of eight too);
@@ -39,7 +41,9 @@ use std::time::{Duration, Instant};
 
 use criterion::{Bencher, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Const, DVector, Dyn, SVector, U2, U3};
-use pendulum_core::batch::{DirectionsBatch, PlanarBatch, PlanarKernel, UnrolledBatch};
+use pendulum_core::batch::{
+    DirectionsBatch, PlanarBatch, PlanarKernel, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
+};
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State, System};
 use pendulum_core::{
     Chain, Circle, ConstantTorque, Derivatives, Directions, Driven, FirstOrder, Harmonic, Inputs, Jacobians,
@@ -54,6 +58,8 @@ pendulum_macros::model! {
     struct Planar4 { kind: planar, links: 4 }
     struct Planar8 { kind: planar, links: 8 }
     struct Planar16 { kind: planar, links: 16 }
+    struct Spatial4 { kind: spatial, links: 4 }
+    struct Spatial8 { kind: spatial, links: 8 }
 }
 
 /// `n` links of about 1 cm and 10 g, each mass, length and damping within a factor `spread`.
@@ -518,6 +524,50 @@ fn generated_one<M: PlanarKernel<N> + From<Chain<Const<N>>> + Clone, const N: us
     });
 }
 
+/// One generated spatial model type: its `CHAINS` models one call each against the batch,
+/// at polar angles between 0.3 and 2.8 rad.
+fn generated_spatial<M, const N: usize, const D: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    r: &mut ChaCha8Rng,
+) where
+    M: SpatialKernel<N> + Model<Links = Const<N>, Dof = Const<D>, Space = U3> + From<Chain<Const<N>>> + Clone,
+{
+    let models: Vec<M> = (0..CHAINS).map(|_| M::from(fixed_chain::<N>(r))).collect();
+    let q: Vec<f64> = (0..CHAINS * D)
+        .map(|i| if i % D < N { r.random_range(0.3..2.8) } else { r.random_range(-3.0..3.0) })
+        .collect();
+    let qd: Vec<f64> = (0..CHAINS * D).map(|_| r.random_range(-1.0..1.0)).collect();
+    let states: Vec<(SVector<f64, D>, SVector<f64, D>)> = (0..CHAINS)
+        .map(|k| {
+            let row = k * D..(k + 1) * D;
+            (SVector::from_column_slice(&q[row.clone()]), SVector::from_column_slice(&qd[row]))
+        })
+        .collect();
+    let inputs = Inputs::<Const<D>, U3>::zeros(Const::<D>);
+    let mut one = SVector::<f64, D>::zeros();
+    group.bench_with_input(BenchmarkId::new("spatial/single", N), &N, |b, _| {
+        b.iter(|| {
+            for (model, (q, qd)) in models.iter().zip(&states) {
+                model.accelerations(q, qd, &inputs, &mut one).expect("single");
+                black_box(&one);
+            }
+        })
+    });
+    let batch = UnrolledSpatialBatch::new(models).expect("batch");
+    let four = batch.clone().with_avx512(false);
+    let mut out = vec![0.0; CHAINS * D];
+    batch_rows(group, ("spatial", N), [&four, &batch], |batch| {
+        batch.accelerations(&q, &qd, None, None, &mut out).expect("batch");
+    });
+    let (q32, qd32): (Vec<f32>, Vec<f32>) = q.iter().zip(&qd).map(|(&a, &b)| (a as f32, b as f32)).unzip();
+    let (mut out32, one) = (vec![0.0f32; CHAINS * D], pool(1));
+    group.bench_with_input(BenchmarkId::new("spatial/batch_f32_1_thread", N), &N, |b, _| {
+        in_pool(b, &one, || {
+            batch.accelerations_f32(&q32, &qd32, None, None, &mut out32).expect("batch");
+        })
+    });
+}
+
 /// 100 RK4 steps of each of the `CHAINS` models alone against the batch's run.
 fn generated_rk4<M, const N: usize, const D: usize>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -596,6 +646,8 @@ fn generated(c: &mut Criterion) {
     generated_one::<Planar4, 4>(&mut group, &mut r);
     generated_one::<Planar8, 8>(&mut group, &mut r);
     generated_one::<Planar16, 16>(&mut group, &mut r);
+    generated_spatial::<Spatial4, 4, 8>(&mut group, &mut r);
+    generated_spatial::<Spatial8, 8, 16>(&mut group, &mut r);
     generated_rk4::<Planar4, 4, 8>(&mut group, &mut r);
     generated_rk4::<Planar8, 8, 16>(&mut group, &mut r);
     group.finish();

@@ -466,178 +466,37 @@ const _: () = {
                     Ok(()) => error,
                 }
             }
-            let rod_im = &self.rods.inverse_mass;
-            let rod_l = &self.rods.length;
-            let rod_il = &self.rods.inverse_length;
-            let rod_drag = &self.rods.drag;
-            let rod_diag = &self.rods.diagonal;
-            let g = self.rods.gravity;
-            let one = <f64 as ::pendulum_core::lanes::Lane>::splat(1.0);
-            let zero = <f64 as ::pendulum_core::lanes::Lane>::splat(0.0);
             let torque = &inputs.torque;
             let pivot = &inputs.pivot_acceleration;
             let mut trig = [[0.0f64; 2]; 8];
             let mut angles = [0.0f64; 8];
             angles[..6].copy_from_slice(q.as_slice());
             ::pendulum_core::__private::sin_cos_into(&angles, &mut trig);
-            let pa_x = pivot[0];
-            let pa_y = pivot[1];
-            let pa_z = pivot[2];
-            let [st0, ct0] = trig[0];
+            let [st0, _] = trig[0];
             if let Err(error) = ::pendulum_core::check_polar_sin(1, q[0], st0) {
                 return Err(failure(q, qd, inputs, error));
             }
-            let [sp0, cp0] = trig[3];
-            let dth0 = qd[0];
-            let dph0 = qd[3];
-            let is0 = one / st0;
-            let ux0 = st0 * cp0;
-            let uy0 = st0 * sp0;
-            let uz0 = -ct0;
-            let etx0 = ct0 * cp0;
-            let ety0 = ct0 * sp0;
-            let rate2_0 = dth0 * dth0 + st0 * st0 * dph0 * dph0;
-            let pull_th0 = torque[0] * rod_il[0] - rod_drag[0] * dth0;
-            let pull_ph0 = torque[3] * rod_il[0] * is0 - rod_drag[0] * st0 * dph0;
-            let fx0 = pull_th0 * etx0 - pull_ph0 * sp0;
-            let fy0 = pull_th0 * ety0 + pull_ph0 * cp0;
-            let fz0 = pull_th0 * st0;
-            let [st1, ct1] = trig[1];
+            let [st1, _] = trig[1];
             if let Err(error) = ::pendulum_core::check_polar_sin(2, q[1], st1) {
                 return Err(failure(q, qd, inputs, error));
             }
-            let [sp1, cp1] = trig[4];
-            let dth1 = qd[1];
-            let dph1 = qd[4];
-            let is1 = one / st1;
-            let ux1 = st1 * cp1;
-            let uy1 = st1 * sp1;
-            let uz1 = -ct1;
-            let etx1 = ct1 * cp1;
-            let ety1 = ct1 * sp1;
-            let rate2_1 = dth1 * dth1 + st1 * st1 * dph1 * dph1;
-            let pull_th1 = torque[1] * rod_il[1] - rod_drag[1] * dth1;
-            let pull_ph1 = torque[4] * rod_il[1] * is1 - rod_drag[1] * st1 * dph1;
-            let fx1 = pull_th1 * etx1 - pull_ph1 * sp1;
-            let fy1 = pull_th1 * ety1 + pull_ph1 * cp1;
-            let fz1 = pull_th1 * st1;
-            let [st2, ct2] = trig[2];
+            let [st2, _] = trig[2];
             if let Err(error) = ::pendulum_core::check_polar_sin(3, q[2], st2) {
                 return Err(failure(q, qd, inputs, error));
             }
-            let [sp2, cp2] = trig[5];
-            let dth2 = qd[2];
-            let dph2 = qd[5];
-            let is2 = one / st2;
-            let ux2 = st2 * cp2;
-            let uy2 = st2 * sp2;
-            let uz2 = -ct2;
-            let etx2 = ct2 * cp2;
-            let ety2 = ct2 * sp2;
-            let rate2_2 = dth2 * dth2 + st2 * st2 * dph2 * dph2;
-            let pull_th2 = torque[2] * rod_il[2] - rod_drag[2] * dth2;
-            let pull_ph2 = torque[5] * rod_il[2] * is2 - rod_drag[2] * st2 * dph2;
-            let fx2 = pull_th2 * etx2 - pull_ph2 * sp2;
-            let fy2 = pull_th2 * ety2 + pull_ph2 * cp2;
-            let fz2 = pull_th2 * st2;
-            let free_x0 = (fx0 - fx1) * rod_im[0];
-            let free_y0 = (fy0 - fy1) * rod_im[0];
-            let free_z0 = -g + (fz0 - fz1) * rod_im[0];
-            let b0 =
-                rod_l[0] * rate2_0 + ux0 * (free_x0 - pa_x) + uy0 * (free_y0 - pa_y) + uz0 * (free_z0 - pa_z);
-            let free_x1 = (fx1 - fx2) * rod_im[1];
-            let free_y1 = (fy1 - fy2) * rod_im[1];
-            let free_z1 = -g + (fz1 - fz2) * rod_im[1];
-            let b1 = rod_l[1] * rate2_1
-                + ux1 * (free_x1 - free_x0)
-                + uy1 * (free_y1 - free_y0)
-                + uz1 * (free_z1 - free_z0);
-            let free_x2 = fx2 * rod_im[2];
-            let free_y2 = fy2 * rod_im[2];
-            let free_z2 = -g + fz2 * rod_im[2];
-            let b2 = rod_l[2] * rate2_2
-                + ux2 * (free_x2 - free_x1)
-                + uy2 * (free_y2 - free_y1)
-                + uz2 * (free_z2 - free_z1);
-            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * rod_im[0];
-            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * rod_im[1];
-            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
-            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
-            #[cold]
-            #[inline(never)]
-            fn pivots<V: ::pendulum_core::lanes::Lane>(diagonal: [V; 3], off: [V; 3], rhs: [V; 3]) -> [V; 3] {
-                let one = V::splat(1.0);
-                let ip0 = one / diagonal[0];
-                let e0 = rhs[0];
-                let s0 = e0 * ip0;
-                let fac1 = off[1] * ip0;
-                let ip1 = one / (diagonal[1] - fac1 * off[1]);
-                let e1 = rhs[1] - fac1 * e0;
-                let s1 = e1 * ip1;
-                let fac2 = off[2] * ip1;
-                let ip2 = one / (diagonal[2] - fac2 * off[2]);
-                let e2 = rhs[2] - fac2 * e1;
-                let s2 = e2 * ip2;
-                let t2 = s2;
-                let t1 = s1 - fac2 * t2;
-                let t0 = s0 - fac1 * t1;
-                [t0, t1, t2]
-            }
-            let (t0, t1, t2) = {
-                let p0 = rod_diag[0];
-                let yt0 = b0;
-                let q2 = rod_diag[2];
-                let zb2 = b2;
-                let rp0 = one / p0;
-                let rq2 = one / q2;
-                let t1 = (b1 - off1 * yt0 * rp0 - off2 * zb2 * rq2)
-                    / (rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
-                let t0 = yt0 * rp0 - off1 * rp0 * t1;
-                let t2 = zb2 * rq2 - off2 * rq2 * t1;
-                let outside = <f64 as ::pendulum_core::lanes::Lane>::none();
-                let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
-                    outside,
-                    ::pendulum_core::lanes::Lane::continuant_outside(p0),
-                );
-                let outside = <f64 as ::pendulum_core::lanes::Lane>::or(
-                    outside,
-                    ::pendulum_core::lanes::Lane::continuant_outside(q2),
-                );
-                if <f64 as ::pendulum_core::lanes::Lane>::any(outside) {
-                    let t = pivots([rod_diag[0], rod_diag[1], rod_diag[2]], [zero, off1, off2], [b0, b1, b2]);
-                    (
-                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[0], t0),
-                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[1], t1),
-                        <f64 as ::pendulum_core::lanes::Lane>::select(outside, t[2], t2),
-                    )
-                } else {
-                    (t0, t1, t2)
-                }
+            let both = |v: &[f64]| -> [[f64; 3]; 2] {
+                [::core::array::from_fn(|i| v[i]), ::core::array::from_fn(|i| v[3 + i])]
             };
-            let a_x2 = free_x2 + (-t2 * ux2) * rod_im[2];
-            let a_y2 = free_y2 + (-t2 * uy2) * rod_im[2];
-            let a_z2 = free_z2 + (-t2 * uz2) * rod_im[2];
-            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * rod_im[1];
-            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * rod_im[1];
-            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * rod_im[1];
-            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * rod_im[0];
-            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * rod_im[0];
-            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * rod_im[0];
-            let udd_x0 = (a_x0 - pa_x) * rod_il[0];
-            let udd_y0 = (a_y0 - pa_y) * rod_il[0];
-            let udd_z0 = (a_z0 - pa_z) * rod_il[0];
-            let x_th0 = etx0 * udd_x0 + ety0 * udd_y0 + st0 * udd_z0 + dph0 * dph0 * st0 * ct0;
-            let x_ph0 = (cp0 * udd_y0 - sp0 * udd_x0 - 2.0 * dth0 * dph0 * ct0) * is0;
-            let udd_x1 = (a_x1 - a_x0) * rod_il[1];
-            let udd_y1 = (a_y1 - a_y0) * rod_il[1];
-            let udd_z1 = (a_z1 - a_z0) * rod_il[1];
-            let x_th1 = etx1 * udd_x1 + ety1 * udd_y1 + st1 * udd_z1 + dph1 * dph1 * st1 * ct1;
-            let x_ph1 = (cp1 * udd_y1 - sp1 * udd_x1 - 2.0 * dth1 * dph1 * ct1) * is1;
-            let udd_x2 = (a_x2 - a_x1) * rod_il[2];
-            let udd_y2 = (a_y2 - a_y1) * rod_il[2];
-            let udd_z2 = (a_z2 - a_z1) * rod_il[2];
-            let x_th2 = etx2 * udd_x2 + ety2 * udd_y2 + st2 * udd_z2 + dph2 * dph2 * st2 * ct2;
-            let x_ph2 = (cp2 * udd_y2 - sp2 * udd_x2 - 2.0 * dth2 * dph2 * ct2) * is2;
+            let trig: [[[f64; 2]; 3]; 2] =
+                [::core::array::from_fn(|i| trig[i]), ::core::array::from_fn(|i| trig[3 + i])];
+            let [[x_th0, x_th1, x_th2], [x_ph0, x_ph1, x_ph2]] =
+                <Self as ::pendulum_core::batch::SpatialKernel<3>>::kernel::<f64>(
+                    &self.rods,
+                    &trig,
+                    &both(qd.as_slice()),
+                    &both(torque.as_slice()),
+                    [pivot[0], pivot[1], pivot[2]],
+                );
             if (((x_th0 - x_th0) + ((x_th1 - x_th1) + (x_th2 - x_th2)))
                 + ((x_ph0 - x_ph0) + ((x_ph1 - x_ph1) + (x_ph2 - x_ph2))))
                 != 0.0
@@ -1070,6 +929,198 @@ const _: () = {
             dp[(5, 0)] = st2 * sp2 * ml2;
             dp[(5, 1)] = -st2 * cp2 * ml2;
             dp[(5, 2)] = 0.0;
+        }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl ::pendulum_core::batch::SpatialKernel<3> for Spatial3 {
+        fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, 3> {
+            &self.rods
+        }
+        fn row_accelerations(
+            &self,
+            q: &[f64],
+            qd: &[f64],
+            torque: &[f64],
+            pivot: [f64; 3],
+            out: &mut [f64],
+        ) -> Result<()> {
+            let inputs = Inputs {
+                torque: SVector::from_column_slice(torque),
+                pivot_acceleration: SVector::from(pivot),
+            };
+            let mut result = SVector::zeros();
+            let (q, qd) = (SVector::from_column_slice(q), SVector::from_column_slice(qd));
+            Model::accelerations(self, &q, &qd, &inputs, &mut result)?;
+            out.copy_from_slice(result.as_slice());
+            Ok(())
+        }
+        #[inline(always)]
+        fn kernel<V: ::pendulum_core::lanes::Lane>(
+            c: &::pendulum_core::batch::LinkConstants<V, 3>,
+            trig: &[[[V; 2]; 3]; 2],
+            rates: &[[V; 3]; 2],
+            torque: &[[V; 3]; 2],
+            pivot: [V; 3],
+        ) -> [[V; 3]; 2] {
+            let rod_im = &c.inverse_mass;
+            let rod_l = &c.length;
+            let rod_il = &c.inverse_length;
+            let rod_drag = &c.drag;
+            let rod_diag = &c.diagonal;
+            let g = c.gravity;
+            let one = <V as ::pendulum_core::lanes::Lane>::splat(1.0);
+            let zero = <V as ::pendulum_core::lanes::Lane>::splat(0.0);
+            let [pa_x, pa_y, pa_z] = pivot;
+            let two = <V as ::pendulum_core::lanes::Lane>::splat(2.0);
+            let [polar, azimuth] = trig;
+            let [st0, ct0] = polar[0];
+            let [sp0, cp0] = azimuth[0];
+            let dth0 = rates[0][0];
+            let dph0 = rates[1][0];
+            let is0 = one / st0;
+            let ux0 = st0 * cp0;
+            let uy0 = st0 * sp0;
+            let uz0 = -ct0;
+            let etx0 = ct0 * cp0;
+            let ety0 = ct0 * sp0;
+            let rate2_0 = dth0 * dth0 + st0 * st0 * dph0 * dph0;
+            let pull_th0 = torque[0][0] * rod_il[0] - rod_drag[0] * dth0;
+            let pull_ph0 = torque[1][0] * rod_il[0] * is0 - rod_drag[0] * st0 * dph0;
+            let fx0 = pull_th0 * etx0 - pull_ph0 * sp0;
+            let fy0 = pull_th0 * ety0 + pull_ph0 * cp0;
+            let fz0 = pull_th0 * st0;
+            let [st1, ct1] = polar[1];
+            let [sp1, cp1] = azimuth[1];
+            let dth1 = rates[0][1];
+            let dph1 = rates[1][1];
+            let is1 = one / st1;
+            let ux1 = st1 * cp1;
+            let uy1 = st1 * sp1;
+            let uz1 = -ct1;
+            let etx1 = ct1 * cp1;
+            let ety1 = ct1 * sp1;
+            let rate2_1 = dth1 * dth1 + st1 * st1 * dph1 * dph1;
+            let pull_th1 = torque[0][1] * rod_il[1] - rod_drag[1] * dth1;
+            let pull_ph1 = torque[1][1] * rod_il[1] * is1 - rod_drag[1] * st1 * dph1;
+            let fx1 = pull_th1 * etx1 - pull_ph1 * sp1;
+            let fy1 = pull_th1 * ety1 + pull_ph1 * cp1;
+            let fz1 = pull_th1 * st1;
+            let [st2, ct2] = polar[2];
+            let [sp2, cp2] = azimuth[2];
+            let dth2 = rates[0][2];
+            let dph2 = rates[1][2];
+            let is2 = one / st2;
+            let ux2 = st2 * cp2;
+            let uy2 = st2 * sp2;
+            let uz2 = -ct2;
+            let etx2 = ct2 * cp2;
+            let ety2 = ct2 * sp2;
+            let rate2_2 = dth2 * dth2 + st2 * st2 * dph2 * dph2;
+            let pull_th2 = torque[0][2] * rod_il[2] - rod_drag[2] * dth2;
+            let pull_ph2 = torque[1][2] * rod_il[2] * is2 - rod_drag[2] * st2 * dph2;
+            let fx2 = pull_th2 * etx2 - pull_ph2 * sp2;
+            let fy2 = pull_th2 * ety2 + pull_ph2 * cp2;
+            let fz2 = pull_th2 * st2;
+            let free_x0 = (fx0 - fx1) * rod_im[0];
+            let free_y0 = (fy0 - fy1) * rod_im[0];
+            let free_z0 = -g + (fz0 - fz1) * rod_im[0];
+            let b0 =
+                rod_l[0] * rate2_0 + ux0 * (free_x0 - pa_x) + uy0 * (free_y0 - pa_y) + uz0 * (free_z0 - pa_z);
+            let free_x1 = (fx1 - fx2) * rod_im[1];
+            let free_y1 = (fy1 - fy2) * rod_im[1];
+            let free_z1 = -g + (fz1 - fz2) * rod_im[1];
+            let b1 = rod_l[1] * rate2_1
+                + ux1 * (free_x1 - free_x0)
+                + uy1 * (free_y1 - free_y0)
+                + uz1 * (free_z1 - free_z0);
+            let free_x2 = fx2 * rod_im[2];
+            let free_y2 = fy2 * rod_im[2];
+            let free_z2 = -g + fz2 * rod_im[2];
+            let b2 = rod_l[2] * rate2_2
+                + ux2 * (free_x2 - free_x1)
+                + uy2 * (free_y2 - free_y1)
+                + uz2 * (free_z2 - free_z1);
+            let off1 = -(ux0 * ux1 + uy0 * uy1 + uz0 * uz1) * rod_im[0];
+            let off2 = -(ux1 * ux2 + uy1 * uy2 + uz1 * uz2) * rod_im[1];
+            #[doc = r" The tensions by classical pivots and back substitution, for chains whose"]
+            #[doc = r" continuants leave `CONTINUANT_RANGE`."]
+            #[cold]
+            #[inline(never)]
+            fn pivots<V: ::pendulum_core::lanes::Lane>(diagonal: [V; 3], off: [V; 3], rhs: [V; 3]) -> [V; 3] {
+                let one = V::splat(1.0);
+                let ip0 = one / diagonal[0];
+                let e0 = rhs[0];
+                let s0 = e0 * ip0;
+                let fac1 = off[1] * ip0;
+                let ip1 = one / (diagonal[1] - fac1 * off[1]);
+                let e1 = rhs[1] - fac1 * e0;
+                let s1 = e1 * ip1;
+                let fac2 = off[2] * ip1;
+                let ip2 = one / (diagonal[2] - fac2 * off[2]);
+                let e2 = rhs[2] - fac2 * e1;
+                let s2 = e2 * ip2;
+                let t2 = s2;
+                let t1 = s1 - fac2 * t2;
+                let t0 = s0 - fac1 * t1;
+                [t0, t1, t2]
+            }
+            let (t0, t1, t2) = {
+                let p0 = rod_diag[0];
+                let yt0 = b0;
+                let q2 = rod_diag[2];
+                let zb2 = b2;
+                let rp0 = one / p0;
+                let rq2 = one / q2;
+                let t1 = (b1 - off1 * yt0 * rp0 - off2 * zb2 * rq2)
+                    / (rod_diag[1] - (off1 * off1) * rp0 - (off2 * off2) * rq2);
+                let t0 = yt0 * rp0 - off1 * rp0 * t1;
+                let t2 = zb2 * rq2 - off2 * rq2 * t1;
+                let outside = <V as ::pendulum_core::lanes::Lane>::none();
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::continuant_outside(p0),
+                );
+                let outside = <V as ::pendulum_core::lanes::Lane>::or(
+                    outside,
+                    ::pendulum_core::lanes::Lane::continuant_outside(q2),
+                );
+                if <V as ::pendulum_core::lanes::Lane>::any(outside) {
+                    let t = pivots([rod_diag[0], rod_diag[1], rod_diag[2]], [zero, off1, off2], [b0, b1, b2]);
+                    (
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[0], t0),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[1], t1),
+                        <V as ::pendulum_core::lanes::Lane>::select(outside, t[2], t2),
+                    )
+                } else {
+                    (t0, t1, t2)
+                }
+            };
+            let a_x2 = free_x2 + (-t2 * ux2) * rod_im[2];
+            let a_y2 = free_y2 + (-t2 * uy2) * rod_im[2];
+            let a_z2 = free_z2 + (-t2 * uz2) * rod_im[2];
+            let a_x1 = free_x1 + (t2 * ux2 - t1 * ux1) * rod_im[1];
+            let a_y1 = free_y1 + (t2 * uy2 - t1 * uy1) * rod_im[1];
+            let a_z1 = free_z1 + (t2 * uz2 - t1 * uz1) * rod_im[1];
+            let a_x0 = free_x0 + (t1 * ux1 - t0 * ux0) * rod_im[0];
+            let a_y0 = free_y0 + (t1 * uy1 - t0 * uy0) * rod_im[0];
+            let a_z0 = free_z0 + (t1 * uz1 - t0 * uz0) * rod_im[0];
+            let udd_x0 = (a_x0 - pa_x) * rod_il[0];
+            let udd_y0 = (a_y0 - pa_y) * rod_il[0];
+            let udd_z0 = (a_z0 - pa_z) * rod_il[0];
+            let x_th0 = etx0 * udd_x0 + ety0 * udd_y0 + st0 * udd_z0 + dph0 * dph0 * st0 * ct0;
+            let x_ph0 = (cp0 * udd_y0 - sp0 * udd_x0 - two * dth0 * dph0 * ct0) * is0;
+            let udd_x1 = (a_x1 - a_x0) * rod_il[1];
+            let udd_y1 = (a_y1 - a_y0) * rod_il[1];
+            let udd_z1 = (a_z1 - a_z0) * rod_il[1];
+            let x_th1 = etx1 * udd_x1 + ety1 * udd_y1 + st1 * udd_z1 + dph1 * dph1 * st1 * ct1;
+            let x_ph1 = (cp1 * udd_y1 - sp1 * udd_x1 - two * dth1 * dph1 * ct1) * is1;
+            let udd_x2 = (a_x2 - a_x1) * rod_il[2];
+            let udd_y2 = (a_y2 - a_y1) * rod_il[2];
+            let udd_z2 = (a_z2 - a_z1) * rod_il[2];
+            let x_th2 = etx2 * udd_x2 + ety2 * udd_y2 + st2 * udd_z2 + dph2 * dph2 * st2 * ct2;
+            let x_ph2 = (cp2 * udd_y2 - sp2 * udd_x2 - two * dth2 * dph2 * ct2) * is2;
+            [[x_th0, x_th1, x_th2], [x_ph0, x_ph1, x_ph2]]
         }
     }
 };

@@ -64,10 +64,11 @@ use proc_macro::TokenStream;
 /// missized input, named) takes precedence: a non-finite input always makes the result
 /// non-finite, so the happy path does not check the inputs one by one.
 ///
-/// A planar model with `algorithm: tension` also implements
-/// `pendulum_core::batch::PlanarKernel<n>`: its accelerations are written once, as a
-/// kernel over any lane type, which `accelerations` runs on `f64` and
-/// `pendulum_core::batch::UnrolledBatch` on four chains at once (bit for bit, or in
+/// A model with `algorithm: tension` also implements
+/// `pendulum_core::batch::PlanarKernel<n>` (planar) or `SpatialKernel<n>` (spatial): its
+/// accelerations are written once, as a kernel over any lane type, which `accelerations`
+/// runs on `f64` and `pendulum_core::batch::UnrolledBatch` (planar) or
+/// `UnrolledSpatialBatch` (spatial) on four or eight chains at once (bit for bit, or in
 /// single precision).
 ///
 /// Mistakes in the input are compile errors pointing at the offending token, all

@@ -8,8 +8,8 @@
 //! detected at run time like the sine kernel's; a portable loop otherwise). Blocks of
 //! `WIDTH` chains go to the cores through rayon (the current pool: wrap a call in
 //! `ThreadPool::install` to choose the threads).
-//! [`UnrolledBatch`] does the same for the straight-line kernels `model!` generates for
-//! planar chains of a fixed number of links.
+//! [`UnrolledBatch`] and [`UnrolledSpatialBatch`] do the same for the straight-line
+//! kernels `model!` generates for planar and spatial chains of a fixed number of links.
 //!
 //! **Bit for bit.** A lane does the same IEEE operations in the same order as the
 //! single-chain call (no fused multiply-add, the same sine kernel), so every chain of a
@@ -52,7 +52,7 @@ pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
 pub(crate) use rooms::Rooms;
 pub(crate) use transpose::{gather, scatter};
-pub use unrolled::{LinkConstants, PlanarKernel, UnrolledBatch};
+pub use unrolled::{LinkConstants, PlanarKernel, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;
@@ -173,10 +173,10 @@ pub(crate) fn block_chains<const W: usize>(b: usize, chains: usize) -> [usize; W
 }
 
 /// The first non-finite input of chain `chain` as the single-chain check names it: its row
-/// of `n` in `q`, `qd` and `torque`, then its row of 2 in `pivot`.
+/// of `n` in `q`, `qd` and `torque`, then its row of `space` (2 or 3) in `pivot`.
 pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
     chain: usize,
-    n: usize,
+    [n, space]: [usize; 2],
     [q, qd]: [&[T]; 2],
     torque: Option<&[T]>,
     pivot: Option<&[T]>,
@@ -185,12 +185,12 @@ pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
     row("q", q, n)
         .or_else(|| row("qd", qd, n))
         .or_else(|| torque.and_then(|t| row("torque", t, n)))
-        .or_else(|| pivot.and_then(|p| row("pivot_acceleration", p, 2)))
+        .or_else(|| pivot.and_then(|p| row("pivot_acceleration", p, space)))
 }
 
 /// Whether every entry of `v` is finite (a loop without early exit, so that it vectorises).
 #[inline(always)]
-fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
+pub(crate) fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
     v.iter().fold(true, |finite, &x| finite & x.into().is_finite())
 }
 

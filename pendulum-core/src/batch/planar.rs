@@ -364,7 +364,8 @@ impl PlanarBatch {
                 let lanes = block_chains::<W>(b, chains);
                 let suspect = kernel(b, lanes, scratch, out);
                 failed_rows(out, n, (lanes, suspect), nan, |chain| {
-                    first_bad_input(chain, n, [q, qd], torque, pivot).unwrap_or_else(|| otherwise.clone())
+                    first_bad_input(chain, [n, 2], [q, qd], torque, pivot)
+                        .unwrap_or_else(|| otherwise.clone())
                 })
             },
         )

@@ -192,7 +192,7 @@ impl PlanarBatch {
                 dq.fill(f32::NAN);
                 dqd.fill(f32::NAN);
                 let chain = lanes[k];
-                let error = first_bad_input(chain, n, [q, qd], torque, pivot);
+                let error = first_bad_input(chain, [n, 2], [q, qd], torque, pivot);
                 failures.push(Failure { chain, error: error.unwrap_or(Error::SinglePrecisionOverflow) });
             }
             failures

@@ -27,7 +27,7 @@ use quote::quote;
 
 use self::names::{chart, index, space};
 use crate::parse::{Input, ModelDef};
-use crate::plan::{Algorithm, Kind, Plan};
+use crate::plan::{Algorithm, Plan};
 
 /// Everything `model!` emits for its input.
 pub fn expand(input: &Input) -> TokenStream {
@@ -54,8 +54,9 @@ fn model(def: &ModelDef) -> TokenStream {
         model_impl(name, &plan, algorithm),
         derivatives::derivatives_impl(name, &plan, algorithm),
     ];
-    if (plan.kind, algorithm) == (Kind::Planar, Algorithm::Tension) {
-        // The accelerations' kernel, which `pendulum_core::batch::UnrolledBatch` runs in lanes.
+    if algorithm == Algorithm::Tension {
+        // The accelerations' kernel, which `pendulum_core::batch::UnrolledBatch` (planar)
+        // and `UnrolledSpatialBatch` (spatial) run in lanes.
         impls.push(tension::kernel_impl(name, &plan));
     }
     quote! {

@@ -160,26 +160,73 @@ fn planar_kernel(plan: &Plan) -> TokenStream {
     quote!({ #body [#(#outputs),*] })
 }
 
-/// `impl PlanarKernel<n>` ([`planar_kernel`]) for a planar tension model.
+/// `impl PlanarKernel<n>` ([`planar_kernel`]) for a planar tension model, or
+/// `impl SpatialKernel<n>` ([`spatial_kernel`]) for a spatial one.
 pub(super) fn kernel_impl(name: &Ident, plan: &Plan) -> TokenStream {
     let n = index(plan.links);
-    let body = planar_kernel(plan);
+    let body = match plan.kind {
+        Kind::Planar => planar_kernel(plan),
+        Kind::Spatial => spatial_kernel(plan),
+    };
+    let (trait_name, signature, row_accelerations) = match plan.kind {
+        Kind::Planar => (
+            quote!(PlanarKernel),
+            quote! {
+                fn kernel<V: ::pendulum_core::lanes::Lane>(
+                    c: &::pendulum_core::batch::LinkConstants<V, #n>,
+                    trig: &[[V; 2]; #n],
+                    rates: &[V; #n],
+                    torque: &[V; #n],
+                    pivot: [V; 2],
+                ) -> [V; #n]
+            },
+            quote!(),
+        ),
+        Kind::Spatial => (
+            quote!(SpatialKernel),
+            quote! {
+                fn kernel<V: ::pendulum_core::lanes::Lane>(
+                    c: &::pendulum_core::batch::LinkConstants<V, #n>,
+                    trig: &[[[V; 2]; #n]; 2],
+                    rates: &[[V; #n]; 2],
+                    torque: &[[V; #n]; 2],
+                    pivot: [V; 3],
+                ) -> [[V; #n]; 2]
+            },
+            quote! {
+                fn row_accelerations(
+                    &self,
+                    q: &[f64],
+                    qd: &[f64],
+                    torque: &[f64],
+                    pivot: [f64; 3],
+                    out: &mut [f64],
+                ) -> Result<()> {
+                    let inputs = Inputs {
+                        torque: SVector::from_column_slice(torque),
+                        pivot_acceleration: SVector::from(pivot),
+                    };
+                    let mut result = SVector::zeros();
+                    let (q, qd) = (SVector::from_column_slice(q), SVector::from_column_slice(qd));
+                    Model::accelerations(self, &q, &qd, &inputs, &mut result)?;
+                    out.copy_from_slice(result.as_slice());
+                    Ok(())
+                }
+            },
+        ),
+    };
     quote! {
         #[automatically_derived]
         #[allow(clippy::suboptimal_flops, clippy::eq_op)]
-        impl ::pendulum_core::batch::PlanarKernel<#n> for #name {
+        impl ::pendulum_core::batch::#trait_name<#n> for #name {
             fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, #n> {
                 &self.rods
             }
 
+            #row_accelerations
+
             #[inline(always)]
-            fn kernel<V: ::pendulum_core::lanes::Lane>(
-                c: &::pendulum_core::batch::LinkConstants<V, #n>,
-                trig: &[[V; 2]; #n],
-                rates: &[V; #n],
-                torque: &[V; #n],
-                pivot: [V; 2],
-            ) -> [V; #n]
+            #signature
             #body
         }
     }
@@ -212,7 +259,7 @@ fn planar_accelerations(plan: &Plan) -> TokenStream {
 pub(super) fn accelerations(plan: &Plan) -> TokenStream {
     match plan.kind {
         Kind::Planar => planar_accelerations(plan),
-        Kind::Spatial => spatial(plan),
+        Kind::Spatial => spatial_accelerations(plan),
     }
 }
 
@@ -225,7 +272,11 @@ fn field(name: &str, i: usize) -> TokenStream {
 
 /// The spatial route in Cartesian components (module docs): directions, force pairs and
 /// free accelerations per link, the tension solve, then `ü_i` mapped to `(θ̈_i, φ̈_i)`.
-fn spatial(plan: &Plan) -> TokenStream {
+///
+/// Written once, as the body of `SpatialKernel::kernel` over any lane type `V`
+/// (`pendulum_core::batch`): `accelerations` runs it on `f64` after checking every polar
+/// sine ([`spatial_accelerations`]), `UnrolledSpatialBatch` on four or eight chains at once.
+fn spatial_kernel(plan: &Plan) -> TokenStream {
     let n = plan.links;
     const XYZ: [&str; 3] = ["x", "y", "z"];
     let u = |c: &str, i: usize| id(&format!("u{c}"), i);
@@ -233,31 +284,28 @@ fn spatial(plan: &Plan) -> TokenStream {
     let free = |c: &str, i: usize| id(&format!("free_{c}"), i);
     let a = |c: &str, i: usize| id(&format!("a_{c}"), i);
     let pivot_names: Vec<Ident> = XYZ.iter().map(|c| format_ident!("pa_{c}")).collect();
-    // Sines and cosines of every angle at once (a vectorised kernel), then the links'
-    // directions, rates and force pairs.
-    let mut body = rod_constants::locals(plan, &quote!(self.rods), &quote!(f64));
-    body.extend(prelude(plan));
-    for (k, p) in pivot_names.iter().enumerate() {
-        let k = index(k);
-        body.extend(quote!(let #p = pivot[#k];));
-    }
+    let lane = quote!(V);
+    let mut body = rod_constants::locals(plan, &quote!(c), &lane);
+    body.extend(quote! {
+        let [#(#pivot_names),*] = pivot;
+        let two = <V as ::pendulum_core::lanes::Lane>::splat(2.0);
+        let [polar, azimuth] = trig;
+    });
+    // The links' directions, rates and force pairs.
     for i in 0..n {
         let (st, ct, dth, sp, cp, dph, is) =
             (id("st", i), id("ct", i), id("dth", i), id("sp", i), id("cp", i), id("dph", i), id("is", i));
-        let (th, phi, link) = (index(i), index(n + i), index(i + 1));
+        let ii = index(i);
         let (il, drag) = (field("rod_il", i), field("rod_drag", i));
         let (rate2, pull, pull_ph) = (id("rate2_", i), id("pull_th", i), id("pull_ph", i));
         let [ux, uy, uz] = [u("x", i), u("y", i), u("z", i)];
         let [fx, fy, fz] = [f("x", i), f("y", i), f("z", i)];
         let (etx, ety) = (id("etx", i), id("ety", i));
         body.extend(quote! {
-            let [#st, #ct] = trig[#th];
-            if let Err(error) = ::pendulum_core::check_polar_sin(#link, q[#th], #st) {
-                return Err(failure(q, qd, inputs, error));
-            }
-            let [#sp, #cp] = trig[#phi];
-            let #dth = qd[#th];
-            let #dph = qd[#phi];
+            let [#st, #ct] = polar[#ii];
+            let [#sp, #cp] = azimuth[#ii];
+            let #dth = rates[0][#ii];
+            let #dph = rates[1][#ii];
             let #is = one / #st;
             let #ux = #st * #cp;
             let #uy = #st * #sp;
@@ -265,8 +313,8 @@ fn spatial(plan: &Plan) -> TokenStream {
             let #etx = #ct * #cp;
             let #ety = #ct * #sp;
             let #rate2 = #dth * #dth + #st * #st * #dph * #dph;
-            let #pull = torque[#th] * #il - #drag * #dth;
-            let #pull_ph = torque[#phi] * #il * #is - #drag * #st * #dph;
+            let #pull = torque[0][#ii] * #il - #drag * #dth;
+            let #pull_ph = torque[1][#ii] * #il * #is - #drag * #st * #dph;
             let #fx = #pull * #etx - #pull_ph * #sp;
             let #fy = #pull * #ety + #pull_ph * #cp;
             let #fz = #pull * #st;
@@ -302,7 +350,7 @@ fn spatial(plan: &Plan) -> TokenStream {
         });
         body.extend(quote!(let #c = -(#(#products)+*) * #im_above;));
     }
-    body.extend(twisted_solve(n, &quote!(f64)));
+    body.extend(twisted_solve(n, &lane));
 
     // Mass accelerations a_i, link accelerations ü_i, angle accelerations.
     for i in (0..n).rev() {
@@ -318,7 +366,7 @@ fn spatial(plan: &Plan) -> TokenStream {
             body.extend(quote!(let #ai = #fa + (#pull_below #t * #ui) * #im;));
         }
     }
-    let mut outputs: Vec<TokenStream> = vec![quote!(); plan.dof()];
+    let (mut polar, mut azimuthal) = (Vec::new(), Vec::new());
     for i in 0..n {
         let il = field("rod_il", i);
         let [wx, wy, wz] = XYZ.map(|c| id(&format!("udd_{c}"), i));
@@ -341,11 +389,47 @@ fn spatial(plan: &Plan) -> TokenStream {
         let (x_th, x_ph) = (id("x_th", i), id("x_ph", i));
         body.extend(quote! {
             let #x_th = #etx * #wx + #ety * #wy + #st * #wz + #dph * #dph * #st * #ct;
-            let #x_ph = (#cp * #wy - #sp * #wx - 2.0 * #dth * #dph * #ct) * #is;
+            let #x_ph = (#cp * #wy - #sp * #wx - two * #dth * #dph * #ct) * #is;
         });
-        outputs[i] = quote!(#x_th);
-        outputs[n + i] = quote!(#x_ph);
+        polar.push(x_th);
+        azimuthal.push(x_ph);
     }
+    quote!({ #body [[#(#polar),*], [#(#azimuthal),*]] })
+}
+
+/// The spatial `fn accelerations`: the sines and cosines, every link's polar sine checked
+/// (`check_polar_sin`, in link order), then [`spatial_kernel`] on `f64`.
+fn spatial_accelerations(plan: &Plan) -> TokenStream {
+    let n = plan.links;
+    let links = index(n);
+    let mut body = prelude(plan);
+    for i in 0..n {
+        let (th, link, st) = (index(i), index(i + 1), id("st", i));
+        body.extend(quote! {
+            let [#st, _] = trig[#th];
+            if let Err(error) = ::pendulum_core::check_polar_sin(#link, q[#th], #st) {
+                return Err(failure(q, qd, inputs, error));
+            }
+        });
+    }
+    let polar: Vec<Ident> = (0..n).map(|i| id("x_th", i)).collect();
+    let azimuthal: Vec<Ident> = (0..n).map(|i| id("x_ph", i)).collect();
+    body.extend(quote! {
+        let both = |v: &[f64]| -> [[f64; #links]; 2] {
+            [::core::array::from_fn(|i| v[i]), ::core::array::from_fn(|i| v[#links + i])]
+        };
+        let trig: [[[f64; 2]; #links]; 2] =
+            [::core::array::from_fn(|i| trig[i]), ::core::array::from_fn(|i| trig[#links + i])];
+        let [[#(#polar),*], [#(#azimuthal),*]] =
+            <Self as ::pendulum_core::batch::SpatialKernel<#links>>::kernel::<f64>(
+                &self.rods,
+                &trig,
+                &both(qd.as_slice()),
+                &both(torque.as_slice()),
+                [pivot[0], pivot[1], pivot[2]],
+            );
+    });
+    let outputs: Vec<TokenStream> = polar.iter().chain(&azimuthal).map(|x| quote!(#x)).collect();
     wrap(plan, body, &outputs)
 }
 

@@ -1,4 +1,4 @@
-//! `model!`'s planar models in lanes: the generated straight-line tension solve run for
+//! `model!`'s tension models in lanes: the generated straight-line tension solve run for
 //! [`WIDTH`] chains at once, one chain per lane.
 //!
 //! A planar model generated with `algorithm: tension` (the default from four links) writes
@@ -10,15 +10,21 @@
 //! `Avx8` register) where it has AVX-512 VL, elsewhere on [`Lanes`]. Single precision runs
 //! eight chains a register with AVX2 (`AvxF32`). The operations are the same, lane by lane, with the same sine
 //! kernel, so every chain of a batch gets its single model's `θ̈` bit for bit.
+//!
+//! The spatial tension models (`spatial`) run the same way: [`SpatialKernel::kernel`] in
+//! the model's spherical angles, [`UnrolledSpatialBatch`] on the same lanes.
 
 mod precision;
 mod rk4;
 mod single;
+mod spatial;
 
 use nalgebra::{Const, SVector, U2, Vector2};
 
+pub use self::spatial::{SpatialKernel, UnrolledSpatialBatch};
+
 use self::precision::{KernelLanes, Precision, join};
-use super::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks_of, gather, scatter};
+use super::{F64x4, Failure, WIDTH, all_finite, block_chains, check_len, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
@@ -40,22 +46,24 @@ struct Rows<'a, P> {
 }
 
 /// A task's arrays for a group's angles and their sines and cosines, in lanes: kept for the
-/// task's groups (zeroed per group they were 3% of the n = 8 call).
-pub(super) struct SineRoom<L, const N: usize> {
+/// task's groups (zeroed per group they were 3% of the n = 8 call). `G` arrays of `N`
+/// angles: one per block of a group (planar), or two (spatial: the polar angles, then the
+/// azimuths).
+pub(super) struct SineRoom<L, const N: usize, const G: usize = GROUP> {
     /// Each block's angles `θ_i` (rad), for the caller to fill.
-    pub(super) angles: [[L; N]; GROUP],
-    sin: [[L; N]; GROUP],
-    cos: [[L; N]; GROUP],
+    pub(super) angles: [[L; N]; G],
+    sin: [[L; N]; G],
+    cos: [[L; N]; G],
 }
 
-impl<L: Lane, const N: usize> SineRoom<L, N> {
+impl<L: Lane, const N: usize, const G: usize> SineRoom<L, N, G> {
     pub(super) fn new() -> Self {
-        let zero = [[L::splat(0.0); N]; GROUP];
+        let zero = [[L::splat(0.0); N]; G];
         Self { angles: zero, sin: zero, cos: zero }
     }
 
-    /// `sin θ_i`, `cos θ_i` of the first `count` blocks' angles, by `P`'s sine kernel in one
-    /// call.
+    /// `sin θ_i`, `cos θ_i` of the first `count` arrays of angles, by `P`'s sine kernel in
+    /// one call.
     #[inline(always)]
     pub(super) fn sin_cos<P: Precision<Lanes = L>>(&mut self, count: usize) {
         P::sin_cos_split(
@@ -65,9 +73,9 @@ impl<L: Lane, const N: usize> SineRoom<L, N> {
         );
     }
 
-    /// Blocks `blocks`' `[sin θ_i, cos θ_i]` (after [`sin_cos`](Self::sin_cos)) into `trig`,
-    /// in lanes `V` (`blocks[1]` joined only when `V` holds two). (Returned by value, the
-    /// array was kept on the stack at n = 16: 0.70×.)
+    /// Arrays `arrays`' `[sin θ_i, cos θ_i]` (after [`sin_cos`](Self::sin_cos)) into `trig`,
+    /// in lanes `V` (`arrays[1]` joined only when `V` holds two blocks). (Returned by value,
+    /// the array was kept on the stack at n = 16: 0.70×.)
     #[inline(always)]
     pub(super) fn trig<P: Precision<Lanes = L>, V: KernelLanes<P>>(
         &self,
@@ -88,21 +96,84 @@ fn unit_blocks(u: usize, blocks: usize, count: usize) -> [usize; 2] {
     [blocks * u, (blocks * u + blocks - 1).min(count - 1)]
 }
 
-/// Rows `v` (`N` a chain) of the chains `blocks[0]`, then `blocks[1]` when `V` holds two
-/// blocks, into lanes `out` (link `i` in `out[i]`).
+/// Rows `v` (`M·N` a chain) of the chains `blocks[0]`, then `blocks[1]` when `V` holds two
+/// blocks, into lanes `out` (entry `N·c + i` of a row in `out[c][i]`).
 #[inline(always)]
-fn gather_joined<P: Precision, V: KernelLanes<P>, const N: usize>(
+fn gather_joined<P: Precision, V: KernelLanes<P>, const N: usize, const M: usize>(
     v: &[P],
     blocks: [[usize; WIDTH]; 2],
-    out: &mut [V; N],
+    out: &mut [[V; N]; M],
 ) {
-    let mut lanes = [[P::Lanes::splat(0.0); N]; 2];
+    let mut lanes = [[[P::Lanes::splat(0.0); N]; M]; 2];
     for (lanes, &chains) in lanes.iter_mut().zip(&blocks).take(V::BLOCKS) {
-        gather::<P, WIDTH>(v, chains, N, P::flatten_mut(lanes));
+        gather::<P, WIDTH>(v, chains, M * N, P::flatten_mut(lanes.as_flattened_mut()));
     }
-    for (i, out) in out.iter_mut().enumerate() {
-        *out = V::join([lanes[0][i], lanes[1][i]]);
+    for (c, out) in out.iter_mut().enumerate() {
+        for (i, out) in out.iter_mut().enumerate() {
+            *out = V::join([lanes[0][c][i], lanes[1][c][i]]);
+        }
     }
+}
+
+/// The blocks' constants of a batch of `models` side by side, in `f64` and `f32` lanes
+/// (`constants` reads a model's).
+///
+/// Errors: [`Error::EmptyBatch`].
+#[allow(clippy::type_complexity)]
+fn constant_blocks<M, const N: usize>(
+    models: &[M],
+    constants: impl Fn(&M) -> &LinkConstants<f64, N>,
+) -> Result<(Vec<LinkConstants<F64x4, N>>, Vec<LinkConstants<Lanes32<WIDTH>, N>>)> {
+    if models.is_empty() {
+        return Err(Error::EmptyBatch);
+    }
+    let block = |b: usize| block_chains(b, models.len()).map(|c| constants(&models[c]));
+    let count = models.len().div_ceil(WIDTH);
+    let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
+    let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
+    Ok((blocks, blocks_f32))
+}
+
+/// That `q`, `qd`, `out` and the torques hold `chains` rows of `m`, the pivot
+/// accelerations rows of `space`.
+fn check_rows<P>(
+    [q, qd]: [&[P]; 2],
+    torque: Option<&[P]>,
+    pivot: Option<&[P]>,
+    out: &[P],
+    chains: usize,
+    [m, space]: [usize; 2],
+) -> Result<()> {
+    check_len("q", q, chains, m)?;
+    check_len("qd", qd, chains, m)?;
+    check_len("out", out, chains, m)?;
+    if let Some(t) = torque {
+        check_len("torque", t, chains, m)?;
+    }
+    if let Some(p) = pivot {
+        check_len("pivot", p, chains, space)?;
+    }
+    Ok(())
+}
+
+/// The chains whose rows of `out` (`m` each, the first chain `first`) are not all finite,
+/// each with `error(chain)`, their rows set to NaN.
+fn non_finite_rows<P: Precision>(
+    out: &mut [P],
+    m: usize,
+    first: usize,
+    error: &impl Fn(usize) -> Error,
+) -> Vec<Failure> {
+    let mut failures = Vec::new();
+    for (k, row) in out.chunks_exact_mut(m).enumerate() {
+        if all_finite(row) {
+            continue;
+        }
+        let chain = first + k;
+        failures.push(Failure { chain, error: error(chain) });
+        row.fill(P::NAN);
+    }
+    failures
 }
 
 /// A chain's per-link constants as a generated tension model reads them, `N` of each: one
@@ -224,13 +295,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     ///
     /// Errors: [`Error::EmptyBatch`].
     pub fn new(models: Vec<M>) -> Result<Self> {
-        if models.is_empty() {
-            return Err(Error::EmptyBatch);
-        }
-        let block = |b: usize| block_chains(b, models.len()).map(|c| models[c].constants());
-        let count = models.len().div_ceil(WIDTH);
-        let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
-        let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
+        let (blocks, blocks_f32) = constant_blocks(&models, M::constants)?;
         Ok(Self { models, blocks, blocks_f32, avx512: true })
     }
 
@@ -324,15 +389,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         error: impl Fn(usize) -> Error + Sync + Send,
     ) -> Result<Vec<Failure>> {
         let chains = self.len();
-        check_len("q", q, chains, N)?;
-        check_len("qd", qd, chains, N)?;
-        check_len("out", out, chains, N)?;
-        if let Some(t) = torque {
-            check_len("torque", t, chains, N)?;
-        }
-        if let Some(p) = pivot {
-            check_len("pivot", p, chains, 2)?;
-        }
+        check_rows([q, qd], torque, pivot, out, chains, [N, 2])?;
         let failures =
             for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, N, N, SineRoom::new, |room, g, out| {
                 let first = GROUP * g;
@@ -340,16 +397,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
                 let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
                 let rows = Rows { q, qd, torque, pivot };
                 self.group_simd::<P>(&blocks[first..first + count], room, lanes, rows, out);
-                let mut failures = Vec::new();
-                for (k, row) in out.chunks_exact_mut(N).enumerate() {
-                    if row.iter().all(|&v| v.into().is_finite()) {
-                        continue;
-                    }
-                    let chain = WIDTH * first + k;
-                    failures.push(Failure { chain, error: error(chain) });
-                    row.fill(P::NAN);
-                }
-                failures
+                non_finite_rows(out, N, WIDTH * first, &error)
             });
         Ok(failures)
     }
@@ -379,10 +427,10 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             room.trig(pair, &mut trig);
             let blocks = pair.map(|j| lanes[j]);
             let mut rates = [V::splat(0.0); N];
-            gather_joined::<P, V, N>(qd, blocks, &mut rates);
+            gather_joined::<P, V, N, 1>(qd, blocks, std::array::from_mut(&mut rates));
             let mut torques = [V::splat(0.0); N];
             if let Some(t) = torque {
-                gather_joined::<P, V, N>(t, blocks, &mut torques);
+                gather_joined::<P, V, N, 1>(t, blocks, std::array::from_mut(&mut torques));
             }
             let mut pivots = [V::splat(0.0); 2];
             if let Some(p) = pivot {

@@ -28,7 +28,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
         self.evaluate(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
-            first_bad_input(chain, N, [q, qd], torque, pivot).unwrap_or(Error::SinglePrecisionOverflow)
+            first_bad_input(chain, [N, 2], [q, qd], torque, pivot).unwrap_or(Error::SinglePrecisionOverflow)
         })
     }
 }

@@ -1,0 +1,359 @@
+//! `model!`'s spatial models in lanes: the generated straight-line tension solve in the
+//! spherical angles `q = (θ_1 … θ_n, φ_1 … φ_n)`, run for [`WIDTH`] chains at once (eight
+//! in `f64` where the CPU has AVX-512 VL, eight in `f32` with AVX2), one chain per lane,
+//! bit for bit each chain's own `Model::accelerations` in `f64`.
+//!
+//! The model's `accelerations` checks every polar sine (`check_polar_sin`) before its
+//! kernel; here the check runs in lanes ([`near_pole`]), and a chain that fails it, or
+//! whose result is not finite, is run alone for its error.
+
+use super::precision::{KernelLanes, Precision};
+use super::{
+    GROUP, LinkConstants, Rows, SineRoom, check_rows, constant_blocks, gather_joined, non_finite_rows,
+    unit_blocks,
+};
+use crate::batch::{F64x4, Failure, WIDTH, block_chains, first_bad_input, for_blocks_of, gather, scatter};
+use crate::error::{Error, Result};
+use crate::kinematics::SINGULARITY_TOLERANCE;
+use crate::lanes::{Lane, Lanes32};
+
+/// The polar sines `check_polar_sin` accepts, `[SINGULARITY_TOLERANCE, ∞]`, as
+/// [`Lane::outside`]'s `(low, span)` of bit patterns.
+const ACCEPTED_SINES: (u64, u64) = {
+    let low = SINGULARITY_TOLERANCE.to_bits();
+    (low, f64::INFINITY.to_bits() - low)
+};
+
+/// A spatial model of `N` links whose `(θ̈, φ̈)` is one straight-line kernel over [`Lane`]s:
+/// what `pendulum_macros::model!` emits for `kind: spatial` with `algorithm: tension` (the
+/// default from two links). Its `Model::accelerations` checks the polar sines, then runs
+/// `kernel::<f64>`; [`UnrolledSpatialBatch`] runs it on four or eight chains at once.
+pub trait SpatialKernel<const N: usize>: Send + Sync {
+    /// The constants `new` stored.
+    fn constants(&self) -> &LinkConstants<f64, N>;
+
+    /// The model's own `Model::accelerations` on rows: `q`, `qd`, `torque` and `out` of
+    /// `2N` (the polar angles, then the azimuths), the pivot's acceleration `p̈` (m/s²).
+    fn row_accelerations(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        torque: &[f64],
+        pivot: [f64; 3],
+        out: &mut [f64],
+    ) -> Result<()>;
+
+    /// `[θ̈, φ̈]` (rad/s²), lane by lane, from `trig = [[sin θ_i, cos θ_i], [sin φ_i, cos φ_i]]`,
+    /// the rates `[θ̇, φ̇]` (rad/s), the generalized torques `[σ_θ, σ_φ]` (N·m) and the
+    /// pivot's acceleration `p̈ = (ẍ, ÿ, z̈)` (m/s²): the rods' tension system in Cartesian
+    /// components. Divides by `sin θ_i`: the caller checks the polar sines first.
+    fn kernel<V: Lane>(
+        c: &LinkConstants<V, N>,
+        trig: &[[[V; 2]; N]; 2],
+        rates: &[[V; N]; 2],
+        torque: &[[V; N]; 2],
+        pivot: [V; 3],
+    ) -> [[V; N]; 2];
+}
+
+/// `B` chains of one generated spatial model type `M` (`N` links each, each its own masses,
+/// lengths, damping and gravity), evaluated four per instruction stream (eight in `f64` with
+/// AVX-512, eight in `f32` with AVX2). Rows are the models' own coordinates: `2N` a chain,
+/// the polar angles `θ_i` then the azimuths `φ_i`.
+///
+/// ```
+/// use pendulum_core::batch::UnrolledSpatialBatch;
+/// use pendulum_core::Chain;
+///
+/// pendulum_macros::model! { struct Spatial4 { kind: spatial, links: 4 } }
+///
+/// let models = (0..8).map(|k| Spatial4::new(Chain::uniform(4, 0.1 + 0.01 * k as f64, 0.2, 9.81).unwrap()));
+/// let batch = UnrolledSpatialBatch::new(models.collect())?;
+/// let (q, qd) = (vec![0.3; 8 * 8], vec![0.5; 8 * 8]);
+/// let mut qdd = vec![0.0; 8 * 8];
+/// let failures = batch.accelerations(&q, &qd, None, None, &mut qdd)?;
+/// assert!(failures.is_empty());
+/// # Ok::<(), pendulum_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct UnrolledSpatialBatch<M, const N: usize> {
+    models: Vec<M>,
+    /// Per block of [`WIDTH`] chains, their constants side by side.
+    blocks: Vec<LinkConstants<F64x4, N>>,
+    /// The same in single precision.
+    blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
+    /// Whether the calls may use AVX-512 where the CPU has it.
+    avx512: bool,
+}
+
+/// The lanes where some `|sin θ_i| < SINGULARITY_TOLERANCE` (or a sine is NaN): where the
+/// model's `check_polar_sin` refuses the state. (`Lane` has no absolute value: a sine
+/// below the tolerance, negative ones included, is negated, and the result checked again.)
+#[inline(always)]
+fn near_pole<V: Lane, const N: usize>(polar: &[[V; 2]; N]) -> V::Mask {
+    let (low, span) = ACCEPTED_SINES;
+    let mut near = V::none();
+    for &[sin, _] in polar {
+        let magnitude = V::select(sin.outside(low, span), -sin, sin);
+        near = V::or(near, magnitude.outside(low, span));
+    }
+    near
+}
+
+impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
+    /// The batch of `models`, chain `k` being `models[k]`.
+    ///
+    /// Errors: [`Error::EmptyBatch`].
+    pub fn new(models: Vec<M>) -> Result<Self> {
+        let (blocks, blocks_f32) = constant_blocks(&models, M::constants)?;
+        Ok(Self { models, blocks, blocks_f32, avx512: true })
+    }
+
+    /// Whether the evaluations may work on eight `f64` chains per AVX-512 register where the
+    /// CPU has AVX-512 VL (the default), or keep four per AVX2 register (`false`). The
+    /// results are the same bits either way.
+    pub fn with_avx512(mut self, allowed: bool) -> Self {
+        self.avx512 = allowed;
+        self
+    }
+
+    /// Whether the calls run with AVX-512 (allowed, and the CPU has AVX-512 VL).
+    pub fn uses_avx512(&self) -> bool {
+        self.avx512 && crate::lanes::has_avx512vl()
+    }
+
+    /// Number of chains `B`.
+    pub fn len(&self) -> usize {
+        self.models.len()
+    }
+
+    /// Never: a batch has at least one chain.
+    pub fn is_empty(&self) -> bool {
+        self.models.is_empty()
+    }
+
+    /// Chain `k`'s model.
+    pub fn model(&self, k: usize) -> &M {
+        &self.models[k]
+    }
+
+    /// The angle accelerations `(θ̈, φ̈)` (rad/s²) of every chain, written into `out` as `B`
+    /// rows of `2N` (the model's coordinates: polar angles, then azimuths), at angles `q`
+    /// (rad) and rates `qd` (rad/s) given the same way, with each chain's generalized torques
+    /// from `torque` (`B` rows of `2N`, N·m; `None`: none) and pivot acceleration
+    /// `p̈ = (ẍ, ÿ, z̈)` from `pivot` (`B` rows of 3, m/s²; `None`: pivots at rest). Row `k`
+    /// equals `model(k).accelerations(..)` bit for bit; the blocks go over the current
+    /// rayon pool.
+    ///
+    /// Returns the chains that failed, in order, each with its single model's error (a polar
+    /// angle at a pole, `Error::SingularAngle`; a non-finite input, named; a non-finite
+    /// result); their rows of `out` are NaN. Errors: [`Error::LengthMismatch`] when an array
+    /// does not hold `B` rows.
+    pub fn accelerations(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        torque: Option<&[f64]>,
+        pivot: Option<&[f64]>,
+        out: &mut [f64],
+    ) -> Result<Vec<Failure>> {
+        self.evaluate(&self.blocks, [q, qd], torque, pivot, out, |chain| {
+            self.error_of(chain, q, qd, torque, pivot)
+        })
+    }
+
+    /// [`accelerations`](Self::accelerations) in single precision: the same solve on eight
+    /// chains at once (four without AVX2), from `f32` arrays laid out the same way. Not bit
+    /// for bit the `f64` model (its error: `docs/ensembles.md`).
+    ///
+    /// Returns the chains that failed, in order: a non-finite input (named), a polar sine
+    /// (in `f32`) below `SINGULARITY_TOLERANCE` ([`Error::SingularAngle`]), or
+    /// [`Error::SinglePrecisionOverflow`] when finite inputs give a non-finite result;
+    /// their rows of `out` are NaN. Errors: [`Error::LengthMismatch`].
+    pub fn accelerations_f32(
+        &self,
+        q: &[f32],
+        qd: &[f32],
+        torque: Option<&[f32]>,
+        pivot: Option<&[f32]>,
+        out: &mut [f32],
+    ) -> Result<Vec<Failure>> {
+        self.evaluate(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
+            first_bad_input(chain, [2 * N, 3], [q, qd], torque, pivot)
+                .or_else(|| singular_angle(&q[2 * N * chain..2 * N * chain + N]))
+                .unwrap_or(Error::SinglePrecisionOverflow)
+        })
+    }
+
+    /// Chain `chain`'s single model's error at its row of the inputs (out of the hot path).
+    #[cold]
+    fn error_of(
+        &self,
+        chain: usize,
+        q: &[f64],
+        qd: &[f64],
+        torque: Option<&[f64]>,
+        pivot: Option<&[f64]>,
+    ) -> Error {
+        let m = 2 * N;
+        let row = |v: &'_ [f64]| v[chain * m..(chain + 1) * m].to_vec();
+        let torque = torque.map_or_else(|| vec![0.0; m], row);
+        let pivot = pivot.map_or([0.0; 3], |p| [p[3 * chain], p[3 * chain + 1], p[3 * chain + 2]]);
+        let mut out = vec![0.0; m];
+        match self.models[chain].row_accelerations(&row(q), &row(qd), &torque, pivot, &mut out) {
+            Err(error) => error,
+            // The kernel's lanes are the single model's: unreachable unless they differ.
+            Ok(()) => Error::NotPositiveDefinite,
+        }
+    }
+
+    /// `(θ̈, φ̈)` of every chain in precision `P`, from the blocks' constants in `P`; a chain
+    /// whose row is not finite (or whose state is at a pole) fails with `error(chain)`, its
+    /// row NaN.
+    fn evaluate<P: Precision>(
+        &self,
+        blocks: &[LinkConstants<P::Lanes, N>],
+        [q, qd]: [&[P]; 2],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+        error: impl Fn(usize) -> Error + Sync + Send,
+    ) -> Result<Vec<Failure>> {
+        let (chains, m) = (self.len(), 2 * N);
+        check_rows([q, qd], torque, pivot, out, chains, [m, 3])?;
+        let room = SineRoom::<P::Lanes, N, { 2 * GROUP }>::new;
+        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, m, N, room, |room, g, out| {
+            let first = GROUP * g;
+            let count = (out.len() / m).div_ceil(WIDTH);
+            let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
+            let rows = Rows { q, qd, torque, pivot };
+            self.group_simd::<P>(&blocks[first..first + count], room, lanes, rows, out);
+            non_finite_rows(out, m, WIDTH * first, &error)
+        });
+        Ok(failures)
+    }
+
+    /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`): each
+    /// block's angles gathered into lanes (block `j`'s polar angles in the room's array
+    /// `2j`, its azimuths in `2j + 1`), the sines and cosines of all of them in one call of
+    /// the sine kernel, then the kernel in lanes of type `V` on one block or two at once,
+    /// the lanes at a pole made NaN, scattered into `out` (the group's rows).
+    #[inline(always)]
+    fn group<P: Precision, V: KernelLanes<P>>(
+        &self,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
+        lanes: [[usize; WIDTH]; GROUP],
+        Rows { q, qd, torque, pivot }: Rows<'_, P>,
+        out: &mut [P],
+    ) {
+        let zero = P::Lanes::splat(0.0);
+        let (count, m) = (c.len(), 2 * N);
+        for (angles, &lanes) in room.angles.chunks_exact_mut(2).zip(&lanes).take(count) {
+            gather::<P, WIDTH>(q, lanes, m, P::flatten_mut(angles.as_flattened_mut()));
+        }
+        room.sin_cos::<P>(2 * count);
+        for u in 0..count.div_ceil(V::BLOCKS) {
+            let pair = unit_blocks(u, V::BLOCKS, count);
+            let mut trig = [[[V::splat(0.0); 2]; N]; 2];
+            room.trig(pair.map(|j| 2 * j), &mut trig[0]);
+            room.trig(pair.map(|j| 2 * j + 1), &mut trig[1]);
+            let blocks = pair.map(|j| lanes[j]);
+            let mut rates = [[V::splat(0.0); N]; 2];
+            gather_joined::<P, V, N, 2>(qd, blocks, &mut rates);
+            let mut torques = [[V::splat(0.0); N]; 2];
+            if let Some(t) = torque {
+                gather_joined::<P, V, N, 2>(t, blocks, &mut torques);
+            }
+            let mut pivots = [V::splat(0.0); 3];
+            if let Some(p) = pivot {
+                let [a, b] = blocks;
+                pivots = std::array::from_fn(|d| {
+                    V::join([P::lanes(|k| p[3 * a[k] + d]), P::lanes(|k| p[3 * b[k] + d])])
+                });
+            }
+            let constants = LinkConstants::joined([&c[pair[0]], &c[pair[1]]]);
+            let mut accelerations = M::kernel(&constants, &trig, &rates, &torques, pivots);
+            let near = near_pole(&trig[0]);
+            if V::any(near) {
+                accelerations[0][0] = V::select(near, V::splat(f64::NAN), accelerations[0][0]);
+            }
+            let mut result = [[[zero; N]; 2]; 2];
+            for (coordinate, a) in accelerations.iter().enumerate() {
+                for (i, &a) in a.iter().enumerate() {
+                    [result[0][coordinate][i], result[1][coordinate][i]] = a.split();
+                }
+            }
+            for (result, j) in result.iter().zip(V::BLOCKS * u..count).take(V::BLOCKS) {
+                let rows = WIDTH * m * j..(WIDTH * m * (j + 1)).min(out.len());
+                scatter::<P, WIDTH>(P::flatten(result.as_flattened()), m, &mut out[rows]);
+            }
+        }
+    }
+
+    /// [`group`](Self::group) in AVX2 registers when the CPU has them (eight chains an
+    /// AVX-512 register where it has AVX-512 VL and they are allowed), else in
+    /// [`Precision::Lanes`].
+    fn group_simd<P: Precision>(
+        &self,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
+        lanes: [[usize; WIDTH]; GROUP],
+        rows: Rows<'_, P>,
+        out: &mut [P],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if self.uses_avx512() {
+            // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
+            return unsafe { self.group_avx512::<P>(c, room, lanes, rows, out) };
+        }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::has_avx2() {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.group_avx2::<P>(c, room, lanes, rows, out) };
+        }
+        self.group::<P, P::Lanes>(c, room, lanes, rows, out)
+    }
+
+    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Wide`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    fn group_avx512<P: Precision>(
+        &self,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
+        lanes: [[usize; WIDTH]; GROUP],
+        rows: Rows<'_, P>,
+        out: &mut [P],
+    ) {
+        self.group::<P, P::Wide>(c, room, lanes, rows, out)
+    }
+
+    /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn group_avx2<P: Precision>(
+        &self,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
+        lanes: [[usize; WIDTH]; GROUP],
+        rows: Rows<'_, P>,
+        out: &mut [P],
+    ) {
+        self.group::<P, P::Registers>(c, room, lanes, rows, out)
+    }
+}
+
+/// The first polar angle of `polar` (a chain's `θ_i`, `f32`) whose sine in single
+/// precision is below the tolerance, named as `check_polar_sin` names it.
+fn singular_angle(polar: &[f32]) -> Option<Error> {
+    polar.iter().enumerate().find_map(|(i, &theta)| {
+        let sin_theta = f64::from(theta.sin().abs());
+        (sin_theta < SINGULARITY_TOLERANCE).then_some(Error::SingularAngle {
+            link: i + 1,
+            theta: theta.into(),
+            sin_theta,
+            tolerance: SINGULARITY_TOLERANCE,
+        })
+    })
+}
