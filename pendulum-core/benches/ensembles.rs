@@ -26,7 +26,8 @@
 //!   the same way (`UnrolledSpatialBatch`);
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
-//!   lanes instead of eight too);
+//!   lanes instead of eight too), and `…/spatial_…/4` the same for the spatial model
+//!   (`UnrolledSpatialBatch::integrate_rk4`);
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
 //!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
 //!   `state_jacobians_f32`;
@@ -568,6 +569,59 @@ fn generated_spatial<M, const N: usize, const D: usize>(
     });
 }
 
+/// 100 RK4 steps of 0.1 ms of each of the `CHAINS` spatial models alone against the
+/// batch's run (`D = 2N` coordinates, states of `X = 4N`), polar angles between 0.3 and
+/// 2.8 rad.
+fn generated_spatial_rk4<M, const N: usize, const D: usize, const X: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    r: &mut ChaCha8Rng,
+) where
+    M: SpatialKernel<N> + Model<Links = Const<N>, Dof = Const<D>, Space = U3> + From<Chain<Const<N>>> + Clone,
+    Const<D>: nalgebra::DimMul<U2, Output = Const<X>>,
+{
+    const STEPS: usize = 100;
+    const H: f64 = 1e-4;
+    let models: Vec<M> = (0..CHAINS).map(|_| M::from(fixed_chain::<N>(r))).collect();
+    let states: Vec<State<Const<X>>> = (0..CHAINS)
+        .map(|_| {
+            let x = SVector::<f64, X>::from_fn(|i, _| match i / N {
+                0 => r.random_range(0.3..2.8),
+                1 => r.random_range(-3.0..3.0),
+                _ => r.random_range(-1.0..1.0),
+            });
+            State::new(0.0, x)
+        })
+        .collect();
+    group.throughput(Throughput::Elements((CHAINS * STEPS) as u64));
+    let systems: Vec<_> = models.iter().cloned().map(FirstOrder::new).collect();
+    let mut rk4 = Rk4::new(&systems[0]);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/spatial_single", N), &N, |b, _| {
+        b.iter(|| {
+            for (system, state) in systems.iter().zip(&states) {
+                let mut state = state.clone();
+                for _ in 0..STEPS {
+                    rk4.step(system, &mut state, H).expect("single");
+                }
+                black_box(&state);
+            }
+        })
+    });
+    let batch = UnrolledSpatialBatch::new(models).expect("batch");
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let id = BenchmarkId::new(format!("rk4_100_steps/spatial_batch_{threads}_threads"), N);
+        group.bench_with_input(id, &N, |b, _| {
+            in_pool(b, &pool, || {
+                let mut run = states.clone();
+                let failures = batch.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                assert!(failures.is_empty());
+                black_box(&run);
+            })
+        });
+    }
+    group.throughput(Throughput::Elements(CHAINS as u64));
+}
+
 /// 100 RK4 steps of each of the `CHAINS` models alone against the batch's run.
 fn generated_rk4<M, const N: usize, const D: usize>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -650,6 +704,7 @@ fn generated(c: &mut Criterion) {
     generated_spatial::<Spatial8, 8, 16>(&mut group, &mut r);
     generated_rk4::<Planar4, 4, 8>(&mut group, &mut r);
     generated_rk4::<Planar8, 8, 16>(&mut group, &mut r);
+    generated_spatial_rk4::<Spatial4, 4, 8, 16>(&mut group, &mut r);
     group.finish();
 }
 

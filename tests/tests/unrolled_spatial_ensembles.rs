@@ -3,11 +3,13 @@
 //! the lanes per register and however the chains are split into calls, the chains whose
 //! tension continuants leave their range included; a chain at a pole of its chart, or with
 //! a non-finite input, is reported by its index with its model's error while the others
-//! finish.
+//! finish; and RK4 runs of a batch are each chain's own `Rk4` on `FirstOrder::new(model)`,
+//! bit for bit, a chain whose stage reaches a pole stopping alone where it stopped.
 
-use nalgebra::{Const, SVector, U3, Vector3};
-use pendulum_core::batch::{SpatialKernel, UnrolledSpatialBatch};
-use pendulum_core::{Chain, Error, Inputs, Model};
+use nalgebra::{Const, SVector, U2, U3, Vector3};
+use pendulum_core::batch::{Failure, SpatialKernel, UnrolledSpatialBatch};
+use pendulum_core::integrate::{Integrator, Rk4, State};
+use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -288,4 +290,134 @@ fn in_single_precision_a_failing_chain_is_named_and_the_others_finish() {
         let row = &out[8 * k..8 * k + 8];
         assert_eq!(row.iter().all(|x| x.is_nan()), k == 3 || k == 7, "chain {k}: {row:?}");
     }
+}
+
+/// Each chain's state after `steps` steps of `Rk4` on `FirstOrder::new(model)`, alone, and
+/// its error (the state left where it failed).
+fn stepped_alone<M, const N: usize, const Q: usize, const D: usize>(
+    models: &[M],
+    states: &[State<Const<D>>],
+    h: f64,
+    steps: usize,
+) -> Vec<(State<Const<D>>, Option<Error>)>
+where
+    M: Model<Links = Const<N>, Dof = Const<Q>, Space = U3> + Clone,
+    Const<Q>: nalgebra::DimMul<U2, Output = Const<D>>,
+{
+    models
+        .iter()
+        .zip(states)
+        .map(|(model, state)| {
+            let system = FirstOrder::new(model.clone());
+            let mut rk4 = Rk4::new(&system);
+            let mut state = state.clone();
+            let error = (0..steps).find_map(|_| rk4.step(&system, &mut state, h).err());
+            (state, error)
+        })
+        .collect()
+}
+
+/// `chains` random states `(θ, φ, θ̇, φ̇)` at random times, the polar angles between 0.2
+/// and 2.9 rad.
+fn random_states<const D: usize>(chains: usize, r: &mut ChaCha8Rng) -> Vec<State<Const<D>>> {
+    (0..chains)
+        .map(|_| {
+            let x = SVector::<f64, D>::from_fn(|i, _| match 4 * i / D {
+                0 => r.random_range(0.2..2.9),
+                1 => r.random_range(-3.0..3.0),
+                _ => r.random_range(-5.0..5.0),
+            });
+            State::new(r.random_range(0.0..10.0), x)
+        })
+        .collect()
+}
+
+/// The batch's RK4 runs equal each chain's alone in time, state and compensation, and fail
+/// where they fail with their errors: on 1 and 2 threads, in eight lanes a register and in
+/// four, and in two calls of half the steps each.
+fn check_rk4<M, const N: usize, const Q: usize, const D: usize>(
+    models: Vec<M>,
+    states: Vec<State<Const<D>>>,
+    h: f64,
+    steps: usize,
+) where
+    M: SpatialKernel<N> + Model<Links = Const<N>, Dof = Const<Q>, Space = U3> + Clone,
+    Const<Q>: nalgebra::DimMul<U2, Output = Const<D>>,
+{
+    let alone = stepped_alone::<M, N, Q, D>(&models, &states, h, steps);
+    let eight = UnrolledSpatialBatch::new(models).expect("batch");
+    let four = eight.clone().with_avx512(false);
+    for batch in [&eight, &four] {
+        let what = format!("{} chains of {N}, AVX-512 {}", states.len(), batch.uses_avx512());
+        let compare = |batched: &[State<Const<D>>], failures: &[Failure], what: &str| {
+            let mut failed = failures.iter();
+            for (k, (state, (single, error))) in batched.iter().zip(&alone).enumerate() {
+                assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
+                assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
+                assert_bits(
+                    state.compensation().as_slice(),
+                    single.compensation().as_slice(),
+                    &format!("{what}: chain {k}'s compensation"),
+                );
+                if let Some(error) = error {
+                    let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
+                    assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
+                }
+            }
+            assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+        };
+        for pool in pools() {
+            let mut batched = states.clone();
+            let failures = pool.install(|| batch.integrate_rk4(&mut batched, h, steps)).expect("batch");
+            compare(&batched, &failures, &format!("{what}, {} threads", pool.current_num_threads()));
+        }
+        let mut batched = states.clone();
+        let first = batch.integrate_rk4(&mut batched, h, steps / 2).expect("batch");
+        let mut failures = batch.integrate_rk4(&mut batched, h, steps - steps / 2).expect("batch");
+        failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
+        failures.extend(first);
+        failures.sort_by_key(|f| f.chain);
+        compare(&batched, &failures, &format!("{what}, in two calls"));
+    }
+}
+
+#[test]
+fn rk4_runs_of_a_batch_equal_each_chain_stepped_alone_bit_for_bit() {
+    let mut r = ChaCha8Rng::seed_from_u64(61);
+    // 37 chains: ten blocks of four in groups of four (the last one short), each group a
+    // task of its own on two threads; 9 chains: three blocks, the last alone in its pair.
+    for chains in [1, 6, 9, 13, 37] {
+        let states = random_states::<8>(chains, &mut r);
+        check_rk4::<Spatial2, 2, 4, 8>(random_models(chains, &mut r), states, 1e-3, 20);
+        let states = random_states::<16>(chains, &mut r);
+        check_rk4::<Spatial4, 4, 8, 16>(random_models(chains, &mut r), states, 3e-4, 20);
+    }
+}
+
+#[test]
+fn a_chain_whose_run_reaches_a_pole_stops_there_with_its_own_error() {
+    let mut r = ChaCha8Rng::seed_from_u64(3);
+    let models: Vec<Spatial4> = random_models(11, &mut r);
+    let mut states = random_states::<16>(11, &mut r);
+    let mut set = |k: usize, entries: &[(usize, f64)]| {
+        let mut x = *states[k].x();
+        for &(i, value) in entries {
+            x[i] = value;
+        }
+        states[k] = State::new(states[k].t(), x);
+    };
+    // Chain 2: link 3 swings towards the pole, so that the second stage of the first step
+    // (`θ + (h/2) θ̇`) lands 5e-7 rad from it (a finite result, which the model refuses),
+    // after a first stage at 2.505e-4 rad, which it accepts. Chain 5: an azimuth is NaN.
+    // Chain 9: link 1 starts at the pole.
+    set(2, &[(2, 2.5e-4 + 5e-7), (8 + 2, -0.5), (8 + 4 + 2, 0.0)]);
+    set(5, &[(6, f64::NAN)]);
+    set(9, &[(0, 0.0)]);
+    let h = 1e-3;
+    let alone = stepped_alone::<Spatial4, 4, 8, 16>(&models, &states, h, 10);
+    let failed: Vec<usize> = (0..11).filter(|&k| alone[k].1.is_some()).collect();
+    assert_eq!(failed, [2, 5, 9], "{alone:?}");
+    assert!(matches!(alone[2].1, Some(Error::SingularAngle { link: 3, .. })), "{:?}", alone[2].1);
+    assert!(matches!(alone[9].1, Some(Error::SingularAngle { link: 1, .. })), "{:?}", alone[9].1);
+    check_rk4::<Spatial4, 4, 8, 16>(models, states, h, 10);
 }

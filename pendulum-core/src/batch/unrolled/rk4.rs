@@ -1,81 +1,226 @@
-//! Runs of RK4 for a batch of generated planar models, in lanes: each chain's
+//! Runs of RK4 for a batch of generated models, in lanes: each chain's
 //! [`Rk4`](crate::integrate::Rk4) on [`FirstOrder::new`](crate::FirstOrder::new) of its
 //! model (pivot at rest, no torques), the states in lanes from the first step to the last.
+//! One run serves the planar models (`K = 1` array of `N` coordinates a block, the angles
+//! `θ_i`) and the spatial ones (`K = 2`: the polar angles, then the azimuths), through
+//! [`Stages`].
 
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
 
 use super::precision::{KernelLanes, join};
-use super::{GROUP, LinkConstants, PlanarKernel, SineRoom, UnrolledBatch, unit_blocks};
+use super::spatial::near_pole;
+use super::{
+    GROUP, LinkConstants, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
+    unit_blocks,
+};
 use crate::batch::{F64x4, Failure, WIDTH, for_blocks_of};
 use crate::error::{Error, Result};
 use crate::integrate::{State, kahan_add};
 use crate::lanes::{Lane, Lanes};
 
-/// A block's states in lanes: `θ`, `θ̇` and their compensations, `t` and its compensation.
-struct Block<const N: usize> {
-    q: [F64x4; N],
-    qd: [F64x4; N],
-    q_carry: [F64x4; N],
-    qd_carry: [F64x4; N],
+/// A block's states in lanes: its `K` arrays of `N` coordinates, their rates and their
+/// compensations, `t` and its compensation.
+struct Block<const N: usize, const K: usize> {
+    q: [[F64x4; N]; K],
+    qd: [[F64x4; N]; K],
+    q_carry: [[F64x4; N]; K],
+    qd_carry: [[F64x4; N]; K],
     t: F64x4,
     t_carry: F64x4,
 }
 
-impl<const N: usize> Default for Block<N> {
+impl<const N: usize, const K: usize> Default for Block<N, K> {
     fn default() -> Self {
-        let zero = Lanes([0.0; WIDTH]);
-        Self { q: [zero; N], qd: [zero; N], q_carry: [zero; N], qd_carry: [zero; N], t: zero, t_carry: zero }
+        let zero = [[Lanes([0.0; WIDTH]); N]; K];
+        let t = Lanes([0.0; WIDTH]);
+        Self { q: zero, qd: zero, q_carry: zero, qd_carry: zero, t, t_carry: t }
     }
 }
 
-/// `θ̈(θ, θ̇)` for [`increment`]: a type of its own rather than a closure, for the lanes'
+/// `q̈(q, q̇)` for [`increment`]: a type of its own rather than a closure, for the lanes'
 /// kernel must be inlined into its caller to run with the caller's target features, and a
 /// closure called four times was compiled as a function of its own, without them (SSE2 in
 /// the AVX2 run, half its time).
 trait Accelerations<V, const N: usize, const G: usize> {
-    /// `θ̈` (rad/s²) of `G` blocks at angles `q` (rad) and rates `qd` (rad/s).
+    /// `q̈` (rad/s²) of `G` arrays of coordinates `q` (rad) and rates `qd` (rad/s).
     fn at(&mut self, q: &[[V; N]; G], qd: &[[V; N]; G]) -> [[V; N]; G];
 }
 
-/// A model's kernels on the first `count` blocks of a group, constants `c`, in lanes of
-/// type `V`, pivot at rest and no torques: the sines and cosines of all their angles in
-/// one call of the sine kernel (in `room`), then block by block the kernel.
-struct Kernel<'a, M, V, const N: usize> {
-    c: &'a [LinkConstants<V, N>; GROUP],
-    count: usize,
-    room: &'a mut SineRoom<F64x4, N>,
-    model: std::marker::PhantomData<M>,
+/// A batch of generated models as its RK4 run sees it: `A` arrays of `N` coordinates a
+/// group ([`GROUP`] blocks of `A / GROUP` arrays each), the blocks' constants, and the
+/// accelerations of a group's blocks in lanes.
+trait Stages<const N: usize, const A: usize>: Sync {
+    /// Per block of [`WIDTH`] chains, their constants side by side.
+    fn blocks(&self) -> &[LinkConstants<F64x4, N>];
+
+    /// Whether the run uses AVX-512 registers.
+    fn uses_avx512(&self) -> bool;
+
+    /// `q̈` of the first `count` blocks of a group (unit `u`'s arrays from `A / GROUP · u`),
+    /// constants `c` per unit, in lanes of type `V`, pivot at rest and no torques: the
+    /// sines and cosines of all their angles in one call of the sine kernel (in `room`),
+    /// then unit by unit the kernel. A lane the model refuses (a pole) is NaN.
+    fn at<V: KernelLanes<f64>>(
+        c: &[LinkConstants<V, N>; GROUP],
+        count: usize,
+        room: &mut SineRoom<F64x4, N, A>,
+        q: &[[V; N]; A],
+        qd: &[[V; N]; A],
+    ) -> [[V; N]; A];
+
+    /// The error of chain `chain`'s own RK4 step from `(t, x)` (out of the hot path): the
+    /// first stage's whose accelerations fail, else a non-finite increment.
+    fn step_error(&self, chain: usize, t: f64, x: &[f64], h: f64) -> Error;
 }
 
-impl<M: PlanarKernel<N>, V: KernelLanes<f64>, const N: usize> Accelerations<V, N, GROUP>
-    for Kernel<'_, M, V, N>
+/// [`Stages::at`] as an [`Accelerations`] (inlined into the run).
+struct Kernel<'a, B, V, const N: usize, const A: usize> {
+    c: &'a [LinkConstants<V, N>; GROUP],
+    count: usize,
+    room: &'a mut SineRoom<F64x4, N, A>,
+    batch: std::marker::PhantomData<B>,
+}
+
+impl<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const A: usize> Accelerations<V, N, A>
+    for Kernel<'_, B, V, N, A>
 {
     #[inline(always)]
-    fn at(&mut self, q: &[[V; N]; GROUP], qd: &[[V; N]; GROUP]) -> [[V; N]; GROUP] {
+    fn at(&mut self, q: &[[V; N]; A], qd: &[[V; N]; A]) -> [[V; N]; A] {
+        B::at(self.c, self.count, self.room, q, qd)
+    }
+}
+
+impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N> {
+    fn blocks(&self) -> &[LinkConstants<F64x4, N>] {
+        &self.blocks
+    }
+
+    fn uses_avx512(&self) -> bool {
+        UnrolledBatch::uses_avx512(self)
+    }
+
+    #[inline(always)]
+    fn at<V: KernelLanes<f64>>(
+        c: &[LinkConstants<V, N>; GROUP],
+        count: usize,
+        room: &mut SineRoom<F64x4, N, GROUP>,
+        q: &[[V; N]; GROUP],
+        qd: &[[V; N]; GROUP],
+    ) -> [[V; N]; GROUP] {
         let zero = V::splat(0.0);
-        let count = self.count;
         let units = count.div_ceil(V::BLOCKS);
         for (u, q) in q.iter().enumerate().take(units) {
             let [a, b] = unit_blocks(u, V::BLOCKS, count);
             for (i, q) in q.iter().enumerate() {
-                [self.room.angles[a][i], self.room.angles[b][i]] = q.split();
+                [room.angles[a][i], room.angles[b][i]] = q.split();
             }
         }
-        self.room.sin_cos::<f64>(count);
+        room.sin_cos::<f64>(count);
         let mut out = [[zero; N]; GROUP];
         for u in 0..units {
             let mut trig = [[zero; 2]; N];
-            self.room.trig(unit_blocks(u, V::BLOCKS, count), &mut trig);
-            out[u] = M::kernel(&self.c[u], &trig, &qd[u], &[zero; N], [zero; 2]);
+            room.trig(unit_blocks(u, V::BLOCKS, count), &mut trig);
+            out[u] = M::kernel(&c[u], &trig, &qd[u], &[zero; N], [zero; 2]);
         }
         out
     }
+
+    #[cold]
+    fn step_error(&self, chain: usize, t: f64, x: &[f64], h: f64) -> Error {
+        let model = &self.models[chain];
+        let inputs = model.zero_inputs();
+        let mut first = None;
+        let (q, qd): ([f64; N], [f64; N]) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
+        increment::<f64, N, 1>(&[q], &[qd], h, |q: &[[f64; N]; 1], qd: &[[f64; N]; 1]| {
+            let mut out = SVector::<f64, N>::zeros();
+            let (q, qd) = (SVector::<f64, N>::from(q[0]), SVector::<f64, N>::from(qd[0]));
+            match model.accelerations(&q, &qd, &inputs, &mut out) {
+                Ok(()) => [out.data.0[0]],
+                Err(error) => {
+                    first.get_or_insert(error);
+                    [[f64::NAN; N]]
+                }
+            }
+        });
+        first.unwrap_or(Error::NonFiniteState { t, h })
+    }
 }
 
-/// Any closure `θ̈(θ, θ̇)` of one block (out of the hot path: a closure is compiled apart).
-impl<V, const N: usize, F: FnMut(&[V; N], &[V; N]) -> [V; N]> Accelerations<V, N, 1> for F {
-    fn at(&mut self, q: &[[V; N]; 1], qd: &[[V; N]; 1]) -> [[V; N]; 1] {
-        [self(&q[0], &qd[0])]
+impl<M: SpatialKernel<N>, const N: usize> Stages<N, { 2 * GROUP }> for UnrolledSpatialBatch<M, N> {
+    fn blocks(&self) -> &[LinkConstants<F64x4, N>] {
+        &self.blocks
+    }
+
+    fn uses_avx512(&self) -> bool {
+        UnrolledSpatialBatch::uses_avx512(self)
+    }
+
+    #[inline(always)]
+    fn at<V: KernelLanes<f64>>(
+        c: &[LinkConstants<V, N>; GROUP],
+        count: usize,
+        room: &mut SineRoom<F64x4, N, { 2 * GROUP }>,
+        q: &[[V; N]; 2 * GROUP],
+        qd: &[[V; N]; 2 * GROUP],
+    ) -> [[V; N]; 2 * GROUP] {
+        let zero = V::splat(0.0);
+        let units = count.div_ceil(V::BLOCKS);
+        for u in 0..units {
+            let [a, b] = unit_blocks(u, V::BLOCKS, count);
+            for coordinate in 0..2 {
+                for (i, q) in q[2 * u + coordinate].iter().enumerate() {
+                    [room.angles[2 * a + coordinate][i], room.angles[2 * b + coordinate][i]] = q.split();
+                }
+            }
+        }
+        room.sin_cos::<f64>(2 * count);
+        let mut out = [[zero; N]; 2 * GROUP];
+        for u in 0..units {
+            let pair = unit_blocks(u, V::BLOCKS, count);
+            let mut trig = [[[zero; 2]; N]; 2];
+            room.trig(pair.map(|j| 2 * j), &mut trig[0]);
+            room.trig(pair.map(|j| 2 * j + 1), &mut trig[1]);
+            let rates = [qd[2 * u], qd[2 * u + 1]];
+            let mut accelerations = M::kernel(&c[u], &trig, &rates, &[[zero; N]; 2], [zero; 3]);
+            let near = near_pole(&trig[0]);
+            if V::any(near) {
+                accelerations[0][0] = V::select(near, V::splat(f64::NAN), accelerations[0][0]);
+            }
+            [out[2 * u], out[2 * u + 1]] = accelerations;
+        }
+        out
+    }
+
+    #[cold]
+    fn step_error(&self, chain: usize, t: f64, x: &[f64], h: f64) -> Error {
+        let model = &self.models[chain];
+        let mut first = None;
+        let arrays = |x: &[f64]| -> [[f64; N]; 2] {
+            [x[..N].try_into().expect("N"), x[N..2 * N].try_into().expect("N")]
+        };
+        let (q, qd) = (arrays(&x[..2 * N]), arrays(&x[2 * N..]));
+        let torque = vec![0.0; 2 * N];
+        increment::<f64, N, 2>(&q, &qd, h, |q: &[[f64; N]; 2], qd: &[[f64; N]; 2]| {
+            let mut out = [[0.0; N]; 2];
+            let (q, qd, result) = (q.as_flattened(), qd.as_flattened(), out.as_flattened_mut());
+            match model.row_accelerations(q, qd, &torque, [0.0; 3], result) {
+                Ok(()) => out,
+                Err(error) => {
+                    first.get_or_insert(error);
+                    [[f64::NAN; N]; 2]
+                }
+            }
+        });
+        first.unwrap_or(Error::NonFiniteState { t, h })
+    }
+}
+
+/// Any closure `q̈(q, q̇)` (out of the hot path: a closure is compiled apart).
+impl<V, const N: usize, const G: usize, F: FnMut(&[[V; N]; G], &[[V; N]; G]) -> [[V; N]; G]>
+    Accelerations<V, N, G> for F
+{
+    fn at(&mut self, q: &[[V; N]; G], qd: &[[V; N]; G]) -> [[V; N]; G] {
+        self(q, qd)
     }
 }
 
@@ -150,214 +295,244 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         DefaultAllocator: Allocator<D>,
         State<D>: Send,
     {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
-        if states.len() != self.len() {
-            return Err(Error::LengthMismatch { what: "states", expected: self.len(), got: states.len() });
-        }
-        if let Some(s) = states.iter().find(|s| s.x().len() != 2 * N) {
-            return Err(Error::LengthMismatch { what: "x", expected: 2 * N, got: s.x().len() });
-        }
-        let solves = (4 * N).saturating_mul(steps);
-        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(
-            states,
-            1,
-            solves,
-            SineRoom::new,
-            |room, g, states| {
-                let first = GROUP * g;
-                let count = states.len().div_ceil(WIDTH);
-                let mut s: [Block<N>; GROUP] = std::array::from_fn(|_| Block::default());
-                for (s, block) in s.iter_mut().zip(states.chunks(WIDTH)) {
-                    let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
-                    let entries = |j: usize, carry: bool| {
-                        Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
-                    };
-                    *s = Block {
-                        q: std::array::from_fn(|i| entries(i, false)),
-                        qd: std::array::from_fn(|i| entries(N + i, false)),
-                        q_carry: std::array::from_fn(|i| entries(i, true)),
-                        qd_carry: std::array::from_fn(|i| entries(N + i, true)),
-                        t: Lanes::from_fn(|k| parts[k].0),
-                        t_carry: Lanes::from_fn(|k| parts[k].1),
-                    };
-                }
-                let alive = self.rk4_run_simd(first, count, room, h, steps, &mut s);
-                let mut failures = Vec::new();
-                for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
-                    for (k, state) in block.iter_mut().enumerate() {
-                        let x = (s.q.iter().zip(&s.q_carry)).chain(s.qd.iter().zip(&s.qd_carry));
-                        state.set_parts(s.t.0[k], s.t_carry.0[k], x.map(|(x, carry)| (x.0[k], carry.0[k])));
-                        if !alive[j][k] {
-                            let chain = WIDTH * (first + j) + k;
-                            failures.push(Failure {
-                                chain,
-                                error: self.step_error(chain, state.t(), state.x().as_slice(), h),
-                            });
-                        }
+        integrate::<Self, D, N, 1, GROUP>(self, self.len(), states, h, steps)
+    }
+}
+
+impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
+    /// `steps` steps of RK4 of size `h` (s) for every chain, each from its own state
+    /// `x = (θ, φ, θ̇, φ̇)` (`4N` entries: rad, rad/s) and time: exactly what `steps` calls
+    /// of [`Rk4`](crate::integrate::Rk4)'s `step` on `FirstOrder::new(model)` give for each
+    /// chain alone, bit for bit (compensated time and state included), with the states
+    /// kept in lanes from the first step to the last.
+    ///
+    /// Returns the chains that failed, in order, each with the error its own step gave (a
+    /// stage at a pole of the chart, `Error::SingularAngle`; a non-finite state or
+    /// acceleration); a failed chain is left at the start of the step that failed and the
+    /// others go on. Errors: [`Error::InvalidStepSize`] for a zero or non-finite `h`,
+    /// [`Error::LengthMismatch`] for a number of states other than `B` or a state of the
+    /// wrong length.
+    pub fn integrate_rk4<D: Dim>(&self, states: &mut [State<D>], h: f64, steps: usize) -> Result<Vec<Failure>>
+    where
+        DefaultAllocator: Allocator<D>,
+        State<D>: Send,
+    {
+        integrate::<Self, D, N, 2, { 2 * GROUP }>(self, self.len(), states, h, steps)
+    }
+}
+
+/// The run of `integrate_rk4` for a batch `batch` of `chains` chains whose blocks hold `K`
+/// arrays of `N` coordinates (`A = K · GROUP` a group): states `x = (q, q̇)` of `2KN`.
+fn integrate<B, D: Dim, const N: usize, const K: usize, const A: usize>(
+    batch: &B,
+    chains: usize,
+    states: &mut [State<D>],
+    h: f64,
+    steps: usize,
+) -> Result<Vec<Failure>>
+where
+    B: Stages<N, A>,
+    DefaultAllocator: Allocator<D>,
+    State<D>: Send,
+{
+    debug_assert_eq!(A, K * GROUP);
+    let m = K * N;
+    if !h.is_finite() || h == 0.0 {
+        return Err(Error::InvalidStepSize { h });
+    }
+    if states.len() != chains {
+        return Err(Error::LengthMismatch { what: "states", expected: chains, got: states.len() });
+    }
+    if let Some(s) = states.iter().find(|s| s.x().len() != 2 * m) {
+        return Err(Error::LengthMismatch { what: "x", expected: 2 * m, got: s.x().len() });
+    }
+    let solves = (4 * N).saturating_mul(steps);
+    let failures =
+        for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(states, 1, solves, SineRoom::new, |room, g, states| {
+            let first = GROUP * g;
+            let count = states.len().div_ceil(WIDTH);
+            let mut s: [Block<N, K>; GROUP] = std::array::from_fn(|_| Block::default());
+            for (s, block) in s.iter_mut().zip(states.chunks(WIDTH)) {
+                let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
+                let entries = |j: usize, carry: bool| {
+                    Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
+                };
+                let arrays = |offset: usize, carry: bool| -> [[F64x4; N]; K] {
+                    std::array::from_fn(|c| std::array::from_fn(|i| entries(offset + N * c + i, carry)))
+                };
+                *s = Block {
+                    q: arrays(0, false),
+                    qd: arrays(m, false),
+                    q_carry: arrays(0, true),
+                    qd_carry: arrays(m, true),
+                    t: Lanes::from_fn(|k| parts[k].0),
+                    t_carry: Lanes::from_fn(|k| parts[k].1),
+                };
+            }
+            let alive = rk4_run_simd::<B, N, K, A>(batch, (first, count), room, h, steps, &mut s);
+            let mut failures = Vec::new();
+            for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
+                for (k, state) in block.iter_mut().enumerate() {
+                    let x = lane(&s.q, &s.q_carry, k).chain(lane(&s.qd, &s.qd_carry, k));
+                    state.set_parts(s.t.0[k], s.t_carry.0[k], x);
+                    if !alive[j][k] {
+                        let chain = WIDTH * (first + j) + k;
+                        failures.push(Failure {
+                            chain,
+                            error: batch.step_error(chain, state.t(), state.x().as_slice(), h),
+                        });
                     }
                 }
-                failures
-            },
-        );
-        Ok(failures)
-    }
-
-    /// The error of chain `chain`'s own RK4 step from `state` (out of the hot path): the
-    /// first stage's whose accelerations fail, else a non-finite increment.
-    #[cold]
-    fn step_error(&self, chain: usize, t: f64, x: &[f64], h: f64) -> Error {
-        let model = &self.models[chain];
-        let inputs = model.zero_inputs();
-        let mut first = None;
-        let (q, qd): ([f64; N], [f64; N]) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
-        increment::<f64, N, 1>(&[q], &[qd], h, |q: &[f64; N], qd: &[f64; N]| {
-            let mut out = SVector::<f64, N>::zeros();
-            let (q, qd) = (SVector::<f64, N>::from_column_slice(q), SVector::<f64, N>::from_column_slice(qd));
-            match model.accelerations(&q, &qd, &inputs, &mut out) {
-                Ok(()) => out.data.0[0],
-                Err(error) => {
-                    first.get_or_insert(error);
-                    [f64::NAN; N]
-                }
             }
+            failures
         });
-        first.unwrap_or(Error::NonFiniteState { t, h })
-    }
+    Ok(failures)
+}
 
-    /// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the
-    /// first `count` of them), in lanes of type `V` (holding one block each, or two); a lane
-    /// whose increment is not finite stops at the start of that step. Returns the lanes
-    /// that ran to the end.
-    #[inline(always)]
-    fn rk4_run<V: KernelLanes<f64>>(
-        &self,
-        (first, count): (usize, usize),
-        room: &mut SineRoom<F64x4, N>,
-        h: f64,
-        steps: usize,
-        s: &mut [Block<N>; GROUP],
-    ) -> [[bool; WIDTH]; GROUP] {
-        let zero = V::splat(0.0);
-        let units = count.div_ceil(V::BLOCKS);
-        let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|u| {
-            let [a, b] = unit_blocks(u.min(units - 1), V::BLOCKS, count);
-            LinkConstants::joined([&self.blocks[first + a], &self.blocks[first + b]])
-        });
-        let (mut q, mut qd) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
-        let (mut q_carry, mut qd_carry) = ([[zero; N]; GROUP], [[zero; N]; GROUP]);
-        let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
-        for u in 0..units {
-            let [a, b] = unit_blocks(u, V::BLOCKS, count).map(|j| &s[j]);
-            (q[u], qd[u]) = (join([&a.q, &b.q]), join([&a.qd, &b.qd]));
-            (q_carry[u], qd_carry[u]) = (join([&a.q_carry, &b.q_carry]), join([&a.qd_carry, &b.qd_carry]));
-            (t[u], t_carry[u]) = (V::join([a.t, b.t]), V::join([a.t_carry, b.t_carry]));
+/// Lane `k`'s entries of `x` and their compensations `carry`, in order.
+fn lane<'a, const N: usize, const K: usize>(
+    x: &'a [[F64x4; N]; K],
+    carry: &'a [[F64x4; N]; K],
+    k: usize,
+) -> impl Iterator<Item = (f64, f64)> + 'a {
+    x.as_flattened().iter().zip(carry.as_flattened()).map(move |(x, carry)| (x.0[k], carry.0[k]))
+}
+
+/// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the first
+/// `count` of them), in lanes of type `V` (holding one block each, or two; unit `u`'s
+/// arrays from `K·u`); a lane whose increment is not finite stops at the start of that
+/// step. Returns the lanes that ran to the end.
+#[inline(always)]
+fn rk4_run<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const K: usize, const A: usize>(
+    batch: &B,
+    (first, count): (usize, usize),
+    room: &mut SineRoom<F64x4, N, A>,
+    h: f64,
+    steps: usize,
+    s: &mut [Block<N, K>; GROUP],
+) -> [[bool; WIDTH]; GROUP] {
+    let zero = V::splat(0.0);
+    let units = count.div_ceil(V::BLOCKS);
+    let blocks = batch.blocks();
+    let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|u| {
+        let [a, b] = unit_blocks(u.min(units - 1), V::BLOCKS, count);
+        LinkConstants::joined([&blocks[first + a], &blocks[first + b]])
+    });
+    let (mut q, mut qd) = ([[zero; N]; A], [[zero; N]; A]);
+    let (mut q_carry, mut qd_carry) = ([[zero; N]; A], [[zero; N]; A]);
+    let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
+    for u in 0..units {
+        let [a, b] = unit_blocks(u, V::BLOCKS, count).map(|j| &s[j]);
+        for c in 0..K {
+            (q[K * u + c], qd[K * u + c]) = (join([&a.q[c], &b.q[c]]), join([&a.qd[c], &b.qd[c]]));
+            q_carry[K * u + c] = join([&a.q_carry[c], &b.q_carry[c]]);
+            qd_carry[K * u + c] = join([&a.qd_carry[c], &b.qd_carry[c]]);
         }
-        let mut stopped = [V::none(); GROUP];
-        for _ in 0..steps {
-            let kernel =
-                Kernel::<M, V, N> { c: &c, count, room: &mut *room, model: std::marker::PhantomData };
-            let (dq, dqd) = increment(&q, &qd, h, kernel);
-            for u in 0..units {
-                // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
-                let mut probe = zero;
-                for d in dq[u].iter().chain(&dqd[u]) {
-                    #[allow(clippy::eq_op)]
-                    let nan_if_not_finite = *d - *d;
-                    probe += nan_if_not_finite;
-                }
-                let stop = V::or(stopped[u], probe.outside(0, 0));
-                stopped[u] = stop;
-                let advance = |x: &mut V, carry: &mut V, delta: V| {
-                    let (new, new_carry) = kahan_add(*x, *carry, delta);
-                    (*x, *carry) = (V::select(stop, *x, new), V::select(stop, *carry, new_carry));
-                };
-                advance(&mut t[u], &mut t_carry[u], V::splat(h));
+        (t[u], t_carry[u]) = (V::join([a.t, b.t]), V::join([a.t_carry, b.t_carry]));
+    }
+    let mut stopped = [V::none(); GROUP];
+    for _ in 0..steps {
+        let kernel = Kernel::<B, V, N, A> { c: &c, count, room: &mut *room, batch: std::marker::PhantomData };
+        let (dq, dqd) = increment(&q, &qd, h, kernel);
+        for u in 0..units {
+            let arrays = K * u..K * (u + 1);
+            // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
+            let mut probe = zero;
+            for d in dq[arrays.clone()].as_flattened().iter().chain(dqd[arrays.clone()].as_flattened()) {
+                #[allow(clippy::eq_op)]
+                let nan_if_not_finite = *d - *d;
+                probe += nan_if_not_finite;
+            }
+            let stop = V::or(stopped[u], probe.outside(0, 0));
+            stopped[u] = stop;
+            let advance = |x: &mut V, carry: &mut V, delta: V| {
+                let (new, new_carry) = kahan_add(*x, *carry, delta);
+                (*x, *carry) = (V::select(stop, *x, new), V::select(stop, *carry, new_carry));
+            };
+            advance(&mut t[u], &mut t_carry[u], V::splat(h));
+            for a in arrays {
                 for i in 0..N {
-                    advance(&mut q[u][i], &mut q_carry[u][i], dq[u][i]);
-                    advance(&mut qd[u][i], &mut qd_carry[u][i], dqd[u][i]);
+                    advance(&mut q[a][i], &mut q_carry[a][i], dq[a][i]);
+                    advance(&mut qd[a][i], &mut qd_carry[a][i], dqd[a][i]);
                 }
             }
-            if stopped[..units].iter().all(|&stop| V::all(stop)) {
-                break;
-            }
         }
-        let mut alive = [[false; WIDTH]; GROUP];
-        for u in 0..units {
-            // Each block of the unit once (an odd last block is both halves).
-            let blocks = unit_blocks(u, V::BLOCKS, count);
-            for (half, j) in blocks.into_iter().enumerate().take(V::BLOCKS.min(count - V::BLOCKS * u)) {
+        if stopped[..units].iter().all(|&stop| V::all(stop)) {
+            break;
+        }
+    }
+    let mut alive = [[false; WIDTH]; GROUP];
+    for u in 0..units {
+        // Each block of the unit once (an odd last block is both halves).
+        let blocks = unit_blocks(u, V::BLOCKS, count);
+        for (half, j) in blocks.into_iter().enumerate().take(V::BLOCKS.min(count - V::BLOCKS * u)) {
+            for c in 0..K {
                 let back = |v: &[V; N], to: &mut [F64x4; N]| {
                     for (to, v) in to.iter_mut().zip(v) {
                         *to = v.split()[half];
                     }
                 };
-                back(&q[u], &mut s[j].q);
-                back(&qd[u], &mut s[j].qd);
-                back(&q_carry[u], &mut s[j].q_carry);
-                back(&qd_carry[u], &mut s[j].qd_carry);
-                (s[j].t, s[j].t_carry) = (t[u].split()[half], t_carry[u].split()[half]);
-                let ran = V::select(stopped[u], zero, V::splat(1.0)).split()[half];
-                alive[j] = ran.0.map(|alive| alive == 1.0);
+                back(&q[K * u + c], &mut s[j].q[c]);
+                back(&qd[K * u + c], &mut s[j].qd[c]);
+                back(&q_carry[K * u + c], &mut s[j].q_carry[c]);
+                back(&qd_carry[K * u + c], &mut s[j].qd_carry[c]);
             }
+            (s[j].t, s[j].t_carry) = (t[u].split()[half], t_carry[u].split()[half]);
+            let ran = V::select(stopped[u], zero, V::splat(1.0)).split()[half];
+            alive[j] = ran.0.map(|alive| alive == 1.0);
         }
-        alive
     }
+    alive
+}
 
-    /// [`rk4_run`](Self::rk4_run) in AVX-512 registers (two blocks each) where the CPU has
-    /// AVX-512 VL and the batch allows it, in AVX2 registers where it has AVX2, else in
-    /// [`Lanes`].
-    fn rk4_run_simd(
-        &self,
-        first: usize,
-        count: usize,
-        room: &mut SineRoom<F64x4, N>,
-        h: f64,
-        steps: usize,
-        s: &mut [Block<N>; GROUP],
-    ) -> [[bool; WIDTH]; GROUP] {
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
-            return unsafe { self.rk4_run_avx512(first, count, room, h, steps, s) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if crate::lanes::has_avx2() {
-            // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.rk4_run_avx2(first, count, room, h, steps, s) };
-        }
-        self.rk4_run::<F64x4>((first, count), room, h, steps, s)
-    }
-
-    /// [`rk4_run`](Self::rk4_run) compiled for AVX-512, two blocks in each
-    /// [`Avx8`](crate::lanes::Avx8) register (1.18–1.26× four lanes, `docs/ensembles.md`).
+/// [`rk4_run`] in AVX-512 registers (two blocks each) where the CPU has AVX-512 VL and the
+/// batch allows it, in AVX2 registers where it has AVX2, else in [`Lanes`].
+fn rk4_run_simd<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
+    batch: &B,
+    group: (usize, usize),
+    room: &mut SineRoom<F64x4, N, A>,
+    h: f64,
+    steps: usize,
+    s: &mut [Block<N, K>; GROUP],
+) -> [[bool; WIDTH]; GROUP] {
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,avx512f,avx512vl")]
-    fn rk4_run_avx512(
-        &self,
-        first: usize,
-        count: usize,
-        room: &mut SineRoom<F64x4, N>,
-        h: f64,
-        steps: usize,
-        s: &mut [Block<N>; GROUP],
-    ) -> [[bool; WIDTH]; GROUP] {
-        self.rk4_run::<crate::lanes::Avx8>((first, count), room, h, steps, s)
+    if batch.uses_avx512() {
+        // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
+        return unsafe { rk4_run_avx512(batch, group, room, h, steps, s) };
     }
-
-    /// [`rk4_run`](Self::rk4_run) compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn rk4_run_avx2(
-        &self,
-        first: usize,
-        count: usize,
-        room: &mut SineRoom<F64x4, N>,
-        h: f64,
-        steps: usize,
-        s: &mut [Block<N>; GROUP],
-    ) -> [[bool; WIDTH]; GROUP] {
-        self.rk4_run::<crate::lanes::Avx4>((first, count), room, h, steps, s)
+    if crate::lanes::has_avx2() {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { rk4_run_avx2(batch, group, room, h, steps, s) };
     }
+    rk4_run::<B, F64x4, N, K, A>(batch, group, room, h, steps, s)
+}
+
+/// [`rk4_run`] compiled for AVX-512, two blocks in each [`Avx8`](crate::lanes::Avx8)
+/// register (1.18–1.26× four lanes, `docs/ensembles.md`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+fn rk4_run_avx512<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
+    batch: &B,
+    group: (usize, usize),
+    room: &mut SineRoom<F64x4, N, A>,
+    h: f64,
+    steps: usize,
+    s: &mut [Block<N, K>; GROUP],
+) -> [[bool; WIDTH]; GROUP] {
+    rk4_run::<B, crate::lanes::Avx8, N, K, A>(batch, group, room, h, steps, s)
+}
+
+/// [`rk4_run`] compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn rk4_run_avx2<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
+    batch: &B,
+    group: (usize, usize),
+    room: &mut SineRoom<F64x4, N, A>,
+    h: f64,
+    steps: usize,
+    s: &mut [Block<N, K>; GROUP],
+) -> [[bool; WIDTH]; GROUP] {
+    rk4_run::<B, crate::lanes::Avx4, N, K, A>(batch, group, room, h, steps, s)
 }

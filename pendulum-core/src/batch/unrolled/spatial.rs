@@ -5,7 +5,8 @@
 //!
 //! The model's `accelerations` checks every polar sine (`check_polar_sin`) before its
 //! kernel; here the check runs in lanes ([`near_pole`]), and a chain that fails it, or
-//! whose result is not finite, is run alone for its error.
+//! whose result is not finite, is run alone for its error. Their RK4 runs are the planar
+//! models' (`rk4`), with two arrays of coordinates a block.
 
 use super::precision::{KernelLanes, Precision};
 use super::{
@@ -57,8 +58,8 @@ pub trait SpatialKernel<const N: usize>: Send + Sync {
 }
 
 /// `B` chains of one generated spatial model type `M` (`N` links each, each its own masses,
-/// lengths, damping and gravity), evaluated four per instruction stream (eight in `f64` with
-/// AVX-512, eight in `f32` with AVX2). Rows are the models' own coordinates: `2N` a chain,
+/// lengths, damping and gravity), evaluated and stepped four per instruction stream (eight
+/// in `f64` with AVX-512, eight in `f32` with AVX2). Rows are the models' own coordinates: `2N` a chain,
 /// the polar angles `θ_i` then the azimuths `φ_i`.
 ///
 /// ```
@@ -77,9 +78,9 @@ pub trait SpatialKernel<const N: usize>: Send + Sync {
 /// ```
 #[derive(Debug, Clone)]
 pub struct UnrolledSpatialBatch<M, const N: usize> {
-    models: Vec<M>,
+    pub(super) models: Vec<M>,
     /// Per block of [`WIDTH`] chains, their constants side by side.
-    blocks: Vec<LinkConstants<F64x4, N>>,
+    pub(super) blocks: Vec<LinkConstants<F64x4, N>>,
     /// The same in single precision.
     blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
     /// Whether the calls may use AVX-512 where the CPU has it.
@@ -90,7 +91,7 @@ pub struct UnrolledSpatialBatch<M, const N: usize> {
 /// model's `check_polar_sin` refuses the state. (`Lane` has no absolute value: a sine
 /// below the tolerance, negative ones included, is negated, and the result checked again.)
 #[inline(always)]
-fn near_pole<V: Lane, const N: usize>(polar: &[[V; 2]; N]) -> V::Mask {
+pub(super) fn near_pole<V: Lane, const N: usize>(polar: &[[V; 2]; N]) -> V::Mask {
     let (low, span) = ACCEPTED_SINES;
     let mut near = V::none();
     for &[sin, _] in polar {
