@@ -3033,11 +3033,15 @@ const _: () = {
         }
     }
     #[automatically_derived]
-    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
-    impl ::pendulum_core::batch::PlanarKernel<12> for Planar12 {
+    impl ::pendulum_core::batch::Generated<12> for Planar12 {
+        type Chart = ::pendulum_core::kinematics::PlanarAngles;
         fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, 12> {
             &self.rods
         }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl ::pendulum_core::batch::PlanarKernel<12> for Planar12 {
         #[inline(always)]
         fn kernel<V: ::pendulum_core::lanes::Lane>(
             c: &::pendulum_core::batch::LinkConstants<V, 12>,

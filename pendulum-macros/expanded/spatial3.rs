@@ -932,11 +932,15 @@ const _: () = {
         }
     }
     #[automatically_derived]
-    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
-    impl ::pendulum_core::batch::SpatialKernel<3> for Spatial3 {
+    impl ::pendulum_core::batch::Generated<3> for Spatial3 {
+        type Chart = ::pendulum_core::kinematics::SphericalAngles;
         fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, 3> {
             &self.rods
         }
+    }
+    #[automatically_derived]
+    #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+    impl ::pendulum_core::batch::SpatialKernel<3> for Spatial3 {
         fn row_accelerations(
             &self,
             q: &[f64],

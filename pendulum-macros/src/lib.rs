@@ -64,8 +64,9 @@ use proc_macro::TokenStream;
 /// missized input, named) takes precedence: a non-finite input always makes the result
 /// non-finite, so the happy path does not check the inputs one by one.
 ///
-/// A model with `algorithm: tension` also implements
-/// `pendulum_core::batch::PlanarKernel<n>` (planar) or `SpatialKernel<n>` (spatial): its
+/// A model with `algorithm: tension` also implements `pendulum_core::batch::Generated<n>`
+/// (its stored constants and its chart) and `PlanarKernel<n>` (planar) or
+/// `SpatialKernel<n>` (spatial): its
 /// accelerations are written once, as a kernel over any lane type, which `accelerations`
 /// runs on `f64` and `pendulum_core::batch::UnrolledBatch` (planar) or
 /// `UnrolledSpatialBatch` (spatial) on four or eight chains at once (bit for bit, or in

@@ -52,7 +52,9 @@ pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
 pub(crate) use rooms::Rooms;
 pub(crate) use transpose::{gather, scatter};
-pub use unrolled::{LinkConstants, PlanarKernel, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch};
+pub use unrolled::{
+    Generated, LinkConstants, PlanarKernel, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
+};
 
 /// Chains per block: four `f64` lanes, one AVX2 register.
 pub const WIDTH: usize = 4;

@@ -19,7 +19,7 @@ use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
 use super::guards::{failure, finite_probe};
-use super::names::{index, space};
+use super::names::{chart, index, space};
 use super::rod_constants::{self, id};
 use crate::plan::{Kind, Plan};
 
@@ -215,14 +215,20 @@ pub(super) fn kernel_impl(name: &Ident, plan: &Plan) -> TokenStream {
             },
         ),
     };
+    let chart = chart(plan);
     quote! {
         #[automatically_derived]
-        #[allow(clippy::suboptimal_flops, clippy::eq_op)]
-        impl ::pendulum_core::batch::#trait_name<#n> for #name {
+        impl ::pendulum_core::batch::Generated<#n> for #name {
+            type Chart = ::pendulum_core::kinematics::#chart;
+
             fn constants(&self) -> &::pendulum_core::batch::LinkConstants<f64, #n> {
                 &self.rods
             }
+        }
 
+        #[automatically_derived]
+        #[allow(clippy::suboptimal_flops, clippy::eq_op)]
+        impl ::pendulum_core::batch::#trait_name<#n> for #name {
             #row_accelerations
 
             #[inline(always)]

@@ -26,6 +26,7 @@ pub use self::spatial::{SpatialKernel, UnrolledSpatialBatch};
 use self::precision::{KernelLanes, Precision, join};
 use super::{F64x4, Failure, WIDTH, all_finite, block_chains, check_len, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
+use crate::kinematics::PlanarAngles;
 use crate::lanes::{Lane, Lanes, Lanes32};
 use crate::model::{Inputs, Model};
 
@@ -113,25 +114,6 @@ fn gather_joined<P: Precision, V: KernelLanes<P>, const N: usize, const M: usize
             *out = V::join([lanes[0][c][i], lanes[1][c][i]]);
         }
     }
-}
-
-/// The blocks' constants of a batch of `models` side by side, in `f64` and `f32` lanes
-/// (`constants` reads a model's).
-///
-/// Errors: [`Error::EmptyBatch`].
-#[allow(clippy::type_complexity)]
-fn constant_blocks<M, const N: usize>(
-    models: &[M],
-    constants: impl Fn(&M) -> &LinkConstants<f64, N>,
-) -> Result<(Vec<LinkConstants<F64x4, N>>, Vec<LinkConstants<Lanes32<WIDTH>, N>>)> {
-    if models.is_empty() {
-        return Err(Error::EmptyBatch);
-    }
-    let block = |b: usize| block_chains(b, models.len()).map(|c| constants(&models[c]));
-    let count = models.len().div_ceil(WIDTH);
-    let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
-    let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
-    Ok((blocks, blocks_f32))
 }
 
 /// That `q`, `qd`, `out` and the torques hold `chains` rows of `m`, the pivot
@@ -238,16 +220,23 @@ impl<L: Copy, const N: usize> LinkConstants<L, N> {
     }
 }
 
+/// A model `model!` generates with `algorithm: tension`, as a batch holds it: the per-link
+/// constants `new` stored, and the coordinates it is written in.
+pub trait Generated<const N: usize>: Send + Sync {
+    /// [`PlanarAngles`] or [`SphericalAngles`](crate::kinematics::SphericalAngles).
+    type Chart;
+
+    /// The constants `new` stored.
+    fn constants(&self) -> &LinkConstants<f64, N>;
+}
+
 /// A planar model of `N` links whose `θ̈` is one straight-line kernel over [`Lane`]s: what
 /// `pendulum_macros::model!` emits for `kind: planar` with `algorithm: tension`. Its
 /// `Model::accelerations` is `kernel::<f64>` (after the sines and cosines, before the
 /// finiteness check); [`UnrolledBatch`] runs `kernel::<Lanes<4>>` (and `Lanes32<4>`).
 pub trait PlanarKernel<const N: usize>:
-    Model<Links = Const<N>, Dof = Const<N>, Space = U2> + Send + Sync
+    Model<Links = Const<N>, Dof = Const<N>, Space = U2> + Generated<N, Chart = PlanarAngles>
 {
-    /// The constants `new` stored.
-    fn constants(&self) -> &LinkConstants<f64, N>;
-
     /// `θ̈_i` (rad/s²), lane by lane, from `trig[i] = [sin θ_i, cos θ_i]`, the rates `θ̇_i`
     /// (rad/s), the joint torques `σ_i` (N·m) and the pivot's acceleration `p̈ = (ẍ, ÿ)`
     /// (m/s²): the rods' tension system solved in the links' own frames. A lane whose
@@ -261,9 +250,11 @@ pub trait PlanarKernel<const N: usize>:
     ) -> [V; N];
 }
 
-/// `B` chains of one generated planar model type `M` (`N` links each, each its own masses,
-/// lengths, damping and gravity), evaluated four per instruction stream (eight in `f64` with
-/// AVX-512, eight in `f32` with AVX2).
+/// `B` chains of one generated model type `M` (`N` links each, each its own masses,
+/// lengths, damping and gravity), evaluated and stepped four per instruction stream (eight
+/// in `f64` with AVX-512, eight in `f32` with AVX2): planar models in the angles `θ_i`
+/// (`K` = [`PlanarAngles`], the default), spatial ones in `(θ_i, φ_i)`
+/// ([`UnrolledSpatialBatch`]).
 ///
 /// ```
 /// use pendulum_core::batch::UnrolledBatch;
@@ -280,7 +271,7 @@ pub trait PlanarKernel<const N: usize>:
 /// # Ok::<(), pendulum_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct UnrolledBatch<M, const N: usize> {
+pub struct UnrolledBatch<M, const N: usize, K = PlanarAngles> {
     models: Vec<M>,
     /// Per block of [`WIDTH`] chains, their constants side by side.
     blocks: Vec<LinkConstants<F64x4, N>>,
@@ -288,15 +279,23 @@ pub struct UnrolledBatch<M, const N: usize> {
     blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
     /// Whether the calls may use AVX-512 where the CPU has it.
     avx512: bool,
+    /// The models' coordinates.
+    chart: std::marker::PhantomData<K>,
 }
 
-impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
-    /// The batch of `models`, chain `k` being `models[k]`.
+impl<M, const N: usize, K> UnrolledBatch<M, N, K> {
+    /// The batch of `models` whose constants `constants` reads.
     ///
     /// Errors: [`Error::EmptyBatch`].
-    pub fn new(models: Vec<M>) -> Result<Self> {
-        let (blocks, blocks_f32) = constant_blocks(&models, M::constants)?;
-        Ok(Self { models, blocks, blocks_f32, avx512: true })
+    fn with_constants(models: Vec<M>, constants: impl Fn(&M) -> &LinkConstants<f64, N>) -> Result<Self> {
+        if models.is_empty() {
+            return Err(Error::EmptyBatch);
+        }
+        let block = |b: usize| block_chains(b, models.len()).map(|c| constants(&models[c]));
+        let count = models.len().div_ceil(WIDTH);
+        let blocks = (0..count).map(|b| LinkConstants::interleave(block(b))).collect();
+        let blocks_f32 = (0..count).map(|b| LinkConstants::interleave_f32(block(b))).collect();
+        Ok(Self { models, blocks, blocks_f32, avx512: true, chart: std::marker::PhantomData })
     }
 
     /// Whether the evaluations and RK4 runs may work on eight `f64` chains per AVX-512
@@ -328,7 +327,18 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     pub fn model(&self, k: usize) -> &M {
         &self.models[k]
     }
+}
 
+impl<M: Generated<N>, const N: usize> UnrolledBatch<M, N, M::Chart> {
+    /// The batch of `models`, chain `k` being `models[k]`.
+    ///
+    /// Errors: [`Error::EmptyBatch`].
+    pub fn new(models: Vec<M>) -> Result<Self> {
+        Self::with_constants(models, M::constants)
+    }
+}
+
+impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     /// The angle accelerations `θ̈` (rad/s²) of every chain, written into `out` as `B` rows of
     /// `N`, at angles `q` (rad) and rates `qd` (rad/s) given the same way, with each chain's
     /// joint torques from `torque` (`B` rows of `N`, N·m; `None`: none) and pivot acceleration

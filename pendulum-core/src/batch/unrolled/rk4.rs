@@ -1,8 +1,8 @@
 //! Runs of RK4 for a batch of generated models, in lanes: each chain's
 //! [`Rk4`](crate::integrate::Rk4) on [`FirstOrder::new`](crate::FirstOrder::new) of its
 //! model (pivot at rest, no torques), the states in lanes from the first step to the last.
-//! One run serves the planar models (`K = 1` array of `N` coordinates a block, the angles
-//! `θ_i`) and the spatial ones (`K = 2`: the polar angles, then the azimuths), through
+//! One run serves the planar models (`C = 1` array of `N` coordinates a block, the angles
+//! `θ_i`) and the spatial ones (`C = 2`: the polar angles, then the azimuths), through
 //! [`Stages`].
 
 use nalgebra::{DefaultAllocator, Dim, SVector, allocator::Allocator};
@@ -47,15 +47,9 @@ trait Accelerations<V, const N: usize, const G: usize> {
 }
 
 /// A batch of generated models as its RK4 run sees it: `A` arrays of `N` coordinates a
-/// group ([`GROUP`] blocks of `A / GROUP` arrays each), the blocks' constants, and the
-/// accelerations of a group's blocks in lanes.
+/// group ([`GROUP`] blocks of `A / GROUP` arrays each), and the accelerations of a group's
+/// blocks in lanes.
 trait Stages<const N: usize, const A: usize>: Sync {
-    /// Per block of [`WIDTH`] chains, their constants side by side.
-    fn blocks(&self) -> &[LinkConstants<F64x4, N>];
-
-    /// Whether the run uses AVX-512 registers.
-    fn uses_avx512(&self) -> bool;
-
     /// `q̈` of the first `count` blocks of a group (unit `u`'s arrays from `A / GROUP · u`),
     /// constants `c` per unit, in lanes of type `V`, pivot at rest and no torques: the
     /// sines and cosines of all their angles in one call of the sine kernel (in `room`),
@@ -91,14 +85,6 @@ impl<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const A: usize> Accel
 }
 
 impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N> {
-    fn blocks(&self) -> &[LinkConstants<F64x4, N>] {
-        &self.blocks
-    }
-
-    fn uses_avx512(&self) -> bool {
-        UnrolledBatch::uses_avx512(self)
-    }
-
     #[inline(always)]
     fn at<V: KernelLanes<f64>>(
         c: &[LinkConstants<V, N>; GROUP],
@@ -147,14 +133,6 @@ impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N
 }
 
 impl<M: SpatialKernel<N>, const N: usize> Stages<N, { 2 * GROUP }> for UnrolledSpatialBatch<M, N> {
-    fn blocks(&self) -> &[LinkConstants<F64x4, N>] {
-        &self.blocks
-    }
-
-    fn uses_avx512(&self) -> bool {
-        UnrolledSpatialBatch::uses_avx512(self)
-    }
-
     #[inline(always)]
     fn at<V: KernelLanes<f64>>(
         c: &[LinkConstants<V, N>; GROUP],
@@ -295,7 +273,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         DefaultAllocator: Allocator<D>,
         State<D>: Send,
     {
-        integrate::<Self, D, N, 1, GROUP>(self, self.len(), states, h, steps)
+        integrate::<_, _, D, N, 1, GROUP>(self, states, h, steps)
     }
 }
 
@@ -317,26 +295,25 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         DefaultAllocator: Allocator<D>,
         State<D>: Send,
     {
-        integrate::<Self, D, N, 2, { 2 * GROUP }>(self, self.len(), states, h, steps)
+        integrate::<_, _, D, N, 2, { 2 * GROUP }>(self, states, h, steps)
     }
 }
 
-/// The run of `integrate_rk4` for a batch `batch` of `chains` chains whose blocks hold `K`
-/// arrays of `N` coordinates (`A = K · GROUP` a group): states `x = (q, q̇)` of `2KN`.
-fn integrate<B, D: Dim, const N: usize, const K: usize, const A: usize>(
-    batch: &B,
-    chains: usize,
+/// The run of `integrate_rk4` for a batch `batch` whose blocks hold `C`
+/// arrays of `N` coordinates (`A = C · GROUP` a group): states `x = (q, q̇)` of `2CN`.
+fn integrate<M, K, D: Dim, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
     states: &mut [State<D>],
     h: f64,
     steps: usize,
 ) -> Result<Vec<Failure>>
 where
-    B: Stages<N, A>,
+    UnrolledBatch<M, N, K>: Stages<N, A>,
     DefaultAllocator: Allocator<D>,
     State<D>: Send,
 {
-    debug_assert_eq!(A, K * GROUP);
-    let m = K * N;
+    debug_assert_eq!(A, C * GROUP);
+    let (chains, m) = (batch.len(), C * N);
     if !h.is_finite() || h == 0.0 {
         return Err(Error::InvalidStepSize { h });
     }
@@ -351,13 +328,13 @@ where
         for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(states, 1, solves, SineRoom::new, |room, g, states| {
             let first = GROUP * g;
             let count = states.len().div_ceil(WIDTH);
-            let mut s: [Block<N, K>; GROUP] = std::array::from_fn(|_| Block::default());
+            let mut s: [Block<N, C>; GROUP] = std::array::from_fn(|_| Block::default());
             for (s, block) in s.iter_mut().zip(states.chunks(WIDTH)) {
                 let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
                 let entries = |j: usize, carry: bool| {
                     Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
                 };
-                let arrays = |offset: usize, carry: bool| -> [[F64x4; N]; K] {
+                let arrays = |offset: usize, carry: bool| -> [[F64x4; N]; C] {
                     std::array::from_fn(|c| std::array::from_fn(|i| entries(offset + N * c + i, carry)))
                 };
                 *s = Block {
@@ -369,7 +346,7 @@ where
                     t_carry: Lanes::from_fn(|k| parts[k].1),
                 };
             }
-            let alive = rk4_run_simd::<B, N, K, A>(batch, (first, count), room, h, steps, &mut s);
+            let alive = rk4_run_simd::<M, K, N, C, A>(batch, (first, count), room, h, steps, &mut s);
             let mut failures = Vec::new();
             for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
                 for (k, state) in block.iter_mut().enumerate() {
@@ -400,20 +377,23 @@ fn lane<'a, const N: usize, const K: usize>(
 
 /// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the first
 /// `count` of them), in lanes of type `V` (holding one block each, or two; unit `u`'s
-/// arrays from `K·u`); a lane whose increment is not finite stops at the start of that
+/// arrays from `C·u`); a lane whose increment is not finite stops at the start of that
 /// step. Returns the lanes that ran to the end.
 #[inline(always)]
-fn rk4_run<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const K: usize, const A: usize>(
-    batch: &B,
+fn rk4_run<M, K, V: KernelLanes<f64>, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
     (first, count): (usize, usize),
     room: &mut SineRoom<F64x4, N, A>,
     h: f64,
     steps: usize,
-    s: &mut [Block<N, K>; GROUP],
-) -> [[bool; WIDTH]; GROUP] {
+    s: &mut [Block<N, C>; GROUP],
+) -> [[bool; WIDTH]; GROUP]
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
     let zero = V::splat(0.0);
     let units = count.div_ceil(V::BLOCKS);
-    let blocks = batch.blocks();
+    let blocks = &batch.blocks;
     let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|u| {
         let [a, b] = unit_blocks(u.min(units - 1), V::BLOCKS, count);
         LinkConstants::joined([&blocks[first + a], &blocks[first + b]])
@@ -423,19 +403,24 @@ fn rk4_run<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const K: usize,
     let (mut t, mut t_carry) = ([zero; GROUP], [zero; GROUP]);
     for u in 0..units {
         let [a, b] = unit_blocks(u, V::BLOCKS, count).map(|j| &s[j]);
-        for c in 0..K {
-            (q[K * u + c], qd[K * u + c]) = (join([&a.q[c], &b.q[c]]), join([&a.qd[c], &b.qd[c]]));
-            q_carry[K * u + c] = join([&a.q_carry[c], &b.q_carry[c]]);
-            qd_carry[K * u + c] = join([&a.qd_carry[c], &b.qd_carry[c]]);
+        for c in 0..C {
+            (q[C * u + c], qd[C * u + c]) = (join([&a.q[c], &b.q[c]]), join([&a.qd[c], &b.qd[c]]));
+            q_carry[C * u + c] = join([&a.q_carry[c], &b.q_carry[c]]);
+            qd_carry[C * u + c] = join([&a.qd_carry[c], &b.qd_carry[c]]);
         }
         (t[u], t_carry[u]) = (V::join([a.t, b.t]), V::join([a.t_carry, b.t_carry]));
     }
     let mut stopped = [V::none(); GROUP];
     for _ in 0..steps {
-        let kernel = Kernel::<B, V, N, A> { c: &c, count, room: &mut *room, batch: std::marker::PhantomData };
+        let kernel = Kernel::<UnrolledBatch<M, N, K>, V, N, A> {
+            c: &c,
+            count,
+            room: &mut *room,
+            batch: std::marker::PhantomData,
+        };
         let (dq, dqd) = increment(&q, &qd, h, kernel);
         for u in 0..units {
-            let arrays = K * u..K * (u + 1);
+            let arrays = C * u..C * (u + 1);
             // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
             let mut probe = zero;
             for d in dq[arrays.clone()].as_flattened().iter().chain(dqd[arrays.clone()].as_flattened()) {
@@ -466,16 +451,16 @@ fn rk4_run<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const K: usize,
         // Each block of the unit once (an odd last block is both halves).
         let blocks = unit_blocks(u, V::BLOCKS, count);
         for (half, j) in blocks.into_iter().enumerate().take(V::BLOCKS.min(count - V::BLOCKS * u)) {
-            for c in 0..K {
+            for c in 0..C {
                 let back = |v: &[V; N], to: &mut [F64x4; N]| {
                     for (to, v) in to.iter_mut().zip(v) {
                         *to = v.split()[half];
                     }
                 };
-                back(&q[K * u + c], &mut s[j].q[c]);
-                back(&qd[K * u + c], &mut s[j].qd[c]);
-                back(&q_carry[K * u + c], &mut s[j].q_carry[c]);
-                back(&qd_carry[K * u + c], &mut s[j].qd_carry[c]);
+                back(&q[C * u + c], &mut s[j].q[c]);
+                back(&qd[C * u + c], &mut s[j].qd[c]);
+                back(&q_carry[C * u + c], &mut s[j].q_carry[c]);
+                back(&qd_carry[C * u + c], &mut s[j].qd_carry[c]);
             }
             (s[j].t, s[j].t_carry) = (t[u].split()[half], t_carry[u].split()[half]);
             let ran = V::select(stopped[u], zero, V::splat(1.0)).split()[half];
@@ -487,14 +472,17 @@ fn rk4_run<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const K: usize,
 
 /// [`rk4_run`] in AVX-512 registers (two blocks each) where the CPU has AVX-512 VL and the
 /// batch allows it, in AVX2 registers where it has AVX2, else in [`Lanes`].
-fn rk4_run_simd<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
-    batch: &B,
+fn rk4_run_simd<M, K, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
     group: (usize, usize),
     room: &mut SineRoom<F64x4, N, A>,
     h: f64,
     steps: usize,
-    s: &mut [Block<N, K>; GROUP],
-) -> [[bool; WIDTH]; GROUP] {
+    s: &mut [Block<N, C>; GROUP],
+) -> [[bool; WIDTH]; GROUP]
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
     #[cfg(target_arch = "x86_64")]
     if batch.uses_avx512() {
         // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
@@ -505,34 +493,40 @@ fn rk4_run_simd<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>
         // SAFETY: the CPU has AVX2, checked just above.
         return unsafe { rk4_run_avx2(batch, group, room, h, steps, s) };
     }
-    rk4_run::<B, F64x4, N, K, A>(batch, group, room, h, steps, s)
+    rk4_run::<M, K, F64x4, N, C, A>(batch, group, room, h, steps, s)
 }
 
 /// [`rk4_run`] compiled for AVX-512, two blocks in each [`Avx8`](crate::lanes::Avx8)
 /// register (1.18–1.26× four lanes, `docs/ensembles.md`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl")]
-fn rk4_run_avx512<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
-    batch: &B,
+fn rk4_run_avx512<M, K, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
     group: (usize, usize),
     room: &mut SineRoom<F64x4, N, A>,
     h: f64,
     steps: usize,
-    s: &mut [Block<N, K>; GROUP],
-) -> [[bool; WIDTH]; GROUP] {
-    rk4_run::<B, crate::lanes::Avx8, N, K, A>(batch, group, room, h, steps, s)
+    s: &mut [Block<N, C>; GROUP],
+) -> [[bool; WIDTH]; GROUP]
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
+    rk4_run::<M, K, crate::lanes::Avx8, N, C, A>(batch, group, room, h, steps, s)
 }
 
 /// [`rk4_run`] compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn rk4_run_avx2<B: Stages<N, A>, const N: usize, const K: usize, const A: usize>(
-    batch: &B,
+fn rk4_run_avx2<M, K, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
     group: (usize, usize),
     room: &mut SineRoom<F64x4, N, A>,
     h: f64,
     steps: usize,
-    s: &mut [Block<N, K>; GROUP],
-) -> [[bool; WIDTH]; GROUP] {
-    rk4_run::<B, crate::lanes::Avx4, N, K, A>(batch, group, room, h, steps, s)
+    s: &mut [Block<N, C>; GROUP],
+) -> [[bool; WIDTH]; GROUP]
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
+    rk4_run::<M, K, crate::lanes::Avx4, N, C, A>(batch, group, room, h, steps, s)
 }

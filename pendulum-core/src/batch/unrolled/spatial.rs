@@ -10,13 +10,13 @@
 
 use super::precision::{KernelLanes, Precision};
 use super::{
-    GROUP, LinkConstants, Rows, SineRoom, check_rows, constant_blocks, gather_joined, non_finite_rows,
-    unit_blocks,
+    GROUP, Generated, LinkConstants, Rows, SineRoom, UnrolledBatch, check_rows, gather_joined,
+    non_finite_rows, unit_blocks,
 };
-use crate::batch::{F64x4, Failure, WIDTH, block_chains, first_bad_input, for_blocks_of, gather, scatter};
+use crate::batch::{Failure, WIDTH, block_chains, first_bad_input, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
-use crate::kinematics::SINGULARITY_TOLERANCE;
-use crate::lanes::{Lane, Lanes32};
+use crate::kinematics::{SINGULARITY_TOLERANCE, SphericalAngles};
+use crate::lanes::Lane;
 
 /// The polar sines `check_polar_sin` accepts, `[SINGULARITY_TOLERANCE, ∞]`, as
 /// [`Lane::outside`]'s `(low, span)` of bit patterns.
@@ -29,10 +29,7 @@ const ACCEPTED_SINES: (u64, u64) = {
 /// what `pendulum_macros::model!` emits for `kind: spatial` with `algorithm: tension` (the
 /// default from two links). Its `Model::accelerations` checks the polar sines, then runs
 /// `kernel::<f64>`; [`UnrolledSpatialBatch`] runs it on four or eight chains at once.
-pub trait SpatialKernel<const N: usize>: Send + Sync {
-    /// The constants `new` stored.
-    fn constants(&self) -> &LinkConstants<f64, N>;
-
+pub trait SpatialKernel<const N: usize>: Generated<N, Chart = SphericalAngles> {
     /// The model's own `Model::accelerations` on rows: `q`, `qd`, `torque` and `out` of
     /// `2N` (the polar angles, then the azimuths), the pivot's acceleration `p̈` (m/s²).
     fn row_accelerations(
@@ -59,8 +56,9 @@ pub trait SpatialKernel<const N: usize>: Send + Sync {
 
 /// `B` chains of one generated spatial model type `M` (`N` links each, each its own masses,
 /// lengths, damping and gravity), evaluated and stepped four per instruction stream (eight
-/// in `f64` with AVX-512, eight in `f32` with AVX2). Rows are the models' own coordinates: `2N` a chain,
-/// the polar angles `θ_i` then the azimuths `φ_i`.
+/// in `f64` with AVX-512, eight in `f32` with AVX2): [`UnrolledBatch`] in the models'
+/// spherical angles. Rows are the models' own coordinates: `2N` a chain, the polar angles
+/// `θ_i` then the azimuths `φ_i`.
 ///
 /// ```
 /// use pendulum_core::batch::UnrolledSpatialBatch;
@@ -76,16 +74,7 @@ pub trait SpatialKernel<const N: usize>: Send + Sync {
 /// assert!(failures.is_empty());
 /// # Ok::<(), pendulum_core::Error>(())
 /// ```
-#[derive(Debug, Clone)]
-pub struct UnrolledSpatialBatch<M, const N: usize> {
-    pub(super) models: Vec<M>,
-    /// Per block of [`WIDTH`] chains, their constants side by side.
-    pub(super) blocks: Vec<LinkConstants<F64x4, N>>,
-    /// The same in single precision.
-    blocks_f32: Vec<LinkConstants<Lanes32<WIDTH>, N>>,
-    /// Whether the calls may use AVX-512 where the CPU has it.
-    avx512: bool,
-}
+pub type UnrolledSpatialBatch<M, const N: usize> = UnrolledBatch<M, N, SphericalAngles>;
 
 /// The lanes where some `|sin θ_i| < SINGULARITY_TOLERANCE` (or a sine is NaN): where the
 /// model's `check_polar_sin` refuses the state. (`Lane` has no absolute value: a sine
@@ -102,42 +91,6 @@ pub(super) fn near_pole<V: Lane, const N: usize>(polar: &[[V; 2]; N]) -> V::Mask
 }
 
 impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
-    /// The batch of `models`, chain `k` being `models[k]`.
-    ///
-    /// Errors: [`Error::EmptyBatch`].
-    pub fn new(models: Vec<M>) -> Result<Self> {
-        let (blocks, blocks_f32) = constant_blocks(&models, M::constants)?;
-        Ok(Self { models, blocks, blocks_f32, avx512: true })
-    }
-
-    /// Whether the evaluations may work on eight `f64` chains per AVX-512 register where the
-    /// CPU has AVX-512 VL (the default), or keep four per AVX2 register (`false`). The
-    /// results are the same bits either way.
-    pub fn with_avx512(mut self, allowed: bool) -> Self {
-        self.avx512 = allowed;
-        self
-    }
-
-    /// Whether the calls run with AVX-512 (allowed, and the CPU has AVX-512 VL).
-    pub fn uses_avx512(&self) -> bool {
-        self.avx512 && crate::lanes::has_avx512vl()
-    }
-
-    /// Number of chains `B`.
-    pub fn len(&self) -> usize {
-        self.models.len()
-    }
-
-    /// Never: a batch has at least one chain.
-    pub fn is_empty(&self) -> bool {
-        self.models.is_empty()
-    }
-
-    /// Chain `k`'s model.
-    pub fn model(&self, k: usize) -> &M {
-        &self.models[k]
-    }
-
     /// The angle accelerations `(θ̈, φ̈)` (rad/s²) of every chain, written into `out` as `B`
     /// rows of `2N` (the model's coordinates: polar angles, then azimuths), at angles `q`
     /// (rad) and rates `qd` (rad/s) given the same way, with each chain's generalized torques
