@@ -1,7 +1,8 @@
-//! Fixtures of the batch tests (`ensembles.rs`, `single_precision.rs`): random chains and
-//! whirls, and thread pools of one and two threads.
+//! Fixtures of the batch tests (`ensembles.rs`, `single_precision.rs`,
+//! `unrolled_spatial_ensembles.rs`, …): random chains and whirls, thread pools of one and two
+//! threads, and the comparison bit for bit.
 
-use nalgebra::{DVector, Dyn, U3};
+use nalgebra::{Const, DVector, Dyn, U3};
 use pendulum_core::{Chain, Circle, Directions};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -13,6 +14,14 @@ pub fn random_chain(n: usize, r: &mut ChaCha8Rng) -> Chain<Dyn> {
     let (masses, lengths, damping) = (decades(-2.0), decades(-2.0), decades(-5.0));
     let g = r.random_range(1.0..20.0);
     Chain::new(&masses, &lengths, g).and_then(|c| c.with_damping(&damping)).expect("chain")
+}
+
+/// [`random_chain`] of `N` links, as a fixed-size chain (the same draws).
+pub fn random_fixed_chain<const N: usize>(r: &mut ChaCha8Rng) -> Chain<Const<N>> {
+    let chain = random_chain(N, r);
+    Chain::new(chain.masses().as_slice(), chain.lengths().as_slice(), chain.gravity())
+        .and_then(|c| c.with_damping(chain.damping().as_slice()))
+        .expect("chain")
 }
 
 /// Chains of `n` links whose masses, lengths and damping are spread over `decades`

@@ -10,6 +10,7 @@ use nalgebra::{Const, SVector, U2, U3, Vector3};
 use pendulum_core::batch::{Failure, SpatialKernel, UnrolledSpatialBatch};
 use pendulum_core::integrate::{Integrator, Rk4, State};
 use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
+use pendulum_tests::batches::{assert_bits, pools, random_fixed_chain};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -21,17 +22,8 @@ pendulum_macros::model! {
     struct Spatial8 { kind: spatial, links: 8 }
 }
 
-/// `N` links with masses, lengths and damping log-uniform over two decades, gravity
-/// between 1 and 20 m/s².
-fn random_chain<const N: usize>(r: &mut ChaCha8Rng) -> Chain<Const<N>> {
-    let mut decades = |lo: f64| (0..N).map(|_| 10f64.powf(lo + 2.0 * r.random::<f64>())).collect::<Vec<_>>();
-    let (masses, lengths, damping) = (decades(-2.0), decades(-2.0), decades(-5.0));
-    let g = r.random_range(1.0..20.0);
-    Chain::new(&masses, &lengths, g).and_then(|c| c.with_damping(&damping)).expect("chain")
-}
-
 fn random_models<M: From<Chain<Const<N>>>, const N: usize>(chains: usize, r: &mut ChaCha8Rng) -> Vec<M> {
-    (0..chains).map(|_| M::from(random_chain::<N>(r))).collect()
+    (0..chains).map(|_| M::from(random_fixed_chain::<N>(r))).collect()
 }
 
 /// Random states of `chains` chains of `n` links: rows of `2n` angles (polar angles over
@@ -64,17 +56,6 @@ fn each_alone<M: Model<Links = Const<N>, Dof = Const<D>, Space = U3>, const N: u
             model.accelerations(&row(q, k), &row(qd, k), &inputs, &mut out).map(|()| out.as_slice().to_vec())
         })
         .collect()
-}
-
-/// Every entry equal bit for bit.
-fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
-    for (i, (a, b)) in batch.iter().zip(single).enumerate() {
-        assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
-    }
-}
-
-fn pools() -> [rayon::ThreadPool; 2] {
-    [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
 }
 
 /// The batch of `models` at `inputs`, on 1 and 2 threads, in eight lanes a register and
