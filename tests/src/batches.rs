@@ -3,7 +3,10 @@
 //! threads, and the comparison bit for bit.
 
 use nalgebra::{Const, DVector, Dyn, U3};
-use pendulum_core::{Chain, Circle, Directions};
+use nalgebra::{DefaultAllocator, Dim, allocator::Allocator};
+use pendulum_core::batch::Failure;
+use pendulum_core::integrate::State;
+use pendulum_core::{Chain, Circle, Directions, Error};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -62,4 +65,58 @@ pub fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
     for (i, (a, b)) in batch.iter().zip(single).enumerate() {
         assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
     }
+}
+
+/// A batch's rows `out` (`m` a chain) and its `failures` against each chain alone
+/// (`single`: its row, or its error): equal bit for bit, and failing exactly where the
+/// chain alone fails, with the same error (as text: errors carry the NaN they found), its
+/// row NaN.
+pub fn assert_rows(
+    out: &[f64],
+    m: usize,
+    single: &[Result<Vec<f64>, Error>],
+    failures: &[Failure],
+    what: &str,
+) {
+    let mut failed = failures.iter();
+    for (k, alone) in single.iter().enumerate() {
+        let row = &out[k * m..(k + 1) * m];
+        match alone {
+            Ok(expected) => assert_bits(row, expected, &format!("{what}, chain {k}")),
+            Err(error) => {
+                let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
+                assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
+                assert!(row.iter().all(|x| x.is_nan()), "{what}: chain {k}'s row is NaN");
+            }
+        }
+    }
+    assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+}
+
+/// A batch's states after a run (`batched`) and its `failures` against each chain's own
+/// run (`alone`: its state and its error): time, state and compensation equal bit for bit,
+/// and the failures the chains' own.
+pub fn assert_runs<D: Dim>(
+    batched: &[State<D>],
+    alone: &[(State<D>, Option<Error>)],
+    failures: &[Failure],
+    what: &str,
+) where
+    DefaultAllocator: Allocator<D>,
+{
+    let mut failed = failures.iter();
+    for (k, (state, (single, error))) in batched.iter().zip(alone).enumerate() {
+        assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
+        assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
+        assert_bits(
+            state.compensation().as_slice(),
+            single.compensation().as_slice(),
+            &format!("{what}: chain {k}'s compensation"),
+        );
+        if let Some(error) = error {
+            let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
+            assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
+        }
+    }
+    assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
 }

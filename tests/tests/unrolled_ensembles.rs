@@ -7,6 +7,7 @@ use nalgebra::{Const, SVector, Vector2};
 use pendulum_core::batch::{PlanarKernel, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Rk4, State};
 use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
+use pendulum_tests::batches::{assert_bits, assert_rows, assert_runs, pools};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -58,17 +59,6 @@ fn each_alone<M: PlanarKernel<N>, const N: usize>(
         .collect()
 }
 
-/// Every entry equal bit for bit.
-fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
-    for (i, (a, b)) in batch.iter().zip(single).enumerate() {
-        assert_eq!(a.to_bits(), b.to_bits(), "{what}[{i}]: batch {a:e} single {b:e}");
-    }
-}
-
-fn pools() -> [rayon::ThreadPool; 2] {
-    [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool"))
-}
-
 /// The batch of `models` at `inputs`, with 1 and 2 threads and split in two calls, equals
 /// each model alone bit for bit, and fails exactly where they fail, with their errors.
 fn check<M: PlanarKernel<N> + Clone, const N: usize>(models: Vec<M>, inputs: &[Vec<f64>; 4]) {
@@ -98,20 +88,7 @@ fn check<M: PlanarKernel<N> + Clone, const N: usize>(models: Vec<M>, inputs: &[V
             pool.current_num_threads(),
             batch.uses_avx512()
         );
-        let mut failed = failures.iter();
-        for (k, alone) in single.iter().enumerate() {
-            let row = &out[k * N..(k + 1) * N];
-            match alone {
-                Ok(expected) => assert_bits(row, expected, &format!("{what}, chain {k}")),
-                Err(error) => {
-                    let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
-                    // As text: the errors carry the NaN they found.
-                    assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
-                    assert!(row.iter().all(|x| x.is_nan()), "{what}: chain {k}'s row is NaN");
-                }
-            }
-        }
-        assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+        assert_rows(&out, N, &single, &failures, &what);
     }
     // Split into two calls off a block boundary: the same numbers.
     let cut = chains / 2 + 1;
@@ -261,22 +238,7 @@ fn check_rk4_runs<M: PlanarKernel<N>, const N: usize, const D: usize>(
 {
     let avx512 = batch.uses_avx512();
     let compare = |batched: &[State<Const<D>>], failures: &[pendulum_core::batch::Failure], what: &str| {
-        let mut failed = failures.iter();
-        let what = format!("{what}, AVX-512 {avx512}");
-        for (k, (state, (single, error))) in batched.iter().zip(alone).enumerate() {
-            assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
-            assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
-            assert_bits(
-                state.compensation().as_slice(),
-                single.compensation().as_slice(),
-                &format!("{what}: chain {k}'s compensation"),
-            );
-            if let Some(error) = error {
-                let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
-                assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
-            }
-        }
-        assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+        assert_runs(batched, alone, failures, &format!("{what}, AVX-512 {avx512}"));
     };
     for pool in pools() {
         let mut batched = states.to_vec();

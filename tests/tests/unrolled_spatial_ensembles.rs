@@ -10,7 +10,7 @@ use nalgebra::{Const, SVector, U2, U3, Vector3};
 use pendulum_core::batch::{Failure, SpatialKernel, UnrolledSpatialBatch};
 use pendulum_core::integrate::{Integrator, Rk4, State};
 use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
-use pendulum_tests::batches::{assert_bits, pools, random_fixed_chain};
+use pendulum_tests::batches::{assert_bits, assert_rows, assert_runs, pools, random_fixed_chain};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -84,19 +84,7 @@ where
             pool.current_num_threads(),
             batch.uses_avx512()
         );
-        let mut failed = failures.iter();
-        for (k, alone) in single.iter().enumerate() {
-            let row = &out[k * D..(k + 1) * D];
-            match alone {
-                Ok(expected) => assert_bits(row, expected, &format!("{what}, chain {k}")),
-                Err(error) => {
-                    let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
-                    assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
-                    assert!(row.iter().all(|x| x.is_nan()), "{what}: chain {k}'s row is NaN");
-                }
-            }
-        }
-        assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+        assert_rows(&out, D, &single, &failures, &what);
     }
     let cut = chains / 2 + 1;
     if cut < chains {
@@ -331,21 +319,7 @@ fn check_rk4<M, const N: usize, const Q: usize, const D: usize>(
     for batch in [&eight, &four] {
         let what = format!("{} chains of {N}, AVX-512 {}", states.len(), batch.uses_avx512());
         let compare = |batched: &[State<Const<D>>], failures: &[Failure], what: &str| {
-            let mut failed = failures.iter();
-            for (k, (state, (single, error))) in batched.iter().zip(&alone).enumerate() {
-                assert_eq!(state.t().to_bits(), single.t().to_bits(), "{what}: chain {k}'s t");
-                assert_bits(state.x().as_slice(), single.x().as_slice(), &format!("{what}: chain {k}'s x"));
-                assert_bits(
-                    state.compensation().as_slice(),
-                    single.compensation().as_slice(),
-                    &format!("{what}: chain {k}'s compensation"),
-                );
-                if let Some(error) = error {
-                    let failure = failed.next().unwrap_or_else(|| panic!("{what}: chain {k} not reported"));
-                    assert_eq!((failure.chain, failure.error.to_string()), (k, error.to_string()), "{what}");
-                }
-            }
-            assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+            assert_runs(batched, &alone, failures, what);
         };
         for pool in pools() {
             let mut batched = states.clone();
