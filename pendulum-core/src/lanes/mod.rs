@@ -93,6 +93,8 @@ pub trait Lane:
     fn splat(x: f64) -> Self;
     /// The square root, correctly rounded, lane by lane.
     fn sqrt(self) -> Self;
+    /// `|x|` (the sign bit cleared), lane by lane.
+    fn abs(self) -> Self;
     /// The flags of the lanes whose bit pattern `b` has `b − low > span` (wrapping): with
     /// `(low, span)` = [`CONTINUANT_RANGE`], the lanes outside `[2⁻⁸⁰⁰, 2⁸⁰⁰]` (negative,
     /// zero, infinite and NaN included).
@@ -127,8 +129,6 @@ pub trait Masked: Lane {
     fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
     /// The flags of `a` that are not in `b`.
     fn and_not(a: Self::Mask, b: Self::Mask) -> Self::Mask;
-    /// `|x|`, lane by lane.
-    fn abs(self) -> Self;
     /// `other` where it is larger, else `self`, lane by lane: `f64::max` for a `self` that
     /// is not NaN (a NaN `other` loses). A compare and a select, which stay in vector
     /// registers (`f64::max` on arrays of eight lanes was computed one lane at a time).
@@ -154,6 +154,10 @@ impl Lane for f64 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
     }
     #[inline(always)]
     fn outside(self, low: u64, span: u64) -> bool {
@@ -194,10 +198,6 @@ impl Masked for f64 {
     #[inline(always)]
     fn and_not(a: bool, b: bool) -> bool {
         a & !b
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        f64::abs(self)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
@@ -350,10 +350,6 @@ macro_rules! lane_masks {
             out
         }
         #[inline(always)]
-        fn abs(self) -> Self {
-            self.map(<$t>::abs)
-        }
-        #[inline(always)]
         fn max(self, other: Self) -> Self {
             let mut out = self.0;
             for k in 0..W {
@@ -464,6 +460,10 @@ impl<const W: usize> Lane for Lanes32<W> {
     fn sqrt(self) -> Self {
         self.map(f32::sqrt)
     }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        self.map(f32::abs)
+    }
     /// `(low, span)` as `f64` bit patterns: each lane widened to `f64` (exact) and checked.
     #[inline(always)]
     fn outside(self, low: u64, span: u64) -> [u32; W] {
@@ -526,6 +526,10 @@ impl<const W: usize> Lane for Lanes<W> {
         self.map(f64::sqrt)
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        self.map(f64::abs)
+    }
+    #[inline(always)]
     fn outside(self, low: u64, span: u64) -> [u64; W] {
         let mut out = [0; W];
         for (o, x) in out.iter_mut().zip(self.0) {
@@ -581,6 +585,7 @@ mod tests {
             assert_eq!((a * b).0[k], a.0[k] * b.0[k]);
             assert_eq!((a / b).0[k].to_bits(), (a.0[k] / b.0[k]).to_bits());
             assert_eq!(a.normalizer().0[k], a.0[k].normalizer());
+            assert_eq!(b.abs().0[k].to_bits(), b.0[k].abs().to_bits());
         }
         let mask =
             Lanes([1.0, 0.0, f64::NAN, 2f64.powi(900)]).outside(CONTINUANT_RANGE.0, CONTINUANT_RANGE.1);

@@ -146,6 +146,10 @@ impl Lane for Avx4 {
     fn sqrt(self) -> Self {
         Self(unsafe { _mm256_sqrt_pd(self.0) })
     }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0) })
+    }
     /// `b − low > span` as unsigned 64-bit integers: both sides with their top bit flipped,
     /// then AVX2's signed comparison.
     #[inline(always)]
@@ -254,6 +258,13 @@ impl Lane for Avx8 {
     fn sqrt(self) -> Self {
         Self(unsafe { _mm512_sqrt_pd(self.0) })
     }
+    /// The sign bit cleared as an integer `and` (AVX-512F; `_mm512_andnot_pd` wants DQ).
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self(unsafe {
+            _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(self.0), _mm512_set1_epi64(i64::MAX)))
+        })
+    }
     /// `b − low > span` as unsigned 64-bit integers (AVX-512 compares them as such).
     #[inline(always)]
     fn outside(self, low: u64, span: u64) -> __mmask8 {
@@ -331,6 +342,10 @@ impl Lane for AvxF32 {
     fn sqrt(self) -> Self {
         Self(unsafe { _mm256_sqrt_ps(self.0) })
     }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+    }
     /// As [`Lanes32`]'s: each lane widened to `f64` (exact) and checked (out of the hot path).
     #[inline(always)]
     fn outside(self, low: u64, span: u64) -> __m256i {
@@ -397,6 +412,7 @@ mod tests {
         assert_eq!(bits(x / y), each(|a, b| a / b));
         assert_eq!(bits(-x), each(|a, _| -a));
         assert_eq!(bits(x.sqrt()), each(|a, _| a.sqrt()));
+        assert_eq!(bits(x.abs()), each(|a, _| a.abs()));
         assert_eq!(bits(x.normalizer()), each(|a, _| a.normalizer()));
         let (low, span) = CONTINUANT_RANGE;
         let flags = |m: V::Mask| V::select(m, V::splat(1.0), V::splat(0.0)).into().0.map(|f| f == 1.0);
@@ -445,6 +461,7 @@ mod tests {
         assert_eq!(reg(x / y), bits(u / v));
         assert_eq!(reg(-x), bits(-u));
         assert_eq!(reg(x.sqrt()), bits(u.sqrt()));
+        assert_eq!(reg(x.abs()), bits(u.abs()));
         assert_eq!(reg(x.normalizer()), bits(u.normalizer()));
         assert_eq!(reg(V::splat(0.1)), bits(Lanes32::splat(0.1)));
         let flags = |m: V::Mask| V::select(m, V::splat(1.0), V::splat(0.0)).into().0.map(|f| f == 1.0);

@@ -77,15 +77,14 @@ pub trait SpatialKernel<const N: usize>: Generated<N, Chart = SphericalAngles> {
 pub type UnrolledSpatialBatch<M, const N: usize> = UnrolledBatch<M, N, SphericalAngles>;
 
 /// The lanes where some `|sin θ_i| < SINGULARITY_TOLERANCE` (or a sine is NaN): where the
-/// model's `check_polar_sin` refuses the state. (`Lane` has no absolute value: a sine
-/// below the tolerance, negative ones included, is negated, and the result checked again.)
+/// model's `check_polar_sin` refuses the state.
 #[inline(always)]
 pub(super) fn near_pole<V: Lane, const N: usize>(polar: &[[V; 2]; N]) -> V::Mask {
     let (low, span) = ACCEPTED_SINES;
+    // A loop, not a fold: a closure may be compiled apart from the kernel's target features.
     let mut near = V::none();
     for &[sin, _] in polar {
-        let magnitude = V::select(sin.outside(low, span), -sin, sin);
-        near = V::or(near, magnitude.outside(low, span));
+        near = V::or(near, sin.abs().outside(low, span));
     }
     near
 }
