@@ -357,7 +357,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         pivot: Option<&[f64]>,
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        self.evaluate(&self.blocks, [q, qd], torque, pivot, out, |chain| {
+        self.evaluate::<_, GROUP>(&self.blocks, [q, qd], torque, pivot, out, |chain| {
             self.error_of(chain, q, qd, torque, pivot)
         })
     }
@@ -385,32 +385,32 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             Ok(()) => Error::NotPositiveDefinite,
         }
     }
+}
 
-    /// `θ̈` of every chain in precision `P`, from the blocks' constants in `P` (the arrays as
-    /// [`accelerations`](Self::accelerations) takes them, `[q, qd]` first); a chain whose
-    /// row is not finite fails with `error(chain)`, its row NaN.
-    fn evaluate<P: Precision>(
+/// A kind of generated model's evaluation of a group in lanes: `A` arrays of `N` angles a
+/// group in its sine room, rows of `ROW` numbers a chain, pivot accelerations of `SPACE`.
+trait Groups<const N: usize, const A: usize>: Sync {
+    /// Numbers a chain's row of `q`, `qd`, torques and results holds.
+    const ROW: usize;
+    /// Components of a pivot acceleration.
+    const SPACE: usize;
+
+    /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`) in lanes of
+    /// type `V`, their results scattered into `out` (the group's rows); a lane the model
+    /// refuses is left non-finite.
+    fn group<P: Precision, V: KernelLanes<P>>(
         &self,
-        blocks: &[LinkConstants<P::Lanes, N>],
-        [q, qd]: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
+        c: &[LinkConstants<P::Lanes, N>],
+        room: &mut SineRoom<P::Lanes, N, A>,
+        lanes: [[usize; WIDTH]; GROUP],
+        rows: Rows<'_, P>,
         out: &mut [P],
-        error: impl Fn(usize) -> Error + Sync + Send,
-    ) -> Result<Vec<Failure>> {
-        let chains = self.len();
-        check_rows([q, qd], torque, pivot, out, chains, [N, 2])?;
-        let failures =
-            for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, N, N, SineRoom::new, |room, g, out| {
-                let first = GROUP * g;
-                let count = (out.len() / N).div_ceil(WIDTH);
-                let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
-                let rows = Rows { q, qd, torque, pivot };
-                self.group_simd::<P>(&blocks[first..first + count], room, lanes, rows, out);
-                non_finite_rows(out, N, WIDTH * first, &error)
-            });
-        Ok(failures)
-    }
+    );
+}
+
+impl<M: PlanarKernel<N>, const N: usize> Groups<N, GROUP> for UnrolledBatch<M, N> {
+    const ROW: usize = N;
+    const SPACE: usize = 2;
 
     /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`): each
     /// block's angles gathered into lanes, the sines and cosines of all of them in one call
@@ -420,7 +420,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
     fn group<P: Precision, V: KernelLanes<P>>(
         &self,
         c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N>,
+        room: &mut SineRoom<P::Lanes, N, GROUP>,
         lanes: [[usize; WIDTH]; GROUP],
         Rows { q, qd, torque, pivot }: Rows<'_, P>,
         out: &mut [P],
@@ -466,57 +466,95 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
             }
         }
     }
+}
 
-    /// [`group`](Self::group) in AVX2 registers when the CPU has them, else in
+impl<M: Sync, const N: usize, K: Sync> UnrolledBatch<M, N, K> {
+    /// The accelerations of every chain in precision `P`, from the blocks' constants in `P`
+    /// (the arrays as `accelerations` takes them, `[q, qd]` first); a chain whose row is not
+    /// finite fails with `error(chain)`, its row NaN.
+    fn evaluate<P: Precision, const A: usize>(
+        &self,
+        blocks: &[LinkConstants<P::Lanes, N>],
+        [q, qd]: [&[P]; 2],
+        torque: Option<&[P]>,
+        pivot: Option<&[P]>,
+        out: &mut [P],
+        error: impl Fn(usize) -> Error + Sync + Send,
+    ) -> Result<Vec<Failure>>
+    where
+        Self: Groups<N, A>,
+    {
+        let (chains, m) = (self.len(), <Self as Groups<N, A>>::ROW);
+        check_rows([q, qd], torque, pivot, out, chains, [m, <Self as Groups<N, A>>::SPACE])?;
+        let failures =
+            for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, m, N, SineRoom::new, |room, g, out| {
+                let first = GROUP * g;
+                let count = (out.len() / m).div_ceil(WIDTH);
+                let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
+                let rows = Rows { q, qd, torque, pivot };
+                self.group_simd::<P, A>(&blocks[first..first + count], room, lanes, rows, out);
+                non_finite_rows(out, m, WIDTH * first, &error)
+            });
+        Ok(failures)
+    }
+
+    /// [`Groups::group`] in AVX-512 registers (two blocks each in `f64`) where the CPU has
+    /// AVX-512 VL and the batch allows it, in AVX2 registers where it has AVX2, else in
     /// [`Precision::Lanes`].
-    fn group_simd<P: Precision>(
+    fn group_simd<P: Precision, const A: usize>(
         &self,
         c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N>,
+        room: &mut SineRoom<P::Lanes, N, A>,
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) {
+    ) where
+        Self: Groups<N, A>,
+    {
         #[cfg(target_arch = "x86_64")]
         if self.uses_avx512() {
             // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
-            return unsafe { self.group_avx512::<P>(c, room, lanes, rows, out) };
+            return unsafe { self.group_avx512::<P, A>(c, room, lanes, rows, out) };
         }
         #[cfg(target_arch = "x86_64")]
         if crate::lanes::has_avx2() {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.group_avx2::<P>(c, room, lanes, rows, out) };
+            return unsafe { self.group_avx2::<P, A>(c, room, lanes, rows, out) };
         }
         self.group::<P, P::Lanes>(c, room, lanes, rows, out)
     }
 
-    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Wide`]: two blocks
-    /// an instruction in `f64` (1.07–1.17× four lanes, `docs/ensembles.md`), and 32
-    /// registers instead of 16 for a kernel that spills.
+    /// [`Groups::group`] compiled for AVX-512 VL, in [`Precision::Wide`]: two blocks an
+    /// instruction in `f64` (1.07–1.17× four lanes, `docs/ensembles.md`), and 32 registers
+    /// instead of 16 for a kernel that spills.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl")]
-    fn group_avx512<P: Precision>(
+    fn group_avx512<P: Precision, const A: usize>(
         &self,
         c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N>,
+        room: &mut SineRoom<P::Lanes, N, A>,
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) {
+    ) where
+        Self: Groups<N, A>,
+    {
         self.group::<P, P::Wide>(c, room, lanes, rows, out)
     }
 
-    /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].
+    /// [`Groups::group`] compiled for AVX2, in [`Precision::Registers`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn group_avx2<P: Precision>(
+    fn group_avx2<P: Precision, const A: usize>(
         &self,
         c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N>,
+        room: &mut SineRoom<P::Lanes, N, A>,
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) {
+    ) where
+        Self: Groups<N, A>,
+    {
         self.group::<P, P::Registers>(c, room, lanes, rows, out)
     }
 }

@@ -4,7 +4,7 @@
 //! single-precision kernel, eight per AVX2 instruction. Not bit for bit the `f64` model:
 //! its accuracy against it is measured in `docs/ensembles.md` and checked in the tests.
 
-use super::{PlanarKernel, UnrolledBatch};
+use super::{GROUP, PlanarKernel, UnrolledBatch};
 use crate::batch::{Failure, first_bad_input};
 use crate::error::{Error, Result};
 
@@ -27,7 +27,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         pivot: Option<&[f32]>,
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        self.evaluate(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
+        self.evaluate::<_, GROUP>(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
             first_bad_input(chain, [N, 2], [q, qd], torque, pivot).unwrap_or(Error::SinglePrecisionOverflow)
         })
     }

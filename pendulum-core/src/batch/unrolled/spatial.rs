@@ -10,10 +10,9 @@
 
 use super::precision::{KernelLanes, Precision};
 use super::{
-    GROUP, Generated, LinkConstants, Rows, SineRoom, UnrolledBatch, check_rows, gather_joined,
-    non_finite_rows, unit_blocks,
+    GROUP, Generated, Groups, LinkConstants, Rows, SineRoom, UnrolledBatch, gather_joined, unit_blocks,
 };
-use crate::batch::{Failure, WIDTH, block_chains, first_bad_input, for_blocks_of, gather, scatter};
+use crate::batch::{Failure, WIDTH, first_bad_input, gather, scatter};
 use crate::error::{Error, Result};
 use crate::kinematics::{SINGULARITY_TOLERANCE, SphericalAngles};
 use crate::lanes::Lane;
@@ -110,7 +109,7 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         pivot: Option<&[f64]>,
         out: &mut [f64],
     ) -> Result<Vec<Failure>> {
-        self.evaluate(&self.blocks, [q, qd], torque, pivot, out, |chain| {
+        self.evaluate::<_, { 2 * GROUP }>(&self.blocks, [q, qd], torque, pivot, out, |chain| {
             self.error_of(chain, q, qd, torque, pivot)
         })
     }
@@ -131,7 +130,7 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         pivot: Option<&[f32]>,
         out: &mut [f32],
     ) -> Result<Vec<Failure>> {
-        self.evaluate(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
+        self.evaluate::<_, { 2 * GROUP }>(&self.blocks_f32, [q, qd], torque, pivot, out, |chain| {
             first_bad_input(chain, [2 * N, 3], [q, qd], torque, pivot)
                 .or_else(|| singular_angle(&q[2 * N * chain..2 * N * chain + N]))
                 .unwrap_or(Error::SinglePrecisionOverflow)
@@ -159,32 +158,11 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
             Ok(()) => Error::NotPositiveDefinite,
         }
     }
+}
 
-    /// `(θ̈, φ̈)` of every chain in precision `P`, from the blocks' constants in `P`; a chain
-    /// whose row is not finite (or whose state is at a pole) fails with `error(chain)`, its
-    /// row NaN.
-    fn evaluate<P: Precision>(
-        &self,
-        blocks: &[LinkConstants<P::Lanes, N>],
-        [q, qd]: [&[P]; 2],
-        torque: Option<&[P]>,
-        pivot: Option<&[P]>,
-        out: &mut [P],
-        error: impl Fn(usize) -> Error + Sync + Send,
-    ) -> Result<Vec<Failure>> {
-        let (chains, m) = (self.len(), 2 * N);
-        check_rows([q, qd], torque, pivot, out, chains, [m, 3])?;
-        let room = SineRoom::<P::Lanes, N, { 2 * GROUP }>::new;
-        let failures = for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(out, m, N, room, |room, g, out| {
-            let first = GROUP * g;
-            let count = (out.len() / m).div_ceil(WIDTH);
-            let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
-            let rows = Rows { q, qd, torque, pivot };
-            self.group_simd::<P>(&blocks[first..first + count], room, lanes, rows, out);
-            non_finite_rows(out, m, WIDTH * first, &error)
-        });
-        Ok(failures)
-    }
+impl<M: SpatialKernel<N>, const N: usize> Groups<N, { 2 * GROUP }> for UnrolledSpatialBatch<M, N> {
+    const ROW: usize = 2 * N;
+    const SPACE: usize = 3;
 
     /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`): each
     /// block's angles gathered into lanes (block `j`'s polar angles in the room's array
@@ -242,58 +220,6 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
                 scatter::<P, WIDTH>(P::flatten(result.as_flattened()), m, &mut out[rows]);
             }
         }
-    }
-
-    /// [`group`](Self::group) in AVX2 registers when the CPU has them (eight chains an
-    /// AVX-512 register where it has AVX-512 VL and they are allowed), else in
-    /// [`Precision::Lanes`].
-    fn group_simd<P: Precision>(
-        &self,
-        c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
-        lanes: [[usize; WIDTH]; GROUP],
-        rows: Rows<'_, P>,
-        out: &mut [P],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if self.uses_avx512() {
-            // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
-            return unsafe { self.group_avx512::<P>(c, room, lanes, rows, out) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if crate::lanes::has_avx2() {
-            // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.group_avx2::<P>(c, room, lanes, rows, out) };
-        }
-        self.group::<P, P::Lanes>(c, room, lanes, rows, out)
-    }
-
-    /// [`group`](Self::group) compiled for AVX-512 VL, in [`Precision::Wide`].
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,avx512f,avx512vl")]
-    fn group_avx512<P: Precision>(
-        &self,
-        c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
-        lanes: [[usize; WIDTH]; GROUP],
-        rows: Rows<'_, P>,
-        out: &mut [P],
-    ) {
-        self.group::<P, P::Wide>(c, room, lanes, rows, out)
-    }
-
-    /// [`group`](Self::group) compiled for AVX2, in [`Precision::Registers`].
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn group_avx2<P: Precision>(
-        &self,
-        c: &[LinkConstants<P::Lanes, N>],
-        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
-        lanes: [[usize; WIDTH]; GROUP],
-        rows: Rows<'_, P>,
-        out: &mut [P],
-    ) {
-        self.group::<P, P::Registers>(c, room, lanes, rows, out)
     }
 }
 
