@@ -27,7 +27,10 @@
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
 //!   lanes instead of eight too), and `…/spatial_…/4` the same for the spatial model
-//!   (`UnrolledSpatialBatch::integrate_rk4`);
+//!   (`UnrolledSpatialBatch::integrate_rk4`), `…/spatial_held_…/4` with torques and pivot
+//!   accelerations held, `…/spatial_whirled_…/4` with each chain's
+//!   pivot on a circle of its own (`FirstOrder::with_inputs(model, Driven)` against
+//!   `integrate_rk4_driven`);
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
 //!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
 //!   `state_jacobians_f32`;
@@ -606,19 +609,70 @@ fn generated_spatial_rk4<M, const N: usize, const D: usize, const X: usize>(
             }
         })
     });
-    let batch = UnrolledSpatialBatch::new(models).expect("batch");
+    let batch = UnrolledSpatialBatch::new(models.clone()).expect("batch");
     for threads in [1, 2] {
         let pool = pool(threads);
         let id = BenchmarkId::new(format!("rk4_100_steps/spatial_batch_{threads}_threads"), N);
         group.bench_with_input(id, &N, |b, _| {
             in_pool(b, &pool, || {
                 let mut run = states.clone();
-                let failures = batch.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                let failures = batch.integrate_rk4(&mut run, None, None, H, STEPS).expect("batch");
                 assert!(failures.is_empty());
                 black_box(&run);
             })
         });
     }
+    // Each chain with its torques and pivot acceleration held (a controller's action).
+    let torque: Vec<f64> = (0..CHAINS * D).map(|_| r.random_range(-1e-4..1e-4)).collect();
+    let pivot: Vec<f64> = (0..CHAINS * 3).map(|_| r.random_range(-1.0..1.0)).collect();
+    let one = pool(1);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/spatial_held_batch_1_threads", N), &N, |b, _| {
+        in_pool(b, &one, || {
+            let mut run = states.clone();
+            let failures =
+                batch.integrate_rk4(&mut run, Some(&torque), Some(&pivot), H, STEPS).expect("batch");
+            assert!(failures.is_empty());
+            black_box(&run);
+        })
+    });
+    // Each chain whirled by its top end (a circle of its own radius and speed), its pivot's
+    // acceleration asked at each stage's time.
+    let drives: Vec<Circle> = (0..CHAINS)
+        .map(|_| Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..20.0)).expect("drive"))
+        .collect();
+    let whirled: Vec<_> = models
+        .iter()
+        .zip(&drives)
+        .map(|(model, drive)| {
+            let torque = ConstantTorque::zeros(Const::<D>);
+            FirstOrder::with_inputs(model.clone(), Driven::new(*drive, torque))
+        })
+        .collect();
+    let mut rk4 = Rk4::new(&whirled[0]);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/spatial_whirled_single", N), &N, |b, _| {
+        b.iter(|| {
+            for (system, state) in whirled.iter().zip(&states) {
+                let mut state = state.clone();
+                for _ in 0..STEPS {
+                    rk4.step(system, &mut state, H).expect("single");
+                }
+                black_box(&state);
+            }
+        })
+    });
+    let one = pool(1);
+    group.bench_with_input(
+        BenchmarkId::new("rk4_100_steps/spatial_whirled_batch_1_threads", N),
+        &N,
+        |b, _| {
+            in_pool(b, &one, || {
+                let mut run = states.clone();
+                let failures = batch.integrate_rk4_driven(&mut run, &drives, None, H, STEPS).expect("batch");
+                assert!(failures.is_empty());
+                black_box(&run);
+            })
+        },
+    );
     group.throughput(Throughput::Elements(CHAINS as u64));
 }
 
@@ -660,7 +714,7 @@ fn generated_rk4<M, const N: usize, const D: usize>(
             |b, _| {
                 in_pool(b, &pool, || {
                     let mut run = states.clone();
-                    batch.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                    batch.integrate_rk4(&mut run, None, None, H, STEPS).expect("batch");
                     black_box(&run);
                 })
             },
@@ -675,7 +729,7 @@ fn generated_rk4<M, const N: usize, const D: usize>(
             |b, _| {
                 in_pool(b, &pool, || {
                     let mut run = states.clone();
-                    four.integrate_rk4(&mut run, H, STEPS).expect("batch");
+                    four.integrate_rk4(&mut run, None, None, H, STEPS).expect("batch");
                     black_box(&run);
                 })
             },

@@ -2,11 +2,11 @@
 //! `unrolled_spatial_ensembles.rs`, …): random chains and whirls, thread pools of one and two
 //! threads, and the comparison bit for bit.
 
-use nalgebra::{Const, DVector, Dyn, U3};
+use nalgebra::{Const, DVector, DimMul, Dyn, U2, U3};
 use nalgebra::{DefaultAllocator, Dim, allocator::Allocator};
 use pendulum_core::batch::Failure;
-use pendulum_core::integrate::State;
-use pendulum_core::{Chain, Circle, Directions, Error};
+use pendulum_core::integrate::{Integrator, Rk4, State, SystemAlloc};
+use pendulum_core::{Chain, Circle, Directions, Error, FirstOrder, InputsAt, Model, ModelAlloc};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -119,4 +119,67 @@ pub fn assert_runs<D: Dim>(
         }
     }
     assert!(failed.next().is_none(), "{what}: only the failing chains are reported");
+}
+
+/// Each chain's state after `steps` steps of size `h` of `Rk4` on
+/// `FirstOrder::with_inputs(models[k], inputs(k))`, alone, from `states[k]`, and its error
+/// (the state left where it failed).
+pub fn stepped_alone<M, I, D>(
+    models: &[M],
+    states: &[State<D>],
+    inputs: impl Fn(usize) -> I,
+    h: f64,
+    steps: usize,
+) -> Vec<(State<D>, Option<Error>)>
+where
+    M: Model + Clone,
+    I: InputsAt<M::Dof, M::Space>,
+    M::Dof: DimMul<U2, Output = D>,
+    D: Dim,
+    DefaultAllocator: ModelAlloc<M::Links, M::Dof, M::Space> + SystemAlloc<D>,
+{
+    models
+        .iter()
+        .zip(states)
+        .enumerate()
+        .map(|(k, (model, state))| {
+            let system = FirstOrder::with_inputs(model.clone(), inputs(k));
+            let mut rk4 = Rk4::new(&system);
+            let mut state = state.clone();
+            let error = (0..steps).find_map(|_| rk4.step(&system, &mut state, h).err());
+            (state, error)
+        })
+        .collect()
+}
+
+/// A batch's run: `steps` steps of every chain of `states`, and its failures.
+pub type Run<'a, D> = &'a (dyn Fn(&mut [State<D>], usize) -> Result<Vec<Failure>, Error> + Sync);
+
+/// A batch's `run` of `steps` steps from `states` against each chain's own run (`alone`,
+/// [`assert_runs`]): on 1 and 2 threads, and in two calls of half the steps each (the
+/// failures of both calls together). `what` names the batch.
+pub fn check_runs<D: Dim>(
+    run: Run<'_, D>,
+    states: &[State<D>],
+    alone: &[(State<D>, Option<Error>)],
+    steps: usize,
+    what: &str,
+) where
+    DefaultAllocator: Allocator<D>,
+    State<D>: Clone + Send,
+{
+    let chains = states.len();
+    for pool in pools() {
+        let mut batched = states.to_vec();
+        let failures = pool.install(|| run(&mut batched, steps)).expect("batch");
+        let threads = pool.current_num_threads();
+        assert_runs(&batched, alone, &failures, &format!("{what}: {chains} chains, {threads} threads"));
+    }
+    let mut batched = states.to_vec();
+    let first = run(&mut batched, steps / 2).expect("batch");
+    let mut failures = run(&mut batched, steps - steps / 2).expect("batch");
+    failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
+    failures.extend(first);
+    failures.sort_by_key(|f| f.chain);
+    assert_runs(&batched, alone, &failures, &format!("{what}: {chains} chains in two calls"));
 }

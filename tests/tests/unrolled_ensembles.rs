@@ -3,11 +3,11 @@
 //! the chains are split into calls, the chains whose tension continuants leave their range
 //! included, and a failing chain is reported by its index while the others finish.
 
-use nalgebra::{Const, SVector, Vector2};
+use nalgebra::{Const, SVector, U2, Vector2};
 use pendulum_core::batch::{PlanarKernel, UnrolledBatch};
-use pendulum_core::integrate::{Integrator, Rk4, State};
-use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
-use pendulum_tests::batches::{assert_bits, assert_rows, assert_runs, pools};
+use pendulum_core::integrate::State;
+use pendulum_core::{Chain, ConstantTorque, Driven, Error, Harmonic, Inputs};
+use pendulum_tests::batches::{self, assert_bits, assert_rows, check_runs, pools};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -171,27 +171,16 @@ fn bad_batches_and_arrays_are_one_line_errors() {
 
 /// Each chain's state after `steps` steps of `Rk4` on `FirstOrder::new(model)`, alone, or
 /// its error (the state left where it failed).
-fn stepped_alone<M, const N: usize, const D: usize>(
+fn stepped_alone<M: PlanarKernel<N> + Clone, const N: usize, const D: usize>(
     models: &[M],
     states: &[State<Const<D>>],
     h: f64,
     steps: usize,
 ) -> Vec<(State<Const<D>>, Option<Error>)>
 where
-    M: Model<Links = Const<N>, Dof = Const<N>, Space = nalgebra::U2> + Clone,
-    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
+    Const<N>: nalgebra::DimMul<U2, Output = Const<D>>,
 {
-    models
-        .iter()
-        .zip(states)
-        .map(|(model, state)| {
-            let system = FirstOrder::new(model.clone());
-            let mut rk4 = Rk4::new(&system);
-            let mut state = state.clone();
-            let error = (0..steps).find_map(|_| rk4.step(&system, &mut state, h).err());
-            (state, error)
-        })
-        .collect()
+    batches::stepped_alone(models, states, |k| models[k].zero_inputs(), h, steps)
 }
 
 /// `chains` random states `(θ, θ̇)` at random times.
@@ -216,46 +205,15 @@ fn check_rk4<M, const N: usize, const D: usize>(
     steps: usize,
 ) where
     M: PlanarKernel<N> + Clone,
-    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
+    Const<N>: nalgebra::DimMul<U2, Output = Const<D>>,
 {
-    let alone = stepped_alone(&models, &states, h, steps);
+    let alone = stepped_alone::<M, N, D>(&models, &states, h, steps);
     let eight = UnrolledBatch::new(models).expect("batch");
     let four = eight.clone().with_avx512(false);
     for batch in [&eight, &four] {
-        check_rk4_runs(batch, &states, &alone, h, steps);
+        let run = |states: &mut [State<Const<D>>], steps| batch.integrate_rk4(states, None, None, h, steps);
+        check_runs(&run, &states, &alone, steps, &format!("N = {N}, AVX-512 {}", batch.uses_avx512()));
     }
-}
-
-/// [`check_rk4`] of one batch against the chains stepped `alone`.
-fn check_rk4_runs<M: PlanarKernel<N>, const N: usize, const D: usize>(
-    batch: &UnrolledBatch<M, N>,
-    states: &[State<Const<D>>],
-    alone: &[(State<Const<D>>, Option<Error>)],
-    h: f64,
-    steps: usize,
-) where
-    Const<N>: nalgebra::DimMul<nalgebra::U2, Output = Const<D>>,
-{
-    let avx512 = batch.uses_avx512();
-    let compare = |batched: &[State<Const<D>>], failures: &[pendulum_core::batch::Failure], what: &str| {
-        assert_runs(batched, alone, failures, &format!("{what}, AVX-512 {avx512}"));
-    };
-    for pool in pools() {
-        let mut batched = states.to_vec();
-        let failures = pool.install(|| batch.integrate_rk4(&mut batched, h, steps)).expect("batch");
-        compare(
-            &batched,
-            &failures,
-            &format!("{} chains of {N}, {} threads", states.len(), pool.current_num_threads()),
-        );
-    }
-    let mut batched = states.to_vec();
-    let first = batch.integrate_rk4(&mut batched, h, steps / 2).expect("batch");
-    let mut failures = batch.integrate_rk4(&mut batched, h, steps - steps / 2).expect("batch");
-    failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
-    failures.extend(first);
-    failures.sort_by_key(|f| f.chain);
-    compare(&batched, &failures, &format!("{} chains of {N} in two calls", states.len()));
 }
 
 #[test]
@@ -290,11 +248,132 @@ fn a_chain_that_fails_in_a_run_stops_where_it_failed_with_its_own_error() {
     check_rk4::<Planar4, 4, 8>(models, states, 1e-3, 10);
     let batch = UnrolledBatch::new(random_models::<Planar4, 4>(2, &mut r)).expect("batch");
     let mut two = random_states::<8>(2, &mut r);
-    assert_eq!(batch.integrate_rk4(&mut two, 0.0, 1).unwrap_err(), Error::InvalidStepSize { h: 0.0 });
     assert_eq!(
-        batch.integrate_rk4(&mut two[..1], 1e-3, 1).unwrap_err().to_string(),
+        batch.integrate_rk4(&mut two, None, None, 0.0, 1).unwrap_err(),
+        Error::InvalidStepSize { h: 0.0 }
+    );
+    assert_eq!(
+        batch.integrate_rk4(&mut two[..1], None, None, 1e-3, 1).unwrap_err().to_string(),
         "states has 1 entries, expected 2"
     );
+    let messages = [
+        batch.integrate_rk4(&mut two, Some(&[0.0; 7]), None, 1e-3, 1),
+        batch.integrate_rk4(&mut two, None, Some(&[0.0; 3]), 1e-3, 1),
+        batch.integrate_rk4_driven(
+            &mut two,
+            &[Harmonic::vertical(0.1, 1.0, 0.0).expect("drive")],
+            None,
+            1e-3,
+            1,
+        ),
+    ]
+    .map(|run| run.unwrap_err().to_string());
+    assert_eq!(
+        messages,
+        [
+            "torque has 7 entries, expected 8",
+            "pivot has 3 entries, expected 4",
+            "drives has 1 entries, expected 2"
+        ]
+    );
+}
+
+/// Random joint torques (`B` rows of `N`) and pivot drives: vertical and sideways
+/// oscillations of random amplitude, frequency and phase.
+fn random_drives(chains: usize, n: usize, r: &mut ChaCha8Rng) -> (Vec<f64>, Vec<Harmonic<U2>>) {
+    let torque = (0..chains * n).map(|_| r.random_range(-1e-3..1e-3)).collect();
+    let drives = (0..chains)
+        .map(|_| {
+            let direction = Vector2::new(r.random_range(-1.0..1.0), 1.0);
+            let (a, w, phase) =
+                (r.random_range(0.0..0.02), r.random_range(1.0..200.0), r.random_range(0.0..6.0));
+            Harmonic::new(direction, a, w, phase).expect("drive")
+        })
+        .collect();
+    (torque, drives)
+}
+
+#[test]
+fn rk4_runs_with_torques_and_pivots_held_or_driven_equal_each_chain_with_its_inputs_alone() {
+    let mut r = ChaCha8Rng::seed_from_u64(29);
+    let h = 1e-3;
+    for chains in [1, 9, 37] {
+        let models: Vec<Planar4> = random_models(chains, &mut r);
+        let states = random_states::<8>(chains, &mut r);
+        let (torque, drives) = random_drives(chains, 4, &mut r);
+        let pivot: Vec<f64> = (0..2 * chains).map(|_| r.random_range(-30.0..30.0)).collect();
+        let row = |k: usize| SVector::<f64, 4>::from_column_slice(&torque[4 * k..4 * k + 4]);
+        let held = |k: usize| Inputs {
+            torque: row(k),
+            pivot_acceleration: Vector2::new(pivot[2 * k], pivot[2 * k + 1]),
+        };
+        let driven = |k: usize| Driven::new(drives[k].clone(), ConstantTorque(row(k)));
+        let alone_held = batches::stepped_alone(&models, &states, held, h, 30);
+        let alone_driven = batches::stepped_alone(&models, &states, driven, h, 30);
+        // The inputs change the runs: the held pivots are not the drives, nor no inputs.
+        let unforced = stepped_alone(&models, &states, h, 30);
+        for ((held, driven), unforced) in alone_held.iter().zip(&alone_driven).zip(&unforced) {
+            assert!(
+                held.0.x() != driven.0.x() && held.0.x() != unforced.0.x() && driven.0.x() != unforced.0.x()
+            );
+        }
+        let eight = UnrolledBatch::new(models).expect("batch");
+        for batch in [eight.clone(), eight.with_avx512(false)] {
+            let run = |states: &mut [State<Const<8>>], steps| {
+                batch.integrate_rk4(states, Some(&torque), Some(&pivot), h, steps)
+            };
+            check_runs(&run, &states, &alone_held, 30, &format!("AVX-512 {}", batch.uses_avx512()));
+            let run = |states: &mut [State<Const<8>>], steps| {
+                batch.integrate_rk4_driven(states, &drives, Some(&torque), h, steps)
+            };
+            check_runs(&run, &states, &alone_driven, 30, &format!("AVX-512 {}", batch.uses_avx512()));
+        }
+    }
+}
+
+#[test]
+fn a_chain_whose_inputs_are_not_finite_fails_alone_with_its_models_error() {
+    let mut r = ChaCha8Rng::seed_from_u64(30);
+    let (chains, h) = (11, 1e-3);
+    let models: Vec<Planar4> = random_models(chains, &mut r);
+    let states = random_states::<8>(chains, &mut r);
+    let (mut torque, mut drives) = random_drives(chains, 4, &mut r);
+    let mut pivot: Vec<f64> = (0..2 * chains).map(|_| r.random_range(-30.0..30.0)).collect();
+    // Chain 1: a NaN torque; chain 4: an infinite held pivot acceleration; chain 6: a drive
+    // whose acceleration A ω² overflows (NaN across the vertical: ∞ · 0).
+    torque[4 + 2] = f64::NAN;
+    pivot[2 * 4 + 1] = f64::INFINITY;
+    drives[6] = Harmonic::vertical(1e300, 1e10, 0.5).expect("drive");
+    let row = |k: usize| SVector::<f64, 4>::from_column_slice(&torque[4 * k..4 * k + 4]);
+    let held = |k: usize| Inputs {
+        torque: row(k),
+        pivot_acceleration: Vector2::new(pivot[2 * k], pivot[2 * k + 1]),
+    };
+    let driven = |k: usize| Driven::new(drives[k].clone(), ConstantTorque(row(k)));
+    let alone_held = batches::stepped_alone(&models, &states, held, h, 12);
+    let alone_driven = batches::stepped_alone(&models, &states, driven, h, 12);
+    let failed = |alone: &[(State<Const<8>>, Option<Error>)]| -> Vec<(usize, &'static str, usize)> {
+        let what = |e: &Error| match e {
+            Error::NonFinite { what, index, .. } => (*what, *index),
+            other => panic!("{other}"),
+        };
+        alone
+            .iter()
+            .enumerate()
+            .filter_map(|(k, a)| a.1.as_ref().map(|e| (k, what(e).0, what(e).1)))
+            .collect()
+    };
+    assert_eq!(failed(&alone_held), [(1, "torque", 2), (4, "pivot_acceleration", 1)]);
+    assert_eq!(failed(&alone_driven), [(1, "torque", 2), (6, "pivot_acceleration", 0)]);
+    let batch = UnrolledBatch::new(models).expect("batch");
+    let run = |states: &mut [State<Const<8>>], steps| {
+        batch.integrate_rk4(states, Some(&torque), Some(&pivot), h, steps)
+    };
+    check_runs(&run, &states, &alone_held, 12, &format!("AVX-512 {}", batch.uses_avx512()));
+    let run = |states: &mut [State<Const<8>>], steps| {
+        batch.integrate_rk4_driven(states, &drives, Some(&torque), h, steps)
+    };
+    check_runs(&run, &states, &alone_driven, 12, &format!("AVX-512 {}", batch.uses_avx512()));
 }
 
 /// The worst `max_i |θ̈32_i − θ̈64_i| / max_i |θ̈64_i|` over `chains` random chains and

@@ -7,10 +7,10 @@
 //! bit for bit, a chain whose stage reaches a pole stopping alone where it stopped.
 
 use nalgebra::{Const, SVector, U2, U3, Vector3};
-use pendulum_core::batch::{Failure, SpatialKernel, UnrolledSpatialBatch};
-use pendulum_core::integrate::{Integrator, Rk4, State};
-use pendulum_core::{Chain, Error, FirstOrder, Inputs, Model};
-use pendulum_tests::batches::{assert_bits, assert_rows, assert_runs, pools, random_fixed_chain};
+use pendulum_core::batch::{SpatialKernel, UnrolledSpatialBatch};
+use pendulum_core::integrate::State;
+use pendulum_core::{Chain, Circle, ConstantTorque, Driven, Error, Inputs, Model};
+use pendulum_tests::batches::{self, assert_bits, assert_rows, check_runs, pools, random_fixed_chain};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -270,20 +270,10 @@ fn stepped_alone<M, const N: usize, const Q: usize, const D: usize>(
     steps: usize,
 ) -> Vec<(State<Const<D>>, Option<Error>)>
 where
-    M: Model<Links = Const<N>, Dof = Const<Q>, Space = U3> + Clone,
+    M: SpatialKernel<N> + Model<Links = Const<N>, Dof = Const<Q>, Space = U3> + Clone,
     Const<Q>: nalgebra::DimMul<U2, Output = Const<D>>,
 {
-    models
-        .iter()
-        .zip(states)
-        .map(|(model, state)| {
-            let system = FirstOrder::new(model.clone());
-            let mut rk4 = Rk4::new(&system);
-            let mut state = state.clone();
-            let error = (0..steps).find_map(|_| rk4.step(&system, &mut state, h).err());
-            (state, error)
-        })
-        .collect()
+    batches::stepped_alone(models, states, |k| models[k].zero_inputs(), h, steps)
 }
 
 /// `chains` random states `(θ, φ, θ̇, φ̇)` at random times, the polar angles between 0.2
@@ -317,22 +307,8 @@ fn check_rk4<M, const N: usize, const Q: usize, const D: usize>(
     let eight = UnrolledSpatialBatch::new(models).expect("batch");
     let four = eight.clone().with_avx512(false);
     for batch in [&eight, &four] {
-        let what = format!("{} chains of {N}, AVX-512 {}", states.len(), batch.uses_avx512());
-        let compare = |batched: &[State<Const<D>>], failures: &[Failure], what: &str| {
-            assert_runs(batched, &alone, failures, what);
-        };
-        for pool in pools() {
-            let mut batched = states.clone();
-            let failures = pool.install(|| batch.integrate_rk4(&mut batched, h, steps)).expect("batch");
-            compare(&batched, &failures, &format!("{what}, {} threads", pool.current_num_threads()));
-        }
-        let mut batched = states.clone();
-        let first = batch.integrate_rk4(&mut batched, h, steps / 2).expect("batch");
-        let mut failures = batch.integrate_rk4(&mut batched, h, steps - steps / 2).expect("batch");
-        failures.retain(|f| !first.iter().any(|g| g.chain == f.chain));
-        failures.extend(first);
-        failures.sort_by_key(|f| f.chain);
-        compare(&batched, &failures, &format!("{what}, in two calls"));
+        let run = |states: &mut [State<Const<D>>], steps| batch.integrate_rk4(states, None, None, h, steps);
+        check_runs(&run, &states, &alone, steps, &format!("N = {N}, AVX-512 {}", batch.uses_avx512()));
     }
 }
 
@@ -375,4 +351,65 @@ fn a_chain_whose_run_reaches_a_pole_stops_there_with_its_own_error() {
     assert!(matches!(alone[2].1, Some(Error::SingularAngle { link: 3, .. })), "{:?}", alone[2].1);
     assert!(matches!(alone[9].1, Some(Error::SingularAngle { link: 1, .. })), "{:?}", alone[9].1);
     check_rk4::<Spatial4, 4, 8, 16>(models, states, h, 10);
+}
+
+/// Random generalized torques (`B` rows of `2N`), held pivot accelerations (`B` rows of 3)
+/// and whirling pivots: circles of random radius and speed.
+fn random_drives(chains: usize, n: usize, r: &mut ChaCha8Rng) -> (Vec<f64>, Vec<f64>, Vec<Circle>) {
+    let torque = (0..chains * 2 * n).map(|_| r.random_range(-1e-3..1e-3)).collect();
+    let pivot = (0..chains * 3).map(|_| r.random_range(-30.0..30.0)).collect();
+    let drives = (0..chains)
+        .map(|_| Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..20.0)).expect("drive"))
+        .collect();
+    (torque, pivot, drives)
+}
+
+#[test]
+fn rk4_runs_with_torques_and_pivots_held_or_whirled_equal_each_chain_with_its_inputs_alone() {
+    let mut r = ChaCha8Rng::seed_from_u64(29);
+    let h = 5e-4;
+    // 11 chains: a chain whose torque is NaN (3), one whose held pivot acceleration is
+    // infinite (7), one whose whirl's acceleration r ω² overflows (9).
+    for chains in [1, 9, 11, 37] {
+        let models: Vec<Spatial4> = random_models(chains, &mut r);
+        let states = random_states::<16>(chains, &mut r);
+        let (mut torque, mut pivot, mut drives) = random_drives(chains, 4, &mut r);
+        if chains == 11 {
+            torque[8 * 3 + 5] = f64::NAN;
+            pivot[3 * 7 + 2] = f64::INFINITY;
+            drives[9] = Circle::new(1e300, 1e10).expect("drive");
+        }
+        let row = |k: usize| SVector::<f64, 8>::from_column_slice(&torque[8 * k..8 * k + 8]);
+        let held = |k: usize| Inputs {
+            torque: row(k),
+            pivot_acceleration: Vector3::from_column_slice(&pivot[3 * k..3 * k + 3]),
+        };
+        let whirled = |k: usize| Driven::new(drives[k], ConstantTorque(row(k)));
+        let alone_held = batches::stepped_alone(&models, &states, held, h, 30);
+        let alone_whirled = batches::stepped_alone(&models, &states, whirled, h, 30);
+        let failed = |alone: &[(State<Const<16>>, Option<Error>)]| -> Vec<usize> {
+            (0..chains).filter(|&k| alone[k].1.is_some()).collect()
+        };
+        let (held_fail, whirled_fail) =
+            if chains == 11 { (vec![3, 7], vec![3, 9]) } else { (vec![], vec![]) };
+        assert_eq!((failed(&alone_held), failed(&alone_whirled)), (held_fail, whirled_fail));
+        // The inputs change the runs: the held pivots are not the whirls, nor no inputs.
+        let unforced = stepped_alone::<Spatial4, 4, 8, 16>(&models, &states, h, 30);
+        for k in (0..chains).filter(|k| ![3, 7, 9].contains(k)) {
+            let [a, b, c] = [&alone_held[k].0, &alone_whirled[k].0, &unforced[k].0].map(|s| *s.x());
+            assert!(a != b && a != c && b != c, "chain {k}");
+        }
+        let eight = UnrolledSpatialBatch::new(models).expect("batch");
+        for batch in [eight.clone(), eight.with_avx512(false)] {
+            let what = format!("AVX-512 {}", batch.uses_avx512());
+            let run = |states: &mut [State<Const<16>>], steps| {
+                batch.integrate_rk4(states, Some(&torque), Some(&pivot), h, steps)
+            };
+            check_runs(&run, &states, &alone_held, 30, &format!("held, {what}"));
+            let run = |states: &mut [State<Const<16>>], steps| {
+                batch.integrate_rk4_driven(states, &drives, Some(&torque), h, steps)
+            };
+            check_runs(&run, &states, &alone_whirled, 30, &format!("whirled, {what}"));
+        }
+    }
 }
