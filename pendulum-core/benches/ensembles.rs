@@ -26,7 +26,7 @@
 //!   the same way (`UnrolledSpatialBatch`);
 //!   `generated/rk4_100_steps/…/n`: 100 RK4 steps of 0.1 ms per chain, `Rk4` on each chain's
 //!   `FirstOrder` against `UnrolledBatch::integrate_rk4` (throughput in chain-steps; four
-//!   lanes instead of eight too), and `…/spatial_…/4` the same for the spatial model
+//!   lanes instead of eight too, and `integrate_rk4_f32`, `…/batch_f32_1_thread`), and `…/spatial_…/4` the same for the spatial model
 //!   (`UnrolledSpatialBatch::integrate_rk4`), `…/spatial_held_…/4` with torques and pivot
 //!   accelerations held, `…/spatial_whirled_…/4` with each chain's
 //!   pivot on a circle of its own (`FirstOrder::with_inputs(model, Driven)` against
@@ -622,10 +622,21 @@ fn generated_spatial_rk4<M, const N: usize, const D: usize, const X: usize>(
             })
         });
     }
+    // The same run in single precision: rows of f32 and their compensations.
+    let rows: Vec<f32> = states.iter().flat_map(|s| s.x().iter().map(|&x| x as f32)).collect();
+    let one = pool(1);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/spatial_batch_f32_1_thread", N), &N, |b, _| {
+        in_pool(b, &one, || {
+            let (mut x, mut carry) = (rows.clone(), vec![0.0f32; rows.len()]);
+            let failures =
+                batch.integrate_rk4_f32((&mut x, &mut carry), None, None, H, STEPS).expect("batch");
+            assert!(failures.is_empty());
+            black_box(&x);
+        })
+    });
     // Each chain with its torques and pivot acceleration held (a controller's action).
     let torque: Vec<f64> = (0..CHAINS * D).map(|_| r.random_range(-1e-4..1e-4)).collect();
     let pivot: Vec<f64> = (0..CHAINS * 3).map(|_| r.random_range(-1.0..1.0)).collect();
-    let one = pool(1);
     group.bench_with_input(BenchmarkId::new("rk4_100_steps/spatial_held_batch_1_threads", N), &N, |b, _| {
         in_pool(b, &one, || {
             let mut run = states.clone();
@@ -720,6 +731,16 @@ fn generated_rk4<M, const N: usize, const D: usize>(
             },
         );
     }
+    // The same run in single precision: rows of f32 and their compensations.
+    let rows: Vec<f32> = states.iter().flat_map(|s| s.x().iter().map(|&x| x as f32)).collect();
+    let one = pool(1);
+    group.bench_with_input(BenchmarkId::new("rk4_100_steps/batch_f32_1_thread", N), &N, |b, _| {
+        in_pool(b, &one, || {
+            let (mut x, mut carry) = (rows.clone(), vec![0.0f32; rows.len()]);
+            batch.integrate_rk4_f32((&mut x, &mut carry), None, None, H, STEPS).expect("batch");
+            black_box(&x);
+        })
+    });
     // What `with_avx512(false)` trades, on a CPU with AVX-512: four lanes instead of eight.
     if batch.uses_avx512() {
         let (four, pool) = (batch.clone().with_avx512(false), pool(1));

@@ -183,3 +183,45 @@ pub fn check_runs<D: Dim>(
     failures.sort_by_key(|f| f.chain);
     assert_runs(&batched, alone, &failures, &format!("{what}: {chains} chains in two calls"));
 }
+
+/// A batch's run in single precision, `run32(x, carry, steps)` on rows of `x = (q, q̇)` and
+/// their compensations, against its `f64` run of the same `states` (`exact`, after `steps`
+/// steps): the worst `max |x₃₂ − x₆₄| / max |x₆₄|` over the chains. On the way, checks that
+/// the `f32` run gives the same bits on 1 and 2 threads and in two calls of half the steps
+/// each (the compensations kept), and fails no chain.
+pub fn f32_run_error<D: Dim>(
+    run32: &(dyn Fn(&mut [f32], &mut [f32], usize) -> Result<Vec<Failure>, Error> + Sync),
+    states: &[State<D>],
+    exact: &[State<D>],
+    steps: usize,
+) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let rows: Vec<f32> = states.iter().flat_map(|s| s.x().iter().map(|&x| x as f32)).collect();
+    let runs: Vec<Vec<f32>> = pools()
+        .iter()
+        .map(|pool| {
+            let (mut x, mut carry) = (rows.clone(), vec![0.0f32; rows.len()]);
+            let failures = pool.install(|| run32(&mut x, &mut carry, steps)).expect("f32 run");
+            assert!(failures.is_empty(), "{failures:?}");
+            x
+        })
+        .collect();
+    let (mut x, mut carry) = (rows.clone(), vec![0.0f32; rows.len()]);
+    assert!(run32(&mut x, &mut carry, steps / 2).expect("f32 run").is_empty());
+    assert!(run32(&mut x, &mut carry, steps - steps / 2).expect("f32 run").is_empty());
+    let bits = |x: &[f32]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&runs[0]), bits(&runs[1]), "1 and 2 threads");
+    assert_eq!(bits(&runs[0]), bits(&x), "one call and two");
+    let m = rows.len() / states.len();
+    exact
+        .iter()
+        .zip(runs[0].chunks(m))
+        .map(|(exact, x32)| {
+            let scale = exact.x().iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            let worst = exact.x().iter().zip(x32).fold(0.0f64, |w, (&a, &b)| w.max((a - f64::from(b)).abs()));
+            worst / scale
+        })
+        .fold(0.0, f64::max)
+}

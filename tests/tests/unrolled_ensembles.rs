@@ -471,3 +471,104 @@ fn in_single_precision_a_failing_chain_is_named_and_the_others_finish() {
     let error = batch.accelerations_f32(&q[..40], &qd, None, None, &mut out).unwrap_err();
     assert_eq!(error.to_string(), "q has 40 entries, expected 44");
 }
+
+/// Chains of `N` links whose masses and lengths go from 10 g and 1 cm up by a factor of up
+/// to `spread`, damping 1e-4 N·m·s, gravity 9.81 m/s².
+fn spread_models<M: From<Chain<Const<N>>>, const N: usize>(
+    chains: usize,
+    spread: f64,
+    r: &mut ChaCha8Rng,
+) -> Vec<M> {
+    (0..chains)
+        .map(|_| {
+            let mut up = |x: f64| (0..N).map(|_| x * r.random_range(1.0..spread)).collect::<Vec<_>>();
+            let (masses, lengths) = (up(0.01), up(0.01));
+            M::from(
+                Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&[1e-4; N])).expect("chain"),
+            )
+        })
+        .collect()
+}
+
+/// [`batches::f32_run_error`] of 64 chains of `N` links (`spread` as [`spread_models`])
+/// swinging from angles and rates within ±1, `steps` steps of 0.1 ms, free and with small
+/// torques and pivot accelerations held: the worse of the two.
+fn f32_run_error<M: PlanarKernel<N> + From<Chain<Const<N>>>, const N: usize, const D: usize>(
+    spread: f64,
+    steps: usize,
+    r: &mut ChaCha8Rng,
+) -> f64
+where
+    Const<N>: nalgebra::DimMul<U2, Output = Const<D>>,
+{
+    let (chains, h) = (64, 1e-4);
+    let batch = UnrolledBatch::new(spread_models::<M, N>(chains, spread, r)).expect("batch");
+    let states: Vec<State<Const<D>>> = (0..chains)
+        .map(|_| State::new(0.0, SVector::<f64, D>::from_fn(|_, _| r.random_range(-1.0..1.0))))
+        .collect();
+    let torque: Vec<f64> = (0..chains * N).map(|_| r.random_range(-1e-5..1e-5)).collect();
+    let pivot: Vec<f64> = (0..chains * 2).map(|_| r.random_range(-1.0..1.0)).collect();
+    let to32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (torque32, pivot32) = (to32(&torque), to32(&pivot));
+    let mut worst = 0.0f64;
+    for held in [false, true] {
+        let mut exact = states.clone();
+        let (t, p) = if held { (Some(&torque[..]), Some(&pivot[..])) } else { (None, None) };
+        assert!(batch.integrate_rk4(&mut exact, t, p, h, steps).expect("f64").is_empty());
+        let (t32, p32) = if held { (Some(&torque32[..]), Some(&pivot32[..])) } else { (None, None) };
+        let run32 =
+            |x: &mut [f32], carry: &mut [f32], steps| batch.integrate_rk4_f32((x, carry), t32, p32, h, steps);
+        worst = worst.max(batches::f32_run_error(&run32, &states, &exact, steps));
+    }
+    worst
+}
+
+#[test]
+fn rk4_runs_in_single_precision_stay_near_the_f64_runs() {
+    let mut r = ChaCha8Rng::seed_from_u64(32);
+    for (spread, steps, bound) in [(2.0, 100, 5e-6), (10.0, 100, 5e-6), (100.0, 100, 1e-5), (2.0, 1000, 3e-4)]
+    {
+        let errors = [
+            f32_run_error::<Planar4, 4, 8>(spread, steps, &mut r),
+            f32_run_error::<Planar8, 8, 16>(spread, steps, &mut r),
+        ];
+        println!("spread {spread}, {steps} steps: n = 4 / 8 {:.1e} / {:.1e}", errors[0], errors[1]);
+        assert!(errors.iter().all(|&e| e < bound), "spread {spread}, {steps} steps: {errors:?}");
+    }
+}
+
+#[test]
+fn in_single_precision_a_run_names_its_failing_chains_and_the_others_finish() {
+    let mut r = ChaCha8Rng::seed_from_u64(33);
+    let (chains, h) = (11, 1e-4);
+    let batch = UnrolledBatch::new(spread_models::<Planar4, 4>(chains, 2.0, &mut r)).expect("batch");
+    let mut x: Vec<f32> = (0..chains * 8).map(|_| r.random_range(-1.0..1.0)).collect();
+    let mut torque = vec![0.0f32; chains * 4];
+    let mut pivot = vec![0.0f32; chains * 2];
+    x[8 * 2 + 5] = f32::NAN; // chain 2: θ̇[1]
+    torque[4 * 5 + 3] = f32::INFINITY; // chain 5
+    pivot[2 * 7] = f32::NAN; // chain 7
+    x[8 * 9 + 4] = 1e20; // chain 9: θ̇² overflows f32
+    let start = x.clone();
+    let mut carry = vec![0.0f32; x.len()];
+    let failures =
+        batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), Some(&pivot), h, 20).expect("run");
+    let found: Vec<(usize, String)> = failures.iter().map(|f| (f.chain, f.error.to_string())).collect();
+    let non_finite = Error::NonFiniteState { t: 0.0, h }.to_string();
+    assert_eq!(
+        found,
+        [
+            (2, "x[5] must be finite, got NaN".to_owned()),
+            (5, "torque[3] must be finite, got inf".to_owned()),
+            (7, "pivot_acceleration[0] must be finite, got NaN".to_owned()),
+            (9, non_finite),
+        ]
+    );
+    for k in 0..chains {
+        let (now, then) = (&x[8 * k..8 * k + 8], &start[8 * k..8 * k + 8]);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(now) == bits(then), [2, 5, 7, 9].contains(&k), "chain {k}");
+    }
+    let error = batch.integrate_rk4_f32((&mut x, &mut carry[1..]), None, None, h, 1).unwrap_err();
+    assert_eq!(error.to_string(), "carry has 87 entries, expected 88");
+}

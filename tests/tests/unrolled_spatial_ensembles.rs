@@ -413,3 +413,107 @@ fn rk4_runs_with_torques_and_pivots_held_or_whirled_equal_each_chain_with_its_in
         }
     }
 }
+
+/// Chains of `N` links whose masses and lengths go from 10 g and 1 cm up by a factor of up
+/// to `spread`, damping 1e-4 N·m·s, gravity 9.81 m/s².
+fn spread_models<M: From<Chain<Const<N>>>, const N: usize>(
+    chains: usize,
+    spread: f64,
+    r: &mut ChaCha8Rng,
+) -> Vec<M> {
+    (0..chains)
+        .map(|_| {
+            let mut up = |x: f64| (0..N).map(|_| x * r.random_range(1.0..spread)).collect::<Vec<_>>();
+            let (masses, lengths) = (up(0.01), up(0.01));
+            M::from(
+                Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&[1e-4; N])).expect("chain"),
+            )
+        })
+        .collect()
+}
+
+/// [`batches::f32_run_error`] of 64 spatial chains of `N` links (`spread` as
+/// [`spread_models`]) from polar angles between 0.3 and 2.8 rad, azimuths within ±3 rad and
+/// rates within ±1 rad/s, `steps` steps of 0.1 ms, free and with small torques and pivot
+/// accelerations held: the worse of the two.
+fn f32_run_error<M, const N: usize, const X: usize>(spread: f64, steps: usize, r: &mut ChaCha8Rng) -> f64
+where
+    M: SpatialKernel<N> + From<Chain<Const<N>>>,
+{
+    let (chains, h) = (64, 1e-4);
+    let batch = UnrolledSpatialBatch::new(spread_models::<M, N>(chains, spread, r)).expect("batch");
+    let states: Vec<State<Const<X>>> = (0..chains)
+        .map(|_| {
+            let x = SVector::<f64, X>::from_fn(|i, _| match i / N {
+                0 => r.random_range(0.3..2.8),
+                1 => r.random_range(-3.0..3.0),
+                _ => r.random_range(-1.0..1.0),
+            });
+            State::new(0.0, x)
+        })
+        .collect();
+    let torque: Vec<f64> = (0..chains * 2 * N).map(|_| r.random_range(-1e-5..1e-5)).collect();
+    let pivot: Vec<f64> = (0..chains * 3).map(|_| r.random_range(-1.0..1.0)).collect();
+    let to32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (torque32, pivot32) = (to32(&torque), to32(&pivot));
+    let mut worst = 0.0f64;
+    for held in [false, true] {
+        let mut exact = states.clone();
+        let (t, p) = if held { (Some(&torque[..]), Some(&pivot[..])) } else { (None, None) };
+        assert!(batch.integrate_rk4(&mut exact, t, p, h, steps).expect("f64").is_empty());
+        let (t32, p32) = if held { (Some(&torque32[..]), Some(&pivot32[..])) } else { (None, None) };
+        let run32 =
+            |x: &mut [f32], carry: &mut [f32], steps| batch.integrate_rk4_f32((x, carry), t32, p32, h, steps);
+        worst = worst.max(batches::f32_run_error(&run32, &states, &exact, steps));
+    }
+    worst
+}
+
+#[test]
+fn rk4_runs_in_single_precision_stay_near_the_f64_runs() {
+    let mut r = ChaCha8Rng::seed_from_u64(32);
+    for (spread, steps, bound) in [(2.0, 100, 5e-6), (10.0, 100, 5e-6), (100.0, 100, 1e-5), (2.0, 1000, 3e-4)]
+    {
+        let errors = [
+            f32_run_error::<Spatial4, 4, 16>(spread, steps, &mut r),
+            f32_run_error::<Spatial8, 8, 32>(spread, steps, &mut r),
+        ];
+        println!("spread {spread}, {steps} steps: n = 4 / 8 {:.1e} / {:.1e}", errors[0], errors[1]);
+        assert!(errors.iter().all(|&e| e < bound), "spread {spread}, {steps} steps: {errors:?}");
+    }
+}
+
+#[test]
+fn in_single_precision_a_run_names_its_failing_chains_and_the_others_finish() {
+    let mut r = ChaCha8Rng::seed_from_u64(33);
+    let (chains, h) = (11, 1e-4);
+    let batch = UnrolledSpatialBatch::new(spread_models::<Spatial4, 4>(chains, 2.0, &mut r)).expect("batch");
+    let mut x: Vec<f32> = (0..chains * 16)
+        .map(|i| if i % 16 < 4 { r.random_range(0.3..2.8) } else { r.random_range(-1.0..1.0) })
+        .collect();
+    let mut torque = vec![0.0f32; chains * 8];
+    let mut pivot = vec![0.0f32; chains * 3];
+    x[16 * 2 + 9] = f32::NAN; // chain 2: x[9], a polar rate
+    torque[8 * 5 + 6] = f32::INFINITY; // chain 5: an azimuthal torque
+    pivot[3 * 7 + 2] = f32::NAN; // chain 7
+    x[16 * 8 + 1] = 0.0; // chain 8: link 2 at the pole
+    x[16 * 9 + 12] = 1e20; // chain 9: φ̇² overflows f32
+    let start = x.clone();
+    let mut carry = vec![0.0f32; x.len()];
+    let failures =
+        batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), Some(&pivot), h, 20).expect("run");
+    let found: Vec<(usize, String)> = failures.iter().map(|f| (f.chain, f.error.to_string())).collect();
+    assert_eq!(found.iter().map(|f| f.0).collect::<Vec<_>>(), [2, 5, 7, 8, 9], "{found:?}");
+    assert_eq!(found[0].1, "x[9] must be finite, got NaN");
+    assert_eq!(found[1].1, "torque[6] must be finite, got inf");
+    assert_eq!(found[2].1, "pivot_acceleration[2] must be finite, got NaN");
+    assert!(matches!(failures[3].error, Error::SingularAngle { link: 2, .. }), "{:?}", failures[3].error);
+    assert_eq!(found[4].1, Error::NonFiniteState { t: 0.0, h }.to_string());
+    for k in 0..chains {
+        let (now, then) = (&x[16 * k..16 * k + 16], &start[16 * k..16 * k + 16]);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(now) == bits(then), [2, 5, 7, 8, 9].contains(&k), "chain {k}");
+    }
+    let error = batch.integrate_rk4_f32((&mut x, &mut carry), None, Some(&pivot[1..]), h, 1).unwrap_err();
+    assert_eq!(error.to_string(), "pivot has 32 entries, expected 33");
+}

@@ -16,6 +16,7 @@
 
 mod precision;
 mod rk4;
+mod rk4_f32;
 mod single;
 mod spatial;
 

@@ -96,6 +96,8 @@ pub(crate) trait Precision: Transpose + Send + Sync + Into<f64> + 'static {
     const NAN: Self;
     /// `f(k)` in lane `k`.
     fn lanes(f: impl Fn(usize) -> Self) -> Self::Lanes;
+    /// `x` rounded to this precision.
+    fn rounded(x: f64) -> Self;
     /// The lanes of `v` one after another (`v[i]`'s lane `k` at `WIDTH·i + k`).
     fn flatten(v: &[Self::Lanes]) -> &[Self];
     /// [`flatten`](Self::flatten), mutably.
@@ -111,6 +113,11 @@ impl Precision for f64 {
     #[cfg(target_arch = "x86_64")]
     type Wide = crate::lanes::Avx8;
     const NAN: Self = f64::NAN;
+
+    #[inline(always)]
+    fn rounded(x: f64) -> Self {
+        x
+    }
 
     #[inline(always)]
     fn lanes(f: impl Fn(usize) -> Self) -> Self::Lanes {
@@ -137,6 +144,11 @@ impl Precision for f32 {
     #[cfg(target_arch = "x86_64")]
     type Wide = crate::lanes::AvxF32;
     const NAN: Self = f32::NAN;
+
+    #[inline(always)]
+    fn rounded(x: f64) -> Self {
+        x as f32
+    }
 
     #[inline(always)]
     fn lanes(f: impl Fn(usize) -> Self) -> Self::Lanes {

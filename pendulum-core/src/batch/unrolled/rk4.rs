@@ -8,7 +8,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, SVector, U2, U3, Vector2, allocator::Allocator};
 
-use super::precision::{KernelLanes, join};
+use super::precision::{KernelLanes, Precision, join};
 use super::spatial::near_pole;
 use super::{
     GROUP, Groups, LinkConstants, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
@@ -24,21 +24,21 @@ use crate::model::Inputs;
 /// A block's states in lanes: its `K` arrays of `N` coordinates, their rates and their
 /// compensations, `t` and its compensation; and its inputs: the `K` arrays of torques
 /// and the pivot acceleration (three components, the third 0 for planar chains) held.
-struct Block<const N: usize, const K: usize> {
-    q: [[F64x4; N]; K],
-    qd: [[F64x4; N]; K],
-    q_carry: [[F64x4; N]; K],
-    qd_carry: [[F64x4; N]; K],
-    t: F64x4,
-    t_carry: F64x4,
-    torque: [[F64x4; N]; K],
-    pivot: [F64x4; 3],
+pub(super) struct Block<L, const N: usize, const K: usize> {
+    pub(super) q: [[L; N]; K],
+    pub(super) qd: [[L; N]; K],
+    pub(super) q_carry: [[L; N]; K],
+    pub(super) qd_carry: [[L; N]; K],
+    pub(super) t: L,
+    pub(super) t_carry: L,
+    pub(super) torque: [[L; N]; K],
+    pub(super) pivot: [L; 3],
 }
 
-impl<const N: usize, const K: usize> Default for Block<N, K> {
+impl<L: Lane, const N: usize, const K: usize> Default for Block<L, N, K> {
     fn default() -> Self {
-        let zero = [[Lanes([0.0; WIDTH]); N]; K];
-        let t = Lanes([0.0; WIDTH]);
+        let zero = [[L::splat(0.0); N]; K];
+        let t = L::splat(0.0);
         Self { q: zero, qd: zero, q_carry: zero, qd_carry: zero, t, t_carry: t, torque: zero, pivot: [t; 3] }
     }
 }
@@ -56,7 +56,7 @@ struct RunInputs<'a> {
 /// space, 2 or 3; `None`: at rest), or chain `k`'s at time `t` from `Driven(k, t)` (three
 /// components, the third 0 for planar chains), asked at each stage's time.
 #[derive(Clone, Copy)]
-enum Pivot<'a> {
+pub(super) enum Pivot<'a> {
     Held(Option<&'a [f64]>),
     Driven(&'a (dyn Fn(usize, f64) -> [f64; 3] + Sync)),
 }
@@ -99,16 +99,16 @@ type StageInputs<'a, V, const N: usize, const A: usize> = Option<(&'a [[V; N]; A
 /// A batch of generated models as its RK4 run sees it: `A` arrays of `N` coordinates a
 /// group ([`GROUP`] blocks of `A / GROUP` arrays each), and the accelerations of a group's
 /// blocks in lanes.
-trait Stages<const N: usize, const A: usize>: Groups<N, A> {
+pub(super) trait Stages<const N: usize, const A: usize>: Groups<N, A> {
     /// `q̈` of the first `count` blocks of a group (unit `u`'s arrays from `A / GROUP · u`)
     /// at `state = [q, q̇]`, constants `c` per unit, in lanes of type `V`, with the torques `torque` (arrays as
     /// `q`) and pivot accelerations `pivot` (per unit; the planar kernel reads two): the
     /// sines and cosines of all their angles in one call of the sine kernel (in `room`),
     /// then unit by unit the kernel. A lane the model refuses (a pole) is NaN.
-    fn at<V: KernelLanes<f64>>(
+    fn at<P: Precision, V: KernelLanes<P>>(
         c: &[LinkConstants<V, N>; GROUP],
         count: usize,
-        room: &mut SineRoom<F64x4, N, A>,
+        room: &mut SineRoom<P::Lanes, N, A>,
         state: [&[[V; N]; A]; 2],
         inputs: StageInputs<'_, V, N, A>,
     ) -> [[V; N]; A];
@@ -130,33 +130,33 @@ trait Stages<const N: usize, const A: usize>: Groups<N, A> {
 /// accelerations `pivots` at `t`, `t + h/2` and `t + h`, the `stage`-th call's taken, and
 /// the torques `torque`; or, unless `FORCED`, zeros for both (a free run: the kernel's
 /// zeros share a register where the inputs' arrays took sixteen at n = 8, 7% of the run).
-struct Kernel<'a, B, V, const N: usize, const A: usize, const FORCED: bool> {
+struct Kernel<'a, B, P: Precision, V, const N: usize, const A: usize, const FORCED: bool> {
     c: &'a [LinkConstants<V, N>; GROUP],
     count: usize,
-    room: &'a mut SineRoom<F64x4, N, A>,
+    room: &'a mut SineRoom<P::Lanes, N, A>,
     torque: &'a [[V; N]; A],
     pivots: &'a [[[V; 3]; GROUP]; 3],
     stage: usize,
     batch: std::marker::PhantomData<B>,
 }
 
-impl<B: Stages<N, A>, V: KernelLanes<f64>, const N: usize, const A: usize, const FORCED: bool>
-    Accelerations<V, N, A> for Kernel<'_, B, V, N, A, FORCED>
+impl<B: Stages<N, A>, P: Precision, V: KernelLanes<P>, const N: usize, const A: usize, const FORCED: bool>
+    Accelerations<V, N, A> for Kernel<'_, B, P, V, N, A, FORCED>
 {
     #[inline(always)]
     fn at(&mut self, q: &[[V; N]; A], qd: &[[V; N]; A]) -> [[V; N]; A] {
         let inputs = FORCED.then(|| (self.torque, &self.pivots[[0, 1, 1, 2][self.stage]]));
         self.stage += 1;
-        B::at(self.c, self.count, self.room, [q, qd], inputs)
+        B::at::<P, V>(self.c, self.count, self.room, [q, qd], inputs)
     }
 }
 
 impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N> {
     #[inline(always)]
-    fn at<V: KernelLanes<f64>>(
+    fn at<P: Precision, V: KernelLanes<P>>(
         c: &[LinkConstants<V, N>; GROUP],
         count: usize,
-        room: &mut SineRoom<F64x4, N, GROUP>,
+        room: &mut SineRoom<P::Lanes, N, GROUP>,
         [q, qd]: [&[[V; N]; GROUP]; 2],
         inputs: StageInputs<'_, V, N, GROUP>,
     ) -> [[V; N]; GROUP] {
@@ -168,7 +168,7 @@ impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N
                 [room.angles[a][i], room.angles[b][i]] = q.split();
             }
         }
-        room.sin_cos::<f64>(count);
+        room.sin_cos::<P>(count);
         let mut out = [[zero; N]; GROUP];
         for u in 0..units {
             let mut trig = [[zero; 2]; N];
@@ -215,10 +215,10 @@ impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N
 
 impl<M: SpatialKernel<N>, const N: usize> Stages<N, { 2 * GROUP }> for UnrolledSpatialBatch<M, N> {
     #[inline(always)]
-    fn at<V: KernelLanes<f64>>(
+    fn at<P: Precision, V: KernelLanes<P>>(
         c: &[LinkConstants<V, N>; GROUP],
         count: usize,
-        room: &mut SineRoom<F64x4, N, { 2 * GROUP }>,
+        room: &mut SineRoom<P::Lanes, N, { 2 * GROUP }>,
         [q, qd]: [&[[V; N]; 2 * GROUP]; 2],
         inputs: StageInputs<'_, V, N, { 2 * GROUP }>,
     ) -> [[V; N]; 2 * GROUP] {
@@ -232,7 +232,7 @@ impl<M: SpatialKernel<N>, const N: usize> Stages<N, { 2 * GROUP }> for UnrolledS
                 }
             }
         }
-        room.sin_cos::<f64>(2 * count);
+        room.sin_cos::<P>(2 * count);
         let mut out = [[zero; N]; 2 * GROUP];
         for u in 0..units {
             let pair = unit_blocks(u, V::BLOCKS, count);
@@ -513,7 +513,7 @@ where
         for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(states, 1, solves, SineRoom::new, |room, g, states| {
             let first = GROUP * g;
             let count = states.len().div_ceil(WIDTH);
-            let mut s: [Block<N, C>; GROUP] = std::array::from_fn(|_| Block::default());
+            let mut s: [Block<F64x4, N, C>; GROUP] = std::array::from_fn(|_| Block::default());
             for (j, (s, block)) in s.iter_mut().zip(states.chunks(WIDTH)).enumerate() {
                 let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
                 let entries = |j: usize, carry: bool| {
@@ -543,11 +543,18 @@ where
                     },
                 };
             }
-            let group = (first, count);
+            let group = (&batch.blocks[..], first, count);
             let alive = if inputs.torque.is_some() || !matches!(inputs.pivot, Pivot::Held(None)) {
-                rk4_run_simd::<M, K, N, C, A, true>(batch, group, room, (h, steps), inputs.pivot, &mut s)
+                rk4_run_simd::<M, K, f64, N, C, A, true>(batch, group, room, (h, steps), inputs.pivot, &mut s)
             } else {
-                rk4_run_simd::<M, K, N, C, A, false>(batch, group, room, (h, steps), inputs.pivot, &mut s)
+                rk4_run_simd::<M, K, f64, N, C, A, false>(
+                    batch,
+                    group,
+                    room,
+                    (h, steps),
+                    inputs.pivot,
+                    &mut s,
+                )
             };
             let mut failures = Vec::new();
             for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
@@ -578,26 +585,34 @@ fn lane<'a, const N: usize, const K: usize>(
 }
 
 /// `steps` RK4 steps of the blocks `s` of the group starting at block `first` (the first
-/// `count` of them), in lanes of type `V` (holding one block each, or two; unit `u`'s
-/// arrays from `C·u`), with the blocks' held torques and pivot accelerations, or the
+/// `count` of them, constants `blocks` in precision `P`), in lanes of type `V` (holding one
+/// block each, or two; unit `u`'s arrays from `C·u`), with the blocks' held torques and pivot accelerations, or the
 /// pivots' from `pivot`'s drives at each step (`FORCED`; zeros otherwise); a lane whose
 /// increment is not finite stops at the start of that step. Returns the lanes that ran to
 /// the end.
 #[inline(always)]
-fn rk4_run<M, K, V: KernelLanes<f64>, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
+fn rk4_run<
+    M,
+    K,
+    P: Precision,
+    V: KernelLanes<P>,
+    const N: usize,
+    const C: usize,
+    const A: usize,
+    const FORCED: bool,
+>(
     batch: &UnrolledBatch<M, N, K>,
-    (first, count): (usize, usize),
-    room: &mut SineRoom<F64x4, N, A>,
+    (blocks, first, count): (&[LinkConstants<P::Lanes, N>], usize, usize),
+    room: &mut SineRoom<P::Lanes, N, A>,
     (h, steps): (f64, usize),
     pivot: Pivot<'_>,
-    s: &mut [Block<N, C>; GROUP],
+    s: &mut [Block<P::Lanes, N, C>; GROUP],
 ) -> [[bool; WIDTH]; GROUP]
 where
     UnrolledBatch<M, N, K>: Stages<N, A>,
 {
     let zero = V::splat(0.0);
     let units = count.div_ceil(V::BLOCKS);
-    let blocks = &batch.blocks;
     let c: [LinkConstants<V, N>; GROUP] = std::array::from_fn(|u| {
         let [a, b] = unit_blocks(u.min(units - 1), V::BLOCKS, count);
         LinkConstants::joined([&blocks[first + a], &blocks[first + b]])
@@ -629,20 +644,23 @@ where
                 let blocks = unit_blocks(u, V::BLOCKS, count);
                 let times = t.split();
                 // Each block's lanes' pivot accelerations at stages 1, 2 and 4 (3 is 2's time).
-                let at: [[[F64x4; 3]; 3]; 2] = std::array::from_fn(|half| {
+                let at: [[[P::Lanes; 3]; 3]; 2] = std::array::from_fn(|half| {
                     let chains = block_chains::<WIDTH>(first + blocks[half], batch.len());
+                    let t = P::flatten(std::slice::from_ref(&times[half]));
                     let p: [[[f64; 3]; 3]; WIDTH] = std::array::from_fn(|k| {
-                        let times = stage_times(times[half].0[k], h);
+                        let times = stage_times(t[k].into(), h);
                         [0, 1, 3].map(|stage| drive(chains[k], times[stage]))
                     });
-                    std::array::from_fn(|stage| std::array::from_fn(|d| Lanes::from_fn(|k| p[k][stage][d])))
+                    std::array::from_fn(|stage| {
+                        std::array::from_fn(|d| P::lanes(|k| P::rounded(p[k][stage][d])))
+                    })
                 });
                 for (stage, pivots) in pivots.iter_mut().enumerate() {
                     pivots[u] = std::array::from_fn(|d| V::join([at[0][stage][d], at[1][stage][d]]));
                 }
             }
         }
-        let kernel = Kernel::<UnrolledBatch<M, N, K>, V, N, A, FORCED> {
+        let kernel = Kernel::<UnrolledBatch<M, N, K>, P, V, N, A, FORCED> {
             c: &c,
             count,
             room: &mut *room,
@@ -685,7 +703,7 @@ where
         let blocks = unit_blocks(u, V::BLOCKS, count);
         for (half, j) in blocks.into_iter().enumerate().take(V::BLOCKS.min(count - V::BLOCKS * u)) {
             for c in 0..C {
-                let back = |v: &[V; N], to: &mut [F64x4; N]| {
+                let back = |v: &[V; N], to: &mut [P::Lanes; N]| {
                     for (to, v) in to.iter_mut().zip(v) {
                         *to = v.split()[half];
                     }
@@ -697,21 +715,31 @@ where
             }
             (s[j].t, s[j].t_carry) = (t[u].split()[half], t_carry[u].split()[half]);
             let ran = V::select(stopped[u], zero, V::splat(1.0)).split()[half];
-            alive[j] = ran.0.map(|alive| alive == 1.0);
+            let ran = P::flatten(std::slice::from_ref(&ran));
+            alive[j] = std::array::from_fn(|k| ran[k].into() == 1.0);
         }
     }
     alive
 }
 
-/// [`rk4_run`] in AVX-512 registers (two blocks each) where the CPU has AVX-512 VL and the
-/// batch allows it, in AVX2 registers where it has AVX2, else in [`Lanes`].
-fn rk4_run_simd<M, K, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
+/// [`rk4_run`] in AVX-512 registers (two blocks each in `f64`) where the CPU has AVX-512
+/// VL and the batch allows it, in AVX2 registers where it has AVX2, else in
+/// [`Precision::Lanes`].
+pub(super) fn rk4_run_simd<
+    M,
+    K,
+    P: Precision,
+    const N: usize,
+    const C: usize,
+    const A: usize,
+    const FORCED: bool,
+>(
     batch: &UnrolledBatch<M, N, K>,
-    group: (usize, usize),
-    room: &mut SineRoom<F64x4, N, A>,
-    (h, steps): (f64, usize),
+    group: (&[LinkConstants<P::Lanes, N>], usize, usize),
+    room: &mut SineRoom<P::Lanes, N, A>,
+    run: (f64, usize),
     pivot: Pivot<'_>,
-    s: &mut [Block<N, C>; GROUP],
+    s: &mut [Block<P::Lanes, N, C>; GROUP],
 ) -> [[bool; WIDTH]; GROUP]
 where
     UnrolledBatch<M, N, K>: Stages<N, A>,
@@ -719,47 +747,49 @@ where
     #[cfg(target_arch = "x86_64")]
     if batch.uses_avx512() {
         // SAFETY: the CPU has AVX-512 VL (and so AVX2), checked just above.
-        return unsafe { rk4_run_avx512::<M, K, N, C, A, FORCED>(batch, group, room, (h, steps), pivot, s) };
+        return unsafe { rk4_run_avx512::<M, K, P, N, C, A, FORCED>(batch, group, room, run, pivot, s) };
     }
     #[cfg(target_arch = "x86_64")]
     if crate::lanes::has_avx2() {
         // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { rk4_run_avx2::<M, K, N, C, A, FORCED>(batch, group, room, (h, steps), pivot, s) };
+        return unsafe { rk4_run_avx2::<M, K, P, N, C, A, FORCED>(batch, group, room, run, pivot, s) };
     }
-    rk4_run::<M, K, F64x4, N, C, A, FORCED>(batch, group, room, (h, steps), pivot, s)
+    rk4_run::<M, K, P, P::Lanes, N, C, A, FORCED>(batch, group, room, run, pivot, s)
 }
 
-/// [`rk4_run`] compiled for AVX-512, two blocks in each [`Avx8`](crate::lanes::Avx8)
-/// register (1.18–1.26× four lanes, `docs/ensembles.md`).
+/// [`rk4_run`] compiled for AVX-512, in [`Precision::Wide`]: two blocks in each
+/// [`Avx8`](crate::lanes::Avx8) register in `f64` (1.18–1.26× four lanes,
+/// `docs/ensembles.md`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl")]
-fn rk4_run_avx512<M, K, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
+fn rk4_run_avx512<M, K, P: Precision, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
     batch: &UnrolledBatch<M, N, K>,
-    group: (usize, usize),
-    room: &mut SineRoom<F64x4, N, A>,
-    (h, steps): (f64, usize),
+    group: (&[LinkConstants<P::Lanes, N>], usize, usize),
+    room: &mut SineRoom<P::Lanes, N, A>,
+    run: (f64, usize),
     pivot: Pivot<'_>,
-    s: &mut [Block<N, C>; GROUP],
+    s: &mut [Block<P::Lanes, N, C>; GROUP],
 ) -> [[bool; WIDTH]; GROUP]
 where
     UnrolledBatch<M, N, K>: Stages<N, A>,
 {
-    rk4_run::<M, K, crate::lanes::Avx8, N, C, A, FORCED>(batch, group, room, (h, steps), pivot, s)
+    rk4_run::<M, K, P, P::Wide, N, C, A, FORCED>(batch, group, room, run, pivot, s)
 }
 
-/// [`rk4_run`] compiled for AVX2, in [`Avx4`](crate::lanes::Avx4) registers.
+/// [`rk4_run`] compiled for AVX2, in [`Precision::Registers`] ([`Avx4`](crate::lanes::Avx4)
+/// in `f64`, [`AvxF32`](crate::lanes::AvxF32) in `f32`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn rk4_run_avx2<M, K, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
+fn rk4_run_avx2<M, K, P: Precision, const N: usize, const C: usize, const A: usize, const FORCED: bool>(
     batch: &UnrolledBatch<M, N, K>,
-    group: (usize, usize),
-    room: &mut SineRoom<F64x4, N, A>,
-    (h, steps): (f64, usize),
+    group: (&[LinkConstants<P::Lanes, N>], usize, usize),
+    room: &mut SineRoom<P::Lanes, N, A>,
+    run: (f64, usize),
     pivot: Pivot<'_>,
-    s: &mut [Block<N, C>; GROUP],
+    s: &mut [Block<P::Lanes, N, C>; GROUP],
 ) -> [[bool; WIDTH]; GROUP]
 where
     UnrolledBatch<M, N, K>: Stages<N, A>,
 {
-    rk4_run::<M, K, crate::lanes::Avx4, N, C, A, FORCED>(batch, group, room, (h, steps), pivot, s)
+    rk4_run::<M, K, P, P::Registers, N, C, A, FORCED>(batch, group, room, run, pivot, s)
 }

@@ -225,7 +225,7 @@ impl<M: SpatialKernel<N>, const N: usize> Groups<N, { 2 * GROUP }> for UnrolledS
 
 /// The first polar angle of `polar` (a chain's `θ_i`, `f32`) whose sine in single
 /// precision is below the tolerance, named as `check_polar_sin` names it.
-fn singular_angle(polar: &[f32]) -> Option<Error> {
+pub(super) fn singular_angle(polar: &[f32]) -> Option<Error> {
     polar.iter().enumerate().find_map(|(i, &theta)| {
         let sin_theta = f64::from(theta.sin().abs());
         (sin_theta < SINGULARITY_TOLERANCE).then_some(Error::SingularAngle {

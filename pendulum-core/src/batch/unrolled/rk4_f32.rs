@@ -1,0 +1,152 @@
+//! RK4 runs of a batch of generated models in single precision: the `f64` runs' steps
+//! (`rk4`) on eight `f32` chains a register (two blocks of four in one AVX2 register),
+//! each chain's constants rounded to `f32`, the sines from the single-precision kernel,
+//! the states as numpy holds them: `B` rows of `x = (q, q̇)` and of their compensations.
+//! Not bit for bit anything: the error against the `f64` runs is measured in
+//! `docs/ensembles.md` and checked in the tests.
+
+use super::rk4::{Block, Pivot, Stages, rk4_run_simd};
+use super::spatial::singular_angle;
+use super::{GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch};
+use crate::batch::{Failure, WIDTH, block_chains, check_len, for_blocks_of, non_finite};
+use crate::error::{Error, Result};
+use crate::lanes::Lanes32;
+
+/// A block of four chains in `f32` lanes.
+type F32x4 = Lanes32<WIDTH>;
+
+impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
+    /// [`integrate_rk4`](Self::integrate_rk4) in single precision: `steps` steps of RK4 of
+    /// size `h` (s) for every chain from its row of `x`, `(θ, θ̇)` (`B` rows of `2N`, numpy's
+    /// `(B, 2N)` in `f32`), with the rounding compensations in `carry` laid out the same way
+    /// (zeros to start; kept from call to call, so that `n` calls of one step equal one call
+    /// of `n` steps), both overwritten; joint torques (`B` rows of `N`) and pivot
+    /// accelerations (`B` rows of 2) held as there. Eight chains a register with AVX2.
+    ///
+    /// Returns the chains that failed, in order, their rows left at the start of the step
+    /// that failed: a non-finite input (named), else [`Error::NonFiniteState`] with the
+    /// step's time counted from the call's start. Errors: [`Error::InvalidStepSize`] for a
+    /// zero or non-finite `h`, [`Error::LengthMismatch`] for arrays not of `B` rows.
+    pub fn integrate_rk4_f32(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        torque: Option<&[f32]>,
+        pivot: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        integrate_f32::<_, _, N, 1, GROUP>(self, (x, carry), (torque, pivot), (h, steps))
+    }
+}
+
+impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
+    /// [`integrate_rk4`](Self::integrate_rk4) in single precision: `steps` steps of RK4 of
+    /// size `h` (s) for every chain from its row of `x`, `(θ, φ, θ̇, φ̇)` (`B` rows of `4N`),
+    /// with the rounding compensations in `carry` laid out the same way (zeros to start;
+    /// kept from call to call), both overwritten; generalized torques (`B` rows of `2N`) and
+    /// pivot accelerations (`B` rows of 3) held. Eight chains a register with AVX2.
+    ///
+    /// Returns the chains that failed, in order, their rows left at the start of the step
+    /// that failed: a non-finite input (named), a polar angle whose sine in `f32` is below
+    /// the tolerance at that start ([`Error::SingularAngle`]), else
+    /// [`Error::NonFiniteState`] with the step's time counted from the call's start (a
+    /// stage that reached a pole included). Errors as the planar batch's.
+    pub fn integrate_rk4_f32(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        torque: Option<&[f32]>,
+        pivot: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        integrate_f32::<_, _, N, 2, { 2 * GROUP }>(self, (x, carry), (torque, pivot), (h, steps))
+    }
+}
+
+/// The run of `integrate_rk4_f32` for a batch whose blocks hold `C` arrays of `N`
+/// coordinates (`A = C · GROUP` a group): rows of `2CN` in `x` and `carry`, torques rows
+/// of `CN`, pivot accelerations rows of [`Groups::SPACE`].
+fn integrate_f32<M, K, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
+    (x, carry): (&mut [f32], &mut [f32]),
+    (torque, pivot): (Option<&[f32]>, Option<&[f32]>),
+    (h, steps): (f64, usize),
+) -> Result<Vec<Failure>>
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
+    let (chains, m) = (batch.len(), C * N);
+    let space = <UnrolledBatch<M, N, K> as Groups<N, A>>::SPACE;
+    if !h.is_finite() || h == 0.0 {
+        return Err(Error::InvalidStepSize { h });
+    }
+    check_len("x", x, chains, 2 * m)?;
+    check_len("carry", carry, chains, 2 * m)?;
+    if let Some(t) = torque {
+        check_len("torque", t, chains, m)?;
+    }
+    if let Some(p) = pivot {
+        check_len("pivot", p, chains, space)?;
+    }
+    let forced = torque.is_some() || pivot.is_some();
+    let solves = (4 * N).saturating_mul(steps);
+    let mut rows: Vec<(&mut [f32], &mut [f32])> = x.chunks_mut(2 * m).zip(carry.chunks_mut(2 * m)).collect();
+    Ok(for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(&mut rows, 1, solves, SineRoom::new, |room, g, rows| {
+        let first = GROUP * g;
+        let count = rows.len().div_ceil(WIDTH);
+        let mut s: [Block<F32x4, N, C>; GROUP] = std::array::from_fn(|_| Block::default());
+        for (j, (s, block)) in s.iter_mut().zip(rows.chunks(WIDTH)).enumerate() {
+            let ids = block_chains::<WIDTH>(first + j, chains);
+            let own = |k: usize| &block[k.min(block.len() - 1)];
+            // Entries `offset + N c + i` of the rows (`carry`: of their compensations).
+            let arrays = |carry: bool, offset: usize| -> [[F32x4; N]; C] {
+                let entry = |k: usize, j: usize| if carry { own(k).1[j] } else { own(k).0[j] };
+                std::array::from_fn(|c| {
+                    std::array::from_fn(|i| Lanes32::from_fn(|k| entry(k, offset + N * c + i)))
+                })
+            };
+            let inputs = |v: &[f32], per: usize, i: usize| Lanes32::from_fn(|k| v[per * ids[k] + i]);
+            (s.q, s.qd) = (arrays(false, 0), arrays(false, m));
+            (s.q_carry, s.qd_carry) = (arrays(true, 0), arrays(true, m));
+            if let Some(t) = torque {
+                s.torque = std::array::from_fn(|c| std::array::from_fn(|i| inputs(t, m, N * c + i)));
+            }
+            if let Some(p) = pivot {
+                for (d, pivot) in s.pivot.iter_mut().enumerate().take(space) {
+                    *pivot = inputs(p, space, d);
+                }
+            }
+        }
+        let group = (&batch.blocks_f32[..], first, count);
+        let held = Pivot::Held(None);
+        let alive = if forced {
+            rk4_run_simd::<M, K, f32, N, C, A, true>(batch, group, room, (h, steps), held, &mut s)
+        } else {
+            rk4_run_simd::<M, K, f32, N, C, A, false>(batch, group, room, (h, steps), held, &mut s)
+        };
+        let mut failures = Vec::new();
+        for (j, (s, block)) in s.iter().zip(rows.chunks_mut(WIDTH)).enumerate() {
+            for (k, (x, carry)) in block.iter_mut().enumerate() {
+                for c in 0..C {
+                    for i in 0..N {
+                        (x[N * c + i], x[m + N * c + i]) = (s.q[c][i].0[k], s.qd[c][i].0[k]);
+                        (carry[N * c + i], carry[m + N * c + i]) =
+                            (s.q_carry[c][i].0[k], s.qd_carry[c][i].0[k]);
+                    }
+                }
+                if !alive[j][k] {
+                    let chain = WIDTH * (first + j) + k;
+                    let bad =
+                        |what, v: &[f32], per: usize| non_finite(what, &v[per * chain..per * (chain + 1)]);
+                    let error = non_finite("x", x)
+                        .or_else(|| torque.and_then(|t| bad("torque", t, m)))
+                        .or_else(|| pivot.and_then(|p| bad("pivot_acceleration", p, space)))
+                        .or_else(|| (C == 2).then(|| singular_angle(&x[..N])).flatten())
+                        .unwrap_or(Error::NonFiniteState { t: s.t.0[k].into(), h });
+                    failures.push(Failure { chain, error });
+                }
+            }
+        }
+        failures
+    }))
+}
