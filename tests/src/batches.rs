@@ -184,13 +184,65 @@ pub fn check_runs<D: Dim>(
     assert_runs(&batched, alone, &failures, &format!("{what}: {chains} chains in two calls"));
 }
 
-/// A batch's run in single precision, `run32(x, carry, steps)` on rows of `x = (q, q̇)` and
-/// their compensations, against its `f64` run of the same `states` (`exact`, after `steps`
-/// steps): the worst `max |x₃₂ − x₆₄| / max |x₆₄|` over the chains. On the way, checks that
-/// the `f32` run gives the same bits on 1 and 2 threads and in two calls of half the steps
+/// A chain of `N` links whose masses and lengths go from 10 g and 1 cm up by a factor of up
+/// to `spread`, damping 1e-4 N·m·s, gravity 9.81 m/s².
+pub fn spread_fixed_chain<const N: usize>(spread: f64, r: &mut ChaCha8Rng) -> Chain<Const<N>> {
+    let mut up = |x: f64| (0..N).map(|_| x * r.random_range(1.0..spread)).collect::<Vec<_>>();
+    let (masses, lengths) = (up(0.01), up(0.01));
+    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&[1e-4; N])).expect("chain")
+}
+
+/// A batch's `f64` run: `steps` steps of `states` with torques and pivot accelerations
+/// (`None`: none) held.
+pub type Run64<'a, D> =
+    &'a dyn Fn(&mut [State<D>], Option<&[f64]>, Option<&[f64]>, usize) -> Result<Vec<Failure>, Error>;
+
+/// A batch's run in single precision: `steps` steps of rows `x = (q, q̇)` and their
+/// compensations `carry`, with torques and pivot accelerations held.
+pub type Run32<'a> = &'a (
+        dyn Fn(&mut [f32], &mut [f32], Option<&[f32]>, Option<&[f32]>, usize) -> Result<Vec<Failure>, Error>
+            + Sync
+    );
+
+/// A batch's run in single precision (`run32`) against its `f64` run (`run64`) of `steps`
+/// steps from `states`, free and with small random torques and pivot accelerations held
+/// (`[torques, pivots]` a chain: up to 1e-5 N·m and 1 m/s²): the worst
+/// `max |x₃₂ − x₆₄| / max |x₆₄|` over the chains and the two. On the way, checks that the
+/// `f32` run gives the same bits on 1 and 2 threads and in two calls of half the steps
 /// each (the compensations kept), and fails no chain.
 pub fn f32_run_error<D: Dim>(
-    run32: &(dyn Fn(&mut [f32], &mut [f32], usize) -> Result<Vec<Failure>, Error> + Sync),
+    run64: Run64<'_, D>,
+    run32: Run32<'_>,
+    states: &[State<D>],
+    [torques, pivots]: [usize; 2],
+    steps: usize,
+    r: &mut ChaCha8Rng,
+) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+    State<D>: Clone,
+{
+    let chains = states.len();
+    let torque: Vec<f64> = (0..chains * torques).map(|_| r.random_range(-1e-5..1e-5)).collect();
+    let pivot: Vec<f64> = (0..chains * pivots).map(|_| r.random_range(-1.0..1.0)).collect();
+    let to32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (torque32, pivot32) = (to32(&torque), to32(&pivot));
+    let mut worst = 0.0f64;
+    for held in [false, true] {
+        let mut exact = states.to_vec();
+        let (t, p) = if held { (Some(&torque[..]), Some(&pivot[..])) } else { (None, None) };
+        assert!(run64(&mut exact, t, p, steps).expect("f64").is_empty());
+        let (t, p) = if held { (Some(&torque32[..]), Some(&pivot32[..])) } else { (None, None) };
+        let run = |x: &mut [f32], carry: &mut [f32], steps| run32(x, carry, t, p, steps);
+        worst = worst.max(f32_error_of(run, states, &exact, steps));
+    }
+    worst
+}
+
+/// [`f32_run_error`] of one run, `run32(x, carry, steps)`, against the `f64` states it
+/// should reach (`exact`).
+fn f32_error_of<D: Dim>(
+    run32: impl Fn(&mut [f32], &mut [f32], usize) -> Result<Vec<Failure>, Error> + Sync,
     states: &[State<D>],
     exact: &[State<D>],
     steps: usize,

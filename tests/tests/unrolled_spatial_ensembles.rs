@@ -414,28 +414,18 @@ fn rk4_runs_with_torques_and_pivots_held_or_whirled_equal_each_chain_with_its_in
     }
 }
 
-/// Chains of `N` links whose masses and lengths go from 10 g and 1 cm up by a factor of up
-/// to `spread`, damping 1e-4 N·m·s, gravity 9.81 m/s².
+/// `chains` models of [`batches::spread_fixed_chain`]s.
 fn spread_models<M: From<Chain<Const<N>>>, const N: usize>(
     chains: usize,
     spread: f64,
     r: &mut ChaCha8Rng,
 ) -> Vec<M> {
-    (0..chains)
-        .map(|_| {
-            let mut up = |x: f64| (0..N).map(|_| x * r.random_range(1.0..spread)).collect::<Vec<_>>();
-            let (masses, lengths) = (up(0.01), up(0.01));
-            M::from(
-                Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&[1e-4; N])).expect("chain"),
-            )
-        })
-        .collect()
+    (0..chains).map(|_| M::from(batches::spread_fixed_chain::<N>(spread, r))).collect()
 }
 
 /// [`batches::f32_run_error`] of 64 spatial chains of `N` links (`spread` as
-/// [`spread_models`]) from polar angles between 0.3 and 2.8 rad, azimuths within ±3 rad and
-/// rates within ±1 rad/s, `steps` steps of 0.1 ms, free and with small torques and pivot
-/// accelerations held: the worse of the two.
+/// [`batches::spread_fixed_chain`]) from polar angles between 0.3 and 2.8 rad, azimuths
+/// within ±3 rad and rates within ±1 rad/s, `steps` steps of 0.1 ms.
 fn f32_run_error<M, const N: usize, const X: usize>(spread: f64, steps: usize, r: &mut ChaCha8Rng) -> f64
 where
     M: SpatialKernel<N> + From<Chain<Const<N>>>,
@@ -452,21 +442,13 @@ where
             State::new(0.0, x)
         })
         .collect();
-    let torque: Vec<f64> = (0..chains * 2 * N).map(|_| r.random_range(-1e-5..1e-5)).collect();
-    let pivot: Vec<f64> = (0..chains * 3).map(|_| r.random_range(-1.0..1.0)).collect();
-    let to32 = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    let (torque32, pivot32) = (to32(&torque), to32(&pivot));
-    let mut worst = 0.0f64;
-    for held in [false, true] {
-        let mut exact = states.clone();
-        let (t, p) = if held { (Some(&torque[..]), Some(&pivot[..])) } else { (None, None) };
-        assert!(batch.integrate_rk4(&mut exact, t, p, h, steps).expect("f64").is_empty());
-        let (t32, p32) = if held { (Some(&torque32[..]), Some(&pivot32[..])) } else { (None, None) };
-        let run32 =
-            |x: &mut [f32], carry: &mut [f32], steps| batch.integrate_rk4_f32((x, carry), t32, p32, h, steps);
-        worst = worst.max(batches::f32_run_error(&run32, &states, &exact, steps));
-    }
-    worst
+    let run64 = |states: &mut [State<Const<X>>], t: Option<&[f64]>, p: Option<&[f64]>, steps: usize| {
+        batch.integrate_rk4(states, t, p, h, steps)
+    };
+    let run32 = |x: &mut [f32], carry: &mut [f32], t: Option<&[f32]>, p: Option<&[f32]>, steps: usize| {
+        batch.integrate_rk4_f32((x, carry), t, p, h, steps)
+    };
+    batches::f32_run_error(&run64, &run32, &states, [2 * N, 3], steps, r)
 }
 
 #[test]

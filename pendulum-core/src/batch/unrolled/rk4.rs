@@ -6,7 +6,7 @@
 //! `θ_i`) and the spatial ones (`C = 2`: the polar angles, then the azimuths), through
 //! [`Stages`].
 
-use nalgebra::{DefaultAllocator, Dim, SVector, U2, U3, Vector2, allocator::Allocator};
+use nalgebra::{DefaultAllocator, Dim, DimName, SVector, U2, U3, Vector2, allocator::Allocator};
 
 use super::precision::{KernelLanes, Precision, join};
 use super::spatial::near_pole;
@@ -402,13 +402,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         DefaultAllocator: Allocator<D>,
         State<D>: Send,
     {
-        check_len("drives", drives, self.len(), 1)?;
-        let drive = |k: usize, t: f64| {
-            let a = drives[k].acceleration(t);
-            [a[0], a[1], 0.0]
-        };
-        let inputs = RunInputs { torque, pivot: Pivot::Driven(&drive) };
-        integrate::<_, _, D, N, 1, GROUP>(self, states, inputs, h, steps)
+        integrate_driven::<_, _, U2, _, D, N, 1, GROUP>(self, states, drives, torque, (h, steps))
     }
 }
 
@@ -465,14 +459,39 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         DefaultAllocator: Allocator<D>,
         State<D>: Send,
     {
-        check_len("drives", drives, self.len(), 1)?;
-        let drive = |k: usize, t: f64| {
-            let a = drives[k].acceleration(t);
-            [a[0], a[1], a[2]]
-        };
-        let inputs = RunInputs { torque, pivot: Pivot::Driven(&drive) };
-        integrate::<_, _, D, N, 2, { 2 * GROUP }>(self, states, inputs, h, steps)
+        integrate_driven::<_, _, U3, _, D, N, 2, { 2 * GROUP }>(self, states, drives, torque, (h, steps))
     }
+}
+
+/// The run of `integrate_rk4_driven`: chain `k`'s pivot acceleration from `drives[k]` at
+/// each stage's time (its `S` components, then zeros up to three).
+fn integrate_driven<
+    M,
+    K,
+    S: DimName,
+    Dr: Drive<S> + Sync,
+    D: Dim,
+    const N: usize,
+    const C: usize,
+    const A: usize,
+>(
+    batch: &UnrolledBatch<M, N, K>,
+    states: &mut [State<D>],
+    drives: &[Dr],
+    torque: Option<&[f64]>,
+    (h, steps): (f64, usize),
+) -> Result<Vec<Failure>>
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+    DefaultAllocator: Allocator<D> + Allocator<S>,
+    State<D>: Send,
+{
+    check_len("drives", drives, batch.len(), 1)?;
+    let drive = |k: usize, t: f64| {
+        let a = drives[k].acceleration(t);
+        std::array::from_fn(|d| if d < S::DIM { a[d] } else { 0.0 })
+    };
+    integrate::<_, _, D, N, C, A>(batch, states, RunInputs { torque, pivot: Pivot::Driven(&drive) }, h, steps)
 }
 
 /// The run of `integrate_rk4` for a batch `batch` whose blocks hold `C`
