@@ -16,7 +16,6 @@
 
 mod precision;
 mod rk4;
-mod rk4_f32;
 mod single;
 mod spatial;
 

@@ -1,13 +1,15 @@
 //! RK4 runs of a batch of generated models in single precision: the `f64` runs' steps
-//! (`rk4`) on eight `f32` chains a register (two blocks of four in one AVX2 register),
+//! (`rk4/mod.rs`) on eight `f32` chains a register (two blocks of four in one AVX2 register),
 //! each chain's constants rounded to `f32`, the sines from the single-precision kernel,
 //! the states as numpy holds them: `B` rows of `x = (q, q̇)` and of their compensations.
 //! Not bit for bit anything: the error against the `f64` runs is measured in
 //! `docs/ensembles.md` and checked in the tests.
 
-use super::rk4::{Block, Pivot, Stages, rk4_run_simd};
-use super::spatial::singular_angle;
-use super::{GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch};
+use super::{Block, Pivot, Stages, rk4_run_simd};
+use crate::batch::unrolled::spatial::singular_angle;
+use crate::batch::unrolled::{
+    GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
+};
 use crate::batch::{Failure, WIDTH, block_chains, check_len, for_blocks_of, non_finite};
 use crate::error::{Error, Result};
 use crate::lanes::Lanes32;
