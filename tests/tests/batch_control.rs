@@ -3,12 +3,13 @@
 //! over the step (`PlanarBatch::integrate_rk4`). Physics: the copies fall without it, and
 //! with it they approach upright at the slowest closed-loop rate the linearisation
 //! predicts; every copy is what the chain alone would do under the same control, bit for
-//! bit.
+//! bit. The same controller holds a batch of the generated model (`model!`,
+//! `UnrolledBatch::integrate_rk4` and `integrate_rk4_f32`) upright at the same rate.
 
 use std::f64::consts::PI;
 
-use nalgebra::{DMatrix, DVector, Dyn};
-use pendulum_core::batch::PlanarBatch;
+use nalgebra::{Const, DMatrix, DVector, Dyn, SVector};
+use pendulum_core::batch::{PlanarBatch, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Rk4, State};
 use pendulum_core::{Chain, FirstOrder, Inputs, Model, PlanarTension, STEADY_TOLERANCE, linearize, lqr};
 use rand::{Rng, SeedableRng};
@@ -20,30 +21,20 @@ const COPIES: usize = 256;
 const PERIOD: f64 = 0.01;
 const STEPS: usize = 10;
 
-fn chain() -> Chain<Dyn> {
+pendulum_macros::model! { struct Triple { kind: planar, links: 3, algorithm: tension } }
+
+fn chain<D: nalgebra::Dim>() -> Chain<D>
+where
+    nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<D>,
+{
     Chain::new(&[0.5, 0.4, 0.3], &[0.4, 0.35, 0.3], 9.81)
         .and_then(|c| c.with_damping(&[1e-3; N]))
         .expect("chain")
 }
 
-/// Distance of a state `x = (θ, θ̇)` from upright at rest (θ = π).
-fn from_upright(x: &[f64]) -> f64 {
-    x.iter().enumerate().map(|(i, v)| if i < N { (v - PI).powi(2) } else { v * v }).sum::<f64>().sqrt()
-}
-
-/// `σ = −K (x − x_up)` of every state, rows of `N`.
-fn torques(gain: &DMatrix<f64>, states: &[State<Dyn>]) -> Vec<f64> {
-    let mut torque = Vec::with_capacity(states.len() * N);
-    for s in states {
-        let dx = DVector::from_fn(2 * N, |i, _| if i < N { s.x()[i] - PI } else { s.x()[i] });
-        torque.extend((-gain * dx).iter());
-    }
-    torque
-}
-
-#[test]
-fn an_lqr_holds_a_batch_of_inverted_triple_pendulums_upright_at_the_predicted_rate() {
-    let model = PlanarTension::new(chain());
+/// The LQR on the chain linearised upright, and its slowest closed-loop rate (1/s).
+fn design() -> (DMatrix<f64>, f64) {
+    let model = PlanarTension::new(chain::<Dyn>());
     let up = DVector::from_element(N, PI);
     let linear =
         linearize(&model, &up, &DVector::zeros(N), &model.zero_inputs(), STEADY_TOLERANCE).expect("linear");
@@ -52,58 +43,126 @@ fn an_lqr_holds_a_batch_of_inverted_triple_pendulums_upright_at_the_predicted_ra
         .expect("lqr");
     let slowest = design.closed_loop[0].re;
     assert!(slowest < 0.0, "the closed loop is stable: {slowest}");
+    (design.gain, slowest)
+}
 
+/// `COPIES` states within 0.05 rad of upright, rates within 0.1 rad/s, as rows of `2N`.
+fn starts() -> Vec<f64> {
     let mut r = ChaCha8Rng::seed_from_u64(3);
-    let start: Vec<State<Dyn>> = (0..COPIES)
-        .map(|_| {
-            let x = (0..2 * N)
-                .map(|i| if i < N { PI + r.random_range(-0.05..0.05) } else { r.random_range(-0.1..0.1) });
-            State::new(0.0, DVector::from_iterator(2 * N, x))
+    (0..COPIES * 2 * N)
+        .map(|i| if i % (2 * N) < N { PI + r.random_range(-0.05..0.05) } else { r.random_range(-0.1..0.1) })
+        .collect()
+}
+
+/// `σ = −K (x − x_up)` of every state of `rows` (`2N` each), rows of `N`.
+fn torques_of(gain: &DMatrix<f64>, rows: &[f64]) -> Vec<f64> {
+    rows.chunks(2 * N)
+        .flat_map(|x| {
+            let dx = DVector::from_fn(2 * N, |i, _| if i < N { x[i] - PI } else { x[i] });
+            (-gain * dx).iter().copied().collect::<Vec<_>>()
         })
-        .collect();
+        .collect()
+}
+
+/// The worst copy's distance from upright after 4 and 6 s of control by `gain` every
+/// 10 ms from `rows`, `period(rows, torque)` running a period with the torques held.
+fn controlled(
+    gain: &DMatrix<f64>,
+    mut rows: Vec<f64>,
+    mut period: impl FnMut(&mut Vec<f64>, &[f64]),
+) -> [f64; 2] {
+    let mut norms = Vec::new();
+    for _ in 0..600 {
+        let torque = torques_of(gain, &rows);
+        period(&mut rows, &torque);
+        norms.push(rows.chunks(2 * N).map(from_upright).fold(0.0, f64::max));
+    }
+    [norms[399], norms[599]]
+}
+
+/// Distance of a state `x = (θ, θ̇)` from upright at rest (θ = π).
+fn from_upright(x: &[f64]) -> f64 {
+    x.iter().enumerate().map(|(i, v)| if i < N { (v - PI).powi(2) } else { v * v }).sum::<f64>().sqrt()
+}
+
+#[test]
+fn an_lqr_holds_a_batch_of_inverted_triple_pendulums_upright_at_the_predicted_rate() {
+    let (gain, slowest) = design();
+    let rows = starts();
+    let start: Vec<State<Dyn>> =
+        rows.chunks(2 * N).map(|x| State::new(0.0, DVector::from_column_slice(x))).collect();
     let batch = PlanarBatch::repeated(chain(), COPIES).expect("batch");
+    let h = PERIOD / STEPS as f64;
 
     // Without control they fall.
     let mut falling = start.clone();
-    assert!(
-        batch
-            .integrate_rk4(&mut falling, None, None, PERIOD / STEPS as f64, 200 * STEPS)
-            .expect("run")
-            .is_empty()
-    );
+    assert!(batch.integrate_rk4(&mut falling, None, None, h, 200 * STEPS).expect("run").is_empty());
     let fallen = falling.iter().filter(|s| from_upright(s.x().as_slice()) > 1.0).count();
     assert!(fallen > COPIES * 9 / 10, "{fallen} of {COPIES} fell in 2 s");
 
     // With it, 6 s in periods of 10 ms; one copy alone alongside, under its own control.
     let mut states = start.clone();
     let mut alone = start[17].clone();
-    let mut norms = Vec::new();
-    for _ in 0..600 {
-        let torque = torques(&design.gain, &states);
-        let failures =
-            batch.integrate_rk4(&mut states, Some(&torque), None, PERIOD / STEPS as f64, STEPS).expect("run");
+    let rows_of =
+        |states: &[State<Dyn>]| states.iter().flat_map(|s| s.x().iter().copied()).collect::<Vec<_>>();
+    let [at4, at6] = controlled(&gain, rows.clone(), |rows, torque| {
+        let failures = batch.integrate_rk4(&mut states, Some(torque), None, h, STEPS).expect("run");
         assert!(failures.is_empty(), "{failures:?}");
         let mut inputs = Inputs::<Dyn, nalgebra::U2>::zeros(Dyn(N));
-        inputs.torque.copy_from_slice(&torques(&design.gain, std::slice::from_ref(&alone)));
+        inputs.torque.copy_from_slice(&torques_of(&gain, alone.x().as_slice()));
         let system = FirstOrder::with_inputs(PlanarTension::new(chain()), inputs);
         let mut rk4 = Rk4::new(&system);
         for _ in 0..STEPS {
-            rk4.step(&system, &mut alone, PERIOD / STEPS as f64).expect("alone");
+            rk4.step(&system, &mut alone, h).expect("alone");
         }
-        norms.push(states.iter().map(|s| from_upright(s.x().as_slice())).fold(0.0, f64::max));
-    }
+        *rows = rows_of(&states);
+    });
     for (a, b) in alone.x().iter().zip(states[17].x().iter()) {
         assert_eq!(a.to_bits(), b.to_bits(), "copy 17 is the chain alone under the same control");
     }
     // Upright, and approaching it at the slowest closed-loop rate: over the last two
     // seconds the worst copy's distance shrinks by e^{σ·2 s}, σ the slowest eigenvalue's
     // real part, within the sampling's and the transients' percent or two.
-    let worst = start.iter().map(|s| from_upright(s.x().as_slice())).fold(0.0, f64::max);
-    let (at4, at6) = (norms[399], norms[599]);
+    let worst = rows.chunks(2 * N).map(from_upright).fold(0.0, f64::max);
     assert!(at6 < 1e-3 * worst, "worst copy after 6 s: {at6:e}, at the start {worst:e}");
     let rate = (at6 / at4).ln() / 2.0;
     println!(
         "fell: {fallen} of {COPIES}; worst {worst:.2e}, after 4 s {at4:.2e}, 6 s {at6:.2e}; rate {rate:.4} 1/s, predicted {slowest:.4} 1/s"
     );
     assert!((rate - slowest).abs() < 0.02 * slowest.abs(), "decay rate {rate} 1/s, predicted {slowest} 1/s");
+}
+
+#[test]
+fn the_same_lqr_holds_a_batch_of_the_generated_model_upright_in_f64_and_in_f32() {
+    let (gain, slowest) = design();
+    let start = starts();
+    let worst = start.chunks(2 * N).map(from_upright).fold(0.0, f64::max);
+    let batch = UnrolledBatch::new(vec![Triple::new(chain::<Const<N>>()); COPIES]).expect("batch");
+    let h = PERIOD / STEPS as f64;
+    let f64_run = controlled(&gain, start.clone(), |rows, torque| {
+        let mut states: Vec<State<Const<6>>> =
+            rows.chunks(2 * N).map(|x| State::new(0.0, SVector::<f64, 6>::from_column_slice(x))).collect();
+        assert!(batch.integrate_rk4(&mut states, Some(torque), None, h, STEPS).expect("run").is_empty());
+        *rows = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+    });
+    let mut carry = vec![0.0f32; start.len()];
+    let f32_run = controlled(&gain, start, |rows, torque| {
+        let mut x: Vec<f32> = rows.iter().map(|&x| x as f32).collect();
+        let torque: Vec<f32> = torque.iter().map(|&t| t as f32).collect();
+        let failures =
+            batch.integrate_rk4_f32((&mut x, &mut carry), Some(&torque), None, h, STEPS).expect("run");
+        assert!(failures.is_empty());
+        *rows = x.iter().map(|&x| f64::from(x)).collect();
+    });
+    for (what, [at4, at6]) in [("f64", f64_run), ("f32", f32_run)] {
+        let rate = (at6 / at4).ln() / 2.0;
+        println!(
+            "{what}: worst {worst:.2e}, after 4 s {at4:.2e}, 6 s {at6:.2e}; rate {rate:.4} 1/s, predicted {slowest:.4} 1/s"
+        );
+        assert!(at6 < 1e-3 * worst, "{what}: worst copy after 6 s: {at6:e}, at the start {worst:e}");
+        assert!(
+            (rate - slowest).abs() < 0.02 * slowest.abs(),
+            "{what}: decay rate {rate} 1/s, predicted {slowest} 1/s"
+        );
+    }
 }
