@@ -30,7 +30,7 @@
 //!   (`UnrolledSpatialBatch::integrate_rk4`), `…/spatial_held_…/4` with torques and pivot
 //!   accelerations held, `…/spatial_whirled_…/4` with each chain's
 //!   pivot on a circle of its own (`FirstOrder::with_inputs(model, Driven)` against
-//!   `integrate_rk4_driven`);
+//!   `integrate_rk4_driven` and `integrate_rk4_driven_f32`);
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
 //!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
 //!   `state_jacobians_f32`;
@@ -681,6 +681,20 @@ fn generated_spatial_rk4<M, const N: usize, const D: usize, const X: usize>(
                 let failures = batch.integrate_rk4_driven(&mut run, &drives, None, H, STEPS).expect("batch");
                 assert!(failures.is_empty());
                 black_box(&run);
+            })
+        },
+    );
+    group.bench_with_input(
+        BenchmarkId::new("rk4_100_steps/spatial_whirled_batch_f32_1_thread", N),
+        &N,
+        |b, _| {
+            in_pool(b, &one, || {
+                let (mut x, mut carry) = (rows.clone(), vec![0.0f32; rows.len()]);
+                let run = (&mut x[..], &mut carry[..]);
+                let failures =
+                    batch.integrate_rk4_driven_f32(run, (0.0, &drives), None, H, STEPS).expect("batch");
+                assert!(failures.is_empty());
+                black_box(&x);
             })
         },
     );

@@ -555,3 +555,45 @@ fn in_single_precision_a_run_names_its_failing_chains_and_the_others_finish() {
     let error = batch.integrate_rk4_f32((&mut x, &mut carry[1..]), None, None, h, 1).unwrap_err();
     assert_eq!(error.to_string(), "carry has 87 entries, expected 88");
 }
+
+#[test]
+fn driven_runs_in_single_precision_stay_near_the_f64_driven_runs() {
+    let mut r = ChaCha8Rng::seed_from_u64(34);
+    let (chains, h, t0, steps) = (64, 1e-4, 0.37, 100);
+    for spread in [2.0, 10.0] {
+        let batch = UnrolledBatch::new(spread_models::<Planar8, 8>(chains, spread, &mut r)).expect("batch");
+        let states: Vec<State<Const<16>>> = (0..chains)
+            .map(|_| State::new(t0, SVector::<f64, 16>::from_fn(|_, _| r.random_range(-1.0..1.0))))
+            .collect();
+        // Each pivot shaken along its own line, by up to 1 cm at up to 400 rad/s.
+        let drives: Vec<Harmonic<U2>> = (0..chains)
+            .map(|_| {
+                let direction = Vector2::new(r.random_range(-1.0..1.0), 1.0);
+                let (a, w) = (r.random_range(0.0..0.01), r.random_range(50.0..400.0));
+                Harmonic::new(direction, a, w, r.random_range(0.0..6.0)).expect("drive")
+            })
+            .collect();
+        let run64 = |states: &mut [State<Const<16>>], steps: usize| {
+            batch.integrate_rk4_driven(states, &drives, None, h, steps)
+        };
+        let run32 = |x: &mut [f32], carry: &mut [f32], steps: usize| {
+            batch.integrate_rk4_driven_f32((x, carry), (t0, &drives), None, h, steps)
+        };
+        let error = batches::f32_driven_error(&run64, &run32, &states, steps);
+        println!("spread {spread}, driven, {steps} steps: n = 8 {error:.1e}");
+        assert!(error < 1e-4, "spread {spread}: {error:e}");
+    }
+    // A drive finite in f64 but not in f32 fails its chain alone, at its first step.
+    let batch = UnrolledBatch::new(spread_models::<Planar4, 4>(3, 2.0, &mut r)).expect("batch");
+    let mut drives = vec![Harmonic::<U2>::vertical(0.01, 100.0, 0.3).expect("drive"); 3];
+    drives[1] = Harmonic::vertical(1e30, 1e10, 0.3).expect("drive");
+    let (mut x, mut carry) = (vec![0.5f32; 24], vec![0.0f32; 24]);
+    let failures =
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (t0, &drives), None, h, 5).expect("run");
+    let found: Vec<(usize, String)> = failures.iter().map(|f| (f.chain, f.error.to_string())).collect();
+    assert_eq!(found, [(1, Error::NonFiniteState { t: t0, h }.to_string())]);
+    assert!(x[8..16].iter().all(|&v| v == 0.5), "chain 1 left at its start");
+    let nan_t0 =
+        batch.integrate_rk4_driven_f32((&mut x, &mut carry), (f64::NAN, &drives), None, h, 1).unwrap_err();
+    assert_eq!(nan_t0.to_string(), "t0[0] must be finite, got NaN");
+}

@@ -499,3 +499,35 @@ fn in_single_precision_a_run_names_its_failing_chains_and_the_others_finish() {
     let error = batch.integrate_rk4_f32((&mut x, &mut carry), None, Some(&pivot[1..]), h, 1).unwrap_err();
     assert_eq!(error.to_string(), "pivot has 32 entries, expected 33");
 }
+
+#[test]
+fn whirled_runs_in_single_precision_stay_near_the_f64_whirled_runs() {
+    let mut r = ChaCha8Rng::seed_from_u64(34);
+    let (chains, h, t0, steps) = (64, 1e-4, 0.37, 100);
+    for spread in [2.0, 10.0] {
+        let batch =
+            UnrolledSpatialBatch::new(spread_models::<Spatial4, 4>(chains, spread, &mut r)).expect("batch");
+        let states: Vec<State<Const<16>>> = (0..chains)
+            .map(|_| {
+                let x = SVector::<f64, 16>::from_fn(|i, _| match i / 4 {
+                    0 => r.random_range(0.3..2.8),
+                    1 => r.random_range(-3.0..3.0),
+                    _ => r.random_range(-1.0..1.0),
+                });
+                State::new(t0, x)
+            })
+            .collect();
+        let drives: Vec<Circle> = (0..chains)
+            .map(|_| Circle::new(r.random_range(0.0..0.05), r.random_range(1.0..20.0)).expect("drive"))
+            .collect();
+        let run64 = |states: &mut [State<Const<16>>], steps: usize| {
+            batch.integrate_rk4_driven(states, &drives, None, h, steps)
+        };
+        let run32 = |x: &mut [f32], carry: &mut [f32], steps: usize| {
+            batch.integrate_rk4_driven_f32((x, carry), (t0, &drives), None, h, steps)
+        };
+        let error = batches::f32_driven_error(&run64, &run32, &states, steps);
+        println!("spread {spread}, whirled, {steps} steps: n = 4 {error:.1e}");
+        assert!(error < 1e-4, "spread {spread}: {error:e}");
+    }
+}

@@ -5,12 +5,15 @@
 //! Not bit for bit anything: the error against the `f64` runs is measured in
 //! `docs/ensembles.md` and checked in the tests.
 
-use super::{Block, Pivot, Stages, rk4_run_simd};
+use nalgebra::{U2, U3};
+
+use super::{Block, Pivot, Stages, drive_of, rk4_run_simd};
 use crate::batch::unrolled::spatial::singular_angle;
 use crate::batch::unrolled::{
     GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
 };
 use crate::batch::{Failure, WIDTH, block_chains, check_len, for_blocks_of, non_finite};
+use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::lanes::Lanes32;
 
@@ -37,7 +40,31 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        integrate_f32::<_, _, N, 1, GROUP>(self, (x, carry), (torque, pivot), (h, steps))
+        integrate_f32::<_, _, N, 1, GROUP>(self, (x, carry), (torque, pivot), None, (h, steps))
+    }
+
+    /// [`integrate_rk4_f32`](Self::integrate_rk4_f32) with chain `k`'s pivot moved by
+    /// `drives[k]` from the time `t0` (s), as
+    /// [`integrate_rk4_driven`](Self::integrate_rk4_driven) moves it: its acceleration
+    /// computed in `f64` at each stage's time (`t`, `t + h/2`, `t + h`, with `t = t0 + j h`
+    /// at step `j`) and rounded to `f32`; the torques held. Not bit for bit anything: its
+    /// error against the `f64` driven run is measured in `docs/ensembles.md`.
+    ///
+    /// Returns the chains that failed, as [`integrate_rk4_f32`](Self::integrate_rk4_f32)
+    /// does (a failed step's time counted from `t0`; a drive whose acceleration is not
+    /// finite in `f32` fails its chain at that step). Errors as there,
+    /// [`Error::LengthMismatch`] for a number of drives other than `B`, and
+    /// [`Error::NonFinite`] for a non-finite `t0`.
+    pub fn integrate_rk4_driven_f32<Dr: Drive<U2> + Sync>(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        (t0, drives): (f64, &[Dr]),
+        torque: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        let drive = drive_of(drives, self.len())?;
+        integrate_f32::<_, _, N, 1, GROUP>(self, (x, carry), (torque, None), Some((t0, &drive)), (h, steps))
     }
 }
 
@@ -61,17 +88,41 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        integrate_f32::<_, _, N, 2, { 2 * GROUP }>(self, (x, carry), (torque, pivot), (h, steps))
+        integrate_f32::<_, _, N, 2, { 2 * GROUP }>(self, (x, carry), (torque, pivot), None, (h, steps))
+    }
+
+    /// [`integrate_rk4_f32`](Self::integrate_rk4_f32) with chain `k`'s pivot moved by
+    /// `drives[k]` from the time `t0` (s): its acceleration computed in `f64` at each
+    /// stage's time (`t = t0 + j h` at step `j`) and rounded to `f32`; the torques held.
+    /// Chains whirled by their top ends in single precision, each on its own
+    /// [`Circle`](crate::Circle), say. Failures and errors as the planar batch's
+    /// `integrate_rk4_driven_f32`.
+    pub fn integrate_rk4_driven_f32<Dr: Drive<U3> + Sync>(
+        &self,
+        (x, carry): (&mut [f32], &mut [f32]),
+        (t0, drives): (f64, &[Dr]),
+        torque: Option<&[f32]>,
+        h: f64,
+        steps: usize,
+    ) -> Result<Vec<Failure>> {
+        let drive = drive_of(drives, self.len())?;
+        let run = (h, steps);
+        integrate_f32::<_, _, N, 2, { 2 * GROUP }>(self, (x, carry), (torque, None), Some((t0, &drive)), run)
     }
 }
 
+/// Chain `k`'s pivot acceleration at time `t` (m/s²), from its drive.
+type DriveAt<'a> = &'a (dyn Fn(usize, f64) -> [f64; 3] + Sync);
+
 /// The run of `integrate_rk4_f32` for a batch whose blocks hold `C` arrays of `N`
 /// coordinates (`A = C · GROUP` a group): rows of `2CN` in `x` and `carry`, torques rows
-/// of `CN`, pivot accelerations rows of [`Groups::SPACE`].
+/// of `CN`, pivot accelerations rows of [`Groups::SPACE`] held, or the pivots moved by
+/// `drive` from its start time.
 fn integrate_f32<M, K, const N: usize, const C: usize, const A: usize>(
     batch: &UnrolledBatch<M, N, K>,
     (x, carry): (&mut [f32], &mut [f32]),
     (torque, pivot): (Option<&[f32]>, Option<&[f32]>),
+    drive: Option<(f64, DriveAt<'_>)>,
     (h, steps): (f64, usize),
 ) -> Result<Vec<Failure>>
 where
@@ -82,6 +133,10 @@ where
     if !h.is_finite() || h == 0.0 {
         return Err(Error::InvalidStepSize { h });
     }
+    let t0 = drive.map_or(0.0, |(t0, _)| t0);
+    if !t0.is_finite() {
+        return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
+    }
     check_len("x", x, chains, 2 * m)?;
     check_len("carry", carry, chains, 2 * m)?;
     if let Some(t) = torque {
@@ -90,7 +145,11 @@ where
     if let Some(p) = pivot {
         check_len("pivot", p, chains, space)?;
     }
-    let forced = torque.is_some() || pivot.is_some();
+    let forced = torque.is_some() || pivot.is_some() || drive.is_some();
+    let moved = match drive {
+        Some((t0, drive)) => Pivot::Driven { drive, t0: Some(t0) },
+        None => Pivot::Held(None),
+    };
     let solves = (4 * N).saturating_mul(steps);
     let mut rows: Vec<(&mut [f32], &mut [f32])> = x.chunks_mut(2 * m).zip(carry.chunks_mut(2 * m)).collect();
     Ok(for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(&mut rows, 1, solves, SineRoom::new, |room, g, rows| {
@@ -120,11 +179,10 @@ where
             }
         }
         let group = (&batch.blocks_f32[..], first, count);
-        let held = Pivot::Held(None);
         let alive = if forced {
-            rk4_run_simd::<M, K, f32, N, C, A, true>(batch, group, room, (h, steps), held, &mut s)
+            rk4_run_simd::<M, K, f32, N, C, A, true>(batch, group, room, (h, steps), moved, &mut s)
         } else {
-            rk4_run_simd::<M, K, f32, N, C, A, false>(batch, group, room, (h, steps), held, &mut s)
+            rk4_run_simd::<M, K, f32, N, C, A, false>(batch, group, room, (h, steps), moved, &mut s)
         };
         let mut failures = Vec::new();
         for (j, (s, block)) in s.iter().zip(rows.chunks_mut(WIDTH)).enumerate() {
@@ -144,7 +202,7 @@ where
                         .or_else(|| torque.and_then(|t| bad("torque", t, m)))
                         .or_else(|| pivot.and_then(|p| bad("pivot_acceleration", p, space)))
                         .or_else(|| (C == 2).then(|| singular_angle(&x[..N])).flatten())
-                        .unwrap_or(Error::NonFiniteState { t: s.t.0[k].into(), h });
+                        .unwrap_or(Error::NonFiniteState { t: t0 + f64::from(s.t.0[k]), h });
                     failures.push(Failure { chain, error });
                 }
             }

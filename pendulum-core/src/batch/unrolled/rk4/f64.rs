@@ -3,7 +3,7 @@
 
 use nalgebra::{DefaultAllocator, Dim, DimName, U2, U3, allocator::Allocator};
 
-use super::{Block, Pivot, Stages, rk4_run_simd};
+use super::{Block, Pivot, Stages, drive_of, rk4_run_simd};
 use crate::batch::unrolled::{
     GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
 };
@@ -32,7 +32,7 @@ impl RunInputs<'_> {
             Pivot::Held(Some(p)) => {
                 std::array::from_fn(|d| if d < space { p[space * chain + d] } else { 0.0 })
             }
-            Pivot::Driven(drive) => drive(chain, t),
+            Pivot::Driven { drive, .. } => drive(chain, t),
         };
         (torque, pivot)
     }
@@ -176,12 +176,9 @@ where
     DefaultAllocator: Allocator<D> + Allocator<S>,
     State<D>: Send,
 {
-    check_len("drives", drives, batch.len(), 1)?;
-    let drive = |k: usize, t: f64| {
-        let a = drives[k].acceleration(t);
-        std::array::from_fn(|d| if d < S::DIM { a[d] } else { 0.0 })
-    };
-    integrate::<_, _, D, N, C, A>(batch, states, RunInputs { torque, pivot: Pivot::Driven(&drive) }, h, steps)
+    let drive = drive_of(drives, batch.len())?;
+    let pivot = Pivot::Driven { drive: &drive, t0: None };
+    integrate::<_, _, D, N, C, A>(batch, states, RunInputs { torque, pivot }, h, steps)
 }
 
 /// The run of `integrate_rk4` for a batch `batch` whose blocks hold `C`

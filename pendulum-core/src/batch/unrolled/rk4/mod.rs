@@ -15,8 +15,11 @@ mod stages;
 use self::increment::{Accelerations, increment};
 use super::precision::{KernelLanes, Precision, join};
 use super::{GROUP, Groups, LinkConstants, SineRoom, UnrolledBatch, unit_blocks};
-use crate::batch::{WIDTH, block_chains};
-use crate::error::Error;
+use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
+
+use crate::batch::{WIDTH, block_chains, check_len};
+use crate::drive::Drive;
+use crate::error::{Error, Result};
 use crate::integrate::kahan_add;
 use crate::lanes::Lane;
 
@@ -43,12 +46,31 @@ impl<L: Lane, const N: usize, const K: usize> Default for Block<L, N, K> {
 }
 
 /// Each chain's pivot acceleration `p̈` (m/s²) over a run: held (`B` rows of the chain's
-/// space, 2 or 3; `None`: at rest), or chain `k`'s at time `t` from `Driven(k, t)` (three
-/// components, the third 0 for planar chains), asked at each stage's time.
+/// space, 2 or 3; `None`: at rest), or chain `k`'s at time `t` from `drive(k, t)` (three
+/// components, the third 0 for planar chains), asked at each stage's time: from each lane's
+/// own time (`t0` `None`, the `f64` runs), or from `t0 + j h` at step `j` (`f32` runs,
+/// whose lanes' time is too coarse).
 #[derive(Clone, Copy)]
 enum Pivot<'a> {
     Held(Option<&'a [f64]>),
-    Driven(&'a (dyn Fn(usize, f64) -> [f64; 3] + Sync)),
+    Driven { drive: &'a (dyn Fn(usize, f64) -> [f64; 3] + Sync), t0: Option<f64> },
+}
+
+/// Chain `k`'s pivot acceleration `p̈(t)` (m/s²) from `drives[k]`, its `S` components then
+/// zeros up to three. Errors: [`Error::LengthMismatch`] for a number of drives other than
+/// `chains`.
+fn drive_of<S: DimName, Dr: Drive<S> + Sync>(
+    drives: &[Dr],
+    chains: usize,
+) -> Result<impl Fn(usize, f64) -> [f64; 3] + Sync + '_>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    check_len("drives", drives, chains, 1)?;
+    Ok(|k: usize, t: f64| {
+        let a = drives[k].acceleration(t);
+        std::array::from_fn(|d| if d < S::DIM { a[d] } else { 0.0 })
+    })
 }
 
 /// The times of `Rk4`'s four stages from a step's start `t`, as it forms them.
@@ -170,8 +192,8 @@ where
         }
     }
     let mut stopped = [V::none(); GROUP];
-    for _ in 0..steps {
-        if let (true, Pivot::Driven(drive)) = (FORCED, pivot) {
+    for step in 0..steps {
+        if let (true, Pivot::Driven { drive, t0 }) = (FORCED, pivot) {
             for (u, t) in t.iter().enumerate().take(units) {
                 let blocks = unit_blocks(u, V::BLOCKS, count);
                 let times = t.split();
@@ -180,7 +202,7 @@ where
                     let chains = block_chains::<WIDTH>(first + blocks[half], batch.len());
                     let t = P::flatten(std::slice::from_ref(&times[half]));
                     let p: [[[f64; 3]; 3]; WIDTH] = std::array::from_fn(|k| {
-                        let times = stage_times(t[k].into(), h);
+                        let times = stage_times(t0.map_or(t[k].into(), |t0| t0 + step as f64 * h), h);
                         [0, 1, 3].map(|stage| drive(chains[k], times[stage]))
                     });
                     std::array::from_fn(|stage| {
