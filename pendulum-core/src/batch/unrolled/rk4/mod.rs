@@ -197,8 +197,9 @@ where
             for (u, t) in t.iter().enumerate().take(units) {
                 let blocks = unit_blocks(u, V::BLOCKS, count);
                 let times = t.split();
-                // Each block's lanes' pivot accelerations at stages 1, 2 and 4 (3 is 2's time).
-                let at: [[[P::Lanes; 3]; 3]; 2] = std::array::from_fn(|half| {
+                // Each block's lanes' pivot accelerations at stages 1, 2 and 4 (3 is 2's time);
+                // a unit of one block (four lanes, or an odd last block) asks its drives once.
+                let fill = |half: usize| -> [[P::Lanes; 3]; 3] {
                     let chains = block_chains::<WIDTH>(first + blocks[half], batch.len());
                     let t = P::flatten(std::slice::from_ref(&times[half]));
                     let p: [[[f64; 3]; 3]; WIDTH] = std::array::from_fn(|k| {
@@ -208,7 +209,9 @@ where
                     std::array::from_fn(|stage| {
                         std::array::from_fn(|d| P::lanes(|k| P::rounded(p[k][stage][d])))
                     })
-                });
+                };
+                let first_half = fill(0);
+                let at = [first_half, if blocks[1] == blocks[0] { first_half } else { fill(1) }];
                 for (stage, pivots) in pivots.iter_mut().enumerate() {
                     pivots[u] = std::array::from_fn(|d| V::join([at[0][stage][d], at[1][stage][d]]));
                 }
