@@ -7,7 +7,7 @@
 
 use nalgebra::{U2, U3};
 
-use super::{Block, Pivot, Stages, drive_of, rk4_run_simd};
+use super::{Block, Pivot, Stages, check_run, drive_of, rk4_run_group};
 use crate::batch::unrolled::spatial::singular_angle;
 use crate::batch::unrolled::{
     GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
@@ -130,21 +130,13 @@ where
 {
     let (chains, m) = (batch.len(), C * N);
     let space = <UnrolledBatch<M, N, K> as Groups<N, A>>::SPACE;
-    if !h.is_finite() || h == 0.0 {
-        return Err(Error::InvalidStepSize { h });
-    }
+    check_run(h, chains, [m, space], (torque, pivot))?;
     let t0 = drive.map_or(0.0, |(t0, _)| t0);
     if !t0.is_finite() {
         return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
     }
     check_len("x", x, chains, 2 * m)?;
     check_len("carry", carry, chains, 2 * m)?;
-    if let Some(t) = torque {
-        check_len("torque", t, chains, m)?;
-    }
-    if let Some(p) = pivot {
-        check_len("pivot", p, chains, space)?;
-    }
     let forced = torque.is_some() || pivot.is_some() || drive.is_some();
     let moved = match drive {
         Some((t0, drive)) => Pivot::Driven { drive, t0: Some(t0) },
@@ -157,42 +149,22 @@ where
         let count = rows.len().div_ceil(WIDTH);
         let mut s: [Block<F32x4, N, C>; GROUP] = std::array::from_fn(|_| Block::default());
         for (j, (s, block)) in s.iter_mut().zip(rows.chunks(WIDTH)).enumerate() {
+            let own: [(&[f32], &[f32]); WIDTH] = std::array::from_fn(|k| {
+                let (x, carry) = &block[k.min(block.len() - 1)];
+                (&**x, &**carry)
+            });
             let ids = block_chains::<WIDTH>(first + j, chains);
-            let own = |k: usize| &block[k.min(block.len() - 1)];
-            // Entries `offset + N c + i` of the rows (`carry`: of their compensations).
-            let arrays = |carry: bool, offset: usize| -> [[F32x4; N]; C] {
-                let entry = |k: usize, j: usize| if carry { own(k).1[j] } else { own(k).0[j] };
-                std::array::from_fn(|c| {
-                    std::array::from_fn(|i| Lanes32::from_fn(|k| entry(k, offset + N * c + i)))
-                })
-            };
-            let inputs = |v: &[f32], per: usize, i: usize| Lanes32::from_fn(|k| v[per * ids[k] + i]);
-            (s.q, s.qd) = (arrays(false, 0), arrays(false, m));
-            (s.q_carry, s.qd_carry) = (arrays(true, 0), arrays(true, m));
-            if let Some(t) = torque {
-                s.torque = std::array::from_fn(|c| std::array::from_fn(|i| inputs(t, m, N * c + i)));
-            }
-            if let Some(p) = pivot {
-                for (d, pivot) in s.pivot.iter_mut().enumerate().take(space) {
-                    *pivot = inputs(p, space, d);
-                }
-            }
+            *s = Block::from_rows(own, [(0.0, 0.0); WIDTH], ids, (torque, pivot), space);
         }
         let group = (&batch.blocks_f32[..], first, count);
-        let alive = if forced {
-            rk4_run_simd::<M, K, f32, N, C, A, true>(batch, group, room, (h, steps), moved, &mut s)
-        } else {
-            rk4_run_simd::<M, K, f32, N, C, A, false>(batch, group, room, (h, steps), moved, &mut s)
-        };
+        let alive =
+            rk4_run_group::<M, K, f32, N, C, A>(batch, group, room, (h, steps), (moved, forced), &mut s);
         let mut failures = Vec::new();
         for (j, (s, block)) in s.iter().zip(rows.chunks_mut(WIDTH)).enumerate() {
             for (k, (x, carry)) in block.iter_mut().enumerate() {
-                for c in 0..C {
-                    for i in 0..N {
-                        (x[N * c + i], x[m + N * c + i]) = (s.q[c][i].0[k], s.qd[c][i].0[k]);
-                        (carry[N * c + i], carry[m + N * c + i]) =
-                            (s.q_carry[c][i].0[k], s.qd_carry[c][i].0[k]);
-                    }
+                for ((x, carry), (new, new_carry)) in x.iter_mut().zip(carry.iter_mut()).zip(s.row::<f32>(k))
+                {
+                    (*x, *carry) = (new, new_carry);
                 }
                 if !alive[j][k] {
                     let chain = WIDTH * (first + j) + k;

@@ -3,15 +3,14 @@
 
 use nalgebra::{DefaultAllocator, Dim, DimName, U2, U3, allocator::Allocator};
 
-use super::{Block, Pivot, Stages, drive_of, rk4_run_simd};
+use super::{Block, Pivot, Stages, check_run, drive_of, rk4_run_group};
 use crate::batch::unrolled::{
     GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
 };
-use crate::batch::{F64x4, Failure, WIDTH, block_chains, check_len, for_blocks_of};
+use crate::batch::{F64x4, Failure, WIDTH, block_chains, for_blocks_of};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::State;
-use crate::lanes::Lanes;
 
 /// A run's inputs: each chain's torques (`B` rows of `C·N`, N·m; `None`: none), held over
 /// the run (a zero-order hold, as a controller applies its action), and its pivot's
@@ -199,21 +198,18 @@ where
     debug_assert_eq!(A, C * GROUP);
     let (chains, m) = (batch.len(), C * N);
     let space = <UnrolledBatch<M, N, K> as Groups<N, A>>::SPACE;
-    if !h.is_finite() || h == 0.0 {
-        return Err(Error::InvalidStepSize { h });
-    }
+    let held = match inputs.pivot {
+        Pivot::Held(pivot) => (inputs.torque, pivot),
+        Pivot::Driven { .. } => (inputs.torque, None),
+    };
+    check_run(h, chains, [m, space], held)?;
     if states.len() != chains {
         return Err(Error::LengthMismatch { what: "states", expected: chains, got: states.len() });
     }
     if let Some(s) = states.iter().find(|s| s.x().len() != 2 * m) {
         return Err(Error::LengthMismatch { what: "x", expected: 2 * m, got: s.x().len() });
     }
-    if let Some(t) = inputs.torque {
-        check_len("torque", t, chains, m)?;
-    }
-    if let Pivot::Held(Some(p)) = inputs.pivot {
-        check_len("pivot", p, chains, space)?;
-    }
+    let forced = inputs.torque.is_some() || !matches!(inputs.pivot, Pivot::Held(None));
     let solves = (4 * N).saturating_mul(steps);
     let failures =
         for_blocks_of::<{ GROUP * WIDTH }, _, _, _>(states, 1, solves, SineRoom::new, |room, g, states| {
@@ -222,51 +218,23 @@ where
             let mut s: [Block<F64x4, N, C>; GROUP] = std::array::from_fn(|_| Block::default());
             for (j, (s, block)) in s.iter_mut().zip(states.chunks(WIDTH)).enumerate() {
                 let parts: [_; WIDTH] = std::array::from_fn(|k| block[k.min(block.len() - 1)].parts());
-                let entries = |j: usize, carry: bool| {
-                    Lanes::from_fn(|k| if carry { parts[k].3[j] } else { parts[k].2[j] })
-                };
-                let arrays = |offset: usize, carry: bool| -> [[F64x4; N]; C] {
-                    std::array::from_fn(|c| std::array::from_fn(|i| entries(offset + N * c + i, carry)))
-                };
-                let ids = block_chains::<WIDTH>(first + j, chains);
-                let rows = |v: &[f64], per: usize, i: usize| Lanes::from_fn(|k| v[per * ids[k] + i]);
-                *s = Block {
-                    q: arrays(0, false),
-                    qd: arrays(m, false),
-                    q_carry: arrays(0, true),
-                    qd_carry: arrays(m, true),
-                    t: Lanes::from_fn(|k| parts[k].0),
-                    t_carry: Lanes::from_fn(|k| parts[k].1),
-                    torque: match inputs.torque {
-                        Some(t) => std::array::from_fn(|c| std::array::from_fn(|i| rows(t, m, N * c + i))),
-                        None => s.torque,
-                    },
-                    pivot: match inputs.pivot {
-                        Pivot::Held(Some(p)) => {
-                            std::array::from_fn(|d| if d < space { rows(p, space, d) } else { s.pivot[d] })
-                        }
-                        _ => s.pivot,
-                    },
-                };
+                let rows = parts.map(|(_, _, x, carry)| (x, carry));
+                let times = parts.map(|(t, t_carry, ..)| (t, t_carry));
+                *s = Block::from_rows(rows, times, block_chains::<WIDTH>(first + j, chains), held, space);
             }
             let group = (&batch.blocks[..], first, count);
-            let alive = if inputs.torque.is_some() || !matches!(inputs.pivot, Pivot::Held(None)) {
-                rk4_run_simd::<M, K, f64, N, C, A, true>(batch, group, room, (h, steps), inputs.pivot, &mut s)
-            } else {
-                rk4_run_simd::<M, K, f64, N, C, A, false>(
-                    batch,
-                    group,
-                    room,
-                    (h, steps),
-                    inputs.pivot,
-                    &mut s,
-                )
-            };
+            let alive = rk4_run_group::<M, K, f64, N, C, A>(
+                batch,
+                group,
+                room,
+                (h, steps),
+                (inputs.pivot, forced),
+                &mut s,
+            );
             let mut failures = Vec::new();
             for (j, (s, block)) in s.iter().zip(states.chunks_mut(WIDTH)).enumerate() {
                 for (k, state) in block.iter_mut().enumerate() {
-                    let x = lane(&s.q, &s.q_carry, k).chain(lane(&s.qd, &s.qd_carry, k));
-                    state.set_parts(s.t.0[k], s.t_carry.0[k], x);
+                    state.set_parts(s.t.0[k], s.t_carry.0[k], s.row::<f64>(k));
                     if !alive[j][k] {
                         let chain = WIDTH * (first + j) + k;
                         let (torque, pivot) = inputs.of(chain, m, space);
@@ -279,13 +247,4 @@ where
             failures
         });
     Ok(failures)
-}
-
-/// Lane `k`'s entries of `x` and their compensations `carry`, in order.
-fn lane<'a, const N: usize, const K: usize>(
-    x: &'a [[F64x4; N]; K],
-    carry: &'a [[F64x4; N]; K],
-    k: usize,
-) -> impl Iterator<Item = (f64, f64)> + 'a {
-    x.as_flattened().iter().zip(carry.as_flattened()).map(move |(x, carry)| (x.0[k], carry.0[k]))
 }

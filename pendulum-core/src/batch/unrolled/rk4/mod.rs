@@ -45,6 +45,59 @@ impl<L: Lane, const N: usize, const K: usize> Default for Block<L, N, K> {
     }
 }
 
+/// A run's held inputs in precision `P`: each chain's torques (rows of `K·N`, N·m) and pivot
+/// acceleration (rows of the chain's space, 2 or 3; m/s²); `None`: zeros.
+type Held<'a, P> = (Option<&'a [P]>, Option<&'a [P]>);
+
+impl<L: Lane, const N: usize, const K: usize> Block<L, N, K> {
+    /// The block of chains `ids` (lane `k` holds chain `ids[k]`): lane `k`'s state
+    /// `x = (q, q̇)` (`2KN` entries) and their compensations from `rows[k]`, its time and
+    /// the time's compensation from `times[k]`, and its row of the held inputs `held`
+    /// (pivot rows of `space` components).
+    fn from_rows<P: Precision<Lanes = L>>(
+        rows: [(&[P], &[P]); WIDTH],
+        times: [(P, P); WIDTH],
+        ids: [usize; WIDTH],
+        (torque, pivot): Held<'_, P>,
+        space: usize,
+    ) -> Self {
+        let m = K * N;
+        let arrays = |offset: usize, carry: bool| -> [[L; N]; K] {
+            let entry = |k: usize, j: usize| if carry { rows[k].1[j] } else { rows[k].0[j] };
+            std::array::from_fn(|c| std::array::from_fn(|i| P::lanes(|k| entry(k, offset + N * c + i))))
+        };
+        let held = |v: &[P], per: usize, i: usize| P::lanes(|k| v[per * ids[k] + i]);
+        let mut block = Self {
+            q: arrays(0, false),
+            qd: arrays(m, false),
+            q_carry: arrays(0, true),
+            qd_carry: arrays(m, true),
+            t: P::lanes(|k| times[k].0),
+            t_carry: P::lanes(|k| times[k].1),
+            ..Self::default()
+        };
+        if let Some(t) = torque {
+            block.torque = std::array::from_fn(|c| std::array::from_fn(|i| held(t, m, N * c + i)));
+        }
+        if let Some(p) = pivot {
+            for (d, pivot) in block.pivot.iter_mut().enumerate().take(space) {
+                *pivot = held(p, space, d);
+            }
+        }
+        block
+    }
+
+    /// Lane `k`'s state `x = (q, q̇)`, entry by entry with its compensation, as
+    /// [`from_rows`](Self::from_rows) took it.
+    fn row<P: Precision<Lanes = L>>(&self, k: usize) -> impl Iterator<Item = (P, P)> + '_ {
+        fn lane<P: Precision, const N: usize>(v: &[[P::Lanes; N]], k: usize) -> impl Iterator<Item = P> + '_ {
+            P::flatten(v.as_flattened()).iter().skip(k).step_by(WIDTH).copied()
+        }
+        let x = lane::<P, N>(&self.q, k).chain(lane::<P, N>(&self.qd, k));
+        x.zip(lane::<P, N>(&self.q_carry, k).chain(lane::<P, N>(&self.qd_carry, k)))
+    }
+}
+
 /// Each chain's pivot acceleration `p̈` (m/s²) over a run: held (`B` rows of the chain's
 /// space, 2 or 3; `None`: at rest), or chain `k`'s at time `t` from `drive(k, t)` (three
 /// components, the third 0 for planar chains), asked at each stage's time: from each lane's
@@ -304,6 +357,42 @@ where
         return unsafe { rk4_run_avx2::<M, K, P, N, C, A, FORCED>(batch, group, room, run, pivot, s) };
     }
     rk4_run::<M, K, P, P::Lanes, N, C, A, FORCED>(batch, group, room, run, pivot, s)
+}
+
+/// [`rk4_run_simd`] of a run with inputs (`forced`: torques, held pivot accelerations or
+/// drives) or of a free run, compiled apart (its zeros need no arrays).
+fn rk4_run_group<M, K, P: Precision, const N: usize, const C: usize, const A: usize>(
+    batch: &UnrolledBatch<M, N, K>,
+    group: (&[LinkConstants<P::Lanes, N>], usize, usize),
+    room: &mut SineRoom<P::Lanes, N, A>,
+    run: (f64, usize),
+    (pivot, forced): (Pivot<'_>, bool),
+    s: &mut [Block<P::Lanes, N, C>; GROUP],
+) -> [[bool; WIDTH]; GROUP]
+where
+    UnrolledBatch<M, N, K>: Stages<N, A>,
+{
+    if forced {
+        rk4_run_simd::<M, K, P, N, C, A, true>(batch, group, room, run, pivot, s)
+    } else {
+        rk4_run_simd::<M, K, P, N, C, A, false>(batch, group, room, run, pivot, s)
+    }
+}
+
+/// Errors of a run's arguments: [`Error::InvalidStepSize`] for a zero or non-finite `h`,
+/// [`Error::LengthMismatch`] for held inputs not of `chains` rows (torques of `m`, pivot
+/// accelerations of `space`).
+fn check_run<P>(h: f64, chains: usize, [m, space]: [usize; 2], (torque, pivot): Held<'_, P>) -> Result<()> {
+    if !h.is_finite() || h == 0.0 {
+        return Err(Error::InvalidStepSize { h });
+    }
+    if let Some(t) = torque {
+        check_len("torque", t, chains, m)?;
+    }
+    if let Some(p) = pivot {
+        check_len("pivot", p, chains, space)?;
+    }
+    Ok(())
 }
 
 /// [`rk4_run`] compiled for AVX-512, in [`Precision::Wide`]: two blocks in each

@@ -12,7 +12,7 @@ use crate::batch::unrolled::{
     GROUP, LinkConstants, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
     unit_blocks,
 };
-use crate::error::Error;
+use crate::error::{Error, Result};
 use crate::model::Inputs;
 
 impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N> {
@@ -53,27 +53,15 @@ impl<M: PlanarKernel<N>, const N: usize> Stages<N, GROUP> for UnrolledBatch<M, N
         pivot: &dyn Fn(f64) -> [f64; 3],
     ) -> Error {
         let model = &self.models[chain];
-        let mut first = None;
-        let (q, qd): ([f64; N], [f64; N]) = (x[..N].try_into().expect("N"), x[N..].try_into().expect("N"));
-        let (times, mut stage) = (stage_times(t, h), 0);
-        increment::<f64, N, 1>(&[q], &[qd], h, |q: &[[f64; N]; 1], qd: &[[f64; N]; 1]| {
-            let [x, y, _] = pivot(times[stage]);
-            stage += 1;
+        own_step_error::<N, 1>((t, x), h, pivot, |q, qd, [x, y, _]| {
             let inputs = Inputs {
                 torque: SVector::<f64, N>::from_column_slice(torque),
                 pivot_acceleration: Vector2::new(x, y),
             };
             let mut out = SVector::<f64, N>::zeros();
             let (q, qd) = (SVector::<f64, N>::from(q[0]), SVector::<f64, N>::from(qd[0]));
-            match model.accelerations(&q, &qd, &inputs, &mut out) {
-                Ok(()) => [out.data.0[0]],
-                Err(error) => {
-                    first.get_or_insert(error);
-                    [[f64::NAN; N]]
-                }
-            }
-        });
-        first.unwrap_or(Error::NonFiniteState { t, h })
+            model.accelerations(&q, &qd, &inputs, &mut out).map(|()| [out.data.0[0]])
+        })
     }
 }
 
@@ -126,25 +114,36 @@ impl<M: SpatialKernel<N>, const N: usize> Stages<N, { 2 * GROUP }> for UnrolledS
         pivot: &dyn Fn(f64) -> [f64; 3],
     ) -> Error {
         let model = &self.models[chain];
-        let mut first = None;
-        let arrays = |x: &[f64]| -> [[f64; N]; 2] {
-            [x[..N].try_into().expect("N"), x[N..2 * N].try_into().expect("N")]
-        };
-        let (q, qd) = (arrays(&x[..2 * N]), arrays(&x[2 * N..]));
-        let (times, mut stage) = (stage_times(t, h), 0);
-        increment::<f64, N, 2>(&q, &qd, h, |q: &[[f64; N]; 2], qd: &[[f64; N]; 2]| {
-            let p = pivot(times[stage]);
-            stage += 1;
+        own_step_error::<N, 2>((t, x), h, pivot, |q, qd, p| {
             let mut out = [[0.0; N]; 2];
-            let (q, qd, result) = (q.as_flattened(), qd.as_flattened(), out.as_flattened_mut());
-            match model.row_accelerations(q, qd, torque, p, result) {
-                Ok(()) => out,
-                Err(error) => {
-                    first.get_or_insert(error);
-                    [[f64::NAN; N]; 2]
-                }
-            }
-        });
-        first.unwrap_or(Error::NonFiniteState { t, h })
+            let (q, qd) = (q.as_flattened(), qd.as_flattened());
+            model.row_accelerations(q, qd, torque, p, out.as_flattened_mut()).map(|()| out)
+        })
     }
+}
+
+/// The error of one chain's own RK4 step from `(t, x)`, `x = (q, q̇)` of `2CN` entries, its
+/// accelerations `accelerations(q, q̇, p̈)` with the pivot acceleration `pivot(t)` at each
+/// stage's time: the first stage's error, else a non-finite increment
+/// ([`Error::NonFiniteState`]).
+fn own_step_error<const N: usize, const C: usize>(
+    (t, x): (f64, &[f64]),
+    h: f64,
+    pivot: &dyn Fn(f64) -> [f64; 3],
+    mut accelerations: impl FnMut(&[[f64; N]; C], &[[f64; N]; C], [f64; 3]) -> Result<[[f64; N]; C]>,
+) -> Error {
+    let arrays = |x: &[f64]| -> [[f64; N]; C] {
+        std::array::from_fn(|c| x[N * c..N * (c + 1)].try_into().expect("N"))
+    };
+    let (q, qd) = (arrays(&x[..C * N]), arrays(&x[C * N..]));
+    let (times, mut stage, mut first) = (stage_times(t, h), 0, None);
+    increment::<f64, N, C>(&q, &qd, h, |q: &[[f64; N]; C], qd: &[[f64; N]; C]| {
+        let at = accelerations(q, qd, pivot(times[stage]));
+        stage += 1;
+        at.unwrap_or_else(|error| {
+            first.get_or_insert(error);
+            [[f64::NAN; N]; C]
+        })
+    });
+    first.unwrap_or(Error::NonFiniteState { t, h })
 }
