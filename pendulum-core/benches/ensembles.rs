@@ -30,7 +30,8 @@
 //!   (`UnrolledSpatialBatch::integrate_rk4`), `…/spatial_held_…/4` with torques and pivot
 //!   accelerations held, `…/spatial_whirled_…/4` with each chain's
 //!   pivot on a circle of its own (`FirstOrder::with_inputs(model, Driven)` against
-//!   `integrate_rk4_driven` and `integrate_rk4_driven_f32`);
+//!   `integrate_rk4_driven` and `integrate_rk4_driven_f32`, and in four lanes,
+//!   `…_four_lanes`);
 //! - `jacobians/planar/…/{8,20,100}`: `∂θ̈/∂θ`, `∂θ̈/∂θ̇` of 64 chains, one at a time
 //!   against `PlanarBatch::state_jacobians` (in lanes) on one thread and on two, and
 //!   `state_jacobians_f32`;
@@ -679,6 +680,20 @@ fn generated_spatial_rk4<M, const N: usize, const D: usize, const X: usize>(
             in_pool(b, &one, || {
                 let mut run = states.clone();
                 let failures = batch.integrate_rk4_driven(&mut run, &drives, None, H, STEPS).expect("batch");
+                assert!(failures.is_empty());
+                black_box(&run);
+            })
+        },
+    );
+    // Four lanes (every CPU without AVX-512): a unit of one block asks its drives once a stage.
+    let four = batch.clone().with_avx512(false);
+    group.bench_with_input(
+        BenchmarkId::new("rk4_100_steps/spatial_whirled_batch_1_threads_four_lanes", N),
+        &N,
+        |b, _| {
+            in_pool(b, &one, || {
+                let mut run = states.clone();
+                let failures = four.integrate_rk4_driven(&mut run, &drives, None, H, STEPS).expect("batch");
                 assert!(failures.is_empty());
                 black_box(&run);
             })

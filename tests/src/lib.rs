@@ -3,6 +3,7 @@
 #![doc = include_str!("../../README.md")]
 
 pub mod batches;
+pub mod control;
 
 use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 use pendulum_core::{Inputs, Model, ModelAlloc};

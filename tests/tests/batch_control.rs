@@ -4,7 +4,9 @@
 //! with it they approach upright at the slowest closed-loop rate the linearisation
 //! predicts; every copy is what the chain alone would do under the same control, bit for
 //! bit. The same controller holds a batch of the generated model (`model!`,
-//! `UnrolledBatch::integrate_rk4` and `integrate_rk4_f32`) upright at the same rate.
+//! `UnrolledBatch::integrate_rk4` and `integrate_rk4_f32`) upright at the same rate; and a
+//! batch of copies whose masses and lengths differ (±10%) each decays at the rate of its
+//! own loop, linearised and sampled (`pendulum_tests::control::sampled_loop`).
 
 use std::f64::consts::PI;
 
@@ -12,6 +14,7 @@ use nalgebra::{Const, DMatrix, DVector, Dyn, SVector};
 use pendulum_core::batch::{PlanarBatch, UnrolledBatch};
 use pendulum_core::integrate::{Integrator, Rk4, State};
 use pendulum_core::{Chain, FirstOrder, Inputs, Model, PlanarTension, STEADY_TOLERANCE, linearize, lqr};
+use pendulum_tests::control;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -54,35 +57,24 @@ fn starts() -> Vec<f64> {
         .collect()
 }
 
-/// `σ = −K (x − x_up)` of every state of `rows` (`2N` each), rows of `N`.
-fn torques_of(gain: &DMatrix<f64>, rows: &[f64]) -> Vec<f64> {
-    rows.chunks(2 * N)
-        .flat_map(|x| {
-            let dx = DVector::from_fn(2 * N, |i, _| if i < N { x[i] - PI } else { x[i] });
-            (-gain * dx).iter().copied().collect::<Vec<_>>()
-        })
-        .collect()
-}
-
 /// The worst copy's distance from upright after 4 and 6 s of control by `gain` every
 /// 10 ms from `rows`, `period(rows, torque)` running a period with the torques held.
 fn controlled(
     gain: &DMatrix<f64>,
-    mut rows: Vec<f64>,
+    rows: Vec<f64>,
     mut period: impl FnMut(&mut Vec<f64>, &[f64]),
 ) -> [f64; 2] {
-    let mut norms = Vec::new();
-    for _ in 0..600 {
-        let torque = torques_of(gain, &rows);
-        period(&mut rows, &torque);
-        norms.push(rows.chunks(2 * N).map(from_upright).fold(0.0, f64::max));
-    }
-    [norms[399], norms[599]]
+    let distances = control::controlled(gain, (rows, N), 600, |rows, torque| {
+        period(rows, torque);
+        Ok(())
+    })
+    .expect("control");
+    [400, 600].map(|i| distances[i].iter().copied().fold(0.0, f64::max))
 }
 
 /// Distance of a state `x = (θ, θ̇)` from upright at rest (θ = π).
 fn from_upright(x: &[f64]) -> f64 {
-    x.iter().enumerate().map(|(i, v)| if i < N { (v - PI).powi(2) } else { v * v }).sum::<f64>().sqrt()
+    control::from_upright(x, N)
 }
 
 #[test]
@@ -109,7 +101,7 @@ fn an_lqr_holds_a_batch_of_inverted_triple_pendulums_upright_at_the_predicted_ra
         let failures = batch.integrate_rk4(&mut states, Some(torque), None, h, STEPS).expect("run");
         assert!(failures.is_empty(), "{failures:?}");
         let mut inputs = Inputs::<Dyn, nalgebra::U2>::zeros(Dyn(N));
-        inputs.torque.copy_from_slice(&torques_of(&gain, alone.x().as_slice()));
+        inputs.torque.copy_from_slice(&control::torques_of(&gain, alone.x().as_slice(), N));
         let system = FirstOrder::with_inputs(PlanarTension::new(chain()), inputs);
         let mut rk4 = Rk4::new(&system);
         for _ in 0..STEPS {
@@ -165,4 +157,58 @@ fn the_same_lqr_holds_a_batch_of_the_generated_model_upright_in_f64_and_in_f32()
             "{what}: decay rate {rate} 1/s, predicted {slowest} 1/s"
         );
     }
+}
+
+/// The chain with its masses and lengths scaled by `scale` (the masses', then the lengths').
+fn scaled<D: nalgebra::Dim>(scale: &[f64; 2 * N]) -> Chain<D>
+where
+    nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<D>,
+{
+    let nominal = chain::<Dyn>();
+    let masses: Vec<f64> = (0..N).map(|i| nominal.masses()[i] * scale[i]).collect();
+    let lengths: Vec<f64> = (0..N).map(|i| nominal.lengths()[i] * scale[N + i]).collect();
+    Chain::new(&masses, &lengths, 9.81).and_then(|c| c.with_damping(&[1e-3; N])).expect("chain")
+}
+
+#[test]
+fn each_copy_of_a_batch_of_differing_plants_decays_as_its_own_sampled_linear_loop_predicts() {
+    // The nominal gain on copies whose masses and lengths are each within ±10% of nominal:
+    // every copy's distance from upright over 4–6 s shrinks at the rate of its own loop
+    // linearised and sampled (the torques held over each period), from its own start.
+    let (gain, _) = design();
+    let mut r = ChaCha8Rng::seed_from_u64(11);
+    let scales: Vec<[f64; 2 * N]> =
+        (0..COPIES).map(|_| std::array::from_fn(|_| r.random_range(0.9..1.1))).collect();
+    let start = starts();
+    let batch = UnrolledBatch::new(scales.iter().map(|s| Triple::new(scaled(s))).collect()).expect("batch");
+    let h = PERIOD / STEPS as f64;
+    let mut states: Vec<State<Const<{ 2 * N }>>> =
+        start.chunks(2 * N).map(|x| State::new(0.0, SVector::from_column_slice(x))).collect();
+    let run = control::controlled(&gain, (start.clone(), N), 600, |rows, torque| {
+        assert!(batch.integrate_rk4(&mut states, Some(torque), None, h, STEPS)?.is_empty());
+        *rows = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+        Ok(())
+    })
+    .expect("run");
+    let mut off: Vec<f64> = scales
+        .iter()
+        .zip(start.chunks(2 * N))
+        .enumerate()
+        .map(|(k, (scale, x))| {
+            let model = PlanarTension::new(scaled::<Dyn>(scale));
+            let up = DVector::from_element(N, PI);
+            let linear = linearize(&model, &up, &DVector::zeros(N), &model.zero_inputs(), STEADY_TOLERANCE)
+                .expect("linear");
+            let map = control::sampled_loop(&linear.a, &linear.b_torque, &gain, PERIOD);
+            let (at4, at6) = (map.pow(400) * control::from_up(x, N), map.pow(600) * control::from_up(x, N));
+            let theory = (at6.norm() / at4.norm()).ln() / 2.0;
+            let measured = (run[600][k] / run[400][k]).ln() / 2.0;
+            assert!(theory < -1.0, "copy {k}: the sampled loop decays at {theory} 1/s");
+            (measured / theory - 1.0).abs()
+        })
+        .collect();
+    off.sort_by(f64::total_cmp);
+    let (median, worst) = (off[COPIES / 2], off[COPIES - 1]);
+    println!("rates against each copy's sampled linear loop: median {median:.1e}, worst {worst:.1e} off");
+    assert!(median < 1e-5 && worst < 0.02, "median {median:e}, worst {worst:e}");
 }
