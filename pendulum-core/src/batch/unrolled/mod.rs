@@ -24,6 +24,7 @@ use nalgebra::{Const, SVector, U2, Vector2};
 pub use self::spatial::{SpatialKernel, UnrolledSpatialBatch};
 
 use self::precision::{KernelLanes, Precision, join};
+use super::lane_states::non_finite_sum;
 use super::{F64x4, Failure, WIDTH, all_finite, block_chains, check_len, for_blocks_of, gather, scatter};
 use crate::error::{Error, Result};
 use crate::kinematics::PlanarAngles;
@@ -397,7 +398,7 @@ trait Groups<const N: usize, const A: usize>: Sync {
 
     /// Blocks `c` of a group (at most [`GROUP`], chains `lanes[j]` in block `j`) in lanes of
     /// type `V`, their results scattered into `out` (the group's rows); a lane the model
-    /// refuses is left non-finite.
+    /// refuses is left non-finite. Returns whether every result is finite.
     fn group<P: Precision, V: KernelLanes<P>>(
         &self,
         c: &[LinkConstants<P::Lanes, N>],
@@ -405,7 +406,7 @@ trait Groups<const N: usize, const A: usize>: Sync {
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    );
+    ) -> bool;
 }
 
 impl<M: PlanarKernel<N>, const N: usize> Groups<N, GROUP> for UnrolledBatch<M, N> {
@@ -424,9 +425,10 @@ impl<M: PlanarKernel<N>, const N: usize> Groups<N, GROUP> for UnrolledBatch<M, N
         lanes: [[usize; WIDTH]; GROUP],
         Rows { q, qd, torque, pivot }: Rows<'_, P>,
         out: &mut [P],
-    ) {
+    ) -> bool {
         let zero = P::Lanes::splat(0.0);
         let count = c.len();
+        let mut failed = V::none();
         for (angles, &lanes) in room.angles.iter_mut().zip(&lanes).take(count) {
             gather::<P, WIDTH>(q, lanes, N, P::flatten_mut(angles));
         }
@@ -456,6 +458,7 @@ impl<M: PlanarKernel<N>, const N: usize> Groups<N, GROUP> for UnrolledBatch<M, N
                 &torques,
                 pivots,
             );
+            failed = V::or(failed, non_finite_sum(&accelerations).outside(0, 0));
             let mut result = [[zero; N]; 2];
             for (i, a) in accelerations.into_iter().enumerate() {
                 [result[0][i], result[1][i]] = a.split();
@@ -465,6 +468,7 @@ impl<M: PlanarKernel<N>, const N: usize> Groups<N, GROUP> for UnrolledBatch<M, N
                 scatter::<P, WIDTH>(P::flatten(result), N, &mut out[rows]);
             }
         }
+        !V::any(failed)
     }
 }
 
@@ -492,8 +496,10 @@ impl<M: Sync, const N: usize, K: Sync> UnrolledBatch<M, N, K> {
                 let count = (out.len() / m).div_ceil(WIDTH);
                 let lanes = std::array::from_fn(|j| block_chains(first + j.min(count - 1), chains));
                 let rows = Rows { q, qd, torque, pivot };
-                self.group_simd::<P, A>(&blocks[first..first + count], room, lanes, rows, out);
-                non_finite_rows(out, m, WIDTH * first, &error)
+                // The rows are read only when a lane's result was not finite (row by row,
+                // the check was a tenth of a call at n = 8).
+                let finite = self.group_simd::<P, A>(&blocks[first..first + count], room, lanes, rows, out);
+                if finite { Vec::new() } else { non_finite_rows(out, m, WIDTH * first, &error) }
             });
         Ok(failures)
     }
@@ -508,7 +514,8 @@ impl<M: Sync, const N: usize, K: Sync> UnrolledBatch<M, N, K> {
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) where
+    ) -> bool
+    where
         Self: Groups<N, A>,
     {
         #[cfg(target_arch = "x86_64")]
@@ -536,7 +543,8 @@ impl<M: Sync, const N: usize, K: Sync> UnrolledBatch<M, N, K> {
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) where
+    ) -> bool
+    where
         Self: Groups<N, A>,
     {
         self.group::<P, P::Wide>(c, room, lanes, rows, out)
@@ -552,7 +560,8 @@ impl<M: Sync, const N: usize, K: Sync> UnrolledBatch<M, N, K> {
         lanes: [[usize; WIDTH]; GROUP],
         rows: Rows<'_, P>,
         out: &mut [P],
-    ) where
+    ) -> bool
+    where
         Self: Groups<N, A>,
     {
         self.group::<P, P::Registers>(c, room, lanes, rows, out)

@@ -12,6 +12,7 @@ use super::precision::{KernelLanes, Precision};
 use super::{
     GROUP, Generated, Groups, LinkConstants, Rows, SineRoom, UnrolledBatch, gather_joined, unit_blocks,
 };
+use crate::batch::lane_states::non_finite_sum;
 use crate::batch::{Failure, WIDTH, first_bad_input, gather, scatter};
 use crate::error::{Error, Result};
 use crate::kinematics::{SINGULARITY_TOLERANCE, SphericalAngles};
@@ -177,9 +178,10 @@ impl<M: SpatialKernel<N>, const N: usize> Groups<N, { 2 * GROUP }> for UnrolledS
         lanes: [[usize; WIDTH]; GROUP],
         Rows { q, qd, torque, pivot }: Rows<'_, P>,
         out: &mut [P],
-    ) {
+    ) -> bool {
         let zero = P::Lanes::splat(0.0);
         let (count, m) = (c.len(), 2 * N);
+        let mut failed = V::none();
         for (angles, &lanes) in room.angles.chunks_exact_mut(2).zip(&lanes).take(count) {
             gather::<P, WIDTH>(q, lanes, m, P::flatten_mut(angles.as_flattened_mut()));
         }
@@ -209,6 +211,7 @@ impl<M: SpatialKernel<N>, const N: usize> Groups<N, { 2 * GROUP }> for UnrolledS
             if V::any(near) {
                 accelerations[0][0] = V::select(near, V::splat(f64::NAN), accelerations[0][0]);
             }
+            failed = V::or(failed, non_finite_sum(accelerations.as_flattened()).outside(0, 0));
             let mut result = [[[zero; N]; 2]; 2];
             for (coordinate, a) in accelerations.iter().enumerate() {
                 for (i, &a) in a.iter().enumerate() {
@@ -220,6 +223,7 @@ impl<M: SpatialKernel<N>, const N: usize> Groups<N, { 2 * GROUP }> for UnrolledS
                 scatter::<P, WIDTH>(P::flatten(result.as_flattened()), m, &mut out[rows]);
             }
         }
+        !V::any(failed)
     }
 }
 

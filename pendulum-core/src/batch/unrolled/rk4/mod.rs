@@ -17,6 +17,7 @@ use super::precision::{KernelLanes, Precision, join};
 use super::{GROUP, Groups, LinkConstants, SineRoom, UnrolledBatch, unit_blocks};
 use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 
+use crate::batch::lane_states::non_finite_sum;
 use crate::batch::{WIDTH, block_chains, check_len};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
@@ -282,14 +283,9 @@ where
         let (dq, dqd) = increment(&q, &qd, h, kernel);
         for u in 0..units {
             let arrays = C * u..C * (u + 1);
-            // Σ (δ − δ): +0 in a lane whose increment is finite, NaN otherwise.
-            let mut probe = zero;
-            for d in dq[arrays.clone()].as_flattened().iter().chain(dqd[arrays.clone()].as_flattened()) {
-                #[allow(clippy::eq_op)]
-                let nan_if_not_finite = *d - *d;
-                probe += nan_if_not_finite;
-            }
-            let stop = V::or(stopped[u], probe.outside(0, 0));
+            let increment = non_finite_sum(dq[arrays.clone()].as_flattened())
+                + non_finite_sum(dqd[arrays.clone()].as_flattened());
+            let stop = V::or(stopped[u], increment.outside(0, 0));
             stopped[u] = stop;
             let advance = |x: &mut V, carry: &mut V, delta: V| {
                 let (new, new_carry) = kahan_add(*x, *carry, delta);
