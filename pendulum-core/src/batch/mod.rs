@@ -151,6 +151,24 @@ pub(crate) fn check_states(states: &[State<Dyn>], chains: usize, m: usize) -> Re
     }
 }
 
+/// Checks that a run's held inputs hold `chains` rows: the torques (`None`: none) of `m`,
+/// the pivot accelerations (`None`: at rest) of `space`.
+pub(crate) fn check_held<T>(
+    (torque, pivot): (Option<&[T]>, Option<&[T]>),
+    chains: usize,
+    [m, space]: [usize; 2],
+) -> Result<()> {
+    if let Some(t) = torque {
+        check_len("torque", t, chains, m)?;
+    }
+    pivot.map_or(Ok(()), |p| check_len("pivot", p, chains, space))
+}
+
+/// [`Error::NonFinite`] naming `t0` unless a run's start time `t0` (s) is finite.
+pub(crate) fn check_t0(t0: f64) -> Result<()> {
+    if t0.is_finite() { Ok(()) } else { Err(Error::NonFinite { what: "t0", index: 0, value: t0 }) }
+}
+
 /// Checks that `v` holds `chains` rows of `per_chain` numbers.
 pub(crate) fn check_len<T>(what: &'static str, v: &[T], chains: usize, per_chain: usize) -> Result<()> {
     if v.len() == chains * per_chain {

@@ -17,8 +17,10 @@ use super::{
     Blocks, F32x8, F64x4, Failure, PlanarBatch, WIDTH_F32, block_chains, check_len, check_states,
     for_blocks_of, non_finite, one_of, simd_kernel,
 };
+use crate::batch::{check_held, check_t0};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
+use crate::integrate::check_step_size;
 use crate::integrate::{State, kahan_add};
 use crate::lanes::{Aligned, Lane, Lanes, Lanes32, Masked, one_row_at_a_time};
 
@@ -250,9 +252,7 @@ impl PlanarBatch {
         steps: usize,
     ) -> Result<Vec<Failure>> {
         let drive = self.pivots_of(drives)?;
-        if !t0.is_finite() {
-            return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
-        }
+        check_t0(t0)?;
         self.runs_f32((x, carry), (torque, None), (h, steps), Some((t0, &drive)))
     }
 
@@ -320,13 +320,8 @@ impl PlanarBatch {
 
     /// Checks a run's step and inputs: torques `B` rows of `n`, pivots `B` rows of 2.
     fn check_run<T>(&self, torque: Option<&[T]>, pivot: Option<&[T]>, h: f64) -> Result<()> {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
-        if let Some(torque) = torque {
-            check_len("torque", torque, self.len(), self.links)?;
-        }
-        pivot.map_or(Ok(()), |p| check_len("pivot", p, self.len(), 2))
+        check_step_size(h)?;
+        check_held((torque, pivot), self.len(), [self.links, 2])
     }
 
     simd_kernel! {

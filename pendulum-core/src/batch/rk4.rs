@@ -13,6 +13,7 @@ use super::{
 };
 use crate::drive::Drive;
 use crate::error::{Error, Result};
+use crate::integrate::check_step_size;
 use crate::integrate::{State, kahan_add};
 use crate::lanes::{Lane, Lanes, one_row_at_a_time};
 use crate::models::directions::project_link;
@@ -64,9 +65,7 @@ where
     /// other than `B` or a state of the wrong length, [`Error::InvalidStepSize`] for a
     /// non-finite or zero `h`.
     pub fn integrate_rk4(&self, states: &mut [State<Dyn>], h: f64, steps: usize) -> Result<Vec<Failure>> {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
+        check_step_size(h)?;
         self.check_states(states)?;
         let mut none = vec![(); states.len()];
         let plan = Plan { h, steps: steps as u64, every: steps.max(1) as u64 };

@@ -12,8 +12,10 @@ use super::{
     DirectionsBatch, F32x8, Failure, WIDTH_F32, block_chains, check_len, for_blocks_of, gather, non_finite,
     one_of, scatter, simd_kernel,
 };
+use crate::batch::check_t0;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
+use crate::integrate::check_step_size;
 use crate::lanes::{Aligned, Lane, Lanes32, one_row_at_a_time};
 use crate::models::directions::project_link;
 use crate::rods::Rods;
@@ -56,12 +58,8 @@ where
     /// [`Error::InvalidStepSize`] for a non-finite or zero `h`, [`Error::NonFinite`] for
     /// a non-finite `t0`.
     pub fn integrate_rk4_f32(&self, x: &mut [f32], t0: f64, h: f64, steps: usize) -> Result<Vec<Failure>> {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
-        if !t0.is_finite() {
-            return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
-        }
+        check_step_size(h)?;
+        check_t0(t0)?;
         check_len("x", x, self.len(), 2 * S::DIM * self.links())?;
         Ok(match S::DIM {
             2 => self.runs_f32::<2>(x, t0, h, steps),

@@ -17,7 +17,8 @@ use super::{
 use crate::chain::Chain;
 use crate::drive::Drive;
 use crate::energy::Accounted;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::integrate::check_step_size;
 use crate::integrate::{Integrator, State, kahan_add};
 use crate::lanes::{Aligned, Lane, Lanes, Masked};
 use crate::models::Directions;
@@ -131,9 +132,7 @@ where
         h: f64,
         steps: usize,
     ) -> Result<Vec<Failure>> {
-        if !h.is_finite() || h == 0.0 {
-            return Err(Error::InvalidStepSize { h });
-        }
+        check_step_size(h)?;
         self.check_states(states)?;
         Ok(match S::DIM {
             2 => self.midpoint_in::<2>(states, h, steps),

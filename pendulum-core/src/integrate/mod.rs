@@ -233,14 +233,17 @@ where
     }
 }
 
+/// [`Error::InvalidStepSize`] unless the step size `h` (s) is finite and not zero.
+pub(crate) fn check_step_size(h: f64) -> Result<()> {
+    if h.is_finite() && h != 0.0 { Ok(()) } else { Err(Error::InvalidStepSize { h }) }
+}
+
 /// Checks a step size and the state's length before a step.
 fn check_step<D: Dim>(expected: usize, x: &OVector<f64, D>, h: f64) -> Result<()>
 where
     DefaultAllocator: Allocator<D>,
 {
-    if !(h.is_finite() && h != 0.0) {
-        return Err(Error::InvalidStepSize { h });
-    }
+    check_step_size(h)?;
     if x.len() != expected {
         return Err(Error::LengthMismatch { what: "x", expected, got: x.len() });
     }

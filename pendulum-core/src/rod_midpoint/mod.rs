@@ -118,9 +118,7 @@ impl RodMidpoint {
         DefaultAllocator: Allocator<S>,
     {
         chain.check_state_slice(motion)?;
-        if !(h.is_finite() && h != 0.0) {
-            return Err(Error::InvalidStepSize { h });
-        }
+        crate::integrate::check_step_size(h)?;
         if S::DIM != 2 && S::DIM != 3 {
             return Err(Error::LengthMismatch { what: "space", expected: 3, got: S::DIM });
         }

@@ -26,6 +26,7 @@ pub use self::spatial::{SpatialKernel, UnrolledSpatialBatch};
 use self::precision::{KernelLanes, Precision, join};
 use super::lane_states::non_finite_sum;
 use super::{F64x4, Failure, WIDTH, all_finite, block_chains, check_len, for_blocks_of, gather, scatter};
+use crate::batch::check_held;
 use crate::error::{Error, Result};
 use crate::kinematics::PlanarAngles;
 use crate::lanes::{Lane, Lanes, Lanes32};
@@ -130,13 +131,7 @@ fn check_rows<P>(
     check_len("q", q, chains, m)?;
     check_len("qd", qd, chains, m)?;
     check_len("out", out, chains, m)?;
-    if let Some(t) = torque {
-        check_len("torque", t, chains, m)?;
-    }
-    if let Some(p) = pivot {
-        check_len("pivot", p, chains, space)?;
-    }
-    Ok(())
+    check_held((torque, pivot), chains, [m, space])
 }
 
 /// The chains whose rows of `out` (`m` each, the first chain `first`) are not all finite,

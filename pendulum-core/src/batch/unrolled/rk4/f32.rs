@@ -8,6 +8,7 @@
 use nalgebra::{U2, U3};
 
 use super::{Block, Pivot, Stages, check_run, drive_of, rk4_run_group};
+use crate::batch::check_t0;
 use crate::batch::unrolled::spatial::singular_angle;
 use crate::batch::unrolled::{
     GROUP, Groups, PlanarKernel, SineRoom, SpatialKernel, UnrolledBatch, UnrolledSpatialBatch,
@@ -132,9 +133,7 @@ where
     let space = <UnrolledBatch<M, N, K> as Groups<N, A>>::SPACE;
     check_run(h, chains, [m, space], (torque, pivot))?;
     let t0 = drive.map_or(0.0, |(t0, _)| t0);
-    if !t0.is_finite() {
-        return Err(Error::NonFinite { what: "t0", index: 0, value: t0 });
-    }
+    check_t0(t0)?;
     check_len("x", x, chains, 2 * m)?;
     check_len("carry", carry, chains, 2 * m)?;
     let forced = torque.is_some() || pivot.is_some() || drive.is_some();

@@ -17,10 +17,12 @@ use super::precision::{KernelLanes, Precision, join};
 use super::{GROUP, Groups, LinkConstants, SineRoom, UnrolledBatch, unit_blocks};
 use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 
+use crate::batch::check_held;
 use crate::batch::lane_states::non_finite_sum;
 use crate::batch::{WIDTH, block_chains, check_len};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
+use crate::integrate::check_step_size;
 use crate::integrate::kahan_add;
 use crate::lanes::Lane;
 
@@ -378,17 +380,9 @@ where
 /// Errors of a run's arguments: [`Error::InvalidStepSize`] for a zero or non-finite `h`,
 /// [`Error::LengthMismatch`] for held inputs not of `chains` rows (torques of `m`, pivot
 /// accelerations of `space`).
-fn check_run<P>(h: f64, chains: usize, [m, space]: [usize; 2], (torque, pivot): Held<'_, P>) -> Result<()> {
-    if !h.is_finite() || h == 0.0 {
-        return Err(Error::InvalidStepSize { h });
-    }
-    if let Some(t) = torque {
-        check_len("torque", t, chains, m)?;
-    }
-    if let Some(p) = pivot {
-        check_len("pivot", p, chains, space)?;
-    }
-    Ok(())
+fn check_run<P>(h: f64, chains: usize, [m, space]: [usize; 2], held: Held<'_, P>) -> Result<()> {
+    check_step_size(h)?;
+    check_held(held, chains, [m, space])
 }
 
 /// [`rk4_run`] compiled for AVX-512, in [`Precision::Wide`]: two blocks in each
