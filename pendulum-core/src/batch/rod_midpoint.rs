@@ -124,7 +124,8 @@ where
     ///
     /// Returns the chains that failed, in order, each left at the start of the step that
     /// failed, with that step's error; the others go on. Errors:
-    /// [`Error::InvalidStepSize`] for a zero or non-finite `h`, [`Error::LengthMismatch`]
+    /// [`Error::InvalidStepSize`](crate::Error::InvalidStepSize) for a zero or non-finite `h`,
+    /// [`Error::LengthMismatch`](crate::Error::LengthMismatch)
     /// for a number of states other than `B` or a state of the wrong length.
     pub fn integrate_rod_midpoint(
         &self,
