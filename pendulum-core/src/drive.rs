@@ -41,6 +41,11 @@ where
     fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
         (self.velocity(t), self.acceleration(t))
     }
+    /// `(p(t), ṗ(t))` at once, equal bit for bit to the two calls (an energy needs both;
+    /// the circles share `sin`, `cos` of the phase).
+    fn position_and_velocity(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (self.position(t), self.velocity(t))
+    }
 }
 
 impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for &D
@@ -59,6 +64,9 @@ where
     fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
         (**self).velocity_and_acceleration(t)
     }
+    fn position_and_velocity(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (**self).position_and_velocity(t)
+    }
 }
 
 impl<S: DimName, D: Drive<S> + ?Sized> Drive<S> for Box<D>
@@ -76,6 +84,9 @@ where
     }
     fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
         (**self).velocity_and_acceleration(t)
+    }
+    fn position_and_velocity(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
+        (**self).position_and_velocity(t)
     }
 }
 
@@ -245,6 +256,11 @@ impl Circle {
         (self.angular_frequency * t).sin_cos()
     }
 
+    /// `p = R (cos φ, sin φ, 0)` (m) from `(sin φ, cos φ)`.
+    fn position_from(&self, (s, c): (f64, f64)) -> Vector3<f64> {
+        Vector3::new(c, s, 0.0) * self.radius
+    }
+
     /// `ṗ = Rω (−sin φ, cos φ, 0)` (m/s) from `(sin φ, cos φ)`.
     fn velocity_from(&self, (s, c): (f64, f64)) -> Vector3<f64> {
         Vector3::new(-s, c, 0.0) * (self.radius * self.angular_frequency)
@@ -259,8 +275,7 @@ impl Circle {
 
 impl Drive<U3> for Circle {
     fn position(&self, t: f64) -> Vector3<f64> {
-        let (s, c) = self.turn(t);
-        Vector3::new(c, s, 0.0) * self.radius
+        self.position_from(self.turn(t))
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
         self.velocity_from(self.turn(t))
@@ -271,6 +286,10 @@ impl Drive<U3> for Circle {
     fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let turn = self.turn(t);
         (self.velocity_from(turn), self.acceleration_from(turn))
+    }
+    fn position_and_velocity(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let turn = self.turn(t);
+        (self.position_from(turn), self.velocity_from(turn))
     }
 }
 
@@ -410,6 +429,11 @@ impl RampedCircle {
 }
 
 impl RampedCircle {
+    /// `p = R (cos φ, sin φ, 0)` (m) from `(sin φ, cos φ)`.
+    fn position_from(&self, (s, c): (f64, f64)) -> Vector3<f64> {
+        Vector3::new(c, s, 0.0) * self.radius
+    }
+
     /// `ṗ = R φ̇ (−sin φ, cos φ, 0)` (m/s) from `(φ, φ̇, φ̈)` and `(sin φ, cos φ)`.
     fn velocity_from(&self, (_, rate, _): (f64, f64, f64), (s, c): (f64, f64)) -> Vector3<f64> {
         Vector3::new(-s, c, 0.0) * (self.radius * rate)
@@ -423,8 +447,7 @@ impl RampedCircle {
 
 impl Drive<U3> for RampedCircle {
     fn position(&self, t: f64) -> Vector3<f64> {
-        let (s, c) = self.angle(t).0.sin_cos();
-        Vector3::new(c, s, 0.0) * self.radius
+        self.position_from(self.angle(t).0.sin_cos())
     }
     fn velocity(&self, t: f64) -> Vector3<f64> {
         let angle = self.angle(t);
@@ -438,6 +461,11 @@ impl Drive<U3> for RampedCircle {
         let angle = self.angle(t);
         let turn = angle.0.sin_cos();
         (self.velocity_from(angle, turn), self.acceleration_from(angle, turn))
+    }
+    fn position_and_velocity(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let angle = self.angle(t);
+        let turn = angle.0.sin_cos();
+        (self.position_from(turn), self.velocity_from(angle, turn))
     }
 }
 

@@ -158,7 +158,8 @@ impl WhirlRuns {
     ) -> Result<Observer<'a>, WhirlStop> {
         let tracker = ShapeTracker::new(system.motion_system(), self.shape).map_err(|e| WhirlStop::of(&e))?;
         let balance = RunBalance::of_scale(self.energy_scale);
-        Ok(Observer { system, tracker, balance, initial_energy: None, push_error: None, stop })
+        let motion = DVector::zeros(system.motion_system().state_len());
+        Ok(Observer { system, tracker, balance, motion, initial_energy: None, push_error: None, stop })
     }
 
     /// One whirl with `drive` from the chain's state `start` (`None`: hanging at rest), by
@@ -270,6 +271,9 @@ pub struct Observer<'a> {
     system: &'a Accounted<WhirlModel>,
     tracker: ShapeTracker<'a, Box<dyn Turning>>,
     balance: RunBalance,
+    /// The motion's part of the latest sample (kept: a new array a sample was a few per
+    /// cent of an atlas).
+    motion: DVector<f64>,
     initial_energy: Option<f64>,
     push_error: Option<pendulum_core::Error>,
     stop: &'a (dyn Fn() -> bool + Sync),
@@ -281,8 +285,9 @@ impl Observer<'_> {
     pub fn sample(&mut self, t: f64, x: &DVector<f64>) -> ControlFlow<()> {
         let energy = self.system.energy(t, x);
         self.balance.add(energy, &self.system.ledger(x), *self.initial_energy.get_or_insert(energy));
-        let motion_len = self.system.motion_system().state_len();
-        if let Err(e) = self.tracker.push(t, &x.rows(0, motion_len).into_owned()) {
+        let motion_len = self.motion.len();
+        self.motion.copy_from(&x.rows(0, motion_len));
+        if let Err(e) = self.tracker.push(t, &self.motion) {
             self.push_error = Some(e);
             return ControlFlow::Break(());
         }

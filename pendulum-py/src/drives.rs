@@ -349,4 +349,11 @@ impl Drive<U3> for Pivot {
             Self::Ramped(d) => d.velocity_and_acceleration(t),
         }
     }
+    fn position_and_velocity(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        match self {
+            Self::Harmonic(d) => d.position_and_velocity(t),
+            Self::Circle(d) => d.position_and_velocity(t),
+            Self::Ramped(d) => d.position_and_velocity(t),
+        }
+    }
 }

@@ -171,19 +171,28 @@ where
                 }
                 into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, &mut s.carry);
                 let ran = alive;
-                // Chain `k` of the block out of its lane into its state, and sampled.
-                let take_sample =
-                    |k: usize, s: &Scratch<C, W>, block: &mut [(&mut State<Dyn>, &mut T)]| -> bool {
-                        let Some(sample) = sample else { return false };
-                        let (state, observer) = &mut block[k];
-                        let x = s.x.iter().zip(&s.carry).map(|(x, carry)| (x.0[k], carry.0[k]));
-                        state.set_parts(s.t[0].0[k], s.t[1].0[k], x);
-                        sample(observer, state.t(), state.x()).is_break()
+                // The chains of the block flagged in `which` out of their lanes into their
+                // states, by one transpose of the block (lane by lane, with a stride of a
+                // row, this was a tenth of an atlas), then each sampled: the lanes whose
+                // observer stops the run.
+                let take_samples =
+                    |which: [u64; W], s: &Scratch<C, W>, block: &mut [(&mut State<Dyn>, &mut T)]| {
+                        let mut stopped = [false; W];
+                        let Some(sample) = sample else { return stopped };
+                        let states = block.iter_mut().map(|(state, _)| &mut **state);
+                        out_of_lanes(states, which, m, (&s.t, &s.x, &s.carry));
+                        for ((stopped, (state, observer)), _) in
+                            stopped.iter_mut().zip(block.iter_mut()).zip(which).filter(|(_, k)| *k != 0)
+                        {
+                            *stopped = sample(observer, state.t(), state.x()).is_break();
+                        }
+                        stopped
                     };
-                for (k, end) in ends.iter_mut().enumerate() {
-                    if alive[k] != 0 && take_sample(k, s, block) {
+                let stopped = take_samples(alive, s, block);
+                for ((end, alive), stopped) in ends.iter_mut().zip(&mut alive).zip(stopped) {
+                    if stopped {
                         end.stopped = true;
-                        alive[k] = 0;
+                        *alive = 0;
                     }
                 }
                 let mut done = 0u64;
@@ -204,13 +213,14 @@ where
                         }
                     }
                     done += chunk;
-                    for (k, end) in ends.iter_mut().enumerate() {
-                        if alive[k] != 0 {
-                            (end.steps, end.samples) = (done, end.samples + u64::from(sample.is_some()));
-                            if take_sample(k, s, block) {
-                                end.stopped = done < plan.steps;
-                                alive[k] = 0;
-                            }
+                    for (end, _) in ends.iter_mut().zip(alive).filter(|(_, alive)| *alive != 0) {
+                        (end.steps, end.samples) = (done, end.samples + u64::from(sample.is_some()));
+                    }
+                    let stopped = take_samples(alive, s, block);
+                    for ((end, alive), stopped) in ends.iter_mut().zip(&mut alive).zip(stopped) {
+                        if stopped {
+                            end.stopped = done < plan.steps;
+                            *alive = 0;
                         }
                     }
                 }
@@ -294,12 +304,14 @@ where
         if let Some(velocity) = velocity {
             self.ledger_rates::<C, W>(block, x, (velocity, pivot), k1);
         }
-        // k_{j+1} = f(t + c h, y) at y = x + a k_j, y formed in the stage's pass.
-        let stages = [(at(half), half_lanes), (at(half), half_lanes), (at(h), h_lanes)];
+        // k_{j+1} = f(t + c h, y) at y = x + a k_j, y formed in the stage's pass; the two
+        // stages at t + h/2 ask the drives once.
+        let middle = self.pivot_motion::<C, W>(chains, at(half), accounted);
+        let end = self.pivot_motion::<C, W>(chains, at(h), accounted);
+        let stages = [(middle, half_lanes), (middle, half_lanes), (end, h_lanes)];
         let mut ks = [&mut **k1, &mut **k2, &mut **k3, &mut **k4];
-        for (j, (t, a)) in stages.into_iter().enumerate() {
+        for (j, ((pivot, velocity), a)) in stages.into_iter().enumerate() {
             let [.., before, next] = &mut ks[..j + 2] else { unreachable!("two stages") };
-            let (pivot, velocity) = self.pivot_motion::<C, W>(chains, t, accounted);
             self.stage::<C, W>(block, pivot, (x, a, before), y, rows, next);
             if let Some(velocity) = velocity {
                 self.ledger_rates::<C, W>(block, y, (velocity, pivot), next);

@@ -20,6 +20,8 @@ where
         let (both_v, both_a) = drive.velocity_and_acceleration(t);
         let bits = |x: &OVector<f64, S>| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!((bits(&both_v), bits(&both_a)), (bits(&v), bits(&a)), "t = {t}");
+        let (both_p, both_v) = drive.position_and_velocity(t);
+        assert_eq!((bits(&both_p), bits(&both_v)), (bits(&drive.position(t)), bits(&v)), "t = {t}");
     }
 }
 
@@ -91,6 +93,9 @@ fn assert_consistent_at(drive: &impl Drive<U3>, times: &[f64]) {
         let (both_v, both_a) = drive.velocity_and_acceleration(t);
         let bits = |x: &Vector3<f64>| x.map(f64::to_bits);
         assert_eq!((bits(&both_v), bits(&both_a)), (bits(&v), bits(&a)), "t = {t}: both at once");
+        let (both_p, both_v) = drive.position_and_velocity(t);
+        let position = (bits(&both_p), bits(&both_v));
+        assert_eq!(position, (bits(&drive.position(t)), bits(&v)), "t = {t}: position and velocity");
     }
 }
 

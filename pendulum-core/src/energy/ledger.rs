@@ -320,10 +320,10 @@ where
     /// mass hanging from link `j`, `M = M_1`), and the damping loss
     /// `P_damping = 2D = Σ_i λ_i |w_i|²` (W).
     fn flow_and_powers(&self, t: f64, x: &[f64], out: &mut [f64]) -> Result<Powers> {
-        self.flow(t, x, out)?;
+        // The pivot's motion from one evaluation of the drive (one `sincos` for a circle).
+        let (pivot_velocity, pivot_acceleration) = self.drive().velocity_and_acceleration(t);
+        self.flow_at_pivot(&pivot_acceleration, x, out)?;
         let c = self.chain();
-        let drive = self.drive();
-        let (pivot_velocity, pivot_acceleration) = (drive.velocity(t), drive.acceleration(t));
         let half = x.len() / 2;
         let (w, wd) = (&x[half..], &out[half..]);
         let (tails, lengths, damping) =
@@ -348,7 +348,7 @@ where
     }
 
     fn inertial_energy(&self, t: f64, x: &[f64]) -> f64 {
-        Directions::inertial_energy(self, t, &DVector::from_column_slice(x))
+        self.inertial_energy_of(t, x)
     }
 }
 

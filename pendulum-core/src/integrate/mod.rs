@@ -137,7 +137,12 @@ where
 
     /// `t += h`, `x += increment` with compensated (Kahan) summation.
     pub(crate) fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
-        self.advance_by(h, |i, _| increment[i]);
+        debug_assert_eq!(increment.len(), self.x.len(), "an increment per entry");
+        (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
+        let x = self.x.as_mut_slice().iter_mut().zip(self.x_carry.as_mut_slice());
+        for ((x, carry), &delta) in x.zip(increment.as_slice()) {
+            (*x, *carry) = kahan_add(*x, *carry, delta);
+        }
     }
 
     /// [`advance`](Self::advance) by the increments `increment(i, x_i)`, asked in order.

@@ -4,6 +4,7 @@ use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 
 use super::{Integrator, State, Stats, System, SystemAlloc, check_step};
 use crate::error::{Error, Result};
+use crate::model::all_finite;
 
 /// Classical RK4 for a system of dimension `D`:
 /// ```text
@@ -90,10 +91,17 @@ where
             return Err(e);
         }
         // The increment, reusing y: h/6 (k1 + 2 k2 + 2 k3 + k4).
-        for i in 0..self.y.len() {
-            self.y[i] = h / 6.0 * (self.k1[i] + 2.0 * (self.k2[i] + self.k3[i]) + self.k4[i]);
+        // Slices zipped, not indexed, and the finiteness in one pass that vectorises:
+        // indexed, with a bounds check per vector and the stages' pointers reloaded after
+        // every store, these two loops were a sixth of a whirl of 20 links run alone (and
+        // nalgebra's iterators, which follow strides, twice that).
+        let sixth = h / 6.0;
+        let [k1, k2, k3, k4] = [&self.k1, &self.k2, &self.k3, &self.k4].map(|k| k.as_slice());
+        let stages = k1.iter().zip(k2).zip(k3.iter().zip(k4));
+        for (y, ((k1, k2), (k3, k4))) in self.y.as_mut_slice().iter_mut().zip(stages) {
+            *y = sixth * (k1 + 2.0 * (k2 + k3) + k4);
         }
-        if !self.y.iter().all(|v| v.is_finite()) {
+        if !all_finite(self.y.as_slice()) {
             self.stats.failed_steps += 1;
             return Err(Error::NonFiniteState { t, h });
         }

@@ -146,17 +146,21 @@ where
     }
 
     fn cumulative(&self, x: &DVector<f64>, first: usize) -> Vec<OVector<f64, S>> {
+        self.running_sums(x.as_slice(), first).collect()
+    }
+
+    /// `Σ_{j≤i} l_j x_{first + j}` for each link `i` in turn (`x_j` the `j`-th vector of
+    /// `S` entries of `x`), one at a time: no array of them.
+    fn running_sums<'a>(&'a self, x: &'a [f64], first: usize) -> impl Iterator<Item = OVector<f64, S>> + 'a {
         let lengths = self.chain.lengths();
         let mut sum = OVector::<f64, S>::zeros();
-        (0..self.links())
-            .map(|i| {
-                let base = (first + i) * S::DIM;
-                for k in 0..S::DIM {
-                    sum[k] += lengths[i] * x[base + k];
-                }
-                sum.clone()
-            })
-            .collect()
+        (0..self.links()).map(move |i| {
+            let base = (first + i) * S::DIM;
+            for k in 0..S::DIM {
+                sum[k] += lengths[i] * x[base + k];
+            }
+            sum.clone()
+        })
     }
 
     /// Kinetic energy relative to the pivot, `T = ½ Σ m_i |Σ_{j≤i} l_j w_j|²` (J).
@@ -217,6 +221,18 @@ where
     where
         Dr: Drive<S>,
     {
+        self.accelerations_at_pivot(&self.drive.acceleration(t), x, out, tensions)
+    }
+
+    /// [`accelerations_of_valid`](Self::accelerations_of_valid) with the pivot's
+    /// acceleration `p̈` (m/s²) given.
+    fn accelerations_at_pivot(
+        &self,
+        pivot: &OVector<f64, S>,
+        x: &[f64],
+        out: &mut [f64],
+        tensions: Option<&mut [f64]>,
+    ) -> Result<()> {
         let n = self.links();
         if out.len() != S::DIM * n {
             return Err(Error::LengthMismatch { what: "out", expected: S::DIM * n, got: out.len() });
@@ -226,7 +242,6 @@ where
         {
             return Err(Error::LengthMismatch { what: "tensions", expected: n, got: t.len() });
         }
-        let pivot = self.drive.acceleration(t);
         match S::DIM {
             2 => self.solve::<2>(x, [pivot[0], pivot[1]], out, tensions),
             3 => self.solve::<3>(x, [pivot[0], pivot[1], pivot[2]], out, tensions),
@@ -241,6 +256,11 @@ where
     where
         Dr: Drive<S>,
     {
+        self.flow_at_pivot(&self.drive.acceleration(t), x, out)
+    }
+
+    /// [`flow`](Self::flow) with the pivot's acceleration `p̈` (m/s²) given.
+    pub(crate) fn flow_at_pivot(&self, pivot: &OVector<f64, S>, x: &[f64], out: &mut [f64]) -> Result<()> {
         let half = S::DIM * self.links();
         if out.len() != 2 * half {
             return Err(Error::LengthMismatch { what: "out", expected: 2 * half, got: out.len() });
@@ -248,7 +268,7 @@ where
         self.check_state_slice(x)?;
         let (velocity, acceleration) = out.split_at_mut(half);
         velocity.copy_from_slice(&x[half..]);
-        self.accelerations_of_valid(t, x, acceleration, None)
+        self.accelerations_at_pivot(pivot, x, acceleration, None)
     }
 
     /// The tension solve for `C`-dimensional space (`C = S::DIM`).
@@ -312,19 +332,23 @@ where
     /// The inertial-frame energy `H = ½ Σ m_i |ṗ + v_i|² + Σ m_i g (p + r_i)·e_up` (J) of a
     /// driven chain (`v_i`, `r_i` relative to the pivot).
     pub fn inertial_energy(&self, t: f64, x: &DVector<f64>) -> f64 {
+        self.inertial_energy_of(t, x.as_slice())
+    }
+
+    /// [`inertial_energy`](Self::inertial_energy) of a state held as a slice, without an
+    /// array (an energy is taken at every sample of a whirl).
+    pub(crate) fn inertial_energy_of(&self, t: f64, x: &[f64]) -> f64 {
         let (masses, g) = (self.chain.masses(), self.chain.gravity());
-        let (p, pd) = (self.drive.position(t), self.drive.velocity(t));
+        let (p, pd) = self.drive.position_and_velocity(t);
         let kinetic: f64 = self
-            .relative_velocities(x)
-            .iter()
+            .running_sums(x, self.links())
             .zip(masses.iter())
             .map(|(v, m)| 0.5 * m * (v + &pd).norm_squared())
             .sum();
         let height = p[S::DIM - 1];
         kinetic
             + self
-                .relative_positions(x)
-                .iter()
+                .running_sums(x, 0)
                 .zip(masses.iter())
                 .map(|(r, m)| m * g * (height + r[S::DIM - 1]))
                 .sum::<f64>()
