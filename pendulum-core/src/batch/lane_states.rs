@@ -11,17 +11,19 @@ use crate::lanes::has_avx2;
 use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
 
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
-/// into `t`, the states into `x`, their compensations into `carry`. Compiled for AVX2 where
-/// the CPU has it, so that the tiles' transposes are inlined (called tile by tile from code
-/// without AVX2, getting a whirl's states into lanes and back was a quarter of a one-step
-/// call).
+/// into `t`, the states into `x`, their compensations into `carry`. Returns the lanes whose
+/// state has an entry that is not finite (flag `1`), found in lanes where the numbers
+/// arrive (before the search for the entry, chain by chain in code without AVX2, was a
+/// twelfth of a one-step call). Compiled for AVX2 where the CPU has it, so that the tiles'
+/// transposes are inlined (called tile by tile from code without AVX2, getting a whirl's
+/// states into lanes and back was a quarter of a one-step call).
 pub(super) fn into_lanes<const W: usize>(
     states: [&State<Dyn>; W],
     m: usize,
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
     carry: &mut [Lanes<W>],
-) {
+) -> [u64; W] {
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: the CPU has AVX2, checked just above.
@@ -39,7 +41,7 @@ fn into_lanes_avx2<const W: usize>(
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
     carry: &mut [Lanes<W>],
-) {
+) -> [u64; W] {
     fill_lanes(states, m, t, x, carry)
 }
 
@@ -51,11 +53,12 @@ fn fill_lanes<const W: usize>(
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
     carry: &mut [Lanes<W>],
-) {
+) -> [u64; W] {
     let parts = states.map(State::parts);
     *t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
     gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(x));
     gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
+    non_finite_lanes(&x[..m])
 }
 
 /// The block's states (up to `W`, lane `k` for the `k`-th) that `ran` (flag `1`) out
@@ -112,8 +115,22 @@ fn empty_lanes<const W: usize>(
 /// The lanes in which some entry of `v` is not finite (flag `1`).
 #[inline(always)]
 pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
-    let total = non_finite_sum(v);
+    nan_lanes(non_finite_sum(v))
+}
+
+/// The lanes of `total` that are NaN (flag `1`): of a sum of [`nan_unless_finite`]s, the
+/// lanes in which some term was not finite.
+#[inline(always)]
+pub(super) fn nan_lanes<const W: usize>(total: Lanes<W>) -> [u64; W] {
     std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
+}
+
+/// `y − y`: `0` for a finite `y`, NaN otherwise (lane by lane); summed, NaN where any
+/// term was not finite.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
+pub(super) fn nan_unless_finite<V: Lane>(y: V) -> V {
+    y - y
 }
 
 /// [`non_finite_lanes`] in single precision.
@@ -128,18 +145,17 @@ pub(super) fn non_finite_lanes_f32<const W: usize>(v: &[Lanes32<W>]) -> [u32; W]
 /// each addition; a per-lane loop of flags was vectorised across entries and transposed
 /// back, with spills).
 #[inline(always)]
-#[allow(clippy::eq_op)] // `y − y` on purpose: 0 or NaN.
 pub(super) fn non_finite_sum<V: Lane>(v: &[V]) -> V {
     let mut sums = [V::splat(0.0); 4];
     let mut quads = v.chunks_exact(4);
     for quad in quads.by_ref() {
         for (sum, y) in sums.iter_mut().zip(quad) {
-            *sum += *y - *y;
+            *sum += nan_unless_finite(*y);
         }
         one_row_at_a_time();
     }
     for (sum, y) in sums.iter_mut().zip(quads.remainder()) {
-        *sum += *y - *y;
+        *sum += nan_unless_finite(*y);
     }
     (sums[0] + sums[1]) + (sums[2] + sums[3])
 }

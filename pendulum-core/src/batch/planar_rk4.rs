@@ -21,7 +21,7 @@ use crate::batch::{check_held, check_t0};
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::check_step_size;
-use crate::integrate::{State, kahan_add};
+use crate::integrate::{State, kahan_add, rk4_weighted};
 use crate::lanes::{Aligned, Lane, Lanes, Lanes32, Masked, one_row_at_a_time};
 
 /// A block's run: `sin θ`, `cos θ` of a stage and the solve's room (`n` lanes), the joint
@@ -173,11 +173,12 @@ impl PlanarBatch {
                 let s = &mut **room;
                 let ids = block_chains::<W>(b, self.len());
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
-                let (mut failures, ran) =
-                    start(s, (ids, block.len(), n), (torque, pivot), |k| block[k].x().as_slice());
-                let mut alive = ran.map(u64::from);
                 let mut t = [Lanes([0.0; W]); 2];
-                into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
+                let suspect = into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
+                // A state's entry searched for only where the lanes found one.
+                let x = |k: usize| (suspect[k] != 0).then(|| block[k].x().as_slice());
+                let (mut failures, ran) = start(s, (ids, block.len(), n), (torque, pivot), x);
+                let mut alive = ran.map(u64::from);
                 let (constants, lanes_h) = (one_of(blocks, b), Lanes([h; W]));
                 for _ in 0..steps {
                     if alive == [0; W] {
@@ -278,7 +279,7 @@ impl PlanarBatch {
             || self.rooms.take(|| Run::<F32x8>::new(n)),
             |s, b, block| {
                 let (ids, count) = (block_chains::<WIDTH_F32>(b, self.len()), block.len());
-                let (mut failures, ran) = start(s, (ids, count, n), (torque, pivot), |k| &*block[k].0);
+                let (mut failures, ran) = start(s, (ids, count, n), (torque, pivot), |k| Some(&*block[k].0));
                 let mut alive = ran.map(u32::from);
                 let lanes: [usize; WIDTH_F32] = std::array::from_fn(|k| k.min(count - 1));
                 gather_rows(lanes.map(|k| &*block[k].0), m, Lanes32::flatten_mut(&mut s.x));
@@ -353,9 +354,9 @@ impl PlanarBatch {
                 one_row_at_a_time();
             }
             rates(block, at(2), y, (sin, cos, work), k4);
-            let (sixth, two) = (V::splat(h / 6.0), V::splat(2.0));
+            let sixth = V::splat(h / 6.0);
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
-                *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
+                *y = rk4_weighted(sixth, [*k1, *k2, *k3, *k4]);
                 one_row_at_a_time();
             }
             let bad = V::non_finite(y);
@@ -381,13 +382,13 @@ type RunArgs<'s, 'a> = (&'s mut [State<Dyn>], Inputs<'a, f64>, (f64, usize));
 type PivotAt<'a> = &'a (dyn Fn(usize, f64) -> [f64; 2] + Sync);
 
 /// A block's start: its first `count` chains `ids` (of `n` links) with a non-finite state
-/// (`x(k)` for chain `ids[k]`) or input, as failures; which ones can step; the inputs into
-/// lanes.
+/// (`x(k)` for chain `ids[k]`; `None` for a state already known finite) or input, as
+/// failures; which ones can step; the inputs into lanes.
 fn start<'x, V: RunLane, const W: usize>(
     s: &mut Run<V>,
     (ids, count, n): ([usize; W], usize, usize),
     (torque, pivot): Inputs<'_, V::Num>,
-    x: impl Fn(usize) -> &'x [V::Num],
+    x: impl Fn(usize) -> Option<&'x [V::Num]>,
 ) -> (Vec<Failure>, [bool; W])
 where
     V::Num: 'x,
@@ -395,7 +396,8 @@ where
     let mut failures = Vec::new();
     let mut ok = [false; W];
     for (k, &c) in ids.iter().enumerate().take(count) {
-        let bad = non_finite("x", x(k))
+        let bad = x(k)
+            .and_then(|x| non_finite("x", x))
             .or_else(|| torque.and_then(|t| non_finite("torque", &t[c * n..(c + 1) * n])))
             .or_else(|| pivot.and_then(|p| non_finite("pivot_acceleration", &p[2 * c..2 * c + 2])));
         match bad {

@@ -7,14 +7,14 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::{Block, Scratch};
-use super::lane_states::{into_lanes, non_finite_lanes, out_of_lanes};
+use super::lane_states::{into_lanes, nan_lanes, nan_unless_finite, out_of_lanes};
 use super::{
     Blocks, Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, one_of, simd_kernel,
 };
 use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::check_step_size;
-use crate::integrate::{State, kahan_add};
+use crate::integrate::{State, kahan_add, rk4_weighted};
 use crate::lanes::{Lane, Lanes, one_row_at_a_time};
 use crate::models::directions::project_link;
 
@@ -163,13 +163,14 @@ where
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
                 let mut alive = [0u64; W];
-                for (k, (state, _)) in block.iter().enumerate() {
-                    match non_finite("x", state.x().as_slice()) {
+                let suspect = into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, &mut s.carry);
+                for ((k, (state, _)), suspect) in block.iter().enumerate().zip(suspect) {
+                    // The entry named only where the lanes found one.
+                    match (suspect != 0).then(|| non_finite("x", state.x().as_slice())).flatten() {
                         Some(error) => ends[k].failure = Some((error, 0)),
                         None => alive[k] = 1,
                     }
                 }
-                into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, &mut s.carry);
                 let ran = alive;
                 // The chains of the block flagged in `which` out of their lanes into their
                 // states, by one transpose of the block (lane by lane, with a stride of a
@@ -233,10 +234,9 @@ where
 
     simd_kernel! {
         /// One step of `Projected<Rk4>` in lanes, applied only in the `alive` lanes: the
-        /// increment ([`rk4_increment`](Self::rk4_increment)), then `t += h` and `x += increment`
-        /// by compensated summation ([`State`]'s), the projection of every link
-        /// ([`Constrained::project`]) and the compensation cleared, as `Projected` does. Returns
-        /// the alive lanes whose increment was not finite (left as they were).
+        /// stages ([`rk4_stages`](Self::rk4_stages)), then `t += h` and the new state
+        /// ([`rk4_advance`](Self::rk4_advance)) and the compensation cleared, as `Projected`
+        /// does. Returns the alive lanes whose increment was not finite (left as they were).
         fn rk4_step<const C: usize, const W: usize>(
             &self,
             block: &Block<W>,
@@ -245,28 +245,16 @@ where
             alive: [u64; W],
             s: &mut Scratch<C, W>,
         ) -> [u64; W] {
-            self.rk4_increment::<C, W>(block, chains, s.t[0].0, h, s);
-            let bad = non_finite_lanes(&s.y);
+            self.rk4_stages::<C, W>(block, chains, s.t[0].0, h, s);
+            let bad = self.rk4_advance::<C, W>(h, s);
             let keep: [u64; W] = std::array::from_fn(|k| alive[k] & !bad[k]);
             let [t, t_carry] = &mut s.t;
             let (new_t, new_carry) = kahan_add(*t, *t_carry, Lanes([h; W]));
             (*t, *t_carry) = (Lanes::select(keep, new_t, *t), Lanes::select(keep, new_carry, *t_carry));
             let zero = Lanes([0.0; W]);
-            // k1 is spent: the next state goes there. (Each loop over rows ends with
-            // `one_row_at_a_time`.)
-            let next = &mut s.k[0];
-            for (((next, x), carry), y) in next.iter_mut().zip(&s.x).zip(&s.carry).zip(&s.y) {
-                (*next, _) = kahan_add(*x, *carry, *y);
-                one_row_at_a_time();
-            }
-            let (u, w) = next[..2 * C * self.links()].split_at_mut(C * self.links());
-            for (u, w) in u.chunks_exact_mut(C).zip(w.chunks_exact_mut(C)) {
-                project_link(u, w);
-                one_row_at_a_time();
-            }
             if keep.iter().all(|&k| k != 0) {
-                // Every lane steps (the common case): the next state becomes the state, no
-                // copy (k1 is overwritten by the next step either way).
+                // Every lane steps (the common case): the next state, in k1, becomes the
+                // state, no copy (k1 is overwritten by the next step either way).
                 std::mem::swap(&mut s.x, &mut s.k[0]);
                 s.carry.fill(zero);
             } else {
@@ -281,9 +269,9 @@ where
         dispatch fn rk4_step_simd, rk4_step_avx2, avx512 rk4_step_avx512
     }
     /// The RK4 stages of [`Rk4`](crate::integrate::Rk4) in lanes, from `s.x` at times `t`,
-    /// leaving the increment `h (k1 + 2 k2 + 2 k3 + k4) / 6` in `s.y`.
+    /// into `s.k`.
     #[inline(always)]
-    fn rk4_increment<const C: usize, const W: usize>(
+    fn rk4_stages<const C: usize, const W: usize>(
         &self,
         block: &Block<W>,
         chains: [usize; W],
@@ -317,12 +305,66 @@ where
                 self.ledger_rates::<C, W>(block, y, (velocity, pivot), next);
             }
         }
-        let [k1, k2, k3, k4] = ks;
-        let (sixth, two) = (Lanes([h / 6.0; W]), Lanes([2.0; W]));
-        // Zipped, not indexed: four bounds checks per number were a tenth of the step.
-        for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
-            *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
+    }
+
+    /// The end of a step of `Projected<Rk4>`, row by row in one pass: the increment
+    /// `y = (h/6)·(k1 + 2 (k2 + k3) + k4)` ([`rk4_weighted`]), the sum `x + y` with the
+    /// state's compensation ([`State`]'s; the compensation it leaves is dropped, as
+    /// `Projected` clears it) and each link projected as soon as its rows are summed
+    /// ([`project_link`]), into `k1`. Returns the lanes whose increment is not finite.
+    /// (In passes of their own, the increment, its finiteness, the sum and the projection
+    /// went over the block's rows five times.)
+    #[inline(always)]
+    fn rk4_advance<const C: usize, const W: usize>(&self, h: f64, s: &mut Scratch<C, W>) -> [u64; W] {
+        let half = C * self.links();
+        let sixth = Lanes([h / 6.0; W]);
+        let zero = Lanes([0.0; W]);
+        let [k1, k2, k3, k4] = &mut s.k;
+        let (x, carry) = (&s.x[..], &s.carry[..]);
+        let (k1_motion, k1_rest) = k1.split_at_mut(2 * half);
+        let (k1u, k1w) = k1_motion.split_at_mut(half);
+        let links = (k1u.chunks_exact_mut(C).zip(k1w.chunks_exact_mut(C)))
+            .zip(link_rows::<_, C>(k2, half))
+            .zip(link_rows::<_, C>(k3, half).zip(link_rows::<_, C>(k4, half)))
+            .zip(link_rows::<_, C>(x, half).zip(link_rows::<_, C>(carry, half)));
+        let mut sums = [zero; C];
+        for ((((k1u, k1w), (k2u, k2w)), ((k3u, k3w), (k4u, k4w))), ((xu, xw), (cu, cw))) in links {
+            let (mut u, mut w) = ([zero; C], [zero; C]);
+            for c in 0..C {
+                let y = rk4_weighted(sixth, [k1u[c], k2u[c], k3u[c], k4u[c]]);
+                (u[c], _) = kahan_add(xu[c], cu[c], y);
+                let z = rk4_weighted(sixth, [k1w[c], k2w[c], k3w[c], k4w[c]]);
+                (w[c], _) = kahan_add(xw[c], cw[c], z);
+                sums[c] += nan_unless_finite(y) + nan_unless_finite(z);
+            }
+            project_link(&mut u, &mut w);
+            k1u.copy_from_slice(&u);
+            k1w.copy_from_slice(&w);
             one_row_at_a_time();
         }
+        let rest = (k2[2 * half..].iter().zip(&k3[2 * half..]))
+            .zip(k4[2 * half..].iter().zip(&x[2 * half..]))
+            .zip(&carry[2 * half..]);
+        for (k1, (((k2, k3), (k4, x)), carry)) in k1_rest.iter_mut().zip(rest) {
+            let y = rk4_weighted(sixth, [*k1, *k2, *k3, *k4]);
+            (*k1, _) = kahan_add(*x, *carry, y);
+            sums[0] += nan_unless_finite(y);
+            one_row_at_a_time();
+        }
+        let mut total = zero;
+        for sum in sums {
+            total += sum;
+        }
+        nan_lanes(total)
     }
 }
+
+/// A state `[u | w | …]` (`half` = `C·n` rows of directions `u`, then as many of rates `w`)
+/// link by link: each link's `C` rows of `u` beside its `C` rows of `w`.
+#[inline(always)]
+fn link_rows<V, const C: usize>(v: &[V], half: usize) -> LinkRows<'_, V> {
+    v[..half].chunks_exact(C).zip(v[half..2 * half].chunks_exact(C))
+}
+
+/// [`link_rows`]' iterator.
+type LinkRows<'a, V> = std::iter::Zip<std::slice::ChunksExact<'a, V>, std::slice::ChunksExact<'a, V>>;

@@ -15,7 +15,7 @@ use super::{
 use crate::batch::check_t0;
 use crate::drive::Drive;
 use crate::error::{Error, Result};
-use crate::integrate::check_step_size;
+use crate::integrate::{check_step_size, rk4_weighted};
 use crate::lanes::{Aligned, Lane, Lanes32, one_row_at_a_time};
 use crate::models::directions::project_link;
 use crate::rods::Rods;
@@ -138,9 +138,9 @@ where
             solve.stage(rods, g, middle, x, a_half, k1, y, k2);
             solve.stage(rods, g, middle, x, a_half, k2, y, k3);
             solve.stage(rods, g, end, x, a_full, k3, y, k4);
-            let (sixth, two) = (F32x8::splat(h / 6.0), F32x8::splat(2.0));
+            let sixth = F32x8::splat(h / 6.0);
             for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&**k1).zip(k2.iter().zip(&**k3)).zip(&**k4) {
-                *y = sixth * (*k1 + two * (*k2 + *k3) + *k4);
+                *y = rk4_weighted(sixth, [*k1, *k2, *k3, *k4]);
                 one_row_at_a_time();
             }
             let bad = non_finite_lanes_f32(y);

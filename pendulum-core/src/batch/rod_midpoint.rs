@@ -187,6 +187,8 @@ where
             let chains = block_chains::<W>(b, self.len());
             room.set_masses(chains.map(|k| self.model(k).chain()));
             let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
+            // Its flags of non-finite states go unused: such a lane does not step in lanes,
+            // and the chain alone reports its error (`single_step`).
             into_lanes(lanes.map(|k| &block[k]), m, &mut room.t, &mut room.x, &mut room.carry);
             let mut alive = [0u64; W];
             alive[..block.len()].fill(1);

@@ -44,6 +44,7 @@ pub use fixed_point::GaussFixedPoint;
 pub use gauss::{GaussAlloc, GaussLegendre, GaussOptions};
 pub use projected::{Constrained, Projected};
 pub use rk4::Rk4;
+pub(crate) use rk4::rk4_weighted;
 pub use system::{System, SystemAlloc, central_difference_jacobian};
 pub use tableau::{GAUSS_1, GAUSS_2, GAUSS_3, GaussStages, Tableau};
 
@@ -138,20 +139,22 @@ where
     /// `t += h`, `x += increment` with compensated (Kahan) summation.
     pub(crate) fn advance(&mut self, h: f64, increment: &OVector<f64, D>) {
         debug_assert_eq!(increment.len(), self.x.len(), "an increment per entry");
-        (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
-        let x = self.x.as_mut_slice().iter_mut().zip(self.x_carry.as_mut_slice());
-        for ((x, carry), &delta) in x.zip(increment.as_slice()) {
-            (*x, *carry) = kahan_add(*x, *carry, delta);
-        }
+        self.advance_with(h, increment.as_slice(), |_, &delta| delta);
     }
 
-    /// [`advance`](Self::advance) by the increments `increment(i, x_i)`, asked in order.
-    pub(crate) fn advance_by(&mut self, h: f64, mut increment: impl FnMut(usize, f64) -> f64) {
+    /// [`advance`](Self::advance) by the increments `increment(x_i, d_i)`, asked in order,
+    /// one per item `d_i` of `per_entry` (at least as many as entries). One loop over the
+    /// slices, zipped: it vectorises where `increment` is a plain read.
+    pub(crate) fn advance_with<I: IntoIterator>(
+        &mut self,
+        h: f64,
+        per_entry: I,
+        mut increment: impl FnMut(f64, I::Item) -> f64,
+    ) {
         (self.t, self.t_carry) = kahan_add(self.t, self.t_carry, h);
-        let (x, carry) = (self.x.as_mut_slice(), self.x_carry.as_mut_slice());
-        assert_eq!(x.len(), carry.len(), "a compensation per entry");
-        for i in 0..x.len() {
-            (x[i], carry[i]) = kahan_add(x[i], carry[i], increment(i, x[i]));
+        let x = self.x.as_mut_slice().iter_mut().zip(self.x_carry.as_mut_slice());
+        for ((x, carry), d) in x.zip(per_entry) {
+            (*x, *carry) = kahan_add(*x, *carry, increment(*x, d));
         }
     }
 }

@@ -255,7 +255,7 @@ pub(crate) fn increment<V: Lane>(j: usize, x: V, next: &[V], work: Option<(V, V)
 /// entries), adding the step's `work` to the ledger after them when given.
 fn take_step(state: &mut State<Dyn>, h: f64, next: &[f64], work: Option<&StepWork>) {
     let work = work.map(|w| (w.drive, w.damped));
-    state.advance_by(h, |j, x| increment(j, x, next, work));
+    state.advance_with(h, 0.., |x, j| increment(j, x, next, work));
 }
 
 impl<S: DimName, Dr: Drive<S>> Integrator<Directions<S, Dr>> for RodMidpoint

@@ -1,6 +1,7 @@
 //! The increment of one RK4 step as [`Rk4`](crate::integrate::Rk4) rounds it, for lanes
 //! of chains or for one chain.
 
+use crate::integrate::rk4_weighted;
 use crate::lanes::Lane;
 
 /// `q̈(q, q̇)` for [`increment`]: a type of its own rather than a closure, for the lanes'
@@ -32,7 +33,7 @@ pub(super) fn increment<V: Lane, const N: usize, const G: usize>(
     h: f64,
     mut accelerations: impl Accelerations<V, N, G>,
 ) -> ([[V; N]; G], [[V; N]; G]) {
-    let (half, whole, sixth, two) = (V::splat(0.5 * h), V::splat(h), V::splat(h / 6.0), V::splat(2.0));
+    let (half, whole, sixth) = (V::splat(0.5 * h), V::splat(h), V::splat(h / 6.0));
     // k_s = (θ̇_s, θ̈_s), the stages of `Rk4::stages`.
     let a1 = accelerations.at(q, qd);
     let (q2, qd2) = (axpy(q, half, qd), axpy(qd, half, &a1));
@@ -41,7 +42,7 @@ pub(super) fn increment<V: Lane, const N: usize, const G: usize>(
     let a3 = accelerations.at(&q3, &qd3);
     let (q4, qd4) = (axpy(q, whole, &qd3), axpy(qd, whole, &a3));
     let a4 = accelerations.at(&q4, &qd4);
-    (weighted_sum(sixth, two, [qd, &qd2, &qd3, &qd4]), weighted_sum(sixth, two, [&a1, &a2, &a3, &a4]))
+    (weighted_sum(sixth, [qd, &qd2, &qd3, &qd4]), weighted_sum(sixth, [&a1, &a2, &a3, &a4]))
 }
 
 /// `y = x + a k` as `Rk4`'s `axpy` rounds it, for `G` blocks. A function, not a closure
@@ -58,18 +59,17 @@ fn axpy<V: Lane, const N: usize, const G: usize>(x: &[[V; N]; G], a: V, k: &[[V;
     y
 }
 
-/// `(h/6) (k1 + 2 (k2 + k3) + k4)` as `Rk4` rounds it, for `G` blocks (`sixth` = h/6,
-/// `two` = 2).
+/// `(h/6) (k1 + 2 (k2 + k3) + k4)` as `Rk4` rounds it ([`rk4_weighted`]), for `G` blocks
+/// (`sixth` = h/6).
 #[inline(always)]
 fn weighted_sum<V: Lane, const N: usize, const G: usize>(
     sixth: V,
-    two: V,
     [k1, k2, k3, k4]: [&[[V; N]; G]; 4],
 ) -> [[V; N]; G] {
     let mut out = *k1;
     for j in 0..G {
         for i in 0..N {
-            out[j][i] = sixth * (k1[j][i] + two * (k2[j][i] + k3[j][i]) + k4[j][i]);
+            out[j][i] = rk4_weighted(sixth, [k1[j][i], k2[j][i], k3[j][i], k4[j][i]]);
         }
     }
     out
