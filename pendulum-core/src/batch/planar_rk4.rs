@@ -9,7 +9,7 @@ use nalgebra::{Dyn, U2};
 
 #[cfg(target_arch = "x86_64")]
 use super::F64x8;
-use super::lane_states::{into_lanes, out_of_lanes};
+use super::lane_states::{into_lanes, nan_unless_finite, out_of_lanes};
 use super::planar::{Block, Torques, Work, gather_torques};
 use super::run_lanes::RunLane;
 use super::transpose::{gather_rows, scatter_some_rows};
@@ -328,8 +328,8 @@ impl PlanarBatch {
     simd_kernel! {
         /// One step of [`Rk4`](crate::integrate::Rk4) in lanes `V` for the chains of
         /// `block`, applied only in the `alive` lanes: the stages, the increment
-        /// `h (k1 + 2 k2 + 2 k3 + k4) / 6`, then `x += increment` by compensated summation
-        /// ([`State`]'s). Returns the alive lanes whose increment was not finite (left as
+        /// `h (k1 + 2 k2 + 2 k3 + k4) / 6` ([`rk4_weighted`]), then `x += increment` by
+        /// compensated summation ([`State`]'s). Returns the alive lanes whose increment was not finite (left as
         /// they were).
         fn rk4_step<V: RunLane>(&self, block: &Block<V>, h: f64, alive: V::Mask, s: &mut Run<V>) -> V::Mask {
             let Run { sin, cos, work, torque, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
@@ -354,17 +354,29 @@ impl PlanarBatch {
                 one_row_at_a_time();
             }
             rates(block, at(2), y, (sin, cos, work), k4);
+            // The step's end in one pass over the rows (three before): each row's increment,
+            // its finiteness (a running sum of `y − y`) and its compensated sum with the
+            // state, the new state into k1 and its compensation into k2, both spent.
             let sixth = V::splat(h / 6.0);
-            for (((y, k1), (k2, k3)), k4) in y.iter_mut().zip(&*k1).zip(k2.iter().zip(&*k3)).zip(&*k4) {
-                *y = rk4_weighted(sixth, [*k1, *k2, *k3, *k4]);
+            let mut unfinished = V::splat(0.0);
+            let rows = (k1.iter_mut().zip(k2.iter_mut())).zip((k3.iter().zip(&*k4)).zip(x.iter().zip(&*carry)));
+            for ((k1, k2), ((k3, k4), (x, carry))) in rows {
+                let y = rk4_weighted(sixth, [*k1, *k2, *k3, *k4]);
+                unfinished += nan_unless_finite(y);
+                (*k1, *k2) = kahan_add(*x, *carry, y);
                 one_row_at_a_time();
             }
-            let bad = V::non_finite(y);
+            let bad = V::not_finite(unfinished);
             let keep = V::and_not(alive, bad);
-            for ((x, carry), y) in x.iter_mut().zip(carry.iter_mut()).zip(&*y) {
-                let (new, new_carry) = kahan_add(*x, *carry, *y);
-                (*x, *carry) = (V::select(keep, new, *x), V::select(keep, new_carry, *carry));
-                one_row_at_a_time();
+            if V::all(keep) {
+                // Every lane steps (the common case): no copy.
+                std::mem::swap(x, k1);
+                std::mem::swap(carry, k2);
+            } else {
+                for ((x, carry), (next, next_carry)) in x.iter_mut().zip(carry.iter_mut()).zip(k1.iter().zip(&*k2)) {
+                    (*x, *carry) = (V::select(keep, *next, *x), V::select(keep, *next_carry, *carry));
+                    one_row_at_a_time();
+                }
             }
             V::and(alive, bad)
         }
