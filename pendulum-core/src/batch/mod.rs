@@ -48,6 +48,7 @@ mod run_lanes;
 pub(crate) mod transpose;
 mod unrolled;
 
+pub(crate) use crate::model::{all_finite, non_finite};
 pub use directions::DirectionsBatch;
 pub use planar::PlanarBatch;
 pub(crate) use rooms::Rooms;
@@ -208,12 +209,6 @@ pub(crate) fn first_bad_input<T: Copy + Into<f64>>(
         .or_else(|| pivot.and_then(|p| row("pivot_acceleration", p, space)))
 }
 
-/// Whether every entry of `v` is finite (a loop without early exit, so that it vectorises).
-#[inline(always)]
-pub(crate) fn all_finite<T: Copy + Into<f64>>(v: &[T]) -> bool {
-    v.iter().fold(true, |finite, &x| finite & x.into().is_finite())
-}
-
 /// The chains of a block whose rows of `out` (`m` each, row `k` for chain `chains[k]`) are
 /// not all finite, each with `error(chain)`; their rows set to `nan`. Only the rows of the
 /// lanes flagged in `suspect` are read: the kernels find the lanes with a non-finite result
@@ -234,21 +229,6 @@ pub(crate) fn failed_rows<T: Copy + Into<f64>, const W: usize>(
         }
     }
     failures
-}
-
-/// The first non-finite entry of `v` as the single-chain error.
-pub(crate) fn non_finite<T: Copy + Into<f64>>(what: &'static str, v: &[T]) -> Option<Error> {
-    // The common case in a loop that vectorises; the search one number at a time was a
-    // tenth of a one-step RK4 call.
-    if all_finite(v) {
-        return None;
-    }
-    let value = |index: usize| v[index].into();
-    (0..v.len()).find(|&i| !value(i).is_finite()).map(|index| Error::NonFinite {
-        what,
-        index,
-        value: value(index),
-    })
 }
 
 /// Blocks of `width` chains a rayon task takes at least, for blocks of `solves` rods'
