@@ -8,7 +8,7 @@ use super::transpose::{gather_rows, scatter_some_rows};
 use crate::integrate::State;
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::has_avx2;
-use crate::lanes::{Lane, Lanes, Lanes32, one_row_at_a_time};
+use crate::lanes::{Lane, Lanes, Lanes32, Masked, one_row_at_a_time};
 
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
 /// into `t`, the states into `x`, their compensations into `carry`. Returns the lanes whose
@@ -115,14 +115,7 @@ fn empty_lanes<const W: usize>(
 /// The lanes in which some entry of `v` is not finite (flag `1`).
 #[inline(always)]
 pub(super) fn non_finite_lanes<const W: usize>(v: &[Lanes<W>]) -> [u64; W] {
-    nan_lanes(non_finite_sum(v))
-}
-
-/// The lanes of `total` that are NaN (flag `1`): of a sum of [`nan_unless_finite`]s, the
-/// lanes in which some term was not finite.
-#[inline(always)]
-pub(super) fn nan_lanes<const W: usize>(total: Lanes<W>) -> [u64; W] {
-    std::array::from_fn(|k| u64::from(total.0[k].is_nan()))
+    non_finite_sum(v).not_finite()
 }
 
 /// `y − y`: `0` for a finite `y`, NaN otherwise (lane by lane); summed, NaN where any
@@ -136,8 +129,7 @@ pub(super) fn nan_unless_finite<V: Lane>(y: V) -> V {
 /// [`non_finite_lanes`] in single precision.
 #[inline(always)]
 pub(super) fn non_finite_lanes_f32<const W: usize>(v: &[Lanes32<W>]) -> [u32; W] {
-    let total = non_finite_sum(v);
-    std::array::from_fn(|k| u32::from(total.0[k].is_nan()))
+    non_finite_sum(v).not_finite()
 }
 
 /// Lane by lane, NaN where some entry of `v` is not finite and `0` elsewhere: `y − y` is `0`

@@ -329,8 +329,8 @@ impl PlanarBatch {
         /// One step of [`Rk4`](crate::integrate::Rk4) in lanes `V` for the chains of
         /// `block`, applied only in the `alive` lanes: the stages, the increment
         /// `h (k1 + 2 k2 + 2 k3 + k4) / 6` ([`rk4_weighted`]), then `x += increment` by
-        /// compensated summation ([`State`]'s). Returns the alive lanes whose increment was not finite (left as
-        /// they were).
+        /// compensated summation ([`State`]'s). Returns the alive lanes whose increment was
+        /// not finite (left as they were).
         fn rk4_step<V: RunLane>(&self, block: &Block<V>, h: f64, alive: V::Mask, s: &mut Run<V>) -> V::Mask {
             let Run { sin, cos, work, torque, pivot, torqued, x, carry, y, k: [k1, k2, k3, k4] } = s;
             // Plain calls, not a closure: a closure is not compiled with the kernel's AVX2.

@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 use nalgebra::{DVector, DefaultAllocator, DimName, Dyn, allocator::Allocator};
 
 use super::directions::{Block, Scratch};
-use super::lane_states::{into_lanes, nan_lanes, nan_unless_finite, out_of_lanes};
+use super::lane_states::{into_lanes, nan_unless_finite, out_of_lanes};
 use super::{
     Blocks, Failure, WIDTH, WIDTH_AVX512, block_chains, for_blocks_of, non_finite, one_of, simd_kernel,
 };
@@ -15,7 +15,7 @@ use crate::drive::Drive;
 use crate::error::{Error, Result};
 use crate::integrate::check_step_size;
 use crate::integrate::{State, kahan_add, rk4_weighted};
-use crate::lanes::{Lane, Lanes, one_row_at_a_time};
+use crate::lanes::{Lane, Lanes, Masked, one_row_at_a_time};
 use crate::models::directions::project_link;
 
 use super::DirectionsBatch;
@@ -355,7 +355,7 @@ where
         for sum in sums {
             total += sum;
         }
-        nan_lanes(total)
+        total.not_finite()
     }
 }
 
