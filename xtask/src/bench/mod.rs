@@ -1,9 +1,12 @@
 //! `cargo xtask bench`: runs the criterion benchmarks (`pendulum-core/benches/models.rs`)
 //! into a fresh directory, reads the medians and fastest samples back and writes
 //! `docs/bench.md` (tables, targets, machine, date) and `docs/bench.svg` (log–log plot).
+//! `--ensembles` does the same for the batches (`pendulum-core/benches/ensembles.rs`):
+//! `docs/ensembles-speed.md` and `docs/ensembles-speed.svg` ([`ensembles`]).
 //! `--quick` is a smoke run, and a run filtered by criterion arguments is partial: both
 //! write their report under the target directory instead of `docs/`.
 
+pub mod ensembles;
 mod plot;
 mod report;
 mod results;
@@ -21,12 +24,16 @@ pub use results::{Results, Statistic};
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct Options {
     /// Smoke run (under a minute once built): few sizes, short warm-up and measurement;
-    /// the report goes to `<target>/xtask-bench/quick/`, not `docs/`.
+    /// the report goes to `<target>/xtask-bench/<bench>/quick/`, not `docs/`.
     #[arg(long)]
     pub quick: bool,
     /// Do not run the benchmarks: rewrite the report from the last run's estimates.
     #[arg(long)]
     pub report_only: bool,
+    /// The batches against the single-chain calls instead (`pendulum-core/benches/ensembles.rs`,
+    /// about five minutes): `docs/ensembles-speed.md` and `docs/ensembles-speed.svg`.
+    #[arg(long)]
+    pub ensembles: bool,
     /// Extra arguments for criterion, e.g. a filter such as `planar_accelerations`
     /// (a filtered run's report goes under the target directory, not `docs/`).
     #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -40,26 +47,33 @@ const QUICK: (f64, f64, usize, usize) = (0.02, 0.05, 10, 1_000);
 
 /// The command of a complete run, as recorded in its report.
 const FULL_COMMAND: &str = "cargo xtask bench";
+/// The command of a complete run of the ensembles' benchmarks.
+const ENSEMBLES_COMMAND: &str = "cargo xtask bench --ensembles";
 
 /// Runs the benchmarks and writes the report and plot.
 pub fn run(options: &Options) -> Result<()> {
+    let (bench_name, command) =
+        if options.ensembles { ("ensembles", ENSEMBLES_COMMAND) } else { ("models", FULL_COMMAND) };
     let mode = if options.quick { "quick" } else { "full" };
-    let scratch = target_dir()?.join("xtask-bench").join(mode);
+    let scratch = target_dir()?.join("xtask-bench").join(bench_name).join(mode);
     let criterion = scratch.join("criterion");
     let info_path = scratch.join("run.json");
     let info = if options.report_only {
         read_info(&info_path)?
     } else {
-        let info = bench(options, &criterion)?;
+        let info = bench(options, (bench_name, command), &criterion)?;
         std::fs::write(&info_path, serde_json::to_string_pretty(&info)?)
             .with_context(|| format!("writing {}", info_path.display()))?;
         info
     };
+    // Only a complete full run (no criterion filter) goes to docs/.
+    let complete = !options.quick && info.command == command;
+    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
+    if options.ensembles {
+        return ensembles_report(&criterion, &info, &out_dir);
+    }
     let results = Results::load(&criterion, Statistic::Median)?;
     let fastest = Results::load(&criterion, Statistic::Fastest)?;
-    // Only a complete full run (no criterion filter) goes to docs/.
-    let complete = !options.quick && info.command == FULL_COMMAND;
-    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     let md_path = out_dir.join("bench.md");
     let notes = existing_notes(&crate::workspace_root().join("docs").join("bench.md"));
     std::fs::write(&md_path, report::markdown(&results, &fastest, &info, &notes))
@@ -72,10 +86,51 @@ pub fn run(options: &Options) -> Result<()> {
     Ok(())
 }
 
-/// Runs `cargo bench --workspace --bench models` (pendulum-core's, the workspace's one
+/// `docs/ensembles-speed.md` and `.svg` (in `out_dir`) from the run in `criterion`.
+fn ensembles_report(criterion: &Path, info: &RunInfo, out_dir: &Path) -> Result<()> {
+    let measured = ensembles::Measured::load(criterion)?;
+    let md_path = out_dir.join("ensembles-speed.md");
+    std::fs::write(&md_path, ensembles::markdown(&measured, info, &commit()))
+        .with_context(|| format!("writing {}", md_path.display()))?;
+    let svg_path = out_dir.join("ensembles-speed.svg");
+    std::fs::write(&svg_path, ensembles::svg(&measured)?)
+        .with_context(|| format!("writing {}", svg_path.display()))?;
+    for check in ensembles::checks(&measured) {
+        let met = match check.met() {
+            Some(true) => "met",
+            Some(false) => "MISSED",
+            None => "not run",
+        };
+        let ratio = check.median.map_or("–".into(), |r| format!("{r:.2}×"));
+        println!("{met:>7}  {ratio:>8} (≥ {}×)  {}: {}", check.bound, check.target, check.what);
+    }
+    println!("{} benchmarks; wrote {} and {}", measured.len(), md_path.display(), svg_path.display());
+    Ok(())
+}
+
+/// The checked-out commit, short, with `+changes` when the tree differs from it (from
+/// `git`; `unknown` without it).
+fn commit() -> String {
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .current_dir(crate::workspace_root())
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let Some(hash) = git(&["rev-parse", "--short", "HEAD"]) else { return "unknown".into() };
+    match git(&["status", "--porcelain", "--untracked-files=no"]) {
+        Some(changes) if !changes.is_empty() => format!("{hash}+changes"),
+        _ => hash,
+    }
+}
+
+/// Runs `cargo bench --workspace --bench <name>` (pendulum-core's, the workspace's one
 /// bench of that name) with criterion's output in `criterion` (emptied first, so the
-/// report never mixes runs).
-fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
+/// report never mixes runs); `full` is how the report names a complete run.
+fn bench(options: &Options, (name, full): (&str, &str), criterion: &Path) -> Result<RunInfo> {
     if criterion.exists() {
         std::fs::remove_dir_all(criterion).with_context(|| format!("emptying {}", criterion.display()))?;
     }
@@ -84,7 +139,7 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     // `--workspace` unifies features as `cargo bench --workspace --no-run` (CI) does, so the
     // binary CI compiled is reused rather than built again.
-    let build = ["bench", "--workspace", "--bench", "models"];
+    let build = ["bench", "--workspace", "--bench", name];
     let status = Command::new(&cargo)
         .current_dir(crate::workspace_root())
         .args(build)
@@ -112,7 +167,7 @@ fn bench(options: &Options, criterion: &Path) -> Result<RunInfo> {
     if !status.success() {
         bail!("cargo bench failed ({status})");
     }
-    let mut invocation = String::from(FULL_COMMAND);
+    let mut invocation = String::from(full);
     if options.quick {
         invocation += " --quick";
     }

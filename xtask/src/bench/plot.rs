@@ -33,14 +33,7 @@ fn colour(implementation: &str) -> RGBColor {
 
 /// The SVG text of the plot of `results`' `<kind>_accelerations` groups.
 pub fn svg(results: &Results) -> Result<String> {
-    static FONT: std::sync::Once = std::sync::Once::new();
-    FONT.call_once(|| {
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            epaint_default_fonts::UBUNTU_LIGHT,
-        );
-    });
+    register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (1200, 520)).into_drawing_area();
@@ -52,6 +45,18 @@ pub fn svg(results: &Results) -> Result<String> {
         root.present().map_err(|e| anyhow!("plot: {e}"))?;
     }
     Ok(text)
+}
+
+/// Registers the embedded font as plotters' `sans-serif` (once; see the module docs).
+pub(super) fn register_font() {
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
 }
 
 fn panel_plot(

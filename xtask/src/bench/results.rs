@@ -116,7 +116,7 @@ fn subdirectories(dir: &Path) -> Result<Vec<String>> {
 }
 
 /// The median (ns) in one criterion `estimates.json`.
-fn median_ns(path: &Path) -> Result<f64> {
+pub(crate) fn median_ns(path: &Path) -> Result<f64> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let json: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
@@ -131,7 +131,7 @@ fn median_ns(path: &Path) -> Result<f64> {
 
 /// The fastest sample's time per iteration (ns) in one criterion `sample.json`
 /// (`times[i]` ns over `iters[i]` iterations).
-fn fastest_ns(path: &Path) -> Result<f64> {
+pub(crate) fn fastest_ns(path: &Path) -> Result<f64> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let json: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
