@@ -90,7 +90,7 @@ pub fn run(options: &Options) -> Result<()> {
 fn ensembles_report(criterion: &Path, info: &RunInfo, out_dir: &Path) -> Result<()> {
     let measured = ensembles::Measured::load(criterion)?;
     let md_path = out_dir.join("ensembles-speed.md");
-    std::fs::write(&md_path, ensembles::markdown(&measured, info, &commit()))
+    std::fs::write(&md_path, ensembles::markdown(&measured, info))
         .with_context(|| format!("writing {}", md_path.display()))?;
     let svg_path = out_dir.join("ensembles-speed.svg");
     std::fs::write(&svg_path, ensembles::svg(&measured)?)
@@ -184,6 +184,7 @@ fn bench(options: &Options, (name, full): (&str, &str), criterion: &Path) -> Res
         ),
         load: (load_before, load_average()),
         seconds,
+        commit: commit(),
     })
 }
 

@@ -92,6 +92,10 @@ pub struct RunInfo {
     pub load: (String, String),
     /// Wall time of the benchmark run (built beforehand), s.
     pub seconds: f64,
+    /// The commit benchmarked, short, `+changes` when the tree differed from it (empty in
+    /// the runs recorded before it was).
+    #[serde(default)]
+    pub commit: String,
 }
 
 /// The label of a benchmark function name.
