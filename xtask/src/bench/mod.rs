@@ -34,6 +34,11 @@ pub struct Options {
     /// about five minutes): `docs/ensembles-speed.md` and `docs/ensembles-speed.svg`.
     #[arg(long)]
     pub ensembles: bool,
+    /// With `--ensembles`: this many whole runs, one after another, each ratio taken
+    /// within a run and the report giving each run's (a shared machine's ratios move by
+    /// 10–20% from run to run).
+    #[arg(long, default_value_t = 1, requires = "ensembles", value_parser = clap::value_parser!(u32).range(1..=20))]
+    pub runs: u32,
     /// Extra arguments for criterion, e.g. a filter such as `planar_accelerations`
     /// (a filtered run's report goes under the target directory, not `docs/`).
     #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -52,26 +57,16 @@ const ENSEMBLES_COMMAND: &str = "cargo xtask bench --ensembles";
 
 /// Runs the benchmarks and writes the report and plot.
 pub fn run(options: &Options) -> Result<()> {
-    let (bench_name, command) =
-        if options.ensembles { ("ensembles", ENSEMBLES_COMMAND) } else { ("models", FULL_COMMAND) };
-    let mode = if options.quick { "quick" } else { "full" };
-    let scratch = target_dir()?.join("xtask-bench").join(bench_name).join(mode);
-    let criterion = scratch.join("criterion");
-    let info_path = scratch.join("run.json");
-    let info = if options.report_only {
-        read_info(&info_path)?
-    } else {
-        let info = bench(options, (bench_name, command), &criterion)?;
-        std::fs::write(&info_path, serde_json::to_string_pretty(&info)?)
-            .with_context(|| format!("writing {}", info_path.display()))?;
-        info
-    };
-    // Only a complete full run (no criterion filter) goes to docs/.
-    let complete = !options.quick && info.command == command;
-    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     if options.ensembles {
-        return ensembles_report(&criterion, &info, &out_dir);
+        return run_ensembles(options);
     }
+    let mode = if options.quick { "quick" } else { "full" };
+    let scratch = target_dir()?.join("xtask-bench").join("models").join(mode);
+    let criterion = scratch.join("criterion");
+    let info = run_once(options, ("models", FULL_COMMAND), &scratch)?;
+    // Only a complete full run (no criterion filter) goes to docs/.
+    let complete = !options.quick && info.command == FULL_COMMAND;
+    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     let results = Results::load(&criterion, Statistic::Median)?;
     let fastest = Results::load(&criterion, Statistic::Fastest)?;
     let md_path = out_dir.join("bench.md");
@@ -86,25 +81,57 @@ pub fn run(options: &Options) -> Result<()> {
     Ok(())
 }
 
-/// `docs/ensembles-speed.md` and `.svg` (in `out_dir`) from the run in `criterion`.
-fn ensembles_report(criterion: &Path, info: &RunInfo, out_dir: &Path) -> Result<()> {
-    let measured = ensembles::Measured::load(criterion)?;
+/// The run's facts, from running the benchmarks `name` into `scratch/criterion` (and
+/// saving them in `scratch/run.json`), or with `--report-only` from that file.
+fn run_once(options: &Options, (name, full): (&str, &str), scratch: &Path) -> Result<RunInfo> {
+    let info_path = scratch.join("run.json");
+    if options.report_only {
+        return read_info(&info_path);
+    }
+    let info = bench(options, (name, full), &scratch.join("criterion"))?;
+    std::fs::write(&info_path, serde_json::to_string_pretty(&info)?)
+        .with_context(|| format!("writing {}", info_path.display()))?;
+    Ok(info)
+}
+
+/// `cargo xtask bench --ensembles`: `--runs` runs of the ensembles' benchmarks, then
+/// `ensembles-speed.md` and `.svg` (in `docs/` for a complete full run) and the issue's
+/// checks printed, each run's.
+fn run_ensembles(options: &Options) -> Result<()> {
+    let mode = if options.quick { "quick" } else { "full" };
+    let scratch = target_dir()?.join("xtask-bench").join("ensembles").join(mode);
+    let full = match options.runs {
+        1 => ENSEMBLES_COMMAND.to_string(),
+        k => format!("{ENSEMBLES_COMMAND} --runs {k}"),
+    };
+    let mut runs = Vec::new();
+    for k in 1..=options.runs {
+        let dir = scratch.join(format!("run-{k}"));
+        let info = run_once(options, ("ensembles", &full), &dir)?;
+        runs.push((info, ensembles::Measured::load(&dir.join("criterion"))?));
+    }
+    let complete = !options.quick && runs.iter().all(|(info, _)| info.command == full);
+    let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     let md_path = out_dir.join("ensembles-speed.md");
-    std::fs::write(&md_path, ensembles::markdown(&measured, info))
+    std::fs::write(&md_path, ensembles::markdown(&runs))
         .with_context(|| format!("writing {}", md_path.display()))?;
     let svg_path = out_dir.join("ensembles-speed.svg");
+    let measured: Vec<&ensembles::Measured> = runs.iter().map(|(_, m)| m).collect();
     std::fs::write(&svg_path, ensembles::svg(&measured)?)
         .with_context(|| format!("writing {}", svg_path.display()))?;
-    for check in ensembles::checks(&measured) {
-        let met = match check.met() {
-            Some(true) => "met",
-            Some(false) => "MISSED",
-            None => "not run",
-        };
-        let ratio = check.median.map_or("–".into(), |r| format!("{r:.2}×"));
-        println!("{met:>7}  {ratio:>8} (≥ {}×)  {}: {}", check.bound, check.target, check.what);
+    for (k, m) in measured.iter().enumerate() {
+        println!("run {}:", k + 1);
+        for check in ensembles::checks(m) {
+            let met = match check.met() {
+                Some(true) => "met",
+                Some(false) => "MISSED",
+                None => "not run",
+            };
+            let ratio = check.median.map_or("–".into(), |r| format!("{r:.2}×"));
+            println!("{met:>7}  {ratio:>8} (≥ {}×)  {}: {}", check.bound, check.target, check.what);
+        }
     }
-    println!("{} benchmarks; wrote {} and {}", measured.len(), md_path.display(), svg_path.display());
+    println!("{} runs; wrote {} and {}", runs.len(), md_path.display(), svg_path.display());
     Ok(())
 }
 
