@@ -124,8 +124,8 @@ pub fn markdown(runs: &[(RunInfo, Measured)]) -> String {
         let _ = writeln!(
             out,
             "{} runs of the whole benchmark, one after another; a ratio is always taken within \
-             one run, and the tables give each run's (or their range), the times the middle \
-             run's:\n",
+             one run, and the tables give each run's (or their range), and each benchmark's \
+             time the middle over the runs:\n",
             runs.len()
         );
     }
