@@ -31,7 +31,8 @@ pub struct Options {
     #[arg(long)]
     pub report_only: bool,
     /// The batches against the single-chain calls instead (`pendulum-core/benches/ensembles.rs`,
-    /// about five minutes): `docs/ensembles-speed.md` and `docs/ensembles-speed.svg`.
+    /// about four minutes a run; `--quick` is no shorter, as its groups set their own
+    /// times): `docs/ensembles-speed.md` and `docs/ensembles-speed.svg`.
     #[arg(long)]
     pub ensembles: bool,
     /// With `--ensembles`: this many whole runs, one after another, each ratio taken
@@ -291,8 +292,9 @@ fn utc(secs: u64) -> String {
 
 /// The [`RunInfo`] saved by the last run (for `--report-only`).
 fn read_info(path: &Path) -> Result<RunInfo> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading {} (run `cargo xtask bench` first)", path.display()))?;
+    let text = std::fs::read_to_string(path).with_context(|| {
+        format!("reading {} (run the benchmarks first, without --report-only)", path.display())
+    })?;
     serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }
 
