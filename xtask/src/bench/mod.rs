@@ -111,6 +111,15 @@ fn run_ensembles(options: &Options) -> Result<()> {
         let info = run_once(options, ("ensembles", &full), &dir)?;
         runs.push((info, ensembles::Measured::load(&dir.join("criterion"))?));
     }
+    // An unfiltered run has every benchmark the report names, or the report is out of date.
+    if options.args.is_empty() {
+        for (k, (_, m)) in runs.iter().enumerate() {
+            let missing = ensembles::missing(m);
+            if !missing.is_empty() {
+                bail!("run {}: the report names benchmarks that did not run: {}", k + 1, missing.join(", "));
+            }
+        }
+    }
     let complete = !options.quick && runs.iter().all(|(info, _)| info.command == full);
     let out_dir = if complete { crate::workspace_root().join("docs") } else { scratch.clone() };
     let md_path = out_dir.join("ensembles-speed.md");

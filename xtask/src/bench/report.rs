@@ -130,7 +130,8 @@ pub fn time(ns: f64) -> String {
     format!("{value:.digits$} {unit}")
 }
 
-fn ratio(r: f64) -> String {
+/// A ratio with two decimals below 10, one above.
+pub(crate) fn ratio(r: f64) -> String {
     if r < 10.0 { format!("{r:.2}") } else { format!("{r:.1}") }
 }
 

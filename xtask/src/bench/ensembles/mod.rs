@@ -14,4 +14,4 @@ mod rows;
 pub use measured::{Measured, Timing};
 pub use plot::svg;
 pub use report::markdown;
-pub use rows::{Check, MUJOCO_ROLLOUT_NS, Row, SECTIONS, checks, rows};
+pub use rows::{Check, MUJOCO_ROLLOUT_NS, Row, SECTIONS, checks, missing, rows};

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::measured::Measured;
-use super::report::{middle, ratios};
+use super::report::{middle, range, ratios};
 use super::rows::rows;
 
 /// The sections' names on the plot, in [`super::SECTIONS`] order.
@@ -28,11 +28,8 @@ struct Bar {
 impl Bar {
     /// The bar of `values` (each run's ratio), if any ran.
     fn of(values: &[f64]) -> Option<Self> {
-        Some(Self {
-            middle: middle(values)?,
-            low: values.iter().copied().fold(f64::INFINITY, f64::min),
-            high: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        })
+        let (low, high) = range(values)?;
+        Some(Self { middle: middle(values)?, low, high })
     }
 }
 

@@ -7,15 +7,9 @@ use super::measured::Measured;
 use super::rows::{Check, Row, SECTIONS, checks, rows};
 use crate::bench::report::{RunInfo, time};
 
-/// A ratio with three significant figures.
+/// A ratio as the models' report writes it, with its `×`.
 fn ratio(r: f64) -> String {
-    if r < 10.0 {
-        format!("{r:.2}×")
-    } else if r < 100.0 {
-        format!("{r:.1}×")
-    } else {
-        format!("{r:.0}×")
-    }
+    format!("{}×", crate::bench::report::ratio(r))
 }
 
 /// The middle of `values` (the mean of the two middle ones for an even count), if any.
@@ -29,14 +23,18 @@ pub(super) fn middle(values: &[f64]) -> Option<f64> {
     }
 }
 
+/// The smallest and the largest of `values`, if any.
+pub(super) fn range(values: &[f64]) -> Option<(f64, f64)> {
+    let low = values.iter().copied().reduce(f64::min)?;
+    Some((low, values.iter().copied().fold(low, f64::max)))
+}
+
 /// `values` as one figure, or as their range `a–b` over the runs (`–` for none).
 fn spread(values: &[f64], show: fn(f64) -> String) -> String {
-    let low = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let high = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    match values.len() {
-        0 => "–".into(),
-        _ if show(low) == show(high) => show(low),
-        _ => format!("{}–{}", show(low).trim_end_matches('×'), show(high)),
+    match range(values) {
+        None => "–".into(),
+        Some((low, high)) if show(low) == show(high) => show(low),
+        Some((low, high)) => format!("{}–{}", show(low).trim_end_matches('×'), show(high)),
     }
 }
 

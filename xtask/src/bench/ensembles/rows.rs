@@ -261,9 +261,58 @@ pub fn checks(measured: &Measured) -> Vec<Check> {
     out
 }
 
+/// What the report names but `measured` lacks: each row's benchmark ids that did not run,
+/// and each check that could not be taken. Empty for an unfiltered run of a bench that
+/// still has every benchmark the report names (a renamed one would otherwise be a silent
+/// `–`).
+pub fn missing(measured: &Measured) -> Vec<String> {
+    let mut out: Vec<String> = rows()
+        .iter()
+        .flat_map(|r| [Some(&r.single), Some(&r.batch), r.two_threads.as_ref(), r.f32.as_ref()])
+        .flatten()
+        .filter(|id| measured.get(id).is_none())
+        .cloned()
+        .collect();
+    out.sort();
+    out.dedup();
+    out.extend(
+        checks(measured).into_iter().filter(|c| c.median.is_none()).map(|c| format!("check: {}", c.what)),
+    );
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn missing_names_the_rows_ids_and_the_checks_that_did_not_run() {
+        let mut m = Measured::default();
+        let t = Timing { median: 1.0, fastest: 1.0 };
+        for r in rows() {
+            for id in [Some(r.single), Some(r.batch), r.two_threads, r.f32].into_iter().flatten() {
+                m.insert(&id, t);
+            }
+        }
+        // Every row's ids, and the checks' (which are rows' ids too) complete the run.
+        assert_eq!(missing(&m), Vec::<String>::new());
+        let mut short = Measured::default();
+        for r in rows().into_iter().filter(|r| r.label != "planar (tension), n = 8") {
+            for id in [Some(r.single), Some(r.batch), r.two_threads, r.f32].into_iter().flatten() {
+                short.insert(&id, t);
+            }
+        }
+        assert_eq!(
+            missing(&short),
+            [
+                "accelerations/planar/batch_1_threads/8",
+                "accelerations/planar/batch_2_threads/8",
+                "accelerations/planar/batch_f32_1_thread/8",
+                "accelerations/planar/single/8",
+                "check: planar, n = 8",
+            ]
+        );
+    }
 
     #[test]
     fn ids_name_rows_of_their_own_section_and_are_unique() {
