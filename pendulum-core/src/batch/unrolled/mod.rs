@@ -218,6 +218,12 @@ impl<L: Copy, const N: usize> LinkConstants<L, N> {
 
 /// A model `model!` generates with `algorithm: tension`, as a batch holds it: the per-link
 /// constants `new` stored, and the coordinates it is written in.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` has no batched form: only `model!`'s models with `algorithm: tension` batch",
+    label = "not a model `model!` generated with `algorithm: tension`",
+    note = "tension is the default for planar models from four links and spatial ones from two; declare a smaller one `{{ kind: …, links: …, algorithm: tension }}` to batch it",
+    note = "for chains built at run time (`Chain`), use `PlanarBatch` or `DirectionsBatch`"
+)]
 pub trait Generated<const N: usize>: Send + Sync {
     /// [`PlanarAngles`] or [`SphericalAngles`](crate::kinematics::SphericalAngles).
     type Chart;
@@ -230,6 +236,12 @@ pub trait Generated<const N: usize>: Send + Sync {
 /// `pendulum_macros::model!` emits for `kind: planar` with `algorithm: tension`. Its
 /// `Model::accelerations` is `kernel::<f64>` (after the sines and cosines, before the
 /// finiteness check); [`UnrolledBatch`] runs `kernel::<Lanes<4>>` (and `Lanes32<4>`).
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` has no planar batched kernel: only `model!`'s planar models with `algorithm: tension` have one",
+    label = "not a planar model `model!` generated with `algorithm: tension`",
+    note = "tension is the default for planar models from four links; declare a smaller one `{{ kind: planar, links: …, algorithm: tension }}` to batch it",
+    note = "for spatial models use `UnrolledSpatialBatch`; for chains built at run time, `PlanarBatch`"
+)]
 pub trait PlanarKernel<const N: usize>:
     Model<Links = Const<N>, Dof = Const<N>, Space = U2> + Generated<N, Chart = PlanarAngles>
 {

@@ -29,6 +29,12 @@ const ACCEPTED_SINES: (u64, u64) = {
 /// what `pendulum_macros::model!` emits for `kind: spatial` with `algorithm: tension` (the
 /// default from two links). Its `Model::accelerations` checks the polar sines, then runs
 /// `kernel::<f64>`; [`UnrolledSpatialBatch`] runs it on four or eight chains at once.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` has no spatial batched kernel: only `model!`'s spatial models with `algorithm: tension` have one",
+    label = "not a spatial model `model!` generated with `algorithm: tension`",
+    note = "tension is the default for spatial models from two links; declare a one-link model `{{ kind: spatial, links: 1, algorithm: tension }}` to batch it",
+    note = "for planar models use `UnrolledBatch`; for chains built at run time, `DirectionsBatch`"
+)]
 pub trait SpatialKernel<const N: usize>: Generated<N, Chart = SphericalAngles> {
     /// The model's own `Model::accelerations` on rows: `q`, `qd`, `torque` and `out` of
     /// `2N` (the polar angles, then the azimuths), the pivot's acceleration `p̈` (m/s²).
