@@ -14,7 +14,9 @@ use nalgebra::{DefaultAllocator, Dim, DimName, OVector, U1, U3, Vector3, allocat
 use crate::error::{Error, Result};
 use crate::model::{Inputs, InputsAt};
 
+mod sampled;
 mod steered;
+pub use sampled::Sampled;
 pub use steered::Steered;
 
 /// A prescribed pivot motion: position `p(t)` (m), velocity `ṗ(t)` (m/s) and acceleration
@@ -23,7 +25,8 @@ pub use steered::Steered;
 /// The three must be consistent (`ṗ = dp/dt`, `p̈ = dṗ/dt`) for the energy balance of
 /// [`Accounted`](crate::energy::Accounted) to close; the dynamics use `p̈` only. The built-in
 /// drives are [`Fixed`], [`Harmonic`], [`Circle`] and [`RampedCircle`] (spatial, both
-/// [`Turning`]), [`Steered`] (steered while it runs) and [`FnDrive`] (closures);
+/// [`Turning`]), [`Sampled`] (the spline through sampled positions), [`Steered`]
+/// (steered while it runs) and [`FnDrive`] (closures);
 /// implement the trait for any other motion. `&D` and `Box<D>` (also `Box<dyn Drive<S>>`,
 /// to choose a drive at run time) are drives when `D` is.
 pub trait Drive<S: DimName>

@@ -156,6 +156,22 @@ pub enum Error {
         /// The offending value (for a direction, its Euclidean norm).
         value: f64,
     },
+    /// A sampled pivot path ([`Sampled`](crate::drive::Sampled)) needs two samples at least.
+    #[error("a sampled drive needs at least 2 samples, got {got}")]
+    TooFewSamples {
+        /// The number of samples given.
+        got: usize,
+    },
+    /// A sample time of a sampled pivot path is not after the one before it.
+    #[error("times[{index}] must be after times[{}] = {}, got {}", .index - 1, num(.previous), num(.value))]
+    UnorderedTimes {
+        /// 0-based index of the sample.
+        index: usize,
+        /// Its time, s.
+        value: f64,
+        /// The time before it, s.
+        previous: f64,
+    },
     /// A trajectory run was asked for with a bad end time or sampling.
     #[error("trajectory {what} must be {requirement}, got {}", num(.value))]
     InvalidRun {

@@ -70,7 +70,8 @@ pub use analysis::{
 };
 pub use chain::Chain;
 pub use drive::{
-    Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, RampedCircle, Steered, TorqueAt, Turning,
+    Circle, ConstantTorque, Drive, Driven, Fixed, FnDrive, Harmonic, RampedCircle, Sampled, Steered,
+    TorqueAt, Turning,
 };
 pub use energy::{
     Accounted, AccountedDirections, Balance, Ledger, Powers, inertial_energy, pivot_force, pivot_momentum,

@@ -117,13 +117,20 @@ impl Numbers {
     /// `width = 1`), or one per state (shape `lead + (width,)`, or `lead` when `width = 1`).
     /// Errors name `what` and the shapes.
     pub fn per_state(&self, what: &str, width: usize, lead: &[usize]) -> PyResult<Vec<&[f64]>> {
+        let group = [width];
+        self.per_state_shaped(what, if width == 1 { &[] } else { &group }, lead)
+    }
+
+    /// [`per_state`](Self::per_state) for groups of shape `group` (the numbers of one
+    /// state: `(m, 3)` positions, say): shape `group` for all, or `lead + group`.
+    pub fn per_state_shaped(&self, what: &str, group: &[usize], lead: &[usize]) -> PyResult<Vec<&[f64]>> {
         let count: usize = lead.iter().product();
-        let group: &[usize] = if width == 1 { &[] } else { &[width] };
         let each: Vec<usize> = lead.iter().chain(group).copied().collect();
         if self.shape == group {
             return Ok(vec![&self.data[..]; count]);
         }
         if self.shape == each {
+            let width = group.iter().product::<usize>().max(1);
             return Ok(self.data.chunks_exact(width).collect());
         }
         Err(invalid(format!(

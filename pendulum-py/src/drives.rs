@@ -1,8 +1,9 @@
-//! `pendulum.Harmonic` and `pendulum.Circle`: pivot drives for `Chain.integrate` and
-//! `Chain.trajectory`, their parameters one for all states or one per state, read into
-//! one core drive per state (`Harmonic`, `Circle`) that moves the pivot within a call.
+//! `pendulum.Harmonic`, `pendulum.Circle` and `pendulum.Sampled`: pivot drives for
+//! `Chain.integrate` and `Chain.trajectory`, their parameters one for all states or one per
+//! state, read into one core drive per state (`Harmonic`, `Circle`, `Sampled`) that moves
+//! the pivot within a call.
 
-use nalgebra::{DimName, OVector, U2, U3, Vector3};
+use nalgebra::{DimName, OVector, U2, U3, Vector2, Vector3};
 use pendulum_core::Drive;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -38,6 +39,22 @@ pub struct Circle {
     omega: Numbers,
     /// `T` and `ω0` of a ramp, if any.
     ramp: Option<(Numbers, Numbers)>,
+}
+
+/// The pivot on the cubic spline through sampled positions (`pendulum_core::Sampled`):
+/// `times` (s, increasing, shape `(m,)`), `positions` (m, shape `(m, 2)` planar or
+/// `(m, 3)` in directions, one path for all states, or the states' leading shape plus
+/// `(m, D)`, one per state) and `end_velocities` (m/s, shape `(2, D)` or leading shape plus
+/// `(2, D)`: the velocities at the first and last sample; `None`, the natural spline,
+/// `p̈ = 0` there). Outside its samples the pivot moves on in a straight line at its end
+/// velocity: at rest, if that is zero. A motion of one's own (measured, planned, computed
+/// elsewhere) as a drive, with no Python called while the chains run.
+#[pyclass(module = "pendulum._pendulum", name = "Sampled", frozen)]
+#[derive(Debug, Clone)]
+pub struct Sampled {
+    times: Numbers,
+    positions: Numbers,
+    end_velocities: Option<Numbers>,
 }
 
 /// `what`'s numbers, each checked by `valid` (a requirement in words when not).
@@ -208,6 +225,119 @@ impl Circle {
     }
 }
 
+#[pymethods]
+impl Sampled {
+    #[new]
+    #[pyo3(signature = (times, positions, end_velocities = None))]
+    fn new(
+        times: &Bound<'_, PyAny>,
+        positions: &Bound<'_, PyAny>,
+        end_velocities: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let times = Numbers::read("times", times)?;
+        let [count] = times.shape[..] else {
+            return Err(invalid(format!("times: shape {:?}, expected (m,), one time a sample", times.shape)));
+        };
+        let positions = Numbers::read("positions", positions)?;
+        match positions.shape[..] {
+            [.., rows, 2 | 3] if rows == count => {}
+            _ => {
+                return Err(invalid(format!(
+                    "positions: shape {:?}, expected ({count}, 2) or ({count}, 3) for {count} times, or one such \
+                     path per state",
+                    positions.shape
+                )));
+            }
+        }
+        let end_velocities =
+            end_velocities.filter(|v| !v.is_none()).map(|v| Numbers::read("end_velocities", v));
+        let sampled = Self { times, positions, end_velocities: end_velocities.transpose()? };
+        // Every path checked now (its times, its spline), each state's as the run reads it.
+        let lead = &sampled.positions.shape[..sampled.positions.shape.len() - 2];
+        match sampled.dim() {
+            2 => sampled.drives::<U2>(lead).map(|_| ())?,
+            _ => sampled.drives::<U3>(lead).map(|_| ())?,
+        }
+        Ok(sampled)
+    }
+
+    /// The sample times (s), as given.
+    #[getter]
+    fn times<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.times.to_array(py)
+    }
+
+    /// The sampled positions (m), as given.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.positions.to_array(py)
+    }
+
+    /// The velocities at the first and last sample (m/s), as given; `None` for the
+    /// natural spline.
+    #[getter]
+    fn end_velocities<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.end_velocities.as_ref().map(|v| v.to_array(py)).transpose()
+    }
+
+    fn __repr__(&self) -> String {
+        let (t, count) = (&self.times.data, self.times.data.len());
+        let ends = self.end_velocities.as_ref().map_or("None".to_string(), describe);
+        format!(
+            "Sampled({count} samples from {} to {} s, positions={}, end_velocities={ends})",
+            t[0],
+            t[count - 1],
+            describe(&self.positions)
+        )
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (py, me) = (slf.py(), slf.get());
+        let args = (me.times(py)?, me.positions(py)?, me.end_velocities(py)?);
+        Ok((slf.get_type().into_any(), args.into_pyobject(py)?))
+    }
+}
+
+impl Sampled {
+    /// The components of a position: 2 or 3.
+    fn dim(&self) -> usize {
+        self.positions.shape[self.positions.shape.len() - 1]
+    }
+
+    /// One core drive in `S` per state of the leading shape `lead`.
+    fn drives<S: DimName>(&self, lead: &[usize]) -> PyResult<Vec<pendulum_core::Sampled<S>>>
+    where
+        nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<S>,
+    {
+        let (dim, count) = (S::DIM, self.times.data.len());
+        if self.dim() != dim {
+            let model = if dim == 2 { "model='planar'" } else { "model='directions'" };
+            return Err(invalid(format!("positions: {} components, {model} takes {dim}", self.dim())));
+        }
+        let positions = self.positions.per_state_shaped("positions", &[count, dim], lead)?;
+        let ends = match &self.end_velocities {
+            None => None,
+            Some(v) => Some(v.per_state_shaped("end_velocities", &[2, dim], lead)?),
+        };
+        let vectors =
+            |rows: &[f64]| rows.chunks_exact(dim).map(OVector::<f64, S>::from_column_slice).collect();
+        (0..positions.len())
+            .map(|k| {
+                let (times, path) = (self.times.data.clone(), vectors(positions[k]));
+                match &ends {
+                    None => pendulum_core::Sampled::new(times, path),
+                    Some(ends) => {
+                        let [start, end]: [OVector<f64, S>; 2] =
+                            [&ends[k][..dim], &ends[k][dim..]].map(OVector::from_column_slice);
+                        pendulum_core::Sampled::with_end_velocities(times, path, start, end)
+                    }
+                }
+            })
+            .collect::<Result<_, _>>()
+            .map_err(core_error)
+    }
+}
+
 /// A number as itself, an array by its shape.
 fn describe(numbers: &Numbers) -> String {
     match numbers.shape.as_slice() {
@@ -216,11 +346,12 @@ fn describe(numbers: &Numbers) -> String {
     }
 }
 
-/// A drive given to a run: [`Harmonic`] or [`Circle`].
+/// A drive given to a run: [`Harmonic`], [`Circle`] or [`Sampled`].
 #[derive(Debug, Clone)]
 pub enum Given {
     Harmonic(Harmonic),
     Circle(Circle),
+    Sampled(Sampled),
 }
 
 impl Given {
@@ -233,14 +364,20 @@ impl Given {
         if let Ok(c) = value.cast::<Circle>() {
             return Ok(Some(Self::Circle(c.get().clone())));
         }
+        if let Ok(p) = value.cast::<Sampled>() {
+            return Ok(Some(Self::Sampled(p.get().clone())));
+        }
         let kind = value.get_type().name().map_or_else(|_| "?".to_string(), |n| n.to_string());
-        Err(invalid(format!("drive: a {kind}, expected pendulum.Harmonic or pendulum.Circle")))
+        Err(invalid(format!(
+            "drive: a {kind}, expected pendulum.Harmonic, pendulum.Circle or pendulum.Sampled"
+        )))
     }
 
     /// One planar drive per state of the leading shape `lead`.
-    pub fn planar(&self, lead: &[usize]) -> PyResult<Vec<pendulum_core::Harmonic<U2>>> {
+    pub fn planar(&self, lead: &[usize]) -> PyResult<Vec<PlanarPivot>> {
         match self {
-            Self::Harmonic(h) => h.drives(lead),
+            Self::Harmonic(h) => Ok(h.drives(lead)?.into_iter().map(PlanarPivot::Harmonic).collect()),
+            Self::Sampled(p) => Ok(p.drives(lead)?.into_iter().map(PlanarPivot::Sampled).collect()),
             Self::Circle(_) => Err(invalid(
                 "drive: pendulum.Circle turns the pivot about the vertical, in 3D: model='directions' only",
             )),
@@ -252,6 +389,7 @@ impl Given {
         Ok(match self {
             Self::Harmonic(h) => h.drives(lead)?.into_iter().map(Pivot::Harmonic).collect(),
             Self::Circle(c) => c.drives(lead)?,
+            Self::Sampled(p) => p.drives(lead)?.into_iter().map(Pivot::Sampled).collect(),
         })
     }
 }
@@ -312,48 +450,45 @@ impl Harmonic {
     }
 }
 
+/// `impl Drive<$space> for $name`, each method passed to the variant's drive.
+macro_rules! drive_of_variants {
+    ($name:ident in $space:ty, $vector:ty: $($variant:ident),+) => {
+        impl Drive<$space> for $name {
+            fn position(&self, t: f64) -> $vector {
+                match self { $(Self::$variant(d) => d.position(t)),+ }
+            }
+            fn velocity(&self, t: f64) -> $vector {
+                match self { $(Self::$variant(d) => d.velocity(t)),+ }
+            }
+            fn acceleration(&self, t: f64) -> $vector {
+                match self { $(Self::$variant(d) => d.acceleration(t)),+ }
+            }
+            fn velocity_and_acceleration(&self, t: f64) -> ($vector, $vector) {
+                match self { $(Self::$variant(d) => d.velocity_and_acceleration(t)),+ }
+            }
+            fn position_and_velocity(&self, t: f64) -> ($vector, $vector) {
+                match self { $(Self::$variant(d) => d.position_and_velocity(t)),+ }
+            }
+        }
+    };
+}
+
+/// The pivot drive of a planar chain in a run.
+#[derive(Debug, Clone)]
+pub enum PlanarPivot {
+    Harmonic(pendulum_core::Harmonic<U2>),
+    Sampled(pendulum_core::Sampled<U2>),
+}
+
+drive_of_variants!(PlanarPivot in U2, Vector2<f64>: Harmonic, Sampled);
+
 /// The pivot drive of a chain in directions in a run.
 #[derive(Debug, Clone)]
 pub enum Pivot {
     Harmonic(pendulum_core::Harmonic<U3>),
     Circle(pendulum_core::Circle),
     Ramped(pendulum_core::RampedCircle),
+    Sampled(pendulum_core::Sampled<U3>),
 }
 
-impl Drive<U3> for Pivot {
-    fn position(&self, t: f64) -> Vector3<f64> {
-        match self {
-            Self::Harmonic(d) => d.position(t),
-            Self::Circle(d) => d.position(t),
-            Self::Ramped(d) => d.position(t),
-        }
-    }
-    fn velocity(&self, t: f64) -> Vector3<f64> {
-        match self {
-            Self::Harmonic(d) => d.velocity(t),
-            Self::Circle(d) => d.velocity(t),
-            Self::Ramped(d) => d.velocity(t),
-        }
-    }
-    fn acceleration(&self, t: f64) -> Vector3<f64> {
-        match self {
-            Self::Harmonic(d) => d.acceleration(t),
-            Self::Circle(d) => d.acceleration(t),
-            Self::Ramped(d) => d.acceleration(t),
-        }
-    }
-    fn velocity_and_acceleration(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        match self {
-            Self::Harmonic(d) => d.velocity_and_acceleration(t),
-            Self::Circle(d) => d.velocity_and_acceleration(t),
-            Self::Ramped(d) => d.velocity_and_acceleration(t),
-        }
-    }
-    fn position_and_velocity(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        match self {
-            Self::Harmonic(d) => d.position_and_velocity(t),
-            Self::Circle(d) => d.position_and_velocity(t),
-            Self::Ramped(d) => d.position_and_velocity(t),
-        }
-    }
-}
+drive_of_variants!(Pivot in U3, Vector3<f64>: Harmonic, Circle, Ramped, Sampled);

@@ -32,6 +32,7 @@ fn _pendulum(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<chain::Chain>()?;
     m.add_class::<drives::Harmonic>()?;
     m.add_class::<drives::Circle>()?;
+    m.add_class::<drives::Sampled>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<run::RunResult>()?;
     m.add_class::<string::HeavyString>()?;

@@ -6,9 +6,9 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use nalgebra::{DVector, Dyn, U2};
+use crate::drives::PlanarPivot;
+use nalgebra::{DVector, Dyn};
 use numpy::PyArray1;
-use pendulum_core::Harmonic;
 use pendulum_core::batch::{Failure, PlanarBatch};
 use pendulum_core::integrate::State;
 use pendulum_experiment::Error;
@@ -138,7 +138,7 @@ fn run_in<'py, T: numpy::Element + Copy + Send + 'static>(
 pub fn planar_rk4(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
-    drives: Option<Vec<Harmonic<U2>>>,
+    drives: Option<Vec<PlanarPivot>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f64>> {
@@ -169,7 +169,7 @@ pub fn planar_rk4(
 pub fn planar_rk4_f32(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, torque, pivot]: [&Rows; 4],
-    drives: Option<Vec<Harmonic<U2>>>,
+    drives: Option<Vec<PlanarPivot>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {

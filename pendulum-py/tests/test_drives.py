@@ -1,8 +1,9 @@
-"""Runs whose pivot moves within a call (`drive=pendulum.Harmonic(...)` or
-`pendulum.Circle(...)`, parameters one for all or one per state): Kapitza's inverted
-pendulum against its threshold and slow frequency, a whirled rod on its steady cone,
-the directions against the planar model, drives per state and each state alone bit for
-bit, runs split in calls, and bad input."""
+"""Runs whose pivot moves within a call (`drive=pendulum.Harmonic(...)`,
+`pendulum.Circle(...)` or `pendulum.Sampled(...)`, parameters one for all or one per
+state): Kapitza's inverted pendulum against its threshold and slow frequency, a whirled
+rod on its steady cone, the directions against the planar model, drives per state and
+each state alone bit for bit, runs split in calls, a pivot on samples of a motion against
+the motion itself, and bad input."""
 
 import pickle
 
@@ -236,7 +237,7 @@ def test_bad_drives_are_named():
     for kw, message in [
         (dict(drive=harmonic, pivot_acceleration=[0.0, 1.0]), "pivot_acceleration: a drive moves the pivot"),
         (dict(drive=pendulum.Circle(0.1, 3.0)), "model='directions' only"),
-        (dict(drive=3), "drive: a int, expected pendulum.Harmonic or pendulum.Circle"),
+        (dict(drive=3), "drive: a int, expected pendulum.Harmonic, pendulum.Circle or pendulum.Sampled"),
         (dict(t0=float("nan")), "t0: NaN is not a finite time"),
         (dict(drive=pendulum.Harmonic(0.1, [1.0, 2.0])), "omega: shape [2] is neither [] (one for all) nor [4]"),
         (dict(drive=pendulum.Harmonic(0.1, 1.0, direction=(0, 0, 1))), "direction: 3 components, model='planar' takes 2"),
@@ -260,3 +261,90 @@ def test_bad_drives_are_named():
     with pytest.raises(ValueError, match=r"ramp_time: shape \[2\] is neither \[\] \(one for all\) nor \[3\]"):
         u = np.tile([0.0, 0.0, -1.0], (3, 1))
         pendulum.Chain(1.0, 1.0).integrate(u, h=1e-3, model="directions", drive=pendulum.Circle(0.1, 2.0, ramp_time=[1.0, 2.0]))
+
+
+def sampled(drive_position, drive_velocity, t_end, per_second):
+    """`pendulum.Sampled` through a motion's positions from 0 to `t_end` (s), `per_second`
+    samples a second, its end velocities the motion's."""
+    t = np.linspace(0.0, t_end, int(round(t_end * per_second)) + 1)
+    ends = np.stack([drive_velocity(t[0]), drive_velocity(t[-1])])
+    return pendulum.Sampled(t, np.stack([drive_position(s) for s in t]), end_velocities=ends)
+
+
+def test_a_pivot_on_samples_of_its_motion_moves_the_chain_as_the_motion_does():
+    # Kapitza's rod shaken at 300 rad/s (planar), and a 3-link chain whirled on a circle of
+    # 2 cm at 7 rad/s from hanging (directions): driven by the spline through samples of
+    # the motion, each run approaches the one driven by the motion itself as h⁴, h the
+    # spacing of the samples.
+    amplitude, omega = 0.02, 300.0
+    rod = pendulum.Chain(1.0, 0.5)
+    exact, _ = rod.integrate([np.pi - 0.1], h=2e-5, steps=20_000, drive=pendulum.Harmonic(amplitude, omega))
+    position = lambda t: [0.0, amplitude * np.sin(omega * t)]
+    velocity = lambda t: [0.0, amplitude * omega * np.cos(omega * t)]
+    errors = []
+    for per_turn in (20, 40):
+        drive = sampled(position, velocity, 0.5, per_turn * omega / (2 * np.pi))
+        q, _ = rod.integrate([np.pi - 0.1], h=2e-5, steps=20_000, drive=drive)
+        errors.append(abs(q[0] - exact[0]))
+    print(f"Kapitza's rod after 0.4 s, samples 20 and 40 a turn: errors {errors[0]:.2e}, {errors[1]:.2e} rad")
+    assert errors[1] < 1e-6 and errors[0] / errors[1] > 8, errors
+
+    chain = pendulum.Chain([0.3, 0.2, 0.1], [0.2, 0.15, 0.1])
+    hanging = np.tile([0.0, 0.0, -1.0], 3)
+    kw = dict(h=1e-3, steps=3000, model="directions")
+    exact, _ = chain.integrate(hanging, drive=pendulum.Circle(0.02, 7.0), **kw)
+    circle = lambda t: 0.02 * np.array([np.cos(7.0 * t), np.sin(7.0 * t), 0.0])
+    turning = lambda t: 0.14 * np.array([-np.sin(7.0 * t), np.cos(7.0 * t), 0.0])
+    q, _ = chain.integrate(hanging, drive=sampled(circle, turning, 3.5, 7.0 * 40 / (2 * np.pi)), **kw)
+    assert np.max(np.abs(exact - hanging)) > 0.1, "the whirl moved the chain"
+    assert np.max(np.abs(q - exact)) < 1e-6, np.max(np.abs(q - exact))
+
+
+def test_sampled_paths_per_state_are_each_states_own_run_bit_for_bit():
+    chain = pendulum.Chain([0.4, 0.3], [0.3, 0.2], damping=0.01)
+    t = np.linspace(0.0, 0.2, 11)
+    r = np.random.default_rng(5)
+    paths = 0.01 * r.normal(size=(3, 11, 2))
+    drive = pendulum.Sampled(t, paths)
+    q0 = r.uniform(-1, 1, (3, 2))
+    # From 0.05 s to 0.35 s: on the spline, then on the straight line after it.
+    q, qd = chain.integrate(q0, h=1e-3, steps=300, t0=0.05, drive=drive)
+    for k in range(3):
+        alone = chain.integrate(q0[k], h=1e-3, steps=300, t0=0.05, drive=pendulum.Sampled(t, paths[k]))
+        assert np.array_equal(alone[0], q[k]) and np.array_equal(alone[1], qd[k])
+    assert np.max(np.abs(q[0] - q[1])) > 1e-4, "each state's own path"
+    # The same path for all: one path given once, or once per state.
+    once = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, paths[0]))
+    each = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, np.stack([paths[0]] * 3)))
+    assert all(np.array_equal(a, b) for a, b in zip(once, each))
+    # A path at rest at the origin is the pivot at rest, bit for bit.
+    rest = chain.integrate(q0, h=1e-3, steps=100)
+    still = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, np.zeros((11, 2)), np.zeros((2, 2))))
+    assert all(np.array_equal(a, b) for a, b in zip(rest, still))
+
+
+def test_sampled_drives_print_pickle_and_name_bad_samples():
+    p = pendulum.Sampled([0.0, 0.5, 1.0], np.zeros((4, 3, 3)), end_velocities=np.zeros((2, 3)))
+    assert repr(p) == (
+        "Sampled(3 samples from 0 to 1 s, positions=<array of shape [4, 3, 3]>, end_velocities=<array of shape [2, 3]>)"
+    )
+    back = pickle.loads(pickle.dumps(p))
+    assert np.array_equal(back.times, [0.0, 0.5, 1.0]) and back.positions.shape == (4, 3, 3)
+    assert back.end_velocities.shape == (2, 3) and pendulum.Sampled([0, 1], np.zeros((2, 2))).end_velocities is None
+    for args, message in [
+        (([0.0], [[0.0, 0.0]]), "a sampled drive needs at least 2 samples, got 1"),
+        (([[0.0, 1.0]], [[0.0, 0.0]]), r"times: shape \[1, 2\], expected \(m,\)"),
+        (([0.0, 1.0, 1.0], np.zeros((3, 2))), r"times\[2\] must be after times\[1\] = 1, got 1"),
+        (([0.0, np.nan], np.zeros((2, 2))), "times: NaN is not finite"),
+        (([0.0, 1.0], np.zeros((3, 2))), r"positions: shape \[3, 2\], expected \(2, 2\) or \(2, 3\) for 2 times"),
+        (([0.0, 1.0], np.zeros((2, 4))), r"positions: shape \[2, 4\]"),
+        (([0.0, 1.0], np.zeros((2, 2)), np.zeros((3, 2))), r"end_velocities: shape \[3, 2\] is neither \[2, 2\]"),
+        (([0.0, 1e-300, 1.0], [[0.0, 0.0], [1e300, 0.0], [0.0, 0.0]]), "drive spline acceleration must be finite"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            pendulum.Sampled(*args)
+    chain = pendulum.Chain([1.0, 1.0], 0.5)
+    with pytest.raises(ValueError, match="positions: 3 components, model='planar' takes 2"):
+        chain.integrate(np.zeros(2), h=1e-3, drive=pendulum.Sampled([0.0, 1.0], np.zeros((2, 3))))
+    with pytest.raises(ValueError, match=r"positions: shape \[5, 2, 2\] is neither \[2, 2\] \(one for all\) nor \[4, 2, 2\]"):
+        chain.integrate(np.zeros((4, 2)), h=1e-3, drive=pendulum.Sampled([0.0, 1.0], np.zeros((5, 2, 2))))

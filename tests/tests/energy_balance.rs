@@ -9,7 +9,7 @@ use nalgebra::{DVector, DefaultAllocator, Dyn, OVector, U1, U2, U3, Vector2, Vec
 use pendulum_core::integrate::{GaussLegendre, GaussOptions, State, SystemAlloc};
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Drive, Driven, FirstOrder, FnDrive, Harmonic, Model,
-    ModelAlloc, Planar, Spatial, TorqueAt, trajectory,
+    ModelAlloc, Planar, Sampled, Spatial, TorqueAt, trajectory,
 };
 use pendulum_tests::{random_chain, random_vector, rng};
 use rand::Rng;
@@ -169,5 +169,21 @@ fn a_user_drive_from_closures_balances_too() {
     let system = Accounted::new(model, FnDrive::new(p, v, a), ConstantTorque(DVector::from_vec(vec![0.5])));
     let (worst, end) = closure(&system, &[2.0], &[0.0], 2.0, 2e-3);
     assert!(end.ledger.drive.abs() > 1e-3, "{end:?}");
+    assert!(worst < 1e-8, "relative closure {worst:e}");
+}
+
+#[test]
+fn a_pivot_on_sampled_positions_balances_too() {
+    // A Lissajous path sampled every 50 ms, a whole number of the run's steps: the spline's
+    // kinks in p̈ fall between steps.
+    let path = |t: f64| Vector3::new(0.1 * (3.0 * t).sin(), 0.05 * (5.0 * t).cos(), 0.03 * (4.0 * t).sin());
+    let times: Vec<f64> = (0..=50).map(|k| k as f64 * 0.05).collect();
+    let drive = Sampled::new(times.clone(), times.iter().map(|&t| path(t)).collect()).unwrap();
+    let chain = Chain::<Dyn>::new(&[1.0, 0.7], &[0.5, 0.4], 9.81).unwrap();
+    let model = Spatial::new(chain.with_damping(&[0.05, 0.1]).unwrap());
+    let system = Accounted::new(model, drive, ConstantTorque(DVector::zeros(4)));
+    let (worst, end) = closure(&system, &[1.0, 1.4, 0.0, 0.5], &[0.0, 0.5, 3.0, 2.0], 2.0, 2e-3);
+    println!("sampled path: worst relative closure {worst:e}, final {end:?}");
+    assert!(end.ledger.drive.abs() > 1e-3 && end.ledger.damped > 0.1, "{end:?}");
     assert!(worst < 1e-8, "relative closure {worst:e}");
 }

@@ -6,8 +6,9 @@ pivot that may be fixed or driven, in 2D and 3D — from Rust, as numpy arrays.
   call along leading axes; many states stepped by RK4 per call (``integrate``, sampled by
   ``trajectory``, torques and pivot accelerations held, or the pivot moved by a drive);
   its normal modes and linearisation.
-- ``Harmonic``, ``Circle``: pivot drives for those runs (shaken along a line, or circling
-  about the vertical), their parameters one for all states or one per state.
+- ``Harmonic``, ``Circle``, ``Sampled``: pivot drives for those runs (shaken along a line,
+  circling about the vertical, or on the spline through positions of one's own), their
+  parameters one for all states or one per state.
 - ``Run``: an experiment as ``pendulum simulate`` runs it (the same description as
   run.json), run to arrays with ``Run.run()``; a whirled chain's result says which shape it
   took (``RunResult.shape``).
@@ -43,6 +44,7 @@ from ._pendulum import (
     HeavyString,
     Run,
     RunResult,
+    Sampled,
     __version__,
     page,
     steady,
@@ -64,6 +66,7 @@ __all__ = [
     "HeavyString",
     "Run",
     "RunResult",
+    "Sampled",
     "__version__",
     "page",
     "plot_ledger",

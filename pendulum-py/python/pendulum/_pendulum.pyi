@@ -15,6 +15,7 @@ __all__ = [
     "HeavyString",
     "Run",
     "RunResult",
+    "Sampled",
     "__version__",
     "check_claims",
     "page",
@@ -132,7 +133,7 @@ class Chain:
         steps: int = 1,
         model: str = "planar",
         precision: str = "float64",
-        drive: Union[Harmonic, Circle, None] = None,
+        drive: Union[Harmonic, Circle, Sampled, None] = None,
         t0: float = 0.0,
         method: str = "rk4",
     ) -> tuple[_Array, _Array]: ...
@@ -148,7 +149,7 @@ class Chain:
         every: int = 1,
         model: str = "planar",
         precision: str = "float64",
-        drive: Union[Harmonic, Circle, None] = None,
+        drive: Union[Harmonic, Circle, Sampled, None] = None,
         t0: float = 0.0,
         method: str = "rk4",
     ) -> tuple[_Array, _Array, _Array]: ...
@@ -225,6 +226,22 @@ class Circle:
     def ramp_time(self) -> Optional[Union[float, _Array]]: ...
     @property
     def ramp_from(self) -> Optional[Union[float, _Array]]: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+
+@final
+class Sampled:
+    def __new__(
+        cls,
+        times: npt.ArrayLike,
+        positions: npt.ArrayLike,
+        end_velocities: Optional[npt.ArrayLike] = None,
+    ) -> Sampled: ...
+    @property
+    def times(self) -> _Array: ...
+    @property
+    def positions(self) -> _Array: ...
+    @property
+    def end_velocities(self) -> Optional[_Array]: ...
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
 @final
