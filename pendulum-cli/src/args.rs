@@ -153,6 +153,16 @@ pub struct Physics {
     /// Circle drive with --ramp-time: the speed at t = 0, rad/s [default: 0].
     #[arg(long, value_name = "OMEGA0", allow_negative_numbers = true)]
     pub ramp_from: Option<f64>,
+    /// Sampled drive: the pivot's positions, a text file of rows `t, x, y` (2D) or
+    /// `t, x, y, z` (3D), s and m, times increasing (commas or spaces; `#` starts a
+    /// comment). The pivot moves on the cubic spline through them, and on a straight line
+    /// at its end velocity outside them.
+    #[arg(long, value_name = "FILE")]
+    pub path: Option<std::path::PathBuf>,
+    /// Sampled drive: the pivot at rest at the first and last sample (so it rests before
+    /// and after them) [default: the natural spline, p̈ = 0 there].
+    #[arg(long)]
+    pub path_at_rest: bool,
     /// Time integrator. 3D chains are integrated in unit link directions with a
     /// projection onto the rod constraints after every step (midpoint: exact on them).
     /// [default: chosen from the chain and drive, see run.json's "chosen": midpoint for

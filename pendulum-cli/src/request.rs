@@ -34,6 +34,8 @@ pub fn request(p: &Physics, frames: usize) -> CliResult<Request> {
         radius: p.radius,
         ramp_time: p.ramp_time,
         ramp_from: p.ramp_from,
+        path: p.path.clone(),
+        path_at_rest: p.path_at_rest,
     }
     .config(dim)?;
     let view = View::default_for(dim, &drive);

@@ -614,3 +614,60 @@ fn from_with_a_chain_option_names_only_the_option_given() {
         "error: the argument '--from <RUN_JSON>' cannot be used with --n <N>, --omega <OMEGA>"
     );
 }
+
+#[test]
+fn a_pivot_on_samples_of_a_circle_whirls_the_chain_as_the_circle_does_and_repeats_without_the_file() {
+    let dir = scratch("sampled");
+    // The circle R = 2 cm, ω = 7 rad/s sampled at 100 Hz (about 90 samples a turn) from
+    // −0.5 s to 2.5 s: the natural spline's ends (p̈ = 0 there, not the circle's) stay
+    // outside the run.
+    let rows: String = (-50..=250)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            format!("{t:?}, {:?}, {:?}, 0\n", 0.02 * (7.0 * t).cos(), 0.02 * (7.0 * t).sin())
+        })
+        .collect();
+    std::fs::write(dir.join("circle.txt"), format!("# t, x, y, z\n{rows}")).unwrap();
+    let common = ["simulate", "--dim", "3", "--n", "3", "--initial", "hanging", "--end", "2", "--no-plots"];
+    let fixed = ["--integrator", "rk4", "--step", "0.001", "--every", "100"];
+    let sampled = ["--drive", "sampled", "--path", "circle.txt"];
+    let circle = ["--drive", "circle", "--radius", "0.02", "--omega", "7"];
+    for (drive, out) in [(&sampled[..], "sampled"), (&circle[..], "circle")] {
+        let run = run_in(&dir, &[&common[..], &fixed[..], drive, &["--out", out]].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    let (a, b) =
+        (Csv::read(&dir.join("sampled/trajectory.csv")), Csv::read(&dir.join("circle/trajectory.csv")));
+    let worst = ["u3_x", "u3_y", "u3_z", "pivot_x", "pivot_y"]
+        .iter()
+        .flat_map(|c| a.column(c).into_iter().zip(b.column(c)).map(|(x, y)| (x - y).abs()))
+        .fold(0.0, f64::max);
+    let swung = a.column("u3_x").iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    assert!(swung > 0.05 && worst < 1e-6, "swung {swung}, off by {worst}");
+    let json = run_json(&dir.join("sampled"));
+    assert_eq!(json["config"]["drive"]["kind"], "sampled");
+    assert_eq!(json["config"]["drive"]["times"].as_array().unwrap().len(), 301);
+    // The defaults: the midpoint step, at half the samples' spacing, its ledger closed.
+    let run = run_in(&dir, &[&common[..], &sampled[..], &["--out", "chosen"]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let chosen = run_json(&dir.join("chosen"));
+    assert_eq!(chosen["config"]["integrator"], "midpoint");
+    assert!(
+        (chosen["config"]["step"].as_f64().unwrap() - 0.005).abs() < 1e-12,
+        "{}",
+        chosen["config"]["step"]
+    );
+    let residual = Csv::read(&dir.join("chosen/energy.csv")).column("balance_residual");
+    assert!(residual.iter().all(|r| r.abs() < 1e-9), "{residual:?}");
+    // run.json holds the samples: the run repeats with the file gone.
+    std::fs::remove_file(dir.join("circle.txt")).unwrap();
+    let run = run_in(&dir, &["simulate", "--from", "sampled/run.json", "--out", "again", "--no-plots"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let again = std::fs::read(dir.join("again/trajectory.csv")).unwrap();
+    assert!(again == std::fs::read(dir.join("sampled/trajectory.csv")).unwrap());
+    // A file that is not rows of t and the position is named.
+    std::fs::write(dir.join("bad.txt"), "0 0 0\n1 0 0\n").unwrap();
+    let run = run_in(&dir, &[&common[..], &["--drive", "sampled", "--path", "bad.txt"]].concat());
+    assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+    assert!(stderr(&run).contains("bad.txt holds 6 numbers, not rows of 4"), "{}", stderr(&run));
+}

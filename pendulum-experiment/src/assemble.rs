@@ -13,7 +13,7 @@ use pendulum_core::integrate::{
 use pendulum_core::kinematics::Chart;
 use pendulum_core::{
     Accounted, Chain, Circle, ConstantTorque, Directions, Drive, Driven, FirstOrder, Fixed, Harmonic, Ledger,
-    Model, ModelAlloc, PlanarTension, RampedCircle, RodMidpoint, Spatial, Turning,
+    Model, ModelAlloc, PlanarTension, RampedCircle, RodMidpoint, Sampled, Spatial, Turning,
 };
 
 use crate::description::{DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver};
@@ -329,8 +329,30 @@ pub fn turning_drive(config: &DriveConfig) -> Result<Option<Box<dyn Turning>>> {
         DriveConfig::RampedCircle { radius, initial_omega, omega, duration } => {
             Some(Box::new(RampedCircle::new(radius, initial_omega, omega, duration)?))
         }
-        DriveConfig::Fixed | DriveConfig::Harmonic { .. } => None,
+        DriveConfig::Fixed | DriveConfig::Harmonic { .. } | DriveConfig::Sampled { .. } => None,
     })
+}
+
+/// The spline of a sampled drive in `S` (`at_rest`: zero velocity at the first and last
+/// sample, else the natural spline); errors name the bad sample.
+pub fn sampled_path<S: DimName>(times: &[f64], positions: &[Vec<f64>], at_rest: bool) -> Result<Sampled<S>>
+where
+    DefaultAllocator: nalgebra::allocator::Allocator<S>,
+{
+    let dim = S::DIM;
+    if let Some((k, p)) = positions.iter().enumerate().find(|(_, p)| p.len() != dim) {
+        return Err(Error::invalid(format!(
+            "drive positions[{k}] has {} components, a chain in {dim}D takes {dim}",
+            p.len()
+        )));
+    }
+    let path: Vec<OVector<f64, S>> = positions.iter().map(|p| OVector::from_column_slice(p)).collect();
+    let path = if at_rest {
+        Sampled::with_end_velocities(times.to_vec(), path, OVector::zeros(), OVector::zeros())
+    } else {
+        Sampled::new(times.to_vec(), path)
+    };
+    Ok(path?)
 }
 
 /// The pivot drive of a configuration.
@@ -345,6 +367,9 @@ where
             Box::new(Harmonic::new(d, *amplitude, *omega, *phase)?)
         }
         DriveConfig::Circle { .. } | DriveConfig::RampedCircle { .. } => S::circle(config)?,
+        DriveConfig::Sampled { times, positions, at_rest, .. } => {
+            Box::new(sampled_path::<S>(times, positions, *at_rest)?)
+        }
     })
 }
 

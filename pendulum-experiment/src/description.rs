@@ -138,6 +138,21 @@ pub enum DriveConfig {
         /// Duration of the ramp, s.
         duration: f64,
     },
+    /// The cubic spline through sampled positions (`pendulum_core::Sampled`): natural
+    /// (`p̈ = 0` at the first and last sample) or at rest there; outside the samples a
+    /// straight line at the end velocity.
+    Sampled {
+        /// The file the samples were read from, as given (for the reader; the numbers
+        /// below are the path).
+        file: String,
+        /// Sample times `t_k`, s, increasing.
+        times: Vec<f64>,
+        /// Positions `p_k`, m: 2 (2D) or 3 (3D) components each.
+        positions: Vec<Vec<f64>>,
+        /// Whether the velocity at the first and last sample is zero (else the natural
+        /// spline).
+        at_rest: bool,
+    },
 }
 
 impl DriveConfig {
@@ -145,6 +160,15 @@ impl DriveConfig {
     /// or a ramped speed).
     pub fn circles(&self) -> bool {
         matches!(self, Self::Circle { .. } | Self::RampedCircle { .. })
+    }
+
+    /// A sampled path in words ("pivot on 1000 samples of hand.csv, 0 to 9.99 s"), for the
+    /// pictures' captions; `None` for the other drives.
+    pub fn sampled_words(&self) -> Option<String> {
+        let Self::Sampled { file, times, at_rest, .. } = self else { return None };
+        let (first, last) = (times.first().copied().unwrap_or(0.0), times.last().copied().unwrap_or(0.0));
+        let rest = if *at_rest { ", at rest at both ends" } else { "" };
+        Some(format!("pivot on {} samples of {file}, {first} to {last} s{rest}", times.len()))
     }
 }
 
@@ -297,6 +321,15 @@ impl RunConfig {
                 return Err(Error::invalid(format!(
                     "--direction: got {} components, the {space}D pivot moves in {space}",
                     direction.len()
+                )));
+            }
+        }
+        if let DriveConfig::Sampled { positions, .. } = &self.drive {
+            let space = self.dim.space();
+            if let Some((k, p)) = positions.iter().enumerate().find(|(_, p)| p.len() != space) {
+                return Err(Error::invalid(format!(
+                    "drive positions[{k}]: got {} components, the {space}D pivot moves in {space}",
+                    p.len()
                 )));
             }
         }

@@ -3,10 +3,15 @@
 //! checks and one-line messages every front end shares: per-link lists, the drive, and
 //! the names of the integrators and stage solves.
 
+use std::path::PathBuf;
+
+use nalgebra::{U2, U3};
 use serde::de::DeserializeOwned;
 
+use crate::assemble::sampled_path;
 use crate::description::{Dimension, DriveConfig};
 use crate::error::{Error, Result};
+use crate::initial::read_numbers;
 
 /// The links of a chain from its per-link lists: `n` if given, else the length of a list of
 /// more than one value, else 3 links; a single value is repeated for every link.
@@ -55,6 +60,8 @@ pub enum DriveKind {
     Harmonic,
     /// p(t) = R (cos ωt, sin ωt, 0), a horizontal circle (3D only).
     Circle,
+    /// The cubic spline through the positions of --path FILE (rows of t, x, y[, z]).
+    Sampled,
 }
 
 /// The drive's options: its kind and every parameter any kind takes.
@@ -76,6 +83,10 @@ pub struct DriveOptions {
     pub ramp_time: Option<f64>,
     /// Circle with a ramp: the speed at t = 0, rad/s (`None`: 0).
     pub ramp_from: Option<f64>,
+    /// Sampled: the file of the samples, rows of `t, x, y` (2D) or `t, x, y, z` (3D).
+    pub path: Option<PathBuf>,
+    /// Sampled: the pivot at rest at the first and last sample (else the natural spline).
+    pub path_at_rest: bool,
 }
 
 impl DriveOptions {
@@ -97,6 +108,7 @@ impl DriveOptions {
                     phase: self.phase,
                 }
             }
+            DriveKind::Sampled => self.sampled(dim)?,
             DriveKind::Circle => match self.ramp_time {
                 None => DriveConfig::Circle { radius: self.radius, omega: self.omega },
                 Some(duration) => DriveConfig::RampedCircle {
@@ -116,7 +128,38 @@ impl DriveOptions {
         if self.direction.is_some() && self.kind != DriveKind::Harmonic {
             return Err(Error::invalid("--direction applies to --drive harmonic only"));
         }
+        if (self.path.is_some() || self.path_at_rest) && self.kind != DriveKind::Sampled {
+            return Err(Error::invalid("--path and --path-at-rest apply to --drive sampled only"));
+        }
         Ok(drive)
+    }
+
+    /// The sampled drive of `--path` for a chain in `dim`: its rows read (`t` and the
+    /// position's `dim` components each) and its spline checked.
+    fn sampled(&self, dim: Dimension) -> Result<DriveConfig> {
+        let Some(path) = &self.path else {
+            return Err(Error::invalid("--drive sampled needs --path FILE (rows of t, x, y[, z])"));
+        };
+        let numbers = read_numbers("--path", path)?;
+        let width = 1 + dim.space();
+        if numbers.len() % width != 0 {
+            return Err(Error::invalid(format!(
+                "--path: {} holds {} numbers, not rows of {width} (t and {} components of the position)",
+                path.display(),
+                numbers.len(),
+                dim.space()
+            )));
+        }
+        let times: Vec<f64> = numbers.iter().step_by(width).copied().collect();
+        let positions: Vec<Vec<f64>> = numbers.chunks_exact(width).map(|row| row[1..].to_vec()).collect();
+        // The spline built once here, so that a bad sample is named with the file.
+        let at_rest = self.path_at_rest;
+        let checked = match dim {
+            Dimension::Two => sampled_path::<U2>(&times, &positions, at_rest).map(|_| ()),
+            Dimension::Three => sampled_path::<U3>(&times, &positions, at_rest).map(|_| ()),
+        };
+        checked.map_err(|e| Error::invalid(format!("--path {}: {e}", path.display())))?;
+        Ok(DriveConfig::Sampled { file: path.display().to_string(), times, positions, at_rest })
     }
 }
 
@@ -229,6 +272,8 @@ mod tests {
             radius: 0.02,
             ramp_time: Some(100.0),
             ramp_from: None,
+            path: None,
+            path_at_rest: false,
         };
         assert_eq!(
             circle.config(Dimension::Three).unwrap(),
@@ -241,6 +286,55 @@ mod tests {
             up.config(Dimension::Two).unwrap(),
             DriveConfig::Harmonic { direction: vec![0.0, 1.0], amplitude: 0.05, omega: 5.0, phase: 0.0 }
         );
+    }
+
+    #[test]
+    fn a_sampled_drive_reads_its_rows_and_names_a_bad_file() {
+        let dir = std::env::temp_dir().join(format!("pendulum-options-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = |name: &str, text: &str| {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            path
+        };
+        let base = DriveOptions {
+            kind: DriveKind::Sampled,
+            amplitude: 0.05,
+            omega: 5.0,
+            phase: 0.0,
+            direction: None,
+            radius: 0.02,
+            ramp_time: None,
+            ramp_from: None,
+            path: Some(file("hand.csv", "# t, x, y, z\n0, 0, 0, 0\n0.5, 0.01, 0, 0.02\n1.0 0 0.01 0\n")),
+            path_at_rest: true,
+        };
+        let DriveConfig::Sampled { times, positions, at_rest, file: name } =
+            base.config(Dimension::Three).unwrap()
+        else {
+            panic!("not sampled")
+        };
+        assert_eq!((times, at_rest), (vec![0.0, 0.5, 1.0], true));
+        assert_eq!(positions[1], vec![0.01, 0.0, 0.02]);
+        assert!(name.ends_with("hand.csv"), "{name}");
+        let message = |options: DriveOptions, dim| options.config(dim).unwrap_err().to_string();
+        let short = file("short.csv", "0 0 0 0\n1 0 0\n");
+        let e = message(DriveOptions { path: Some(short), ..base.clone() }, Dimension::Three);
+        assert!(
+            e.ends_with("short.csv holds 7 numbers, not rows of 4 (t and 3 components of the position)"),
+            "{e}"
+        );
+        let unordered = file("back.csv", "0 0 0\n1 0 0\n1 0 1\n");
+        let e = message(DriveOptions { path: Some(unordered), ..base.clone() }, Dimension::Two);
+        assert!(
+            e.starts_with("--path ") && e.ends_with("back.csv: times[2] must be after times[1] = 1, got 1"),
+            "{e}"
+        );
+        let e = message(DriveOptions { path: None, ..base.clone() }, Dimension::Two);
+        assert_eq!(e, "--drive sampled needs --path FILE (rows of t, x, y[, z])");
+        let e = message(DriveOptions { kind: DriveKind::Harmonic, ..base }, Dimension::Two);
+        assert_eq!(e, "--path and --path-at-rest apply to --drive sampled only");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -4,9 +4,10 @@
 //! returns the complete [`RunConfig`]. Also the step a failed run is advised to try
 //! ([`suggested_step`]).
 
-use nalgebra::Dyn;
-use pendulum_core::{Chain, fastest_frequency_bound};
+use nalgebra::{Dyn, U2, U3};
+use pendulum_core::{Chain, Drive, fastest_frequency_bound};
 
+use crate::assemble::sampled_path;
 use crate::description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, View, check_step,
 };
@@ -173,7 +174,7 @@ pub fn choose(config: &Request) -> Result<Choice> {
             IntegratorKind::Midpoint => {
                 let slowest = slowest_swing(&config.lengths, config.gravity);
                 let (omega, what) = match drive {
-                    Some(w) if w > slowest => (w, format!("the drive's period ({w} rad/s)")),
+                    Some(w) if w > slowest => (w, drive_period_words(&config.drive, w)),
                     _ => (slowest, format!("the chain's slowest swing (√(g/L) = {slowest:.3} rad/s)")),
                 };
                 if omega > 0.0 {
@@ -286,16 +287,50 @@ pub fn fastest_mode(chain: &Chain<Dyn>, drive: &DriveConfig) -> f64 {
         DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
             radius * initial_omega.abs().max(omega.abs()).powi(2)
         }
+        // The spline's p̈ is linear between samples: its largest is at one of them.
+        DriveConfig::Sampled { times, positions, at_rest, .. } => {
+            let largest = |acceleration: &[f64]| acceleration.iter().map(|a| a * a).sum::<f64>().sqrt();
+            let at_samples = match positions.first().map(Vec::len) {
+                Some(2) => sampled_path::<U2>(times, positions, *at_rest).map(|s| {
+                    times.iter().map(|&t| largest(s.acceleration(t).as_slice())).fold(0.0, f64::max)
+                }),
+                _ => sampled_path::<U3>(times, positions, *at_rest).map(|s| {
+                    times.iter().map(|&t| largest(s.acceleration(t).as_slice())).fold(0.0, f64::max)
+                }),
+            };
+            at_samples.unwrap_or(0.0)
+        }
     };
     fastest_frequency_bound(chain, chain.gravity() + accel)
 }
 
-/// The drive's angular frequency (rad/s), if it has one.
+/// The drive's angular frequency (rad/s), if it has one. A sampled path's is that of a
+/// period of ten of its closest samples, so that the steps chosen from it resolve every
+/// piece of its spline (the explicit steps at a quarter of the spacing, the midpoint's at
+/// half of it).
 pub fn drive_frequency(drive: &DriveConfig) -> Option<f64> {
     match drive {
         DriveConfig::Fixed => None,
         DriveConfig::Harmonic { omega, .. } | DriveConfig::Circle { omega, .. } => Some(omega.abs()),
         DriveConfig::RampedCircle { initial_omega, omega, .. } => Some(initial_omega.abs().max(omega.abs())),
+        DriveConfig::Sampled { times, .. } => {
+            let closest = times.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
+            (closest.is_finite() && closest > 0.0).then(|| std::f64::consts::TAU / (10.0 * closest))
+        }
+    }
+}
+
+/// The drive's period in words for the step's reason: its angular frequency `w` (rad/s),
+/// or for a sampled path the ten samples [`drive_frequency`] takes as its period.
+fn drive_period_words(drive: &DriveConfig, w: f64) -> String {
+    match drive {
+        DriveConfig::Sampled { .. } => {
+            format!(
+                "ten of the drive's samples (their closest {:.4e} s apart)",
+                std::f64::consts::TAU / w / 10.0
+            )
+        }
+        _ => format!("the drive's period ({w} rad/s)"),
     }
 }
 

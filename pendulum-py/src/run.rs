@@ -25,9 +25,10 @@ const SIGNAL_CHECK: Duration = Duration::from_millis(100);
 ///
 /// Keyword arguments as `pendulum simulate`'s options (SI units, angles in rad):
 /// `dim` (2 or 3), `n`, `masses` (kg), `lengths` (m), `gravity` (m/s²), `damping`
-/// (N·m·s), `torque` (N·m, 2D), `drive` ("fixed", "harmonic", "circle") with `amplitude`
-/// (m), `omega` (rad/s), `phase` (rad), `direction`, `radius` (m), `ramp_time` (s),
-/// `ramp_from` (rad/s); `initial` ("hanging", "horizontal", "tilted:ANGLE", a file or a
+/// (N·m·s), `torque` (N·m, 2D), `drive` ("fixed", "harmonic", "circle", "sampled") with
+/// `amplitude` (m), `omega` (rad/s), `phase` (rad), `direction`, `radius` (m), `ramp_time`
+/// (s), `ramp_from` (rad/s), `path` (a file of rows `t, x, y[, z]`, s and m) and
+/// `path_at_rest`; `initial` ("hanging", "horizontal", "tilted:ANGLE", a file or a
 /// previous run's directory), `spin` (rad/s, 3D), `integrator` ("gl1", "gl2", "gl3", "rk4",
 /// "midpoint", "dp54"; default: chosen), `solver`, `tolerance`, `step` (s; default:
 /// chosen), `end` (s), `every` (default: about 500 samples). What was chosen, and why, is
@@ -74,7 +75,8 @@ impl Run {
     #[new]
     #[pyo3(signature = (*, dim = 2, n = None, masses = None, lengths = None, gravity = 9.81, damping = None,
         torque = None, drive = "fixed", amplitude = 0.05, omega = 10.0, phase = 0.0, direction = None,
-        radius = 0.1, ramp_time = None, ramp_from = None, initial = "tilted:1.0", spin = None,
+        radius = 0.1, ramp_time = None, ramp_from = None, path = None, path_at_rest = false,
+        initial = "tilted:1.0", spin = None,
         integrator = None, solver = "fixed-point", tolerance = None, step = None, end = 10.0, every = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -93,6 +95,8 @@ impl Run {
         radius: f64,
         ramp_time: Option<f64>,
         ramp_from: Option<f64>,
+        path: Option<std::path::PathBuf>,
+        path_at_rest: bool,
         initial: &str,
         spin: Option<f64>,
         integrator: Option<&str>,
@@ -124,10 +128,21 @@ impl Run {
             Some(t) => Some(options::expand("torque", per_link("torque", t)?, n).map_err(run_error)?),
             None => None,
         };
-        let kind = options::by_name("drive", drive, "fixed, harmonic, circle").map_err(run_error)?;
-        let drive = DriveOptions { kind, amplitude, omega, phase, direction, radius, ramp_time, ramp_from }
-            .config(dim)
-            .map_err(run_error)?;
+        let kind = options::by_name("drive", drive, "fixed, harmonic, circle, sampled").map_err(run_error)?;
+        let drive = DriveOptions {
+            kind,
+            amplitude,
+            omega,
+            phase,
+            direction,
+            radius,
+            ramp_time,
+            ramp_from,
+            path,
+            path_at_rest,
+        }
+        .config(dim)
+        .map_err(run_error)?;
         let integrator = integrator
             .map(|s| options::by_name("integrator", s, "gl1, gl2, gl3, rk4, midpoint, dp54"))
             .transpose()
@@ -212,6 +227,7 @@ impl Run {
                 DriveConfig::Harmonic { .. } => "harmonic",
                 DriveConfig::Circle { .. } => "circle",
                 DriveConfig::RampedCircle { .. } => "ramped circle",
+                DriveConfig::Sampled { .. } => "sampled",
             },
             c.end,
             c.integrator,

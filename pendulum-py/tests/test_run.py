@@ -72,13 +72,31 @@ def test_runs_pickle_as_their_description():
     assert np.array_equal(again.run().final_state, run.run().final_state)
 
 
+def test_a_run_on_a_sampled_path_reads_its_file_and_keeps_the_samples(tmp_path):
+    # A pivot lifted 5 cm and set down again over 1 s, at rest before and after.
+    t = np.linspace(0.0, 1.0, 11)
+    np.savetxt(tmp_path / "lift.txt", np.stack([t, 0.0 * t, 0.05 * np.sin(np.pi * t) ** 2], axis=-1))
+    run = pendulum.Run(n=2, drive="sampled", path=tmp_path / "lift.txt", path_at_rest=True, end=2.0, initial="hanging")
+    assert "drive=sampled" in repr(run)
+    result = run.run()
+    pivot_y = result.positions[:, 0, 1]
+    after = pivot_y[result.t > 1.0]
+    assert abs(pivot_y.max() - 0.05) < 2e-3 and np.all(after == after[0]) and abs(after[0]) < 1e-30
+    assert np.max(np.abs(result.ledger["balance_residual"])) < 1e-9
+    described = json.loads(run.to_json())["drive"]
+    assert described["kind"] == "sampled" and described["at_rest"] and len(described["times"]) == 11
+    (tmp_path / "lift.txt").unlink()
+    assert np.array_equal(pendulum.Run.from_json(run.to_json()).run().final_state, result.final_state)
+
+
 @pytest.mark.parametrize(
     "kwargs, message",
     [
         ({"end": -1.0}, "--end must be finite and positive, got -1"),
         ({"step": 0.0}, "--step must be finite and positive, got 0"),
         ({"dim": 4}, "dim: 4 is neither 2 nor 3"),
-        ({"drive": "square"}, "drive: 'square' is not one of fixed, harmonic, circle"),
+        ({"drive": "square"}, "drive: 'square' is not one of fixed, harmonic, circle, sampled"),
+        ({"drive": "sampled"}, r"--drive sampled needs --path FILE \(rows of t, x, y\[, z\]\)"),
         ({"drive": "circle"}, "--drive circle moves the pivot on a horizontal circle: 3D only"),
         ({"masses": [1.0, 2.0], "n": 3}, "masses: got 2 values for 3 links"),
         ({"integrator": "euler"}, "integrator: 'euler' is not one of"),

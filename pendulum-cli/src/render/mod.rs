@@ -413,6 +413,7 @@ fn drive_period(drive: &DriveConfig) -> Option<f64> {
         DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
             (initial_omega.abs().max(omega.abs()), *radius)
         }
+        DriveConfig::Sampled { .. } => return None,
     };
     (omega.is_finite() && omega != 0.0 && size != 0.0).then(|| TAU / omega.abs())
 }

@@ -163,6 +163,7 @@ fn parameters(run: &Run) -> Vec<String> {
                 "pivot on a circle: R = {radius} m, ω from {initial_omega} to {omega} rad/s over {duration} s"
             )
         }
+        DriveConfig::Sampled { .. } => c.drive.sampled_words().unwrap_or_default(),
     };
     let damping = c.damping.iter().fold(0.0_f64, |a, b| a.max(*b));
     let mut lines = vec![
