@@ -313,6 +313,10 @@ def test_sampled_paths_per_state_are_each_states_own_run_bit_for_bit():
         alone = chain.integrate(q0[k], h=1e-3, steps=300, t0=0.05, drive=pendulum.Sampled(t, paths[k]))
         assert np.array_equal(alone[0], q[k]) and np.array_equal(alone[1], qd[k])
     assert np.max(np.abs(q[0] - q[1])) > 1e-4, "each state's own path"
+    # In float32, eight states a register: within the bound of the other drives.
+    q32, qd32 = chain.integrate(q0.astype(np.float32), h=1e-3, steps=300, t0=0.05, drive=drive, precision="float32")
+    scale = np.maximum(np.abs(q).max(axis=-1), np.abs(qd).max(axis=-1))
+    assert q32.dtype == np.float32 and np.max(np.abs(q32 - q).max(axis=-1) / scale) < 1e-4
     # The same path for all: one path given once, or once per state.
     once = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, paths[0]))
     each = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, np.stack([paths[0]] * 3)))
