@@ -252,8 +252,14 @@ impl Sampled {
         let end_velocities =
             end_velocities.filter(|v| !v.is_none()).map(|v| Numbers::read("end_velocities", v));
         let sampled = Self { times, positions, end_velocities: end_velocities.transpose()? };
-        // Every path checked now (its times, its spline), each state's as the run reads it.
-        let lead = &sampled.positions.shape[..sampled.positions.shape.len() - 2];
+        // Every path checked now (its times, its spline), each state's as the run reads it:
+        // the states' leading shape is the positions' or else the end velocities'.
+        let lead_of = |n: &Numbers| n.shape[..n.shape.len().saturating_sub(2)].to_vec();
+        let mut lead = lead_of(&sampled.positions);
+        if let (true, Some(ends)) = (lead.is_empty(), &sampled.end_velocities) {
+            lead = lead_of(ends);
+        }
+        let lead = &lead[..];
         match sampled.dim() {
             2 => sampled.drives::<U2>(lead).map(|_| ())?,
             _ => sampled.drives::<U3>(lead).map(|_| ())?,

@@ -321,6 +321,12 @@ def test_sampled_paths_per_state_are_each_states_own_run_bit_for_bit():
     once = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, paths[0]))
     each = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, np.stack([paths[0]] * 3)))
     assert all(np.array_equal(a, b) for a, b in zip(once, each))
+    # One path, each state its own end velocities.
+    ends = np.zeros((3, 2, 2))
+    ends[1, 1] = [0.1, 0.0]
+    same = np.tile(q0[0], (3, 1))
+    q_ends, _ = chain.integrate(same, h=1e-3, steps=300, t0=0.05, drive=pendulum.Sampled(t, paths[0], ends))
+    assert np.array_equal(q_ends[0], q_ends[2]) and not np.array_equal(q_ends[0], q_ends[1])
     # A path at rest at the origin is the pivot at rest, bit for bit.
     rest = chain.integrate(q0, h=1e-3, steps=100)
     still = chain.integrate(q0, h=1e-3, steps=100, drive=pendulum.Sampled(t, np.zeros((11, 2)), np.zeros((2, 2))))
