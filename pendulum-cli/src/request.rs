@@ -2,7 +2,7 @@
 //! drive's flags handed to the library's [`DriveOptions`] (which refuses the
 //! combinations the description cannot express, by flag name).
 
-use pendulum_experiment::{DriveOptions, Request, RunConfig, View};
+use pendulum_experiment::{DriveOptions, PathSamples, Request, RunConfig, View};
 
 use crate::args::Physics;
 use crate::chain_args::per_link_values;
@@ -34,7 +34,7 @@ pub fn request(p: &Physics, frames: usize) -> CliResult<Request> {
         radius: p.radius,
         ramp_time: p.ramp_time,
         ramp_from: p.ramp_from,
-        path: p.path.clone(),
+        path: p.path.clone().map(PathSamples::File),
         path_at_rest: p.path_at_rest,
     }
     .config(dim)?;

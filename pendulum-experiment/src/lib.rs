@@ -90,7 +90,7 @@ pub use files::SampleFiles;
 pub use final_state::FinalState;
 pub use initial::{InitialSpec, initial_state, read_numbers};
 pub use json::write_json_atomic;
-pub use options::{DriveKind, DriveOptions};
+pub use options::{DriveKind, DriveOptions, PathSamples};
 pub use record::Recorder;
 pub use request::{Choice, Request, choose, drive_frequency, fastest_mode, suggested_step};
 pub use run::{Layout, Report, Sink, Status};

@@ -64,6 +64,22 @@ pub enum DriveKind {
     Sampled,
 }
 
+/// Where a sampled drive's rows come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PathSamples {
+    /// A text file of numbers (commas or spaces, `#` comments), the command line's
+    /// `--path FILE`.
+    File(PathBuf),
+    /// The numbers themselves, row after row, named `label` in run.json and the messages
+    /// (Python's arrays).
+    Rows {
+        /// What names them (`"<array>"`).
+        label: String,
+        /// Every row's `t` and position, one after the other.
+        numbers: Vec<f64>,
+    },
+}
+
 /// The drive's options: its kind and every parameter any kind takes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DriveOptions {
@@ -83,8 +99,8 @@ pub struct DriveOptions {
     pub ramp_time: Option<f64>,
     /// Circle with a ramp: the speed at t = 0, rad/s (`None`: 0).
     pub ramp_from: Option<f64>,
-    /// Sampled: the file of the samples, rows of `t, x, y` (2D) or `t, x, y, z` (3D).
-    pub path: Option<PathBuf>,
+    /// Sampled: the samples, rows of `t, x, y` (2D) or `t, x, y, z` (3D).
+    pub path: Option<PathSamples>,
     /// Sampled: the pivot at rest at the first and last sample (else the natural spline).
     pub path_at_rest: bool,
 }
@@ -137,15 +153,15 @@ impl DriveOptions {
     /// The sampled drive of `--path` for a chain in `dim`: its rows read (`t` and the
     /// position's `dim` components each) and its spline checked.
     fn sampled(&self, dim: Dimension) -> Result<DriveConfig> {
-        let Some(path) = &self.path else {
-            return Err(Error::invalid("--drive sampled needs --path FILE (rows of t, x, y[, z])"));
+        let (label, numbers) = match &self.path {
+            None => return Err(Error::invalid("--drive sampled needs --path FILE (rows of t, x, y[, z])")),
+            Some(PathSamples::File(path)) => (path.display().to_string(), read_numbers("--path", path)?),
+            Some(PathSamples::Rows { label, numbers }) => (label.clone(), numbers.clone()),
         };
-        let numbers = read_numbers("--path", path)?;
         let width = 1 + dim.space();
-        if numbers.len() % width != 0 {
+        if numbers.len() % width != 0 || numbers.is_empty() {
             return Err(Error::invalid(format!(
-                "--path: {} holds {} numbers, not rows of {width} (t and {} components of the position)",
-                path.display(),
+                "--path: {label} holds {} numbers, not rows of {width} (t and {} components of the position)",
                 numbers.len(),
                 dim.space()
             )));
@@ -158,8 +174,8 @@ impl DriveOptions {
             Dimension::Two => sampled_path::<U2>(&times, &positions, at_rest).map(|_| ()),
             Dimension::Three => sampled_path::<U3>(&times, &positions, at_rest).map(|_| ()),
         };
-        checked.map_err(|e| Error::invalid(format!("--path {}: {e}", path.display())))?;
-        Ok(DriveConfig::Sampled { file: path.display().to_string(), times, positions, at_rest })
+        checked.map_err(|e| Error::invalid(format!("--path {label}: {e}")))?;
+        Ok(DriveConfig::Sampled { file: label, times, positions, at_rest })
     }
 }
 
@@ -306,7 +322,10 @@ mod tests {
             radius: 0.02,
             ramp_time: None,
             ramp_from: None,
-            path: Some(file("hand.csv", "# t, x, y, z\n0, 0, 0, 0\n0.5, 0.01, 0, 0.02\n1.0 0 0.01 0\n")),
+            path: Some(PathSamples::File(file(
+                "hand.csv",
+                "# t, x, y, z\n0, 0, 0, 0\n0.5, 0.01, 0, 0.02\n1.0 0 0.01 0\n",
+            ))),
             path_at_rest: true,
         };
         let DriveConfig::Sampled { times, positions, at_rest, file: name } =
@@ -319,13 +338,17 @@ mod tests {
         assert!(name.ends_with("hand.csv"), "{name}");
         let message = |options: DriveOptions, dim| options.config(dim).unwrap_err().to_string();
         let short = file("short.csv", "0 0 0 0\n1 0 0\n");
-        let e = message(DriveOptions { path: Some(short), ..base.clone() }, Dimension::Three);
+        let e =
+            message(DriveOptions { path: Some(PathSamples::File(short)), ..base.clone() }, Dimension::Three);
         assert!(
             e.ends_with("short.csv holds 7 numbers, not rows of 4 (t and 3 components of the position)"),
             "{e}"
         );
         let unordered = file("back.csv", "0 0 0\n1 0 0\n1 0 1\n");
-        let e = message(DriveOptions { path: Some(unordered), ..base.clone() }, Dimension::Two);
+        let e = message(
+            DriveOptions { path: Some(PathSamples::File(unordered)), ..base.clone() },
+            Dimension::Two,
+        );
         assert!(
             e.starts_with("--path ") && e.ends_with("back.csv: times[2] must be after times[1] = 1, got 1"),
             "{e}"

@@ -9,13 +9,13 @@ use std::time::{Duration, Instant};
 use numpy::PyArray1;
 use pendulum_core::ShapeReport;
 use pendulum_experiment::{
-    Dimension, DriveConfig, DriveOptions, InitialSpec, Recorder, Report, Request, RunConfig, RunFile,
-    SampleFiles, View, build, options,
+    Dimension, DriveConfig, DriveOptions, InitialSpec, PathSamples, Recorder, Report, Request, RunConfig,
+    RunFile, SampleFiles, View, build, options,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::arrays::{array, per_link};
+use crate::arrays::{Numbers, array, per_link};
 use crate::errors::{invalid, run_error};
 
 /// How often a long run looks for Ctrl-C.
@@ -27,8 +27,8 @@ const SIGNAL_CHECK: Duration = Duration::from_millis(100);
 /// `dim` (2 or 3), `n`, `masses` (kg), `lengths` (m), `gravity` (m/s²), `damping`
 /// (N·m·s), `torque` (N·m, 2D), `drive` ("fixed", "harmonic", "circle", "sampled") with
 /// `amplitude` (m), `omega` (rad/s), `phase` (rad), `direction`, `radius` (m), `ramp_time`
-/// (s), `ramp_from` (rad/s), `path` (a file of rows `t, x, y[, z]`, s and m) and
-/// `path_at_rest`; `initial` ("hanging", "horizontal", "tilted:ANGLE", a file or a
+/// (s), `ramp_from` (rad/s), `path` (rows `t, x, y[, z]`, s and m: a file, or an array)
+/// and `path_at_rest`; `initial` ("hanging", "horizontal", "tilted:ANGLE", a file or a
 /// previous run's directory), `spin` (rad/s, 3D), `integrator` ("gl1", "gl2", "gl3", "rk4",
 /// "midpoint", "dp54"; default: chosen), `solver`, `tolerance`, `step` (s; default:
 /// chosen), `end` (s), `every` (default: about 500 samples). What was chosen, and why, is
@@ -36,6 +36,21 @@ const SIGNAL_CHECK: Duration = Duration::from_millis(100);
 #[pyclass(module = "pendulum._pendulum", name = "Run", frozen)]
 pub struct Run {
     config: RunConfig,
+}
+
+/// A sampled drive's rows: a file (a `str` or path), or an array of rows `t, x, y[, z]`.
+fn path_samples(path: &Bound<'_, PyAny>) -> PyResult<PathSamples> {
+    if let Ok(file) = path.extract::<std::path::PathBuf>() {
+        return Ok(PathSamples::File(file));
+    }
+    let rows = Numbers::read("path", path)?;
+    if rows.shape.len() != 2 {
+        return Err(invalid(format!(
+            "path: shape {:?}, expected rows of t, x, y[, z] (a 2-dimensional array) or a file",
+            rows.shape
+        )));
+    }
+    Ok(PathSamples::Rows { label: format!("<array of shape {:?}>", rows.shape), numbers: rows.data })
 }
 
 /// The run's samples and how it ended.
@@ -95,7 +110,7 @@ impl Run {
         radius: f64,
         ramp_time: Option<f64>,
         ramp_from: Option<f64>,
-        path: Option<std::path::PathBuf>,
+        path: Option<&Bound<'_, PyAny>>,
         path_at_rest: bool,
         initial: &str,
         spin: Option<f64>,
@@ -129,6 +144,7 @@ impl Run {
             None => None,
         };
         let kind = options::by_name("drive", drive, "fixed, harmonic, circle, sampled").map_err(run_error)?;
+        let path = path.filter(|p| !p.is_none()).map(|p| path_samples(p)).transpose()?;
         let drive = DriveOptions {
             kind,
             amplitude,

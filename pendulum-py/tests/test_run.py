@@ -87,6 +87,15 @@ def test_a_run_on_a_sampled_path_reads_its_file_and_keeps_the_samples(tmp_path):
     assert described["kind"] == "sampled" and described["at_rest"] and len(described["times"]) == 11
     (tmp_path / "lift.txt").unlink()
     assert np.array_equal(pendulum.Run.from_json(run.to_json()).run().final_state, result.final_state)
+    # The rows as an array: the same run.
+    rows = np.stack([t, 0.0 * t, 0.05 * np.sin(np.pi * t) ** 2], axis=-1)
+    from_rows = pendulum.Run(n=2, drive="sampled", path=rows, path_at_rest=True, end=2.0, initial="hanging")
+    assert json.loads(from_rows.to_json())["drive"]["file"] == "<array of shape [11, 3]>"
+    assert np.array_equal(from_rows.run().final_state, result.final_state)
+    with pytest.raises(ValueError, match=r"--path: <array of shape \[11, 3\]> holds 33 numbers, not rows of 4"):
+        pendulum.Run(dim=3, n=2, drive="sampled", path=rows)
+    with pytest.raises(ValueError, match=r"path: shape \[33\], expected rows of t, x, y\[, z\]"):
+        pendulum.Run(n=2, drive="sampled", path=rows.ravel())
 
 
 @pytest.mark.parametrize(

@@ -264,7 +264,7 @@ class Run:
         radius: float = 0.1,
         ramp_time: Optional[float] = None,
         ramp_from: Optional[float] = None,
-        path: Union[str, PathLike[str], None] = None,
+        path: Union[str, PathLike[str], npt.ArrayLike, None] = None,
         path_at_rest: bool = False,
         initial: str = "tilted:1.0",
         spin: Optional[float] = None,
