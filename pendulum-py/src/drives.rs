@@ -327,20 +327,31 @@ impl Sampled {
         };
         let vectors =
             |rows: &[f64]| rows.chunks_exact(dim).map(OVector::<f64, S>::from_column_slice).collect();
-        (0..positions.len())
-            .map(|k| {
-                let (times, path) = (self.times.data.clone(), vectors(positions[k]));
-                match &ends {
-                    None => pendulum_core::Sampled::new(times, path),
-                    Some(ends) => {
-                        let [start, end]: [OVector<f64, S>; 2] =
-                            [&ends[k][..dim], &ends[k][dim..]].map(OVector::from_column_slice);
-                        pendulum_core::Sampled::with_end_velocities(times, path, start, end)
-                    }
+        let build = |k: usize| {
+            let (times, path) = (self.times.data.clone(), vectors(positions[k]));
+            match &ends {
+                None => pendulum_core::Sampled::new(times, path),
+                Some(ends) => {
+                    let [start, end]: [OVector<f64, S>; 2] =
+                        [&ends[k][..dim], &ends[k][dim..]].map(OVector::from_column_slice);
+                    pendulum_core::Sampled::with_end_velocities(times, path, start, end)
                 }
-            })
-            .collect::<Result<_, _>>()
-            .map_err(core_error)
+            }
+        };
+        // A path given once for all states is built once, its clones sharing its samples.
+        let same = |k: usize| {
+            std::ptr::eq(positions[k], positions[k - 1])
+                && ends.as_ref().is_none_or(|ends| std::ptr::eq(ends[k], ends[k - 1]))
+        };
+        let mut drives: Vec<pendulum_core::Sampled<S>> = Vec::with_capacity(positions.len());
+        for k in 0..positions.len() {
+            let drive = match drives.last() {
+                Some(previous) if same(k) => previous.clone(),
+                _ => build(k).map_err(core_error)?,
+            };
+            drives.push(drive);
+        }
+        Ok(drives)
     }
 }
 

@@ -2,6 +2,8 @@
 //! of one's own (measured, planned, or computed elsewhere) drives a chain with a position,
 //! velocity and acceleration that agree at every time.
 
+use std::sync::Arc;
+
 use nalgebra::{DefaultAllocator, DimName, OVector, allocator::Allocator};
 
 use super::Drive;
@@ -30,15 +32,17 @@ use crate::error::{Error, Result};
 /// The spline passes through every sample, and reproduces a cubic motion exactly when the
 /// end velocities are its own: its error for a smooth motion sampled every `h` falls as
 /// `h⁴` in `p` (`h²` in `p̈`). A drive in any space: `(x, y)` planar, `(x, y, z)` spatial.
+///
+/// A clone shares the samples (one path for many chains costs its samples once).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sampled<S: DimName>
 where
     DefaultAllocator: Allocator<S>,
 {
-    times: Vec<f64>,
-    positions: Vec<OVector<f64, S>>,
+    times: Arc<[f64]>,
+    positions: Arc<[OVector<f64, S>]>,
     /// `M_k = p̈(t_k)`, m/s².
-    accelerations: Vec<OVector<f64, S>>,
+    accelerations: Arc<[OVector<f64, S>]>,
     /// `ṗ(t_0)` and `ṗ(t_m)`, m/s, as given or (natural) as the spline has them: the
     /// straight lines outside.
     end_velocities: [OVector<f64, S>; 2],
@@ -89,9 +93,9 @@ where
         let given = ends.is_some();
         let zero = || OVector::zeros();
         let mut sampled = Self {
-            times,
-            positions,
-            accelerations,
+            times: times.into(),
+            positions: positions.into(),
+            accelerations: accelerations.into(),
             end_velocities: ends.unwrap_or_else(|| [zero(), zero()]),
         };
         if !given {
