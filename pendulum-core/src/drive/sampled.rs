@@ -34,6 +34,19 @@ use crate::error::{Error, Result};
 /// `h⁴` in `p` (`h²` in `p̈`). A drive in any space: `(x, y)` planar, `(x, y, z)` spatial.
 ///
 /// A clone shares the samples (one path for many chains costs its samples once).
+///
+/// ```
+/// use nalgebra::Vector2;
+/// use pendulum_core::{Drive, Sampled};
+///
+/// // A pivot lifted 5 cm and set down again over 1 s, at rest before and after.
+/// let times = vec![0.0, 0.5, 1.0];
+/// let up = vec![Vector2::zeros(), Vector2::new(0.0, 0.05), Vector2::zeros()];
+/// let lift = Sampled::with_end_velocities(times, up, Vector2::zeros(), Vector2::zeros())?;
+/// assert_eq!(lift.position(0.5), Vector2::new(0.0, 0.05));
+/// assert_eq!(lift.velocity(2.0), Vector2::zeros());
+/// # Ok::<(), pendulum_core::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sampled<S: DimName>
 where
