@@ -3,6 +3,7 @@
 //! velocity and acceleration that agree at every time.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{DefaultAllocator, DimName, OVector, allocator::Allocator};
 
@@ -47,11 +48,13 @@ use crate::error::{Error, Result};
 /// assert_eq!(lift.velocity(2.0), Vector2::zeros());
 /// # Ok::<(), pendulum_core::Error>(())
 /// ```
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug)]
 pub struct Sampled<S: DimName>
 where
     DefaultAllocator: Allocator<S>,
 {
+    /// The piece the last time read fell in (a hint for the next: no result depends on it).
+    last_piece: AtomicUsize,
     times: Arc<[f64]>,
     positions: Arc<[OVector<f64, S>]>,
     /// `M_k = p̈(t_k)`, m/s².
@@ -106,6 +109,7 @@ where
         let given = ends.is_some();
         let zero = || OVector::zeros();
         let mut sampled = Self {
+            last_piece: AtomicUsize::new(0),
             times: times.into(),
             positions: positions.into(),
             accelerations: accelerations.into(),
@@ -155,10 +159,57 @@ where
             let v = &self.end_velocities[1];
             return (&self.positions[last] + v * (t - last_time), v.clone(), OVector::zeros());
         }
-        // The piece whose start is the last sample time at or before `t` (the last piece
-        // for `t_m` itself; NaN lands on the first and stays NaN).
-        let k = self.times.partition_point(|&s| s <= t).saturating_sub(1).min(last - 1);
-        self.on_interval(k, t)
+        self.on_interval(self.piece(t), t)
+    }
+
+    /// The piece `k` of `t` in `[t_0, t_m]`: the last sample time at or before `t` (the last
+    /// piece for `t_m` itself; NaN lands on the first and stays NaN). The last piece read,
+    /// or the one after it, when `t` is there (a run reads its times in order), else by
+    /// bisection: the same piece either way. Kept only when it changes (chains sharing one
+    /// path do not write to one place at every read).
+    fn piece(&self, t: f64) -> usize {
+        let last = self.times.len() - 1;
+        let holds = |k: usize| k < last && self.times[k] <= t && (t < self.times[k + 1] || k + 1 == last);
+        let hint = self.last_piece.load(Ordering::Relaxed);
+        if holds(hint) {
+            return hint;
+        }
+        let k = if holds(hint + 1) {
+            hint + 1
+        } else {
+            self.times.partition_point(|&s| s <= t).saturating_sub(1).min(last - 1)
+        };
+        self.last_piece.store(k, Ordering::Relaxed);
+        k
+    }
+}
+
+impl<S: DimName> Clone for Sampled<S>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// The same path, its samples shared.
+    fn clone(&self) -> Self {
+        Self {
+            last_piece: AtomicUsize::new(self.last_piece.load(Ordering::Relaxed)),
+            times: Arc::clone(&self.times),
+            positions: Arc::clone(&self.positions),
+            accelerations: Arc::clone(&self.accelerations),
+            end_velocities: self.end_velocities.clone(),
+        }
+    }
+}
+
+impl<S: DimName> PartialEq for Sampled<S>
+where
+    DefaultAllocator: Allocator<S>,
+{
+    /// The same samples and ends (the hint of the last piece read aside).
+    fn eq(&self, other: &Self) -> bool {
+        self.times == other.times
+            && self.positions == other.positions
+            && self.accelerations == other.accelerations
+            && self.end_velocities == other.end_velocities
     }
 }
 
@@ -378,6 +429,22 @@ mod tests {
         let (coarse, fine) = (error(40), error(80));
         let order = (coarse / fine).log2();
         assert!((3.7..4.3).contains(&order), "order {order}: {coarse:e} then {fine:e}");
+    }
+
+    #[test]
+    fn the_piece_read_last_gives_the_piece_bisection_gives() {
+        let times = uneven();
+        let positions: Vec<Vector2<f64>> = times.iter().map(|&t| Vector2::new(t.sin(), t * t)).collect();
+        let path = Sampled::<U2>::new(times.clone(), positions).unwrap();
+        let bisected = |t: f64| times.partition_point(|&s| s <= t).saturating_sub(1).min(times.len() - 2);
+        // In order, backwards, jumping, on samples and between them.
+        let mut reads: Vec<f64> = (0..=400).map(|k| k as f64 * 0.005).collect();
+        reads.extend(reads.clone().iter().rev());
+        reads.extend([1.31, 0.0, 2.0, 0.35, 0.4, 0.399, 1.3, 1.309_999, 2.0, 1.31]);
+        for t in reads {
+            assert_eq!(path.piece(t), bisected(t), "t = {t}");
+            let _ = path.position(t);
+        }
     }
 
     #[test]
