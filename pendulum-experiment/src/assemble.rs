@@ -16,7 +16,9 @@ use pendulum_core::{
     Model, ModelAlloc, PlanarTension, RampedCircle, RodMidpoint, Sampled, Spatial, Turning,
 };
 
-use crate::description::{DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver};
+use crate::description::{
+    DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, check_components,
+};
 use crate::error::{Error, Result};
 
 /// One sample of a run, in plain numbers.
@@ -339,13 +341,7 @@ pub fn sampled_path<S: DimName>(times: &[f64], positions: &[Vec<f64>], at_rest: 
 where
     DefaultAllocator: nalgebra::allocator::Allocator<S>,
 {
-    let dim = S::DIM;
-    if let Some((k, p)) = positions.iter().enumerate().find(|(_, p)| p.len() != dim) {
-        return Err(Error::invalid(format!(
-            "drive positions[{k}] has {} components, a chain in {dim}D takes {dim}",
-            p.len()
-        )));
-    }
+    check_components(positions, S::DIM)?;
     let path: Vec<OVector<f64, S>> = positions.iter().map(|p| OVector::from_column_slice(p)).collect();
     let path = if at_rest {
         Sampled::with_end_velocities(times.to_vec(), path, OVector::zeros(), OVector::zeros())

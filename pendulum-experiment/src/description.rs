@@ -325,13 +325,7 @@ impl RunConfig {
             }
         }
         if let DriveConfig::Sampled { positions, .. } = &self.drive {
-            let space = self.dim.space();
-            if let Some((k, p)) = positions.iter().enumerate().find(|(_, p)| p.len() != space) {
-                return Err(Error::invalid(format!(
-                    "drive positions[{k}]: got {} components, the {space}D pivot moves in {space}",
-                    p.len()
-                )));
-            }
+            check_components(positions, self.dim.space())?;
         }
         if self.integrator == IntegratorKind::Midpoint && self.dim == Dimension::Two {
             return Err(Error::invalid(
@@ -344,6 +338,17 @@ impl RunConfig {
             ));
         }
         Ok(())
+    }
+}
+
+/// Errors unless every sampled position has `space` components (2 in 2D, 3 in 3D).
+pub(crate) fn check_components(positions: &[Vec<f64>], space: usize) -> Result<()> {
+    match positions.iter().enumerate().find(|(_, p)| p.len() != space) {
+        Some((k, p)) => Err(Error::invalid(format!(
+            "drive positions[{k}]: got {} components, the {space}D pivot moves in {space}",
+            p.len()
+        ))),
+        None => Ok(()),
     }
 }
 

@@ -357,6 +357,9 @@ mod tests {
         assert_eq!(e, "--drive sampled needs --path FILE (rows of t, x, y[, z])");
         let e = message(DriveOptions { kind: DriveKind::Harmonic, ..base }, Dimension::Two);
         assert_eq!(e, "--path and --path-at-rest apply to --drive sampled only");
+        // A run.json's path whose positions do not fit the chain's space.
+        let e = sampled_path::<U2>(&[0.0, 1.0], &[vec![0.0, 0.0], vec![0.0, 0.0, 1.0]], false).unwrap_err();
+        assert_eq!(e.to_string(), "drive positions[1]: got 3 components, the 2D pivot moves in 2");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -4,7 +4,7 @@
 //! returns the complete [`RunConfig`]. Also the step a failed run is advised to try
 //! ([`suggested_step`]).
 
-use nalgebra::{Dyn, U2, U3};
+use nalgebra::{DefaultAllocator, DimName, Dyn, U2, U3, allocator::Allocator};
 use pendulum_core::{Chain, Drive, fastest_frequency_bound};
 
 use crate::assemble::sampled_path;
@@ -287,21 +287,22 @@ pub fn fastest_mode(chain: &Chain<Dyn>, drive: &DriveConfig) -> f64 {
         DriveConfig::RampedCircle { radius, initial_omega, omega, .. } => {
             radius * initial_omega.abs().max(omega.abs()).powi(2)
         }
-        // The spline's p̈ is linear between samples: its largest is at one of them.
-        DriveConfig::Sampled { times, positions, at_rest, .. } => {
-            let largest = |acceleration: &[f64]| acceleration.iter().map(|a| a * a).sum::<f64>().sqrt();
-            let at_samples = match positions.first().map(Vec::len) {
-                Some(2) => sampled_path::<U2>(times, positions, *at_rest).map(|s| {
-                    times.iter().map(|&t| largest(s.acceleration(t).as_slice())).fold(0.0, f64::max)
-                }),
-                _ => sampled_path::<U3>(times, positions, *at_rest).map(|s| {
-                    times.iter().map(|&t| largest(s.acceleration(t).as_slice())).fold(0.0, f64::max)
-                }),
-            };
-            at_samples.unwrap_or(0.0)
-        }
+        DriveConfig::Sampled { times, positions, at_rest, .. } => match positions.first().map(Vec::len) {
+            Some(2) => largest_sampled_acceleration::<U2>(times, positions, *at_rest),
+            _ => largest_sampled_acceleration::<U3>(times, positions, *at_rest),
+        },
     };
     fastest_frequency_bound(chain, chain.gravity() + accel)
+}
+
+/// The largest `|p̈|` (m/s²) of a sampled path in `S`: at one of its samples, `p̈` being
+/// linear between them (0 for a path that does not build: its run reports why).
+fn largest_sampled_acceleration<S: DimName>(times: &[f64], positions: &[Vec<f64>], at_rest: bool) -> f64
+where
+    DefaultAllocator: Allocator<S>,
+{
+    sampled_path::<S>(times, positions, at_rest)
+        .map_or(0.0, |path| times.iter().map(|&t| path.acceleration(t).norm()).fold(0.0, f64::max))
 }
 
 /// The drive's angular frequency (rad/s), if it has one. A sampled path's is that of a

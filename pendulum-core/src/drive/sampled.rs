@@ -31,8 +31,10 @@ use crate::error::{Error, Result};
 /// if the end velocities given are zero.
 ///
 /// The spline passes through every sample, and reproduces a cubic motion exactly when the
-/// end velocities are its own: its error for a smooth motion sampled every `h` falls as
-/// `h⁴` in `p` (`h²` in `p̈`). A drive in any space: `(x, y)` planar, `(x, y, z)` spatial.
+/// end velocities are its own: its error for a smooth motion sampled every `h`, given its
+/// end velocities, falls as `h⁴` in `p` (`h²` in `p̈`). The natural spline's `p̈ = 0` at the
+/// ends differs from a motion that accelerates there, over the first and last few samples.
+/// A drive in any space: `(x, y)` planar, `(x, y, z)` spatial.
 ///
 /// A clone shares the samples (one path for many chains costs its samples once).
 ///
