@@ -120,8 +120,8 @@ where
         if !given {
             // The natural spline's own, which the straight lines outside continue.
             let last = sampled.times.len() - 1;
-            let start = sampled.on_interval(0, sampled.times[0]).1;
-            let end = sampled.on_interval(last - 1, sampled.times[last]).1;
+            let start = sampled.velocity_at(sampled.locate(sampled.times[0]));
+            let end = sampled.velocity_at(sampled.locate(sampled.times[last]));
             sampled.end_velocities = [start, end];
         }
         Ok(sampled)
@@ -137,31 +137,53 @@ where
         &self.positions
     }
 
-    /// `(p, ṗ, p̈)` at `t` on the piece `[t_k, t_{k+1}]` (the type's equations).
-    fn on_interval(&self, k: usize, t: f64) -> (OVector<f64, S>, OVector<f64, S>, OVector<f64, S>) {
+    /// Where `t` lies: before the samples, on piece `k` with its `(h_k, a, b)`, or after.
+    fn locate(&self, t: f64) -> Where {
+        let last = self.times.len() - 1;
+        if t < self.times[0] {
+            return Where::Before;
+        }
+        if t > self.times[last] {
+            return Where::After;
+        }
+        let k = self.piece(t);
         let h = self.times[k + 1] - self.times[k];
-        let (a, b) = ((self.times[k + 1] - t) / h, (t - self.times[k]) / h);
-        let (p0, p1) = (&self.positions[k], &self.positions[k + 1]);
-        let (m0, m1) = (&self.accelerations[k], &self.accelerations[k + 1]);
-        let position = p0 * a + p1 * b + (m0 * (a * a * a - a) + m1 * (b * b * b - b)) * (h * h / 6.0);
-        let velocity = (p1 - p0) / h + (m0 * (1.0 - 3.0 * a * a) + m1 * (3.0 * b * b - 1.0)) * (h / 6.0);
-        let acceleration = m0 * a + m1 * b;
-        (position, velocity, acceleration)
+        Where::On(k, h, (self.times[k + 1] - t) / h, (t - self.times[k]) / h)
     }
 
-    /// `(p, ṗ, p̈)` at any time `t`: on its piece, or on the straight lines outside.
-    fn at(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>, OVector<f64, S>) {
+    /// `p(t)` (the type's equation; the straight lines outside).
+    fn position_at(&self, t: f64, at: Where) -> OVector<f64, S> {
         let last = self.times.len() - 1;
-        let (first_time, last_time) = (self.times[0], self.times[last]);
-        if t < first_time {
-            let v = &self.end_velocities[0];
-            return (&self.positions[0] + v * (t - first_time), v.clone(), OVector::zeros());
+        match at {
+            Where::Before => &self.positions[0] + &self.end_velocities[0] * (t - self.times[0]),
+            Where::After => &self.positions[last] + &self.end_velocities[1] * (t - self.times[last]),
+            Where::On(k, h, a, b) => {
+                let (p0, p1) = (&self.positions[k], &self.positions[k + 1]);
+                let (m0, m1) = (&self.accelerations[k], &self.accelerations[k + 1]);
+                p0 * a + p1 * b + (m0 * (a * a * a - a) + m1 * (b * b * b - b)) * (h * h / 6.0)
+            }
         }
-        if t > last_time {
-            let v = &self.end_velocities[1];
-            return (&self.positions[last] + v * (t - last_time), v.clone(), OVector::zeros());
+    }
+
+    /// `ṗ(t)`.
+    fn velocity_at(&self, at: Where) -> OVector<f64, S> {
+        match at {
+            Where::Before => self.end_velocities[0].clone(),
+            Where::After => self.end_velocities[1].clone(),
+            Where::On(k, h, a, b) => {
+                let (p0, p1) = (&self.positions[k], &self.positions[k + 1]);
+                let (m0, m1) = (&self.accelerations[k], &self.accelerations[k + 1]);
+                (p1 - p0) / h + (m0 * (1.0 - 3.0 * a * a) + m1 * (3.0 * b * b - 1.0)) * (h / 6.0)
+            }
         }
-        self.on_interval(self.piece(t), t)
+    }
+
+    /// `p̈(t)`.
+    fn acceleration_at(&self, at: Where) -> OVector<f64, S> {
+        match at {
+            Where::Before | Where::After => OVector::zeros(),
+            Where::On(k, _, a, b) => &self.accelerations[k] * a + &self.accelerations[k + 1] * b,
+        }
     }
 
     /// The piece `k` of `t` in `[t_0, t_m]`: the last sample time at or before `t` (the last
@@ -300,22 +322,31 @@ where
     DefaultAllocator: Allocator<S>,
 {
     fn position(&self, t: f64) -> OVector<f64, S> {
-        self.at(t).0
+        self.position_at(t, self.locate(t))
     }
     fn velocity(&self, t: f64) -> OVector<f64, S> {
-        self.at(t).1
+        self.velocity_at(self.locate(t))
     }
     fn acceleration(&self, t: f64) -> OVector<f64, S> {
-        self.at(t).2
+        self.acceleration_at(self.locate(t))
     }
     fn velocity_and_acceleration(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
-        let (_, v, a) = self.at(t);
-        (v, a)
+        let at = self.locate(t);
+        (self.velocity_at(at), self.acceleration_at(at))
     }
     fn position_and_velocity(&self, t: f64) -> (OVector<f64, S>, OVector<f64, S>) {
-        let (p, v, _) = self.at(t);
-        (p, v)
+        let at = self.locate(t);
+        (self.position_at(t, at), self.velocity_at(at))
     }
+}
+
+/// Where a time lies on a [`Sampled`] path: before its samples, on piece `k` (with
+/// `h_k`, `a`, `b` of the type's equations), or after them.
+#[derive(Debug, Clone, Copy)]
+enum Where {
+    Before,
+    On(usize, f64, f64, f64),
+    After,
 }
 
 #[cfg(test)]
@@ -408,7 +439,8 @@ mod tests {
         // Across every inner sample, from either side.
         let eps = 1e-9;
         for &t in &times[1..times.len() - 1] {
-            let (left, right) = (path.at(t - eps), path.at(t + eps));
+            let at = |t: f64| (path.position(t), path.velocity(t), path.acceleration(t));
+            let (left, right) = (at(t - eps), at(t + eps));
             assert!((left.0 - right.0).norm() < 1e-8, "p at {t}");
             assert!((left.1 - right.1).norm() < 1e-7, "ṗ at {t}");
             assert!((left.2 - right.2).norm() < 1e-6, "p̈ at {t}");
