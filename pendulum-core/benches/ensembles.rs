@@ -12,7 +12,8 @@
 //!   (throughput in chain-steps per second; also in `f32`, `integrate_rk4_f32`, on one
 //!   thread), and 10 steps of the implicit rod midpoint
 //!   chain by chain against `integrate_rod_midpoint` (in lanes) on one thread and on two,
-//!   at steps of 1 ms and of 10 ms (where some chains' steps are halved);
+//!   and `integrate_rod_midpoint_f32` on one, at steps of 1 ms and of 50 ms (where the
+//!   chains take more Newton iterations);
 //! - `rk4/planar_100_steps/…/n`: 100 RK4 steps of 0.1 ms of free planar chains swinging
 //!   (n = 20, 100), `Rk4` on each chain's `FirstOrder` against `PlanarBatch::integrate_rk4`
 //!   on one thread and on two, and `integrate_rk4_f32` on one (throughput in chain-steps);
@@ -350,6 +351,17 @@ fn rk4(c: &mut Criterion) {
                 },
             );
         }
+        // The same in single precision (`integrate_rod_midpoint_f32`), every call from the
+        // same states rounded.
+        let rows32: Vec<f32> = start.iter().flat_map(|s| s.x().iter().map(|&v| v as f32)).collect();
+        let mut rows = rows32.clone();
+        group.bench_function(format!("whirl_100/rod_midpoint_batch_f32_1_thread_10_steps{name}"), |b| {
+            in_pool(b, &one, || {
+                rows.clone_from(&rows32);
+                let failures = batch.integrate_rod_midpoint_f32(&mut rows, 2.0, h, 10).expect("batch");
+                assert!(failures.is_empty(), "{failures:?}");
+            })
+        });
     }
 
     group.finish();

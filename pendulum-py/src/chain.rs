@@ -17,7 +17,7 @@ use crate::detach::maybe_detached;
 use crate::directions;
 use crate::drives::Given;
 use crate::errors::{core_error, invalid, run_error, unknown_precision};
-use crate::planar_runs::{Plan, planar_rk4, planar_rk4_f32, run_as};
+use crate::planar_runs::{Plan, RunOf, planar_rk4, planar_rk4_f32, run_as};
 use crate::planar_states::{
     planar_batch, planar_batch_f32, planar_in_place, planar_jacobians, planar_jacobians_f32, planar_table_f32,
 };
@@ -195,11 +195,6 @@ impl Chain {
             "rod_midpoint" if route != Route::Directions => {
                 return Err(invalid("method: 'rod_midpoint' steps model='directions' (planar runs are RK4)"));
             }
-            "rod_midpoint" if precision != "float64" => {
-                return Err(invalid(format!(
-                    "precision: {precision:?} with method='rod_midpoint' (float64 only)"
-                )));
-            }
             "rod_midpoint" => true,
             _ => return Err(invalid(format!("method: {method:?} is not 'rk4' or 'rod_midpoint'"))),
         };
@@ -216,8 +211,12 @@ impl Chain {
             let b = self.directions_rows(q, qd, torque, pivot)?;
             let drives = drive.map(|d| d.spatial(&b.q.lead)).transpose()?;
             let rows = [b.q, b.qd, b.torque, b.pivot];
-            let double = if implicit { directions::rod_midpoint } else { directions::rk4 };
-            return run_as(py, &self.inner, rows, (plan, drives), precision, double, directions::rk4_f32);
+            let (double, single): (RunOf<_, f64>, RunOf<_, f32>) = if implicit {
+                (directions::rod_midpoint, directions::rod_midpoint_f32)
+            } else {
+                (directions::rk4, directions::rk4_f32)
+            };
+            return run_as(py, &self.inner, rows, (plan, drives), precision, double, single);
         }
         let b = self.batch(Kind::Planar, q, qd, torque, pivot)?;
         let drives = drive.map(|d| d.planar(&b.q.lead)).transpose()?;
@@ -455,12 +454,13 @@ impl Chain {
     /// state's pivot within the call instead, its parameters one for all or one per state,
     /// from the time `t0` (s; pass the end of one call as the start of the next).
     /// `model="directions"` steps the 3D chain in directions by RK4 with each rod put back
-    /// to unit length after every step (float64, no torques), or, with
+    /// to unit length after every step (no torques), or, with
     /// `method="rod_midpoint"`, by the implicit rod midpoint step: stable at any `h`, the
     /// rods exactly rigid, a free chain's energy kept to the Newton tolerance
     /// (docs/integrators.md), its Newton iterations four or eight states per SIMD register.
-    /// `precision="float32"` steps eight planar states per register in single precision and
-    /// returns float32 (its error against float64 in docs/ensembles.md). A state whose step
+    /// `precision="float32"` steps eight states per register in single precision and
+    /// returns float32 (its error against float64 in docs/ensembles.md; the rod midpoint's
+    /// grows as the steps shrink, so in float32 it is for long steps). A state whose step
     /// is not finite raises RuntimeError naming it; Ctrl-C stops the call.
     #[pyo3(signature = (q, qd = None, torque = None, pivot_acceleration = None, *, h, steps = 1, model = "planar", precision = "float64", drive = None, t0 = 0.0, method = "rk4"))]
     #[allow(clippy::too_many_arguments)] // Python's keyword arguments

@@ -245,7 +245,8 @@ pub fn rod_midpoint(
     runs(chain, rows, drives, (plan, Method::RodMidpoint), stop)
 }
 
-/// How a run in float64 steps: [`rk4`] or [`rod_midpoint`].
+/// How a run steps: [`rk4`] or [`rod_midpoint`] (in float64), [`rk4_f32`] or
+/// [`rod_midpoint_f32`].
 #[derive(Debug, Clone, Copy)]
 enum Method {
     Rk4,
@@ -271,14 +272,39 @@ fn runs(
 /// rounded to `f32` (one past its range is an error), each chunk from its own start time.
 pub fn rk4_f32(
     chain: &pendulum_core::Chain<Dyn>,
-    [q, qd, _torque, pivot]: [&Rows; 4],
+    rows: [&Rows; 4],
     drives: Option<Vec<Pivot>>,
     plan: Plan,
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {
+    runs_f32(chain, rows, drives, (plan, Method::Rk4), stop)
+}
+
+/// [`rod_midpoint`] in single precision ([`DirectionsBatch::integrate_rod_midpoint_f32`]:
+/// the Newton iterations in `f32` lanes, a step they cannot take whole the state's own in
+/// `f64`, rounded back), as [`rk4_f32`] takes and gives the numbers.
+pub fn rod_midpoint_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    rows: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    plan: Plan,
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f32>> {
+    runs_f32(chain, rows, drives, (plan, Method::RodMidpoint), stop)
+}
+
+/// The run of `plan` by `method` in single precision, each pivot's acceleration held or,
+/// given `drives`, each pivot moved.
+fn runs_f32(
+    chain: &pendulum_core::Chain<Dyn>,
+    [q, qd, _torque, pivot]: [&Rows; 4],
+    drives: Option<Vec<Pivot>>,
+    run: (Plan, Method),
+    stop: &AtomicBool,
+) -> pendulum_experiment::Result<Samples<f32>> {
     match drives {
-        None => rk4_f32_of(&batch(chain, pivot).map_err(core)?, [q, qd], plan, stop),
-        Some(drives) => rk4_f32_of(&driven(chain, drives)?, [q, qd], plan, stop),
+        None => run_f32_of(&batch(chain, pivot).map_err(core)?, [q, qd], run, stop),
+        Some(drives) => run_f32_of(&driven(chain, drives)?, [q, qd], run, stop),
     }
 }
 
@@ -314,11 +340,12 @@ fn run_of<Dr: Drive<U3> + Clone + Sync>(
     )
 }
 
-/// [`rk4_f32`] of the chains of `batch`.
-fn rk4_f32_of<Dr: Drive<U3> + Sync>(
+/// The single-precision run of the chains of `batch`, whatever drives their pivots, by
+/// `method`.
+fn run_f32_of<Dr: Drive<U3> + Clone + Sync>(
     batch: &DirectionsBatch<U3, Dr>,
     [q, qd]: [&Rows; 2],
-    plan: Plan,
+    (plan, method): (Plan, Method),
     stop: &AtomicBool,
 ) -> pendulum_experiment::Result<Samples<f32>> {
     let half = q.width;
@@ -326,7 +353,10 @@ fn rk4_f32_of<Dr: Drive<U3> + Sync>(
     in_chunks(
         (&q.lead, batch.links(), plan, stop),
         &mut x,
-        |x, t, now| batch.integrate_rk4_f32(x, t, plan.h, now),
+        |x, t, now| match method {
+            Method::Rk4 => batch.integrate_rk4_f32(x, t, plan.h, now),
+            Method::RodMidpoint => batch.integrate_rod_midpoint_f32(x, t, plan.h, now),
+        },
         |x, samples| split(half, x.chunks_exact(2 * half.max(1)), samples),
     )
 }

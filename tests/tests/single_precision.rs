@@ -610,3 +610,110 @@ fn single_precision_planar_runs_fail_by_chain_and_change_with_no_thread_count_or
         assert_eq!(bits, runs[0][k * 2 * n..(k + 1) * 2 * n], "chain {k} alone");
     }
 }
+
+/// `count` uniform chains of `n` links (100 g and 1 m in all, rod damping 1e-4 N·m·s)
+/// whirled on circles of 1–3 cm at 2–9 rad/s, and their states hanging at rest.
+fn hanging_whirls(n: usize, count: usize, r: &mut ChaCha8Rng) -> (Vec<Directions<U3, Circle>>, Vec<f64>) {
+    let models = (0..count)
+        .map(|_| {
+            let chain = pendulum_core::Chain::new(&vec![0.1 / n as f64; n], &vec![1.0 / n as f64; n], 9.81)
+                .and_then(|c| c.with_damping(&vec![1e-4; n]))
+                .expect("chain");
+            let drive = Circle::new(r.random_range(0.01..0.03), r.random_range(2.0..9.0)).expect("drive");
+            Directions::<U3>::new(chain).with_drive(drive)
+        })
+        .collect();
+    let hanging = [0.0, 0.0, -1.0].repeat(n).into_iter().chain(vec![0.0; 3 * n]);
+    (models, hanging.cycle().take(count * 6 * n).collect())
+}
+
+#[test]
+fn single_precision_rod_midpoint_runs_follow_the_f64_ones_and_fail_by_chain() {
+    // Uniform chains whirled from hanging, the implicit rod midpoint in f32 against
+    // `integrate_rod_midpoint` (the bounds of docs/ensembles.md; `--nocapture` prints the
+    // errors): the error grows as the steps shrink (round-off in each of more steps), so
+    // this step is for long steps in f32. One thread or two and one chain alone the same
+    // bits; the rods of unit length.
+    let mut r = ChaCha8Rng::seed_from_u64(55);
+    let chains = 16;
+    for (h, seconds, bound) in [(1e-3, 2.0, 3e-2), (1e-2, 2.0, 1e-3), (5e-2, 4.0, 2e-4)] {
+        for n in [8, 20, 100] {
+            let (models, start) = hanging_whirls(n, chains, &mut r);
+            let (m, steps) = (6 * n, (seconds / h) as usize);
+            let batch = DirectionsBatch::new(models.clone()).expect("batch");
+            let mut states: Vec<State<Dyn>> =
+                start.chunks_exact(m).map(|x| State::new(0.0, DVector::from_column_slice(x))).collect();
+            assert!(batch.integrate_rod_midpoint(&mut states, h, steps).expect("f64").is_empty());
+            let f64s: Vec<f64> = states.iter().flat_map(|s| s.x().iter().copied()).collect();
+            let start: Vec<f32> = start.iter().map(|&v| v as f32).collect();
+            let mut runs = Vec::new();
+            for pool in pools() {
+                let mut x32 = start.clone();
+                let failures = pool.install(|| batch.integrate_rod_midpoint_f32(&mut x32, 0.0, h, steps));
+                assert!(failures.expect("f32").is_empty());
+                runs.push(x32);
+            }
+            assert!(
+                runs[0].iter().zip(&runs[1]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "one thread or two"
+            );
+            let error = worst_relative_error(&f64s, &runs[0], m);
+            let unit = runs[0]
+                .chunks_exact(m)
+                .flat_map(|x| x[..3 * n].chunks_exact(3))
+                .map(|u| (u.iter().map(|&v| f64::from(v) * f64::from(v)).sum::<f64>().sqrt() - 1.0).abs())
+                .fold(0.0, f64::max);
+            let swung = f64s.chunks_exact(m).map(|x| x[3 * n - 1] + 1.0).fold(0.0, f64::max);
+            println!(
+                "rod midpoint in f32, {steps} steps of {h} s, n = {n}: {error:.1e}, |u| − 1 ≤ {unit:.1e}, \
+                 the lowest link up by {swung:.2}"
+            );
+            assert!(error < bound, "{steps} steps of {h} s, n = {n}: {error:e} ≥ {bound:e}");
+            assert!(unit < 1e-6, "n = {n}: |u| − 1 = {unit:e}");
+            let k = 11;
+            let alone = DirectionsBatch::new(vec![models[k].clone()]).expect("batch");
+            let mut x32 = start[k * m..(k + 1) * m].to_vec();
+            assert!(alone.integrate_rod_midpoint_f32(&mut x32, 0.0, h, steps).expect("f32").is_empty());
+            assert!(
+                x32.iter().zip(&runs[0][k * m..]).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "chain {k} alone"
+            );
+        }
+    }
+    // A NaN state fails before any step; a step too long for the lanes (links turning by
+    // more than a radian) is the f64 chain's own, halved; the others run on; bad arguments
+    // are errors.
+    let n = 5;
+    let (models, start) = hanging_whirls(n, 4, &mut r);
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let m = 6 * n;
+    let mut x: Vec<f32> = start.iter().map(|&v| v as f32).collect();
+    x[2 * m + 4] = f32::NAN;
+    x[m + 3 * n..2 * m].fill(40.0);
+    let before = x.clone();
+    let failures = batch.integrate_rod_midpoint_f32(&mut x, 0.5, 0.05, 10).expect("run");
+    assert_eq!(failures.iter().map(|f| f.chain).collect::<Vec<_>>(), [2]);
+    assert!(matches!(failures[0].error, Error::NonFinite { what: "x", index: 4, .. }));
+    assert!(x[2 * m..3 * m].iter().zip(&before[2 * m..]).all(|(a, b)| a.to_bits() == b.to_bits()));
+    let mut whipped =
+        State::new(0.5, DVector::from_iterator(m, before[m..2 * m].iter().map(|&v| f64::from(v))));
+    let mut step = pendulum_core::RodMidpoint::new();
+    for _ in 0..10 {
+        pendulum_core::integrate::Integrator::step(&mut step, &models[1], &mut whipped, 0.05).expect("alone");
+    }
+    assert!(step.stats().halved_steps > 0, "the whipped chain's steps are halved");
+    let whipped32 = worst_relative_error(whipped.x().as_slice(), &x[m..2 * m], m);
+    assert!(whipped32 < 1e-3, "the whipped chain, halved in f64: {whipped32:e}");
+    assert!(matches!(
+        batch.integrate_rod_midpoint_f32(&mut x[..m], 0.0, 1e-3, 1),
+        Err(Error::LengthMismatch { what: "x", .. })
+    ));
+    assert!(matches!(
+        batch.integrate_rod_midpoint_f32(&mut x, 0.0, 0.0, 1),
+        Err(Error::InvalidStepSize { .. })
+    ));
+    assert!(matches!(
+        batch.integrate_rod_midpoint_f32(&mut x, f64::NAN, 1e-3, 1),
+        Err(Error::NonFinite { what: "t0", .. })
+    ));
+}

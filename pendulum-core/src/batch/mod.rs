@@ -42,6 +42,7 @@ mod planar_rk4;
 mod rk4;
 mod rk4_f32;
 mod rod_midpoint;
+mod rod_midpoint_f32;
 mod rooms;
 mod run;
 mod run_lanes;

@@ -87,7 +87,7 @@ impl<const C: usize, const W: usize> Room<C, W> {
 }
 
 /// One chain's step taken by its own integrator, with the ledger when `accounted`.
-fn single_step<S: DimName, Dr: Drive<S> + Clone>(
+pub(super) fn single_step<S: DimName, Dr: Drive<S> + Clone>(
     model: &Directions<S, Dr>,
     accounted: bool,
     state: &mut State<Dyn>,
@@ -255,7 +255,7 @@ where
             }
             solve.tensions(block.rods(), gravity(block.down()), *pivot, motion, tensions);
             let chains = Chains { masses, lengths, damping, down: block.down() };
-            let it = iteration::iterate(work, &chains, tensions, *ends, (motion, h, out), go, limits);
+            let it = iteration::iterate::<C, Lanes<W>, false>(work, &chains, tensions, *ends, (motion, h, out), go, limits);
             let stepped = Lanes::and_not(go, it.failed);
             let work = self.is_accounted().then_some((it.drive, it.damped));
             let (time, time_carry) = kahan_add(t[0], t[1], Lanes([h; W]));

@@ -2,6 +2,18 @@
 //! written once for one chain (`V = f64`) and for a batch's chains in SIMD lanes, so that
 //! each lane does exactly what its chain alone does. A lane that has converged keeps its
 //! numbers while the others iterate on; a lane that fails is flagged and left.
+//!
+//! The unknowns are the masses' places at `t + h`, held one of two ways (`DISPLACED`):
+//! - as positions `x⁺_i` (`false`): the single chain's and the `f64` lanes' way, whose
+//!   numbers the run files recorded by earlier releases repeat bit for bit;
+//! - as displacements `δ_i = x⁺_i − x_i` over the step (`true`), with the rod vectors
+//!   `r_i = l_i u_i` at `t`: the same equations with no two positions of the size of the
+//!   chain subtracted, so the round-off is that of the motion over a step, not of the
+//!   chain's reach. The `f32` lanes need it: in positions, their new velocities
+//!   `2(x⁺_i − x_i)/h − v_i` take a displacement of about `h |v|` from two positions of
+//!   about the reach, and keep only `h |v| / reach` of `f32`'s precision; a whirl of 2000
+//!   steps of 1 ms ended 9e-2 to 1.9 (relative) from the `f64` run, against 7.6e-3 to
+//!   1.4e-2 in displacements (`docs/ensembles.md`).
 
 use super::newton::{self, LinkRow, Pivot, dot};
 use crate::lanes::{Aligned, Masked};
@@ -25,8 +37,9 @@ pub(crate) struct Limits {
 }
 
 /// Buffers kept from step to step, in lanes `V` and `C` dimensions: the positions at `t`
-/// and their iterate at `t + h`, the velocities at `t` (per mass), the multipliers, each
-/// rod's damping pair and mass's inertia term, and the Newton matrix's rows and pivots.
+/// and their iterate at `t + h` (displaced: the rod vectors `r_i` at `t` and the
+/// displacements `δ_i`), the velocities at `t` (per mass), the multipliers, each rod's
+/// damping pair and mass's inertia term, and the Newton matrix's rows and pivots.
 #[derive(Debug, Clone)]
 pub(crate) struct Work<const C: usize, V: Copy> {
     x0: Aligned<[V; C]>,
@@ -102,17 +115,31 @@ fn at<const C: usize, V: Masked>(v: &[V], i: usize) -> [V; C] {
     out
 }
 
-/// Rod `i`'s vectors from the positions at `t` (`x0`) and `t + h` (`x1`), the pivot at
-/// `p0` and `p1`: its endpoint `e_i`, midpoint `d_i` and change `s_i` of the rod vector.
+/// Rod `i`'s vectors at the step's end: its endpoint `e_i` (the rod at `t + h`), midpoint
+/// `d_i` and change `s_i` of the rod vector. From the positions at `t` (`x0`) and `t + h`
+/// (`x1`), the pivot at `p0` and `p1`: `e_i = x⁺_i − x⁺_{i−1}`,
+/// `d_i = (x_i + x⁺_i − x_{i−1} − x⁺_{i−1})/2`, `s_i = (x⁺_i − x_i) − (x⁺_{i−1} − x_{i−1})`.
+/// `DISPLACED`, from the rod vectors `r_i` (`x0`) and the displacements `δ_i` (`x1`):
+/// `s_i = δ_i − δ_{i−1}` (`δ_0 = p1 − p0`), `e_i = r_i + s_i`, `d_i = r_i + s_i/2`.
 #[inline(always)]
-fn rod<const C: usize, V: Masked>(
+fn rod<const C: usize, V: Masked, const DISPLACED: bool>(
     (x0, x1): (&[[V; C]], &[[V; C]]),
     (p0, p1): ([V; C], [V; C]),
     i: usize,
 ) -> [[V; C]; 3] {
+    let half = V::splat(0.5);
+    if DISPLACED {
+        let (r, before) = (x0[i], if i == 0 { sub(p1, p0) } else { x1[i - 1] });
+        let (mut e, mut d, mut s) = (r, r, r);
+        for k in 0..C {
+            s[k] = x1[i][k] - before[k];
+            e[k] = r[k] + s[k];
+            d[k] = r[k] + half * s[k];
+        }
+        return [e, d, s];
+    }
     let (a0, a1) = if i == 0 { (p0, p1) } else { (x0[i - 1], x1[i - 1]) };
     let (b0, b1) = (x0[i], x1[i]);
-    let half = V::splat(0.5);
     let (mut d, mut s) = (b0, b0);
     for k in 0..C {
         d[k] = half * (b0[k] + b1[k] - a0[k] - a1[k]);
@@ -126,10 +153,11 @@ fn rod<const C: usize, V: Masked>(
 /// `Directions` state) and their rod tensions `tensions` (N) at `t`, into `out`: the
 /// midpoint rule on the masses with the rods as constraints (`RodMidpoint`'s equations),
 /// one block-tridiagonal solve per iteration (`newton`). The other lanes are computed but
-/// never flagged, converged or failed.
+/// never flagged, converged or failed. The unknowns in positions or, `DISPLACED`, in
+/// displacements (module docs).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // One step's data, all of it needed.
-pub(crate) fn iterate<const C: usize, V: Masked>(
+pub(crate) fn iterate<const C: usize, V: Masked, const DISPLACED: bool>(
     work: &mut Work<C, V>,
     chains: &Chains<'_, V>,
     tensions: &[V],
@@ -157,11 +185,13 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
     let allowed = V::splat(limits.tolerance) * (reach + far);
     let (u, w) = motion.split_at(C * n);
 
-    // Positions and velocities at t; the start of the iteration: each rod turned by h w_i
-    // (with h²/2 ü_i too it took more iterations), the multipliers μ_i = T_i / l_i at t.
+    // Positions (displaced: rod vectors) and velocities at t; the start of the iteration:
+    // each rod turned by h w_i (with h²/2 ü_i too it took more iterations), the
+    // multipliers μ_i = T_i / l_i at t.
     work.size(n);
     let Work { x0, v0, x1, mu, pairs, inertias, rows, pivots } = work;
     let (mut r0, mut rv, mut r1) = (p0, pv0, p1);
+    let mut moved = sub(p1, p0);
     for i in 0..n {
         let (ui, wi) = (at::<C, V>(u, i), at::<C, V>(w, i));
         let mut turned = ui;
@@ -170,11 +200,16 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
         }
         let norm = dot(turned, turned).sqrt();
         for k in 0..C {
-            r0[k] += l[i] * ui[k];
             rv[k] += l[i] * wi[k];
-            r1[k] += l[i] * turned[k] / norm;
+            if DISPLACED {
+                r0[k] = l[i] * ui[k];
+                moved[k] += l[i] * (turned[k] / norm - ui[k]);
+            } else {
+                r0[k] += l[i] * ui[k];
+                r1[k] += l[i] * turned[k] / norm;
+            }
         }
-        (x0[i], v0[i], x1[i]) = (r0, rv, r1);
+        (x0[i], v0[i], x1[i]) = (r0, rv, if DISPLACED { moved } else { r1 });
         mu[i] = tensions[i] / l[i];
         // Rod i's damping pair per unit change of the rod vector, λ_i/(l_i² h), and mass
         // i's inertia term 2 m_i/h².
@@ -195,12 +230,12 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
         }
         iterations += 1;
         // Residuals and the Newton matrix, link by link (`newton` module docs).
-        let mut next = rod((x0, x1), pivot, 0);
+        let mut next = rod::<C, V, DISPLACED>((x0, x1), pivot, 0);
         for i in 0..n {
             let [e, d, s] = next;
             let has_next = i + 1 < n;
             if has_next {
-                next = rod((x0, x1), pivot, i + 1);
+                next = rod::<C, V, DISPLACED>((x0, x1), pivot, i + 1);
             }
             let [_, d_next, s_next] = next;
             let (mu_i, mu_next) = (mu[i], if has_next { mu[i + 1] } else { zero });
@@ -208,21 +243,28 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
             let (xi, x0i, v0i) = (x1[i], x0[i], v0[i]);
             let mut force = xi;
             for k in 0..C {
-                let mut r = inertias[i] * (xi[k] - x0i[k] - hv * v0i[k]) - m[i] * gravity[k]
-                    + c_i * s[k]
-                    + mu_i * d[k];
+                let travelled = if DISPLACED { xi[k] } else { xi[k] - x0i[k] };
+                let mut r =
+                    inertias[i] * (travelled - hv * v0i[k]) - m[i] * gravity[k] + c_i * s[k] + mu_i * d[k];
                 if has_next {
                     r -= c_next * s_next[k] + mu_next * d_next[k];
                 }
                 force[k] = -r;
             }
+            // |e_i|² − l_i², displaced as (|r_i|² − l_i²) + 2 r_i·s_i + |s_i|² (the first
+            // term zero but for the rounding of u_i).
+            let stretch = if DISPLACED {
+                (dot(x0i, x0i) - l[i] * l[i]) + two * dot(x0i, s) + dot(s, s)
+            } else {
+                dot(e, e) - l[i] * l[i]
+            };
             rows[i] = LinkRow {
                 stiffness: inertias[i] + c_i + c_next + V::splat(0.5) * (mu_i + mu_next),
                 coupling: c_i + V::splat(0.5) * mu_i,
                 midpoint: d,
                 end: e,
                 force,
-                constraint: V::splat(-0.5) * (dot(e, e) - l[i] * l[i]),
+                constraint: V::splat(-0.5) * stretch,
             };
         }
         let singular = newton::solve(rows, pivots);
@@ -247,10 +289,17 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
         previous = largest;
     }
 
-    // The new state and the step's work.
+    // The new state and the step's work: u⁺_i = e_i/l_i, and w⁺_i = (v⁺_i − v⁺_{i−1})/l_i from
+    // the masses' new velocities v⁺_i = 2(x⁺_i − x_i)/h − v_i (v⁺_0 = ṗ(t + h)); displaced,
+    // the same as 2 s_i/(h l_i) − w_i, plus (2(p1 − p0)/h − ṗ(t) − ṗ(t + h))/l_1 for the
+    // first rod.
     let (u_out, w_out) = out.split_at_mut(C * n);
     let mut previous_velocity = pv1;
-    let [_, d_first, s_first] = rod((x0, x1), pivot, 0);
+    let mut lag = pv1;
+    for k in 0..C {
+        lag[k] = two * (p1[k] - p0[k]) / hv - pv0[k] - pv1[k];
+    }
+    let [_, d_first, s_first] = rod::<C, V, DISPLACED>((x0, x1), pivot, 0);
     let mut drive = zero;
     for k in 0..C {
         let term = (-pairs[0] * s_first[k] - mu[0] * d_first[k]) * (p1[k] - p0[k]);
@@ -258,13 +307,19 @@ pub(crate) fn iterate<const C: usize, V: Masked>(
     }
     let mut damped = zero;
     for i in 0..n {
-        let [e, _, s] = rod((x0, x1), pivot, i);
+        let [e, _, s] = rod::<C, V, DISPLACED>((x0, x1), pivot, i);
         damped += pairs[i] * dot(s, s);
         for k in 0..C {
-            let velocity = two * (x1[i][k] - x0[i][k]) / hv - v0[i][k];
             u_out[i * C + k] = e[k] / l[i];
-            w_out[i * C + k] = (velocity - previous_velocity[k]) / l[i];
-            previous_velocity[k] = velocity;
+            w_out[i * C + k] = if DISPLACED {
+                let change = two * s[k] / hv - l[i] * w[i * C + k];
+                (if i == 0 { change + lag[k] } else { change }) / l[i]
+            } else {
+                let velocity = two * (x1[i][k] - x0[i][k]) / hv - v0[i][k];
+                let change = velocity - previous_velocity[k];
+                previous_velocity[k] = velocity;
+                change / l[i]
+            };
         }
     }
     for v in out.iter() {

@@ -95,7 +95,7 @@ pub fn rows() -> Vec<Row> {
             single: format!("rk4/whirl_100/rod_midpoint_single_10_steps{suffix}"),
             batch: format!("rk4/whirl_100/rod_midpoint_batch_1_threads_10_steps{suffix}"),
             two_threads: Some(format!("rk4/whirl_100/rod_midpoint_batch_2_threads_10_steps{suffix}")),
-            f32: None,
+            f32: Some(format!("rk4/whirl_100/rod_midpoint_batch_f32_1_thread_10_steps{suffix}")),
         });
     }
     for n in [20, 100] {
