@@ -1,10 +1,11 @@
-//! What the RK4 runs in lanes share: a block's states ([`State`]: time, state and their
-//! rounding compensations) into lanes and back out, and the lanes whose numbers are not
-//! finite.
+//! What the runs in lanes share: a block's states ([`State`]: time, state and their
+//! rounding compensations) into lanes and back out, the lanes whose numbers are not
+//! finite, and the rows of a single-precision block that may start.
 
 use nalgebra::Dyn;
 
 use super::transpose::{gather_rows, scatter_some_rows};
+use super::{Failure, WIDTH_F32, non_finite};
 use crate::integrate::State;
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::has_avx2;
@@ -150,4 +151,23 @@ pub(super) fn non_finite_sum<V: Lane>(v: &[V]) -> V {
         *sum += nan_unless_finite(*y);
     }
     (sums[0] + sums[1]) + (sums[2] + sums[3])
+}
+
+/// A single-precision block's rows of `x` (`m` numbers each, row `k` chain `chains[k]`)
+/// before its first step: the failures of those with an entry that is not finite (named by
+/// it), and the lanes of the others, which start (flag `1`).
+pub(super) fn finite_rows(
+    x: &[f32],
+    m: usize,
+    chains: [usize; WIDTH_F32],
+) -> (Vec<Failure>, [u32; WIDTH_F32]) {
+    let mut failures = Vec::new();
+    let mut alive = [0u32; WIDTH_F32];
+    for (k, row) in x.chunks_exact(m).enumerate() {
+        match non_finite("x", row) {
+            Some(error) => failures.push(Failure { chain: chains[k], error }),
+            None => alive[k] = 1,
+        }
+    }
+    (failures, alive)
 }

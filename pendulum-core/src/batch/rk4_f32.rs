@@ -7,10 +7,10 @@
 use nalgebra::{DefaultAllocator, DimName, allocator::Allocator};
 
 use super::directions::{Solve, gravity};
-use super::lane_states::non_finite_lanes_f32;
+use super::lane_states::{finite_rows, non_finite_lanes_f32};
 use super::{
-    DirectionsBatch, F32x8, Failure, WIDTH_F32, block_chains, check_len, for_blocks_of, gather, non_finite,
-    one_of, scatter, simd_kernel,
+    DirectionsBatch, F32x8, Failure, WIDTH_F32, block_chains, check_len, for_blocks_of, gather, one_of,
+    scatter, simd_kernel,
 };
 use crate::batch::check_t0;
 use crate::drive::Drive;
@@ -80,14 +80,7 @@ where
             |room, b, rows| {
                 let s = &mut **room;
                 let (ids, count) = (block_chains::<WIDTH_F32>(b, self.len()), rows.len() / m);
-                let mut failures = Vec::new();
-                let mut alive = [0u32; WIDTH_F32];
-                for (k, row) in rows.chunks_exact(m).enumerate() {
-                    match non_finite("x", row) {
-                        Some(error) => failures.push(Failure { chain: ids[k], error }),
-                        None => alive[k] = 1,
-                    }
-                }
+                let (mut failures, mut alive) = finite_rows(rows, m, ids);
                 let lanes: [usize; WIDTH_F32] = std::array::from_fn(|k| k.min(count - 1));
                 gather(rows, lanes, m, Lanes32::flatten_mut(&mut s.x));
                 let block = one_of(&self.blocks_f32, b);
