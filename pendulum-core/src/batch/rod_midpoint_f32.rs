@@ -108,7 +108,10 @@ where
     /// back. The motion only: an [`accounted`](Self::accounted) batch's ledger is not kept.
     /// Not bit for bit anything: its error against
     /// [`integrate_rod_midpoint`](Self::integrate_rod_midpoint) is measured in
-    /// `docs/ensembles.md`.
+    /// `docs/ensembles.md`. Each step adds its rounding, so the error grows as the steps
+    /// shrink: whirls of 8 to 100 links ended about 1e-2 (relative) from the `f64` run
+    /// after 2000 steps of 1 ms, 5e-5 after 80 steps of 50 ms. This is a step for long
+    /// steps, where its own error is far larger than that.
     ///
     /// Returns the chains that failed, in order: a non-finite state (by its entry, before
     /// any step), a step the chain's own integrator could not take either (its error), or
