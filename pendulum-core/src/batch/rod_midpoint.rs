@@ -200,8 +200,11 @@ where
                 let t = room.t[0].0;
                 let drive = |k: usize| self.model(chains[k]).drive();
                 let ends: [[OVector<f64, S>; 4]; W] = std::array::from_fn(|k| {
-                    let d = drive(k);
-                    [d.position(t[k]), d.position(t[k] + h), d.velocity(t[k]), d.velocity(t[k] + h)]
+                    // One evaluation at each end (equal bit for bit to position and velocity
+                    // apart).
+                    let ((p0, v0), (p1, v1)) =
+                        (drive(k).position_and_velocity(t[k]), drive(k).position_and_velocity(t[k] + h));
+                    [p0, p1, v0, v1]
                 });
                 for (e, lanes) in room.ends.iter_mut().enumerate() {
                     for (c, lane) in lanes.iter_mut().enumerate() {
