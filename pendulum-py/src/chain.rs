@@ -108,7 +108,7 @@ impl Chain {
             let b = self.directions_rows(q, qd, torque, pivot_acceleration)?;
             let out =
                 maybe_detached(py, b.q.data.len() * b.q.width, || directions::jacobians_f32(&self.inner, &b))
-                    .map_err(core_error)?;
+                    .map_err(|e| e.named(&b.q.lead))?;
             return jacobian_arrays(py, out, &b);
         }
         if route != Route::Angles(Kind::Planar) {
@@ -122,7 +122,7 @@ impl Chain {
                 [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data],
             )
         })
-        .map_err(core_error)?;
+        .map_err(|e| e.named(&b.q.lead))?;
         jacobian_arrays(py, out, &b)
     }
 
@@ -155,7 +155,7 @@ impl Chain {
         let out = maybe_detached(py, b.q.data.len(), || {
             planar_batch_f32(&self.inner, b.q.count(), [&b.q.data, &b.qd.data, &b.torque.data, &b.pivot.data])
         })
-        .map_err(core_error)?;
+        .map_err(|e| e.named(&b.q.lead))?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 
@@ -238,7 +238,7 @@ impl Chain {
         }
         let width = 3 * self.inner.links();
         let q = Rows::read("q", q, width)?;
-        directions::check_unit(&q.data, width)?;
+        directions::check_unit(&q.data, width, &q.lead)?;
         let qd = Rows::read_like("qd", qd, width, &q)?;
         let torque = Rows::read_like("torque", None, width, &q)?;
         let pivot = Rows::read_like("pivot_acceleration", pivot, 3, &q)?;
@@ -277,11 +277,11 @@ impl Chain {
         match precision {
             "float64" => {
                 let out = maybe_detached(py, numbers, || directions::accelerations(&self.inner, rows));
-                Ok(array(py, out.map_err(core_error)?, lead, &width)?.into_any())
+                Ok(array(py, out.map_err(|e| e.named(lead))?, lead, &width)?.into_any())
             }
             "float32" => {
                 let out = maybe_detached(py, numbers, || directions::accelerations_f32(&self.inner, rows));
-                Ok(array(py, out.map_err(core_error)?, lead, &width)?.into_any())
+                Ok(array(py, out.map_err(|e| e.named(lead))?, lead, &width)?.into_any())
             }
             _ => Err(unknown_precision(precision)),
         }
@@ -442,7 +442,7 @@ impl Chain {
             }
             _ => with_model!(self, kind, |m| states::accelerations(m, &b)),
         })
-        .map_err(core_error)?;
+        .map_err(|e| e.named(&b.q.lead))?;
         Ok(array(py, out, &b.q.lead, &[b.q.width])?.into_any())
     }
 
@@ -555,7 +555,7 @@ impl Chain {
             Route::Angles(kind) => with_model!(self, kind, |m| states::jacobians(m, &b)),
             Route::Directions => directions::jacobians(&self.inner, &b),
         })
-        .map_err(core_error)?;
+        .map_err(|e| e.named(&b.q.lead))?;
         jacobian_arrays(py, [qdd, dq, dqd], &b)
     }
 

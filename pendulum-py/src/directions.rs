@@ -21,9 +21,9 @@ use pyo3::prelude::*;
 use crate::arrays::Rows;
 use crate::detach::maybe_detached;
 use crate::drives::Pivot;
-use crate::errors::{core_error, invalid};
-use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, rounded, split};
-use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
+use crate::errors::{StatesResult, core_error, invalid, numpy_index};
+use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, rounded_rows, split};
+use crate::planar_states::{first_error, first_failure, first_of, first_overflow, in_place, tables_f32};
 use crate::results;
 use crate::states::Batch;
 
@@ -72,14 +72,16 @@ fn batch(
     DirectionsBatch::new((0..count).map(|k| one.clone().with_drive(drive(k))).collect())
 }
 
-/// Checks that every link direction of `q` (rows of `width = 3n`) is a unit vector to
-/// [`UNIT_TOLERANCE`]; the error names the state and the link. A non-finite number is
+/// Checks that every link direction of `q` (rows of `width = 3n`, the states of leading
+/// shape `lead`) is a unit vector to [`UNIT_TOLERANCE`]; the error names the link (from 1,
+/// as the core's errors do) and the state (as numpy indexes it). A non-finite number is
 /// left to the finiteness checks, which name it.
-pub fn check_unit<T: Copy + Into<f64>>(q: &[T], width: usize) -> PyResult<()> {
+pub fn check_unit<T: Copy + Into<f64>>(q: &[T], width: usize, lead: &[usize]) -> PyResult<()> {
     for (state, row) in q.chunks_exact(width.max(1)).enumerate() {
         for (link, u) in row.chunks_exact(3).enumerate() {
             let norm = u.iter().map(|&c| c.into() * c.into()).sum::<f64>().sqrt();
             if norm.is_finite() && (norm - 1.0).abs() > UNIT_TOLERANCE {
+                let (link, state) = (link + 1, numpy_index(state, lead));
                 return Err(invalid(format!(
                     "q: link {link} of state {state} has |u| = {norm}, expected unit directions \
                      (model='directions': q holds each rod's direction (x, y, z), not angles)"
@@ -122,19 +124,19 @@ pub fn accelerations_in_place<'py>(
         |numbers: usize| DirectionsBatch::repeated(model.clone(), numbers / width).map_err(core_error);
     if !single {
         return in_place(py, q, qd, width, |u, w, out| {
-            check_unit(u, width)?;
+            check_unit(u, width, &[u.len() / width])?;
             let batch = batch(u.len())?;
             let failures = maybe_detached(py, u.len(), || batch.accelerations_split(0.0, u, w, out))
                 .map_err(core_error)?;
-            first_failure(failures, u, w, |failure| core_error(failure.error))
+            first_failure(failures, u, w, u.len() / width, first_of)
         });
     }
     let run = |u: &[f32], w: &[f32], out: &mut [f32]| {
-        check_unit(u, width)?;
+        check_unit(u, width, &[u.len() / width])?;
         let batch = batch(u.len())?;
         let failures = maybe_detached(py, u.len(), || batch.accelerations_split_f32(0.0, u, w, out))
             .map_err(core_error)?;
-        first_failure(failures, u, w, |_| core_error(pendulum_core::Error::SinglePrecisionOverflow))
+        first_failure(failures, u, w, u.len() / width, first_overflow)
     };
     match in_place(py, q, qd, width, run)? {
         Some(out) => Ok(Some(out)),
@@ -147,7 +149,7 @@ pub fn accelerations_in_place<'py>(
 pub fn accelerations(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, pivot]: [&Rows; 3],
-) -> pendulum_core::Result<Vec<f64>> {
+) -> StatesResult<Vec<f64>> {
     let mut out = vec![0.0; q.data.len()];
     if q.count() == 0 {
         return Ok(out);
@@ -161,12 +163,12 @@ pub fn accelerations(
 pub fn accelerations_f32(
     chain: &pendulum_core::Chain<Dyn>,
     [q, qd, pivot]: [&Rows; 3],
-) -> pendulum_core::Result<Vec<f32>> {
+) -> StatesResult<Vec<f32>> {
     let mut out = vec![0.0f32; q.data.len()];
     if q.count() == 0 {
         return Ok(out);
     }
-    let (u, w) = (rounded(&q.data)?, rounded(&qd.data)?);
+    let (u, w) = (rounded_rows(&q.data, q.count())?, rounded_rows(&qd.data, q.count())?);
     first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
     Ok(out)
 }
@@ -175,12 +177,12 @@ pub fn accelerations_f32(
 /// [`DirectionsBatch::accelerations_split_f32`] and
 /// [`DirectionsBatch::state_jacobians_split_f32`], the states rounded to `f32` (one past
 /// its range is an error).
-pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f32>; 3]> {
+pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> StatesResult<[Vec<f32>; 3]> {
     let (count, dof) = (b.q.count(), b.q.width);
     let mut udd = vec![0.0f32; count * dof];
     let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));
     if count > 0 {
-        let (u, w) = (rounded(&b.q.data)?, rounded(&b.qd.data)?);
+        let (u, w) = (rounded_rows(&b.q.data, count)?, rounded_rows(&b.qd.data, count)?);
         let batch = batch(chain, &b.pivot)?;
         first_error(batch.accelerations_split_f32(0.0, &u, &w, &mut udd)?)?;
         first_error(batch.state_jacobians_split_f32(0.0, &u, &w, &mut du, &mut dw)?)?;
@@ -206,7 +208,7 @@ pub fn energies(chain: &pendulum_core::Chain<Dyn>, [q, qd]: [&Rows; 2]) -> (Vec<
 /// the lower blocks of each state's [`Directions::analytic_jacobian`](pendulum_core::Directions),
 /// the Jacobian of the first-order system `(u̇, ẇ) = (w, ü)` in the directions' own three
 /// components each (the constraint `|u_i| = 1` not imposed), the states on every core.
-pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> pendulum_core::Result<[Vec<f64>; 3]> {
+pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> StatesResult<[Vec<f64>; 3]> {
     let (count, dof) = (b.q.count(), b.q.width);
     let mut udd = vec![0.0; count * dof];
     let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));

@@ -15,7 +15,7 @@ use pendulum_experiment::Error;
 use pyo3::prelude::*;
 
 use crate::arrays::{Rows, array};
-use crate::errors::{run_error, unknown_precision};
+use crate::errors::{StatesError, StatesResult, numpy_index, run_error, unknown_precision};
 use crate::interrupt::interruptible;
 use crate::results;
 
@@ -252,29 +252,25 @@ pub fn narrow(v: &[f64]) -> pendulum_experiment::Result<Vec<f32>> {
     rounded(v).map_err(core)
 }
 
-/// [`narrow`] with the core's error: the one rounding of every `f32` call.
+/// [`narrow`] with the core's error.
 pub fn rounded(v: &[f64]) -> pendulum_core::Result<Vec<f32>> {
+    rounded_rows(v, 1).map_err(|_| pendulum_core::Error::SinglePrecisionOverflow)
+}
+
+/// `v`, the rows of `count` states, rounded to `f32`: the one rounding of every `f32` call.
+/// A number past `f32`'s range is its state's error
+/// ([`SinglePrecisionOverflow`](pendulum_core::Error::SinglePrecisionOverflow)).
+pub fn rounded_rows(v: &[f64], count: usize) -> StatesResult<Vec<f32>> {
     let out: Vec<f32> = v.iter().map(|&x| x as f32).collect();
-    match out.iter().all(|x| x.is_finite()) {
-        true => Ok(out),
-        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
+    match out.iter().position(|x| !x.is_finite()) {
+        None => Ok(out),
+        Some(i) => {
+            let row = i / (v.len() / count.max(1)).max(1);
+            Err(StatesError::of_state(row, pendulum_core::Error::SinglePrecisionOverflow))
+        }
     }
 }
 
 pub fn core(e: pendulum_core::Error) -> Error {
     Error::invalid(e.to_string())
-}
-
-/// Row `row` of a C-ordered array with leading shape `lead`, as numpy writes its index:
-/// `(1, 2)`; a single leading axis as `4`, none as `0`.
-fn numpy_index(mut row: usize, lead: &[usize]) -> String {
-    let mut index = vec![0; lead.len()];
-    for (i, &extent) in lead.iter().enumerate().rev() {
-        (index[i], row) = (row % extent.max(1), row / extent.max(1));
-    }
-    match index.as_slice() {
-        [] => "0".to_string(),
-        [i] => i.to_string(),
-        more => format!("({})", more.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")),
-    }
 }

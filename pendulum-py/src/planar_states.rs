@@ -9,19 +9,19 @@ use pendulum_core::batch::{Failure, PlanarBatch};
 use pyo3::prelude::*;
 
 use crate::detach::maybe_detached;
-use crate::errors::{core_error, invalid};
-use crate::planar_runs::rounded;
+use crate::errors::{StatesError, StatesResult, core_error, invalid};
+use crate::planar_runs::rounded_rows;
 use crate::results;
 
 /// `θ̈` of every planar state by the batch of chains ([`PlanarBatch::repeated`]) at the
 /// `count` states `q`, `qd`, joint torques `torque` and pivot accelerations `pivot`, rows of
 /// `n`, `n`, `n`, 2: the same numbers as the model's row by row, and the first failing
-/// row's error.
+/// row's error, by its index.
 pub fn planar_batch(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
     [q, qd, torque, pivot]: [&[f64]; 4],
-) -> pendulum_core::Result<Vec<f64>> {
+) -> StatesResult<Vec<f64>> {
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0; q.len()];
     first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?)?;
@@ -31,12 +31,12 @@ pub fn planar_batch(
 /// `θ̈`, `∂θ̈/∂θ` and `∂θ̈/∂θ̇` (row-major) of every planar state by the batch of chains, at
 /// the states of [`planar_batch`]: [`PlanarBatch::accelerations`] and
 /// [`PlanarBatch::state_jacobians`] (in SIMD lanes), each state's numbers bit for bit the
-/// model's alone, and the first failing row's error.
+/// model's alone, and the first failing row's error, by its index.
 pub fn planar_jacobians(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
     [q, qd, torque, pivot]: [&[f64]; 4],
-) -> pendulum_core::Result<[Vec<f64>; 3]> {
+) -> StatesResult<[Vec<f64>; 3]> {
     let n = chain.links();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut qdd = vec![0.0; q.len()];
@@ -46,9 +46,23 @@ pub fn planar_jacobians(
     Ok([qdd, dq, dqd])
 }
 
-/// The first of a batch's `failures` as the error (the first failing row's).
-pub fn first_error(failures: Vec<Failure>) -> pendulum_core::Result<()> {
-    failures.into_iter().next().map_or(Ok(()), |failure| Err(failure.error))
+/// The first of a batch's `failures` as the error, the failing state's.
+pub fn first_error(failures: Vec<Failure>) -> StatesResult<()> {
+    failures.into_iter().next().map_or(Ok(()), |f| Err(StatesError::of_state(f.chain, f.error)))
+}
+
+/// [`first_error`] of a table of failures.
+pub fn first_of(failures: &[Failure]) -> StatesResult<()> {
+    first_error(failures.first().cloned().into_iter().collect())
+}
+
+/// The first of a batch's `failures` in single precision as the error, the failing
+/// state's: the inputs were checked finite in `f64`, so a failure is `f32`'s range (an
+/// input past it, or the solve's numbers).
+pub fn first_overflow(failures: &[Failure]) -> StatesResult<()> {
+    let overflow =
+        |f: &Failure| StatesError::of_state(f.chain, pendulum_core::Error::SinglePrecisionOverflow);
+    failures.first().map_or(Ok(()), |f| Err(overflow(f)))
 }
 
 /// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states,
@@ -57,17 +71,13 @@ pub fn planar_batch_f32(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
     [q, qd, torque, pivot]: [&[f64]; 4],
-) -> pendulum_core::Result<Vec<f32>> {
+) -> StatesResult<Vec<f32>> {
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0f32; q.len()];
-    let (q, qd, torque, pivot) = (rounded(q)?, rounded(qd)?, rounded(torque)?, rounded(pivot)?);
-    let failures = batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?;
-    // The inputs were checked finite in f64: a failure is single precision's range (an
-    // input past f32's, or the solve's numbers).
-    match failures.is_empty() {
-        true => Ok(out),
-        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
-    }
+    let round = |v: &[f64]| rounded_rows(v, count);
+    let (q, qd, torque, pivot) = (round(q)?, round(qd)?, round(torque)?, round(pivot)?);
+    first_overflow(&batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?)?;
+    Ok(out)
 }
 
 /// [`planar_jacobians`] in single precision ([`PlanarBatch::accelerations_f32`] and
@@ -77,20 +87,18 @@ pub fn planar_jacobians_f32(
     chain: &pendulum_core::Chain<Dyn>,
     count: usize,
     [q, qd, torque, pivot]: [&[f64]; 4],
-) -> pendulum_core::Result<[Vec<f32>; 3]> {
+) -> StatesResult<[Vec<f32>; 3]> {
     let n = chain.links();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
-    let (q, qd, torque, pivot) = (rounded(q)?, rounded(qd)?, rounded(torque)?, rounded(pivot)?);
+    let round = |v: &[f64]| rounded_rows(v, count);
+    let (q, qd, torque, pivot) = (round(q)?, round(qd)?, round(torque)?, round(pivot)?);
     let (torque, pivot) = (Some(&torque[..]), Some(&pivot[..]));
     let mut qdd = vec![0.0f32; q.len()];
     let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
     let mut failures = batch.accelerations_f32(&q, &qd, torque, pivot, &mut qdd)?;
     failures.extend(batch.state_jacobians_f32(&q, &qd, torque, pivot, &mut dq, &mut dqd)?);
-    // The inputs were checked finite in f64: a failure is single precision's range.
-    match failures.is_empty() {
-        true => Ok([qdd, dq, dqd]),
-        false => Err(pendulum_core::Error::SinglePrecisionOverflow),
-    }
+    first_overflow(&failures)?;
+    Ok([qdd, dq, dqd])
 }
 
 /// A C-contiguous `(B, n)` float64 array as its `B` and its numbers rounded to `f32`;
@@ -116,10 +124,11 @@ pub fn planar_table_f32<'py>(
     qd: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     tables_f32(py, q, qd, chain.links(), |qs, qds, out| {
-        let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
+        let count = qs.len() / chain.links();
+        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, None, out))
             .map_err(core_error)?;
-        first_failure(failures, qs, qds, |_| core_error(pendulum_core::Error::SinglePrecisionOverflow))
+        first_failure(failures, qs, qds, count, first_overflow)
     })
 }
 
@@ -162,23 +171,29 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
     run: impl Fn(&PlanarBatch, &[T], &[T], &mut [T]) -> pendulum_core::Result<Vec<Failure>> + Send + Sync,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     in_place(py, q, qd, chain.links(), |qs, qds, os| {
-        let batch = PlanarBatch::repeated(chain.clone(), qs.len() / chain.links()).map_err(core_error)?;
+        let count = qs.len() / chain.links();
+        let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        first_failure(failures, qs, qds, |failure| core_error(failure.error))
+        first_failure(failures, qs, qds, count, first_of)
     })
 }
 
-/// The first of a batch's `failures` as the error: a non-finite number of `q` or `qd`
-/// named as the general path names it ([`non_finite_input`]), else `otherwise(failure)`.
+/// The `failures` of a batch of `count` states (rows of `q`, `qd`) as the error, if any: a
+/// non-finite number of `q` or `qd` named as the general path names it
+/// ([`non_finite_input`]), else `otherwise(failures)`'s, naming its state.
 pub fn first_failure<T: Copy + Into<f64>>(
     failures: Vec<Failure>,
     q: &[T],
     qd: &[T],
-    otherwise: impl Fn(Failure) -> PyErr,
+    count: usize,
+    otherwise: impl FnOnce(&[Failure]) -> StatesResult<()>,
 ) -> PyResult<()> {
-    match failures.into_iter().next() {
-        Some(failure) => Err(non_finite_input(q, qd).unwrap_or_else(|| otherwise(failure))),
-        None => Ok(()),
+    if failures.is_empty() {
+        return Ok(());
+    }
+    match non_finite_input(q, qd) {
+        Some(error) => Err(error),
+        None => otherwise(&failures).map_err(|e| e.named(&[count])),
     }
 }
 

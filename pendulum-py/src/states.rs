@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::arrays::{Rows, array};
 use crate::detach::PARALLEL_FROM;
-use crate::errors::core_error;
+use crate::errors::{StatesError, StatesResult, core_error};
 
 /// The inputs of one call: the states and inputs as rows, checked.
 pub struct Batch {
@@ -53,13 +53,8 @@ where
 /// `count` rows of `width` numbers, row `i` written by `f(scratch, i, row)` with a
 /// scratch from `init` per thread: on every core for a large batch (each row the same
 /// computation whatever the thread, so the same bits), and the first failing row's error,
-/// by index.
-pub fn rows<S, F>(
-    count: usize,
-    width: usize,
-    init: impl Fn() -> S + Sync,
-    f: F,
-) -> pendulum_core::Result<Vec<f64>>
+/// by its index.
+pub fn rows<S, F>(count: usize, width: usize, init: impl Fn() -> S + Sync, f: F) -> StatesResult<Vec<f64>>
 where
     F: Fn(&mut S, usize, &mut [f64]) -> pendulum_core::Result<()> + Sync,
 {
@@ -76,15 +71,14 @@ where
             .map_init(&init, |scratch, (i, row)| f(scratch, i, row))
             .collect()
     };
-    results.into_iter().collect::<pendulum_core::Result<()>>()?;
+    if let Some((state, Err(error))) = results.into_iter().enumerate().find(|(_, r)| r.is_err()) {
+        return Err(StatesError::of_state(state, error));
+    }
     Ok(out)
 }
 
 /// `q̈` of every state, row after row.
-pub fn accelerations<M: Model<Links = Dyn, Dof = Dyn> + Sync>(
-    model: &M,
-    b: &Batch,
-) -> pendulum_core::Result<Vec<f64>>
+pub fn accelerations<M: Model<Links = Dyn, Dof = Dyn> + Sync>(model: &M, b: &Batch) -> StatesResult<Vec<f64>>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space>,
 {
@@ -106,7 +100,7 @@ where
 pub fn jacobians<M: Derivatives<Links = Dyn, Dof = Dyn> + Sync>(
     model: &M,
     b: &Batch,
-) -> pendulum_core::Result<[Vec<f64>; 3]>
+) -> StatesResult<[Vec<f64>; 3]>
 where
     DefaultAllocator: ModelAlloc<Dyn, Dyn, M::Space> + nalgebra::allocator::Allocator<Dyn, M::Space>,
 {

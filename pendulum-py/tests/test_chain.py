@@ -390,6 +390,62 @@ def test_a_state_that_blows_up_in_integrate_is_named():
         chain.integrate(np.full((2, 3, 4), 0.4), qd, h=1e-3, steps=10)
 
 
+def test_a_failing_state_of_many_is_named_by_its_index():
+    # Each route of accelerations and Jacobians over many states: the error names the
+    # state as numpy indexes it; a call on one state gives the error alone.
+    chain = pendulum.Chain([1.0] * 4, 0.25)
+    q = np.random.default_rng(5).uniform(0.2, 1.0, (5, 8))
+    q[2, 1] = 0.0                                                 # link 2 of state 2 vertical
+    singular = r"^state 2: link 2 sits at the spherical-angle singularity"
+    with pytest.raises(ValueError, match=singular):
+        chain.accelerations(q, model="spatial")
+    with pytest.raises(ValueError, match=singular):
+        chain.jacobians(q, model="spatial")
+    with pytest.raises(ValueError, match=r"^state \(1, 0\): link 2 sits"):
+        chain.accelerations(q[[1, 3, 4, 2, 0, 1]].reshape(2, 3, 8), model="spatial")
+    with pytest.raises(ValueError, match=r"^link 2 sits"):
+        chain.accelerations(q[2], model="spatial")
+    # Planar states, through the batch of chains: q̇ = 1e200 overflows one state's solve.
+    q, qd = np.full((6, 4), 0.3), np.zeros((6, 4))
+    qd[3] = 1e200
+    for call in [
+        lambda: chain.accelerations(q, qd),                        # in place
+        lambda: chain.accelerations(q, qd, np.zeros(4)),           # with torques
+        lambda: chain.jacobians(q, qd),
+    ]:
+        with pytest.raises(ValueError, match=r"^state 3: "):
+            call()
+    qd30 = np.where(qd > 0, 1e30, 0.0)                             # finite in float32, not its square
+    for call in [
+        lambda: chain.accelerations(q, qd, precision="float32"),     # past float32's range
+        lambda: chain.accelerations(q, qd, np.zeros(4), precision="float32"),
+        lambda: chain.jacobians(q, qd, precision="float32"),
+        lambda: chain.accelerations(q, qd30, precision="float32"),   # a float64 table
+        lambda: chain.accelerations(q.astype(np.float32), qd30.astype(np.float32), precision="float32"),
+        lambda: chain.jacobians(q, qd30, precision="float32"),
+    ]:
+        with pytest.raises(ValueError, match=r"^state 3: the accelerations are not finite in single precision"):
+            call()
+    # Directions.
+    u, w = np.tile([0.0, 0.0, -1.0], (5, 4)), np.zeros((5, 12))
+    w[4] = 1e200
+    w32 = np.where(w > 0, 1e30, 0.0)                               # finite in float32, not its square
+    for call in [
+        lambda: chain.accelerations(u, w, model="directions"),      # in place
+        lambda: chain.accelerations(u, w, None, np.zeros((5, 3)), model="directions"),
+        lambda: chain.jacobians(u, w, model="directions"),
+        lambda: chain.accelerations(u, w32, model="directions", precision="float32"),
+        lambda: chain.jacobians(u, w32, model="directions", precision="float32"),
+    ]:
+        with pytest.raises(ValueError, match=r"^state 4: "):
+            call()
+    # A rod not of unit length: its link counted from 1, as the core's errors count them.
+    stretched = np.tile([0.0, 0.0, -1.0], (2, 3, 4))
+    stretched[1, 0, 3:6] *= 2.0
+    with pytest.raises(ValueError, match=r"^q: link 2 of state \(1, 0\) has \|u\| = 2"):
+        chain.accelerations(stretched, model="directions")
+
+
 @pytest.mark.parametrize(
     "call, message",
     [

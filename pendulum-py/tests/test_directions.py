@@ -147,7 +147,7 @@ def test_tables_read_in_place_give_the_general_paths_numbers():
         chain.accelerations(u, bad, model="directions", precision="float32")
     stretched = u.copy()
     stretched[9, 3:6] *= 1.5
-    with pytest.raises(ValueError, match=r"link 1 of state 9 has \|u\| = 1.5"):
+    with pytest.raises(ValueError, match=r"link 2 of state 9 has \|u\| = 1.5"):
         chain.accelerations(stretched, w, model="directions")
 
 
@@ -325,7 +325,7 @@ def test_the_rod_midpoint_refuses_what_it_does_not_serve():
 def test_bad_input_is_named():
     chain = pendulum.Chain([1.0, 1.0], [1.0, 1.0])
     u = np.array([0.0, 0.0, -1.0, 0.6, 0.0, -0.8])
-    with pytest.raises(ValueError, match=r"q: link 1 of state 2 has \|u\| = 2"):
+    with pytest.raises(ValueError, match=r"q: link 2 of state 2 has \|u\| = 2"):
         chain.accelerations(np.stack([u, u, np.concatenate([u[:3], 2 * u[3:]])]), model="directions")
     with pytest.raises(ValueError, match="the last axis has 2 entries, expected 6"):
         chain.accelerations([0.1, 0.2], model="directions")
