@@ -96,14 +96,14 @@ fn a_3d_start_hanging_straight_down_runs() {
 
 #[test]
 fn an_extreme_chain_fails_at_run_time_with_a_message() {
-    // Valid parameters (every length positive) whose mass matrix underflows.
+    // Valid parameters (every length positive) whose numbers leave f64's range (1/l² overflows).
     let (code, got) =
         run("tiny", &["simulate", "--lengths", "1e-300", "--step", "0.005", "--out", "run", "--no-plots"]);
     assert_eq!(code, Some(1), "{got}");
     assert_eq!(
         got,
-        "error: the run stopped at t = 0 s: step 0 of the run, from t = 0 s, failed: the mass matrix is not \
-         numerically positive definite at this state; files hold what was computed"
+        "error: the run stopped at t = 0 s: step 0 of the run, from t = 0 s, failed: the accelerations are not \
+         finite at this state (its numbers leave the range of f64); files hold what was computed"
     );
 }
 

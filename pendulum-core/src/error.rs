@@ -92,6 +92,11 @@ pub enum Error {
     /// through round-off in extreme parameter ranges).
     #[error("the mass matrix is not numerically positive definite at this state")]
     NotPositiveDefinite,
+    /// The O(n) tension solve (`PlanarTension`, `Directions`, the batches, `model!`'s
+    /// `algorithm: tension`) gave non-finite accelerations from finite inputs: the state's
+    /// or the chain's numbers (a rate, a length, a mass ratio) leave `f64`'s range.
+    #[error("the accelerations are not finite at this state (its numbers leave the range of f64)")]
+    NonFiniteAccelerations,
     /// A single-precision evaluation gave a non-finite result from finite inputs: the
     /// chain's numbers leave `f32`'s range (or its tension solve's) where `f64`'s do not.
     #[error("the accelerations are not finite in single precision at this state (use f64)")]

@@ -1677,7 +1677,7 @@ const _: () = {
                     + ((x_th9 - x_th9) + ((x_th10 - x_th10) + (x_th11 - x_th11)))))
                 != 0.0
             {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+                return Err(failure(q, qd, inputs, Error::NonFiniteAccelerations));
             }
             out[0] = x_th0;
             out[1] = x_th1;

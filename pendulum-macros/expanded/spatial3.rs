@@ -501,7 +501,7 @@ const _: () = {
                 + ((x_ph0 - x_ph0) + ((x_ph1 - x_ph1) + (x_ph2 - x_ph2))))
                 != 0.0
             {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+                return Err(failure(q, qd, inputs, Error::NonFiniteAccelerations));
             }
             out[0] = x_th0;
             out[1] = x_th1;

@@ -58,9 +58,9 @@ use proc_macro::TokenStream;
 /// With `algorithm: dense`, `accelerations` solves `M q̈ = Q − c − (k + d)` by an
 /// unrolled `L D Lᵀ` factorisation (no square roots, one division per pivot). Both
 /// algorithms run `check_polar_sin` on every link for spatial models (with the sines they
-/// compute anyway), and return
-/// `Error::NotPositiveDefinite` if a pivot is not positive or the result is not finite,
-/// and on the way to any error runs `check_inputs` first, whose error (a non-finite or
+/// compute anyway), and return `Error::NotPositiveDefinite` (`dense`: a pivot not
+/// positive or the result not finite) or `Error::NonFiniteAccelerations` (`tension`: the
+/// result not finite), and on the way to any error runs `check_inputs` first, whose error (a non-finite or
 /// missized input, named) takes precedence: a non-finite input always makes the result
 /// non-finite, so the happy path does not check the inputs one by one.
 ///

@@ -421,7 +421,7 @@ where
     }
 
     fn accelerations_in<const C: usize>(&self, t: f64, x: States<'_, f64>, out: &mut [f64]) -> Vec<Failure> {
-        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        let otherwise = (f64::NAN, Error::NonFiniteAccelerations);
         match &self.blocks {
             Blocks::Four(blocks) => {
                 self.in_blocks::<C, WIDTH, _, _>(x, out, otherwise, |b, chains, s, out| {

@@ -56,7 +56,7 @@ where
     ///
     /// Returns the chains that failed, in order, with their errors (a non-finite state as
     /// the chain alone names it; a non-finite result as
-    /// [`Error::NotPositiveDefinite`](crate::Error::NotPositiveDefinite), as in
+    /// [`Error::NonFiniteAccelerations`](crate::Error::NonFiniteAccelerations), as in
     /// [`accelerations`](Self::accelerations)); their blocks are NaN. Errors:
     /// [`Error::LengthMismatch`](crate::Error::LengthMismatch) when an array does not hold
     /// `B` rows or blocks.
@@ -167,7 +167,7 @@ where
         du: &mut [f64],
         dw: &mut [f64],
     ) -> Vec<Failure> {
-        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        let otherwise = (f64::NAN, Error::NonFiniteAccelerations);
         match &self.blocks {
             Blocks::Four(blocks) => {
                 self.jacobian_blocks::<C, WIDTH, _>(x, du, dw, otherwise, |b, chains, room, du, dw| {

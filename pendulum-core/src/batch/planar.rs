@@ -288,7 +288,7 @@ impl PlanarBatch {
         if let Some(torque) = torque {
             check_len("torque", torque, self.len(), self.links)?;
         }
-        let otherwise = (f64::NAN, Error::NotPositiveDefinite);
+        let otherwise = (f64::NAN, Error::NonFiniteAccelerations);
         Ok(match &self.blocks {
             Blocks::Four(blocks) => {
                 self.in_blocks([q, qd], torque, pivot, out, otherwise, |b, lanes, s, out| {

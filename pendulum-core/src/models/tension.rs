@@ -129,7 +129,7 @@ where
                 }
             });
         });
-        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::error::Error::NotPositiveDefinite) }
+        if all_finite(out.as_slice()) { Ok(()) } else { Err(crate::error::Error::NonFiniteAccelerations) }
     }
 }
 
@@ -159,7 +159,7 @@ where
     /// The solve at `(q, q̇, inputs)` kept for its tangents ([`PlanarTangents`]): O(n).
     ///
     /// Errors: [`crate::error::Error::LengthMismatch`] or [`crate::error::Error::NonFinite`]
-    /// for bad inputs, [`crate::error::Error::NotPositiveDefinite`] for a non-finite result.
+    /// for bad inputs, [`crate::error::Error::NonFiniteAccelerations`] for a non-finite result.
     pub fn tangents(
         &self,
         q: &OVector<f64, L>,
@@ -172,7 +172,7 @@ where
         if tangents.accelerations().all(f64::is_finite) {
             Ok(tangents)
         } else {
-            Err(crate::error::Error::NotPositiveDefinite)
+            Err(crate::error::Error::NonFiniteAccelerations)
         }
     }
 }
@@ -183,7 +183,7 @@ where
 /// [`PlanarTension`] and of the generated planar models that take the tension route.
 ///
 /// Errors: [`crate::error::Error::LengthMismatch`] or [`crate::error::Error::NonFinite`]
-/// for bad inputs, [`crate::error::Error::NotPositiveDefinite`] for a non-finite result.
+/// for bad inputs, [`crate::error::Error::NonFiniteAccelerations`] for a non-finite result.
 pub fn planar_tension_jacobians<M, L>(
     model: &M,
     rods: RodConstants<'_>,
@@ -216,7 +216,7 @@ where
     let finite = solve_and_differentiate(rods, gravity, q, qd, inputs, out, parts);
     if !finite {
         check_inputs(n, q, qd, inputs)?;
-        return Err(crate::error::Error::NotPositiveDefinite);
+        return Err(crate::error::Error::NonFiniteAccelerations);
     }
     Ok(())
 }

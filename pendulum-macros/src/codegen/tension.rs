@@ -67,7 +67,7 @@ fn wrap(plan: &Plan, body: TokenStream, outputs: &[TokenStream]) -> TokenStream 
             #failure
             #body
             if #probe != 0.0 {
-                return Err(failure(q, qd, inputs, Error::NotPositiveDefinite));
+                return Err(failure(q, qd, inputs, Error::NonFiniteAccelerations));
             }
             #(out[#out_index] = #outputs;)*
             Ok(())

@@ -390,7 +390,7 @@ impl<M: PlanarKernel<N>, const N: usize> UnrolledBatch<M, N> {
         match self.models[chain].accelerations(&row(q), &row(qd), &inputs, &mut out) {
             Err(error) => error,
             // The kernel's lanes are the single model's: unreachable unless they differ.
-            Ok(()) => Error::NotPositiveDefinite,
+            Ok(()) => Error::NonFiniteAccelerations,
         }
     }
 }

@@ -162,7 +162,7 @@ impl<M: SpatialKernel<N>, const N: usize> UnrolledSpatialBatch<M, N> {
         match self.models[chain].row_accelerations(&row(q), &row(qd), &torque, pivot, &mut out) {
             Err(error) => error,
             // The kernel's lanes are the single model's: unreachable unless they differ.
-            Ok(()) => Error::NotPositiveDefinite,
+            Ok(()) => Error::NonFiniteAccelerations,
         }
     }
 }
