@@ -23,7 +23,7 @@ use crate::detach::maybe_detached;
 use crate::drives::Pivot;
 use crate::errors::{StatesResult, core_error, invalid, numpy_index};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, rounded_rows, split};
-use crate::planar_states::{first_error, first_failure, first_of, first_overflow, in_place, tables_f32};
+use crate::planar_states::{first_error, first_failure, first_overflow, in_place, tables_f32};
 use crate::results;
 use crate::states::Batch;
 
@@ -128,7 +128,7 @@ pub fn accelerations_in_place<'py>(
             let batch = batch(u.len())?;
             let failures = maybe_detached(py, u.len(), || batch.accelerations_split(0.0, u, w, out))
                 .map_err(core_error)?;
-            first_failure(failures, u, w, u.len() / width, first_of)
+            first_failure(failures, u, w, u.len() / width, first_error)
         });
     }
     let run = |u: &[f32], w: &[f32], out: &mut [f32]| {
@@ -154,7 +154,7 @@ pub fn accelerations(
     if q.count() == 0 {
         return Ok(out);
     }
-    first_error(batch(chain, pivot)?.accelerations_split(0.0, &q.data, &qd.data, &mut out)?)?;
+    first_error(&batch(chain, pivot)?.accelerations_split(0.0, &q.data, &qd.data, &mut out)?)?;
     Ok(out)
 }
 
@@ -169,7 +169,7 @@ pub fn accelerations_f32(
         return Ok(out);
     }
     let (u, w) = (rounded_rows(&q.data, q.count())?, rounded_rows(&qd.data, q.count())?);
-    first_error(batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
+    first_error(&batch(chain, pivot)?.accelerations_split_f32(0.0, &u, &w, &mut out)?)?;
     Ok(out)
 }
 
@@ -184,8 +184,8 @@ pub fn jacobians_f32(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> StatesResu
     if count > 0 {
         let (u, w) = (rounded_rows(&b.q.data, count)?, rounded_rows(&b.qd.data, count)?);
         let batch = batch(chain, &b.pivot)?;
-        first_error(batch.accelerations_split_f32(0.0, &u, &w, &mut udd)?)?;
-        first_error(batch.state_jacobians_split_f32(0.0, &u, &w, &mut du, &mut dw)?)?;
+        first_error(&batch.accelerations_split_f32(0.0, &u, &w, &mut udd)?)?;
+        first_error(&batch.state_jacobians_split_f32(0.0, &u, &w, &mut du, &mut dw)?)?;
     }
     Ok([udd, du, dw])
 }
@@ -214,8 +214,8 @@ pub fn jacobians(chain: &pendulum_core::Chain<Dyn>, b: &Batch) -> StatesResult<[
     let (mut du, mut dw) = (results::zeros(count * dof * dof), results::zeros(count * dof * dof));
     if count > 0 {
         let batch = batch(chain, &b.pivot)?;
-        first_error(batch.accelerations_split(0.0, &b.q.data, &b.qd.data, &mut udd)?)?;
-        first_error(batch.state_jacobians_split(0.0, &b.q.data, &b.qd.data, &mut du, &mut dw)?)?;
+        first_error(&batch.accelerations_split(0.0, &b.q.data, &b.qd.data, &mut udd)?)?;
+        first_error(&batch.state_jacobians_split(0.0, &b.q.data, &b.qd.data, &mut du, &mut dw)?)?;
     }
     Ok([udd, du, dw])
 }

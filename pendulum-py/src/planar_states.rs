@@ -24,7 +24,7 @@ pub fn planar_batch(
 ) -> StatesResult<Vec<f64>> {
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut out = vec![0.0; q.len()];
-    first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?)?;
+    first_error(&batch.accelerations(q, qd, Some(torque), Some(pivot), &mut out)?)?;
     Ok(out)
 }
 
@@ -40,20 +40,15 @@ pub fn planar_jacobians(
     let n = chain.links();
     let batch = PlanarBatch::repeated(chain.clone(), count)?;
     let mut qdd = vec![0.0; q.len()];
-    first_error(batch.accelerations(q, qd, Some(torque), Some(pivot), &mut qdd)?)?;
+    first_error(&batch.accelerations(q, qd, Some(torque), Some(pivot), &mut qdd)?)?;
     let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
-    first_error(batch.state_jacobians(q, qd, Some(torque), Some(pivot), &mut dq, &mut dqd)?)?;
+    first_error(&batch.state_jacobians(q, qd, Some(torque), Some(pivot), &mut dq, &mut dqd)?)?;
     Ok([qdd, dq, dqd])
 }
 
 /// The first of a batch's `failures` as the error, the failing state's.
-pub fn first_error(failures: Vec<Failure>) -> StatesResult<()> {
-    failures.into_iter().next().map_or(Ok(()), |f| Err(StatesError::of_state(f.chain, f.error)))
-}
-
-/// [`first_error`] of a table of failures.
-pub fn first_of(failures: &[Failure]) -> StatesResult<()> {
-    first_error(failures.first().cloned().into_iter().collect())
+pub fn first_error(failures: &[Failure]) -> StatesResult<()> {
+    failures.first().map_or(Ok(()), |f| Err(StatesError::of_state(f.chain, f.error.clone())))
 }
 
 /// The first of a batch's `failures` in single precision as the error, the failing
@@ -174,7 +169,7 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
         let count = qs.len() / chain.links();
         let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        first_failure(failures, qs, qds, count, first_of)
+        first_failure(failures, qs, qds, count, first_error)
     })
 }
 
