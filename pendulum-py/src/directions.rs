@@ -23,7 +23,7 @@ use crate::detach::maybe_detached;
 use crate::drives::Pivot;
 use crate::errors::{StatesResult, core_error, invalid, numpy_index};
 use crate::planar_runs::{Plan, Samples, core, in_chunks, narrow, rounded_rows, split};
-use crate::planar_states::{first_error, first_failure, first_overflow, in_place, tables_f32};
+use crate::planar_states::{first_error, first_failure, in_place, tables_f32};
 use crate::results;
 use crate::states::Batch;
 
@@ -136,7 +136,7 @@ pub fn accelerations_in_place<'py>(
         let batch = batch(u.len())?;
         let failures = maybe_detached(py, u.len(), || batch.accelerations_split_f32(0.0, u, w, out))
             .map_err(core_error)?;
-        first_failure(failures, u, w, u.len() / width, first_overflow)
+        first_failure(failures, u, w, u.len() / width, first_error)
     };
     match in_place(py, q, qd, width, run)? {
         Some(out) => Ok(Some(out)),

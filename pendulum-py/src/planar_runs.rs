@@ -249,12 +249,7 @@ pub fn split<'a, T: Copy + 'a>(n: usize, rows: impl Iterator<Item = &'a [T]>, sa
 /// `v` rounded to `f32`; a number past its range is an error
 /// ([`SinglePrecisionOverflow`](pendulum_core::Error::SinglePrecisionOverflow)).
 pub fn narrow(v: &[f64]) -> pendulum_experiment::Result<Vec<f32>> {
-    rounded(v).map_err(core)
-}
-
-/// [`narrow`] with the core's error.
-pub fn rounded(v: &[f64]) -> pendulum_core::Result<Vec<f32>> {
-    rounded_rows(v, 1).map_err(|_| pendulum_core::Error::SinglePrecisionOverflow)
+    rounded_rows(v, 1).map_err(|_| core(pendulum_core::Error::SinglePrecisionOverflow))
 }
 
 /// `v`, the rows of `count` states, rounded to `f32`: the one rounding of every `f32` call.

@@ -46,18 +46,10 @@ pub fn planar_jacobians(
     Ok([qdd, dq, dqd])
 }
 
-/// The first of a batch's `failures` as the error, the failing state's.
+/// The first of a batch's `failures` as the error, the failing state's (in single precision the
+/// batch names an overflow `SinglePrecisionOverflow` itself).
 pub fn first_error(failures: &[Failure]) -> StatesResult<()> {
     failures.first().map_or(Ok(()), |f| Err(StatesError::of_state(f.chain, f.error.clone())))
-}
-
-/// The first of a batch's `failures` in single precision as the error, the failing
-/// state's: the inputs were checked finite in `f64`, so a failure is `f32`'s range (an
-/// input past it, or the solve's numbers).
-pub fn first_overflow(failures: &[Failure]) -> StatesResult<()> {
-    let overflow =
-        |f: &Failure| StatesError::of_state(f.chain, pendulum_core::Error::SinglePrecisionOverflow);
-    failures.first().map_or(Ok(()), |f| Err(overflow(f)))
 }
 
 /// [`planar_batch`] in single precision ([`PlanarBatch::accelerations_f32`]): the states,
@@ -71,7 +63,7 @@ pub fn planar_batch_f32(
     let mut out = vec![0.0f32; q.len()];
     let round = |v: &[f64]| rounded_rows(v, count);
     let (q, qd, torque, pivot) = (round(q)?, round(qd)?, round(torque)?, round(pivot)?);
-    first_overflow(&batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?)?;
+    first_error(&batch.accelerations_f32(&q, &qd, Some(&torque), Some(&pivot), &mut out)?)?;
     Ok(out)
 }
 
@@ -92,7 +84,7 @@ pub fn planar_jacobians_f32(
     let (mut dq, mut dqd) = (results::zeros(count * n * n), results::zeros(count * n * n));
     let mut failures = batch.accelerations_f32(&q, &qd, torque, pivot, &mut qdd)?;
     failures.extend(batch.state_jacobians_f32(&q, &qd, torque, pivot, &mut dq, &mut dqd)?);
-    first_overflow(&failures)?;
+    first_error(&failures)?;
     Ok([qdd, dq, dqd])
 }
 
@@ -123,7 +115,7 @@ pub fn planar_table_f32<'py>(
         let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, None, out))
             .map_err(core_error)?;
-        first_failure(failures, qs, qds, count, first_overflow)
+        first_failure(failures, qs, qds, count, first_error)
     })
 }
 
