@@ -156,6 +156,55 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
     }
 }
 
+#[test]
+fn rk4_steps_from_states_that_carry_a_compensation_equal_each_chain_alone() {
+    // The batch skips the compensations of states that arrive with none; here some chains
+    // of a block bring one (left by RK4 steps without projection) and others none, then
+    // all arrive cleared in the same batch (whose kept lanes still hold the old ones).
+    let mut r = ChaCha8Rng::seed_from_u64(23);
+    let (chains, n, h) = (11, 12, 1e-3);
+    let (models, x): (Vec<_>, Vec<_>) = (0..chains).map(|_| whirl(n, &mut r)).unzip();
+    let batch = DirectionsBatch::new(models.clone()).expect("batch");
+    let mut start: Vec<State<Dyn>> = x.iter().map(|x| State::new(0.0, x.clone())).collect();
+    for (model, state) in models.iter().zip(&mut start).step_by(2) {
+        let mut rk4 = Rk4::new(model);
+        for _ in 0..3 {
+            rk4.step(model, state, h).expect("unprojected");
+        }
+        assert!(state.compensation().iter().any(|&c| c != 0.0), "a compensation to carry");
+    }
+    let single = |start: &[State<Dyn>], steps: usize| -> Vec<State<Dyn>> {
+        let mut states = start.to_vec();
+        for (model, state) in models.iter().zip(&mut states) {
+            let mut rk4 = Projected::new(Rk4::new(model));
+            (0..steps).for_each(|_| rk4.step(model, state, h).expect("single"));
+        }
+        states
+    };
+    let cleared: Vec<State<Dyn>> = start.iter().map(|s| State::new(s.t(), s.x().clone())).collect();
+    for avx512 in [true, false] {
+        let batch = batch.clone().with_avx512(avx512);
+        for pool in pools() {
+            for start in [&start, &cleared, &start] {
+                let expected = single(start, 3);
+                let mut states = start.clone();
+                for _ in 0..3 {
+                    assert!(pool.install(|| batch.step_rk4(&mut states, h)).expect("batch").is_empty());
+                }
+                let mut run = start.clone();
+                assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 3)).expect("batch").is_empty());
+                for (k, ((a, b), c)) in states.iter().zip(&expected).zip(&run).enumerate() {
+                    for s in [a, c] {
+                        assert_eq!(s.t().to_bits(), b.t().to_bits());
+                        assert_bits(s.x().as_slice(), b.x().as_slice(), &format!("chain {k}"));
+                        assert_bits(s.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The states `x` of `models` with empty energy ledgers, at t = 0.
 fn accounted_states(models: &[Directions<U3, Circle>], x: &[DVector<f64>]) -> Vec<State<Dyn>> {
     models

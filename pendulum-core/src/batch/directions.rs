@@ -81,6 +81,9 @@ pub(super) struct Scratch<const C: usize, const W: usize> {
     pub t: [Lanes<W>; 2],
     /// The compensation of the state per lane.
     pub carry: Aligned<Lanes<W>>,
+    /// Whether every entry of `carry` is `+0.0` (then clearing it writes nothing): kept so
+    /// by whatever writes `carry`.
+    pub carry_zero: bool,
     pub x: Aligned<Lanes<W>>,
     pub y: Aligned<Lanes<W>>,
     pub k: [Aligned<Lanes<W>>; 4],
@@ -270,6 +273,7 @@ impl<const C: usize, const W: usize> Scratch<C, W> {
             solve: Solve::new(links),
             t: [Lanes([0.0; W]); 2],
             carry: lanes(),
+            carry_zero: true,
             x: lanes(),
             y: lanes(),
             k: [lanes(), lanes(), lanes(), lanes()],

@@ -11,26 +11,41 @@ use crate::integrate::State;
 use crate::lanes::has_avx2;
 use crate::lanes::{Lane, Lanes, Lanes32, Masked, one_row_at_a_time};
 
+/// What [`into_lanes`] found in a block's states.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Arrival<const W: usize> {
+    /// The lanes whose state has an entry that is not finite (flag `1`), found in lanes
+    /// where the numbers arrive (before the search for the entry, chain by chain in code
+    /// without AVX2, was a twelfth of a one-step call).
+    pub suspect: [u64; W],
+    /// Whether every compensation of the states was `+0.0` (then the lanes' were not
+    /// transposed but cleared).
+    pub uncompensated: bool,
+}
+
+/// The rows of a strip of [`fill_lanes`]: a block's strip of the states (`W` chains of
+/// this many numbers) is still in L1 when it is checked.
+const STRIP: usize = 64;
+
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
-/// into `t`, the states into `x`, their compensations into `carry`. Returns the lanes whose
-/// state has an entry that is not finite (flag `1`), found in lanes where the numbers
-/// arrive (before the search for the entry, chain by chain in code without AVX2, was a
-/// twelfth of a one-step call). Compiled for AVX2 where the CPU has it, so that the tiles'
-/// transposes are inlined (called tile by tile from code without AVX2, getting a whirl's
-/// states into lanes and back was a quarter of a one-step call).
+/// into `t`, the states into `x`, their compensations into `carry`, which is written only
+/// where a state brings one or `carry_zero` is false (it says every entry of `carry` is
+/// `+0.0` already). Compiled for AVX2 where the CPU has it, so that the tiles' transposes
+/// are inlined (called tile by tile from code without AVX2, getting a whirl's states into
+/// lanes and back was a quarter of a one-step call).
 pub(super) fn into_lanes<const W: usize>(
     states: [&State<Dyn>; W],
     m: usize,
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
-    carry: &mut [Lanes<W>],
-) -> [u64; W] {
+    (carry, carry_zero): (&mut [Lanes<W>], bool),
+) -> Arrival<W> {
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { into_lanes_avx2(states, m, t, x, carry) };
+        return unsafe { into_lanes_avx2(states, m, t, x, (carry, carry_zero)) };
     }
-    fill_lanes(states, m, t, x, carry)
+    fill_lanes(states, m, t, x, (carry, carry_zero))
 }
 
 /// [`fill_lanes`] compiled for AVX2.
@@ -41,44 +56,70 @@ fn into_lanes_avx2<const W: usize>(
     m: usize,
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
-    carry: &mut [Lanes<W>],
-) -> [u64; W] {
+    carry: (&mut [Lanes<W>], bool),
+) -> Arrival<W> {
     fill_lanes(states, m, t, x, carry)
 }
 
-/// The body of [`into_lanes`].
+/// The body of [`into_lanes`], in strips of [`STRIP`] rows: each strip transposed, then
+/// searched for entries that are not finite while in L1 (in a pass over the whole block,
+/// the search was a fortieth of a one-step call).
 #[inline(always)]
 fn fill_lanes<const W: usize>(
     states: [&State<Dyn>; W],
     m: usize,
     t: &mut [Lanes<W>; 2],
     x: &mut [Lanes<W>],
-    carry: &mut [Lanes<W>],
-) -> [u64; W] {
+    (carry, carry_zero): (&mut [Lanes<W>], bool),
+) -> Arrival<W> {
     let parts = states.map(State::parts);
     *t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
-    gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(x));
-    gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
-    non_finite_lanes(&x[..m])
+    let rows = parts.map(|p| &p.2[..m]);
+    let mut nan = Lanes([0.0; W]);
+    for start in (0..m).step_by(STRIP) {
+        let end = (start + STRIP).min(m);
+        let lanes = &mut x[start..end];
+        gather_rows(rows.map(|row| &row[start..end]), end - start, Lanes::flatten_mut(lanes));
+        nan += non_finite_sum(lanes);
+    }
+    // Projected steps clear the compensation: a run of them arrives with none, most often
+    // (read to be sure, the compensations were a twentieth of a one-step call).
+    let uncompensated = states.iter().all(|state| state.is_cleared());
+    if !uncompensated {
+        gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
+    } else if !carry_zero {
+        carry[..m].fill(Lanes([0.0; W]));
+    }
+    Arrival { suspect: nan.not_finite(), uncompensated }
 }
 
 /// The block's states (up to `W`, lane `k` for the `k`-th) that `ran` (flag `1`) out
 /// of the lanes [`into_lanes`] filled (by the tiles' transposes for a whole block: one
-/// number at a time, this was a quarter of a one-step call). Compiled for AVX2 where the
-/// CPU has it, as [`into_lanes`].
+/// number at a time, this was a quarter of a one-step call); with no lanes of
+/// compensations (`None`), the states keep their own. Compiled for AVX2 where the CPU has
+/// it, as [`into_lanes`].
 pub(super) fn out_of_lanes<'a, const W: usize>(
     states: impl IntoIterator<Item = &'a mut State<Dyn>>,
     ran: [u64; W],
     m: usize,
-    lanes: (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    lanes: (&[Lanes<W>; 2], &[Lanes<W>], Option<&[Lanes<W>]>),
 ) {
     let mut xs: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
     let mut carries: [Option<&mut [f64]>; W] = std::array::from_fn(|_| None);
     let (t, _, _) = lanes;
     for (k, state) in states.into_iter().enumerate().filter(|(k, _)| ran[*k] != 0) {
-        let (time, time_carry, x, carry) = state.parts_mut();
+        let (time, time_carry, x, carry) = match lanes.2 {
+            Some(_) => {
+                let (time, time_carry, x, carry) = state.parts_mut();
+                (time, time_carry, x, Some(carry))
+            }
+            None => {
+                let (time, time_carry, x) = state.time_and_x_mut();
+                (time, time_carry, x, None)
+            }
+        };
         (*time, *time_carry) = (t[0].0[k], t[1].0[k]);
-        (xs[k], carries[k]) = (Some(x), Some(carry));
+        (xs[k], carries[k]) = (Some(x), carry);
     }
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
@@ -93,24 +134,26 @@ pub(super) fn out_of_lanes<'a, const W: usize>(
 #[target_feature(enable = "avx2")]
 fn empty_lanes_avx2<const W: usize>(
     m: usize,
-    lanes: (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    lanes: (&[Lanes<W>; 2], &[Lanes<W>], Option<&[Lanes<W>]>),
     xs: [Option<&mut [f64]>; W],
     carries: [Option<&mut [f64]>; W],
 ) {
     empty_lanes(m, lanes, xs, carries)
 }
 
-/// The states and their compensations out of the lanes into the rows given (`None`: a
-/// lane left out).
+/// The states and their compensations (when given) out of the lanes into the rows given
+/// (`None`: a lane left out).
 #[inline(always)]
 fn empty_lanes<const W: usize>(
     m: usize,
-    (_, x, carry): (&[Lanes<W>; 2], &[Lanes<W>], &[Lanes<W>]),
+    (_, x, carry): (&[Lanes<W>; 2], &[Lanes<W>], Option<&[Lanes<W>]>),
     xs: [Option<&mut [f64]>; W],
     carries: [Option<&mut [f64]>; W],
 ) {
     scatter_some_rows(Lanes::flatten(x), m, xs);
-    scatter_some_rows(Lanes::flatten(carry), m, carries);
+    if let Some(carry) = carry {
+        scatter_some_rows(Lanes::flatten(carry), m, carries);
+    }
 }
 
 /// The lanes in which some entry of `v` is not finite (flag `1`).

@@ -174,7 +174,8 @@ impl PlanarBatch {
                 let ids = block_chains::<W>(b, self.len());
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let mut t = [Lanes([0.0; W]); 2];
-                let suspect = into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, &mut s.carry);
+                let suspect =
+                    into_lanes(lanes.map(|k| &block[k]), m, &mut t, &mut s.x, (&mut s.carry, false)).suspect;
                 // A state's entry searched for only where the lanes found one.
                 let x = |k: usize| (suspect[k] != 0).then(|| block[k].x().as_slice());
                 let (mut failures, ran) = start(s, (ids, block.len(), n), (torque, pivot), x);
@@ -202,7 +203,7 @@ impl PlanarBatch {
                     t = [Lanes::select(keep, new_t, t[0]), Lanes::select(keep, new_carry, t[1])];
                     alive = keep;
                 }
-                out_of_lanes(block.iter_mut(), ran.map(u64::from), m, (&t, &s.x, &s.carry));
+                out_of_lanes(block.iter_mut(), ran.map(u64::from), m, (&t, &s.x, Some(&s.carry)));
                 failures.sort_by_key(|f| f.chain);
                 failures
             },

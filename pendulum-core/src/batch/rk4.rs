@@ -163,8 +163,13 @@ where
                 let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
                 let mut ends: Vec<End> = block.iter().map(|_| End::default()).collect();
                 let mut alive = [0u64; W];
-                let suspect = into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, &mut s.carry);
-                for ((k, (state, _)), suspect) in block.iter().enumerate().zip(suspect) {
+                let carry = (&mut s.carry[..], s.carry_zero);
+                let arrival = into_lanes(lanes.map(|k| &*block[k].0), m, &mut s.t, &mut s.x, carry);
+                s.carry_zero = arrival.uncompensated;
+                // Each step clears a lane's compensation or leaves it (a failed lane): those
+                // of states that arrive without one stay zero, and the states' own stand.
+                let carried = !arrival.uncompensated;
+                for ((k, (state, _)), suspect) in block.iter().enumerate().zip(arrival.suspect) {
                     // The entry named only where the lanes found one.
                     match (suspect != 0).then(|| non_finite("x", state.x().as_slice())).flatten() {
                         Some(error) => ends[k].failure = Some((error, 0)),
@@ -181,7 +186,7 @@ where
                         let mut stopped = [false; W];
                         let Some(sample) = sample else { return stopped };
                         let states = block.iter_mut().map(|(state, _)| &mut **state);
-                        out_of_lanes(states, which, m, (&s.t, &s.x, &s.carry));
+                        out_of_lanes(states, which, m, (&s.t, &s.x, carried.then_some(&s.carry[..])));
                         for ((stopped, (state, observer)), _) in
                             stopped.iter_mut().zip(block.iter_mut()).zip(which).filter(|(_, k)| *k != 0)
                         {
@@ -226,7 +231,7 @@ where
                     }
                 }
                 let states = block.iter_mut().map(|(state, _)| &mut **state);
-                out_of_lanes(states, ran, m, (&s.t, &s.x, &s.carry));
+                out_of_lanes(states, ran, m, (&s.t, &s.x, carried.then_some(&s.carry[..])));
                 ids.into_iter().zip(ends).collect()
             },
         )
@@ -256,7 +261,10 @@ where
                 // Every lane steps (the common case): the next state, in k1, becomes the
                 // state, no copy (k1 is overwritten by the next step either way).
                 std::mem::swap(&mut s.x, &mut s.k[0]);
-                s.carry.fill(zero);
+                if !s.carry_zero {
+                    s.carry.fill(zero);
+                    s.carry_zero = true;
+                }
             } else {
                 for ((x, carry), next) in s.x.iter_mut().zip(&mut s.carry).zip(&s.k[0]) {
                     *x = Lanes::select(keep, *next, *x);

@@ -189,7 +189,7 @@ where
             let lanes: [usize; W] = std::array::from_fn(|k| k.min(block.len() - 1));
             // Its flags of non-finite states go unused: such a lane does not step in lanes,
             // and the chain alone reports its error (`single_step`).
-            into_lanes(lanes.map(|k| &block[k]), m, &mut room.t, &mut room.x, &mut room.carry);
+            into_lanes(lanes.map(|k| &block[k]), m, &mut room.t, &mut room.x, (&mut room.carry, false));
             let mut alive = [0u64; W];
             alive[..block.len()].fill(1);
             let mut failures = Vec::new();
@@ -227,7 +227,7 @@ where
                     }
                 }
             }
-            out_of_lanes(block.iter_mut(), alive, m, (&room.t, &room.x, &room.carry));
+            out_of_lanes(block.iter_mut(), alive, m, (&room.t, &room.x, Some(&room.carry)));
             failures
         })
     }
