@@ -120,6 +120,15 @@ pub trait Lane:
         let (low, span) = CONTINUANT_RANGE;
         self.outside(low, span)
     }
+    /// `[lowest, highest]` widened to take in `self`, lane by lane, by the rule of x86's
+    /// `minpd` and `maxpd` (`lowest < x ? lowest : x`, one instruction each): a NaN `self`
+    /// is taken in.
+    fn widen(self, range: [Self; 2]) -> [Self; 2];
+    /// The lanes whose range from [`widen`](Self::widen) (started at `[+∞, −∞]`) is NaN
+    /// or reaches outside the continuants' range of their precision: those with a value
+    /// that [`continuant_outside`](Self::continuant_outside) flags, when a NaN value is
+    /// followed by NaN only (as in the continuants' recurrence).
+    fn range_outside(range: [Self; 2]) -> Self::Mask;
 }
 
 /// The comparisons and the flags' logic that control flow in lanes needs (a lane that
@@ -187,6 +196,15 @@ impl Lane for f64 {
     fn normalizer(self) -> Self {
         let biased = (self.to_bits() >> 52) & 0x7ff;
         f64::from_bits(((2046 - biased as i64) as u64 & 0x7ff) << 52)
+    }
+    #[inline(always)]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        [if lowest < self { lowest } else { self }, if highest > self { highest } else { self }]
+    }
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> bool {
+        let [low, high] = CONTINUANT_ENDS;
+        !(lowest >= low && highest <= high)
     }
 }
 
@@ -447,6 +465,14 @@ pub(crate) const CONTINUANT_RANGE_32: (u32, u32) = {
     (low, high - low)
 };
 
+/// [`CONTINUANT_RANGE`]'s ends as numbers: `2⁻⁸⁰⁰` and `2⁸⁰⁰`.
+pub(crate) const CONTINUANT_ENDS: [f64; 2] =
+    [f64::from_bits(CONTINUANT_RANGE.0), f64::from_bits(CONTINUANT_RANGE.0 + CONTINUANT_RANGE.1)];
+
+/// [`CONTINUANT_RANGE_32`]'s ends as numbers: `2⁻⁸⁰` and `2⁸⁰`.
+pub(crate) const CONTINUANT_ENDS_32: [f32; 2] =
+    [f32::from_bits(CONTINUANT_RANGE_32.0), f32::from_bits(CONTINUANT_RANGE_32.0 + CONTINUANT_RANGE_32.1)];
+
 impl<const W: usize> Lane for Lanes32<W> {
     type Mask = [u32; W];
     const WIDTH: usize = W;
@@ -509,6 +535,23 @@ impl<const W: usize> Lane for Lanes32<W> {
         }
         out
     }
+    #[inline(always)]
+    fn widen(self, [mut lowest, mut highest]: [Self; 2]) -> [Self; 2] {
+        for ((lowest, highest), x) in lowest.0.iter_mut().zip(&mut highest.0).zip(self.0) {
+            *lowest = if *lowest < x { *lowest } else { x };
+            *highest = if *highest > x { *highest } else { x };
+        }
+        [lowest, highest]
+    }
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> [u32; W] {
+        let [low, high] = CONTINUANT_ENDS_32;
+        let mut out = [0; W];
+        for ((o, lowest), highest) in out.iter_mut().zip(lowest.0).zip(highest.0) {
+            *o = !(lowest >= low && highest <= high) as u32;
+        }
+        out
+    }
 }
 
 impl<const W: usize> Lane for Lanes<W> {
@@ -561,6 +604,21 @@ impl<const W: usize> Lane for Lanes<W> {
     fn normalizer(self) -> Self {
         self.map(f64::normalizer)
     }
+    #[inline(always)]
+    fn widen(self, [mut lowest, mut highest]: [Self; 2]) -> [Self; 2] {
+        for ((lowest, highest), x) in lowest.0.iter_mut().zip(&mut highest.0).zip(self.0) {
+            [*lowest, *highest] = x.widen([*lowest, *highest]);
+        }
+        [lowest, highest]
+    }
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> [u64; W] {
+        let mut out = [0; W];
+        for ((o, lowest), highest) in out.iter_mut().zip(lowest.0).zip(highest.0) {
+            *o = f64::range_outside([lowest, highest]) as u64;
+        }
+        out
+    }
 }
 
 impl<const W: usize> Masked for Lanes32<W> {
@@ -593,6 +651,97 @@ mod tests {
         assert!(Lanes::<4>::any(mask) && !Lanes::<4>::any(Lanes::<4>::none()));
         assert!(!Lanes::<4>::all(mask) && Lanes::<4>::all([1, 1, 1, 1]));
         assert_eq!(Lanes::select(mask, a, b).0[..2], [0.1f64, -2.0][..]);
+    }
+
+    /// A sequence of continuants as the recurrence can make them: any values (the range's
+    /// ends and their neighbours, ±0, subnormals, ±∞, negatives), until a NaN, then NaN.
+    fn sequence<T: Copy>(picks: &[usize], values: &[T], nan: T) -> Vec<T> {
+        let nan_at = picks.iter().position(|&p| p == values.len());
+        let sequence = picks.iter().map(|&p| values.get(p).copied().unwrap_or(nan));
+        match nan_at {
+            Some(at) => sequence.take(at).chain(std::iter::repeat_n(nan, picks.len() - at)).collect(),
+            None => sequence.collect(),
+        }
+    }
+
+    #[test]
+    fn a_range_of_continuants_flags_what_a_check_of_each_would() {
+        let [low, high] = CONTINUANT_ENDS;
+        let values64 = [
+            1.0,
+            1.5,
+            low,
+            high,
+            low.next_down(),
+            high.next_up(),
+            0.0,
+            -0.0,
+            1e-310,
+            -1.0,
+            -high,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            3e200,
+            2e-230,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+        ];
+        let [low32, high32] = CONTINUANT_ENDS_32;
+        let values32 = [
+            1.0f32,
+            low32,
+            high32,
+            low32.next_down(),
+            high32.next_up(),
+            0.0,
+            -0.0,
+            1e-40,
+            -1.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            3e20,
+            2e-23,
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut pick = |below: usize| {
+            // xorshift64: a fixed, reproducible stream of picks.
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % below as u64) as usize
+        };
+        for length in [0, 1, 2, 3, 5, 9, 20] {
+            for _ in 0..400 {
+                // Index `len` is the NaN; most values picked from the first few (in range).
+                let mut picks = || -> Vec<usize> {
+                    (0..length)
+                        .map(|_| if pick(3) == 0 { pick(values64.len() + 1) } else { pick(4) })
+                        .collect()
+                };
+                let (picks, others) = (picks(), picks());
+                let each = sequence(&picks, &values64, f64::NAN);
+                let range = each.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |r, &x| x.widen(r));
+                let checked = each.iter().any(|&x| x.continuant_outside());
+                assert_eq!(f64::range_outside(range), checked, "{each:?}");
+                // Two sequences in four lanes, alternating.
+                let other = sequence(&others, &values64, f64::NAN);
+                let lanes: Vec<Lanes<4>> =
+                    each.iter().zip(&other).map(|(&a, &b)| Lanes([a, b, b, a])).collect();
+                let start = [Lanes([f64::INFINITY; 4]), Lanes([f64::NEG_INFINITY; 4])];
+                let range = lanes.iter().fold(start, |r, &x| x.widen(r));
+                let checked =
+                    lanes.iter().fold(Lanes::<4>::none(), |m, &x| Lanes::or(m, x.continuant_outside()));
+                assert_eq!(Lanes::range_outside(range), checked, "{lanes:?}");
+                let picks32: Vec<usize> = picks.iter().map(|&p| p.min(values32.len())).collect();
+                let each32 = sequence(&picks32, &values32, f32::NAN);
+                let lanes32: Vec<Lanes32<1>> = each32.iter().map(|&x| Lanes32([x])).collect();
+                let start = [Lanes32([f32::INFINITY]), Lanes32([f32::NEG_INFINITY])];
+                let range = lanes32.iter().fold(start, |r, &x| x.widen(r));
+                let checked =
+                    lanes32.iter().fold(Lanes32::<1>::none(), |m, &x| Lanes32::or(m, x.continuant_outside()));
+                assert_eq!(Lanes32::range_outside(range), checked, "{each32:?}");
+            }
+        }
     }
 
     #[test]

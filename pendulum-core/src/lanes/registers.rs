@@ -19,7 +19,9 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
-use super::{CONTINUANT_RANGE, CONTINUANT_RANGE_32, Lane, Lanes, Lanes32};
+use super::{
+    CONTINUANT_ENDS, CONTINUANT_ENDS_32, CONTINUANT_RANGE, CONTINUANT_RANGE_32, Lane, Lanes, Lanes32,
+};
 
 /// Four `f64` lanes, one AVX register (see the module's docs for where one may exist).
 #[derive(Debug, Clone, Copy)]
@@ -195,6 +197,20 @@ impl Lane for Avx4 {
         let (low, span) = CONTINUANT_RANGE;
         self.outside(low, span)
     }
+    #[inline(always)]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        unsafe { [Self(_mm256_min_pd(lowest.0, self.0)), Self(_mm256_max_pd(highest.0, self.0))] }
+    }
+    /// Not `lowest ≥ 2⁻⁸⁰⁰` or not `highest ≤ 2⁸⁰⁰`, unordered comparisons (true for NaN).
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> __m256i {
+        let [low, high] = CONTINUANT_ENDS;
+        unsafe {
+            let below = _mm256_cmp_pd::<_CMP_NGE_UQ>(lowest.0, _mm256_set1_pd(low));
+            let above = _mm256_cmp_pd::<_CMP_NLE_UQ>(highest.0, _mm256_set1_pd(high));
+            _mm256_castpd_si256(_mm256_or_pd(below, above))
+        }
+    }
 }
 
 register_lanes!(
@@ -303,6 +319,19 @@ impl Lane for Avx8 {
             Self(_mm512_castsi512_pd(_mm512_slli_epi64::<52>(inverse)))
         }
     }
+    #[inline(always)]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        unsafe { [Self(_mm512_min_pd(lowest.0, self.0)), Self(_mm512_max_pd(highest.0, self.0))] }
+    }
+    /// Not `lowest ≥ 2⁻⁸⁰⁰` or not `highest ≤ 2⁸⁰⁰`, unordered comparisons (true for NaN).
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> __mmask8 {
+        let [low, high] = CONTINUANT_ENDS;
+        unsafe {
+            _mm512_cmp_pd_mask::<_CMP_NGE_UQ>(lowest.0, _mm512_set1_pd(low))
+                | _mm512_cmp_pd_mask::<_CMP_NLE_UQ>(highest.0, _mm512_set1_pd(high))
+        }
+    }
 }
 
 impl AvxF32 {
@@ -393,6 +422,20 @@ impl Lane for AvxF32 {
             _mm256_cmpgt_epi32(_mm256_xor_si256(offset, top), _mm256_set1_epi32((span ^ (1 << 31)) as i32))
         }
     }
+    #[inline(always)]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        unsafe { [Self(_mm256_min_ps(lowest.0, self.0)), Self(_mm256_max_ps(highest.0, self.0))] }
+    }
+    /// Not `lowest ≥ 2⁻⁸⁰` or not `highest ≤ 2⁸⁰`, unordered comparisons (true for NaN).
+    #[inline(always)]
+    fn range_outside([lowest, highest]: [Self; 2]) -> __m256i {
+        let [low, high] = CONTINUANT_ENDS_32;
+        unsafe {
+            let below = _mm256_cmp_ps::<_CMP_NGE_UQ>(lowest.0, _mm256_set1_ps(low));
+            let above = _mm256_cmp_ps::<_CMP_NLE_UQ>(highest.0, _mm256_set1_ps(high));
+            _mm256_castps_si256(_mm256_or_ps(below, above))
+        }
+    }
 }
 
 #[cfg(test)]
@@ -418,6 +461,11 @@ mod tests {
         let flags = |m: V::Mask| V::select(m, V::splat(1.0), V::splat(0.0)).into().0.map(|f| f == 1.0);
         let outside = flags(x.continuant_outside());
         assert_eq!(outside, a.map(|v| v.outside(low, span)));
+        let [lowest, highest] = x.widen([y, y]);
+        assert_eq!(bits(lowest), each(|a, b| a.widen([b, b])[0]));
+        assert_eq!(bits(highest), each(|a, b| a.widen([b, b])[1]));
+        let range = flags(V::range_outside([x, y]));
+        assert_eq!(range, std::array::from_fn(|k| f64::range_outside([a[k], b[k]])));
         assert_eq!(V::any(x.continuant_outside()), outside.contains(&true));
         assert_eq!(V::all(x.continuant_outside()), !outside.contains(&false));
         assert!(V::all(V::splat(f64::NAN).continuant_outside()));
@@ -474,6 +522,10 @@ mod tests {
         assert!(V::all(V::splat(f64::NAN).continuant_outside()));
         assert!(!V::any(V::none()));
         assert_eq!(flags(V::or(x.continuant_outside(), V::none())), expected);
+        let [lowest, highest] = x.widen([y, y]);
+        assert_eq!(reg(lowest), bits(u.widen([v, v])[0]));
+        assert_eq!(reg(highest), bits(u.widen([v, v])[1]));
+        assert_eq!(flags(V::range_outside([x, y])), Lanes32::range_outside([u, v]).map(|f| f != 0));
     }
 
     /// [`compare_f32`] of [`AvxF32`], compiled for AVX2, and its blocks joined and split.

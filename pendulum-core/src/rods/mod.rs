@@ -248,19 +248,24 @@ pub use crate::lanes::CONTINUANT_RANGE;
 /// The pivots `1/D_i` of a tridiagonal elimination as ratios of continuants (module docs),
 /// row by row: one multiply and one subtraction per row on the serial chain, the division
 /// off it; both continuants multiplied every [`Lane::RESCALE_ROWS`] rows by the power of two that brings
-/// `P_{i−1}` into `[1, 2)`. The pivots are valid while [`in_range`](Self::in_range) (in the
-/// lanes not flagged by [`outside`](Self::outside)).
+/// `P_{i−1}` into `[1, 2)`. The pivots are valid in the lanes not flagged by
+/// [`outside`](Self::outside).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Continuants<V: Lane = f64> {
     /// `P_{i−1}`, `P_{i−2}` (`P_{−1} = 1`; `P_{−2}` only meets `c_0 = 0`).
     above: V,
     above2: V,
-    out_of_range: V::Mask,
+    /// The smallest and the largest `P_i` so far ([`Lane::widen`]). A NaN `P_i` makes every
+    /// later one NaN (the recurrence multiplies it), so the range ends NaN; the range
+    /// checked once at the end flags the lanes that one check per row would (flags kept
+    /// row by row were five instructions a row, the range two).
+    range: [V; 2],
 }
 
 impl<V: Lane> Continuants<V> {
     pub fn new() -> Self {
-        Self { above: V::splat(1.0), above2: V::splat(0.0), out_of_range: V::none() }
+        let range = [V::splat(f64::INFINITY), V::splat(f64::NEG_INFINITY)];
+        Self { above: V::splat(1.0), above2: V::splat(0.0), range }
     }
 
     /// `1/D_i` of row `i` (rows in order from 0) with `A_ii = diagonal`, `A_{i,i−1} = off`.
@@ -272,7 +277,7 @@ impl<V: Lane> Continuants<V> {
             self.above2 = self.above2 * scale;
         }
         let p = diagonal * self.above - (off * off) * self.above2;
-        self.out_of_range = V::or(self.out_of_range, p.continuant_outside());
+        self.range = p.widen(self.range);
         let inverse_pivot = self.above / p;
         (self.above2, self.above) = (self.above, p);
         inverse_pivot
@@ -281,6 +286,6 @@ impl<V: Lane> Continuants<V> {
     /// The lanes whose continuants left their precision's range ([`Lane::continuant_outside`])
     /// at some row so far.
     pub fn outside(&self) -> V::Mask {
-        self.out_of_range
+        V::range_outside(self.range)
     }
 }
