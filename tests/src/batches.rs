@@ -67,6 +67,17 @@ pub fn assert_bits(batch: &[f64], single: &[f64], what: &str) {
     }
 }
 
+/// Time, state and compensation equal bit for bit.
+pub fn assert_same_state(batch: &State<Dyn>, single: &State<Dyn>, what: &str) {
+    assert_eq!(batch.t().to_bits(), single.t().to_bits(), "{what}: t");
+    assert_bits(batch.x().as_slice(), single.x().as_slice(), what);
+    assert_bits(
+        batch.compensation().as_slice(),
+        single.compensation().as_slice(),
+        &format!("{what}: compensation"),
+    );
+}
+
 /// A batch's rows `out` (`m` a chain) and its `failures` against each chain alone
 /// (`single`: its row, or its error): equal bit for bit, and failing exactly where the
 /// chain alone fails, with the same error (as text: errors carry the NaN they found), its

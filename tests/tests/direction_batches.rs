@@ -11,7 +11,7 @@ use pendulum_core::RodMidpoint;
 use pendulum_core::batch::DirectionsBatch;
 use pendulum_core::integrate::{Integrator, Projected, Rk4, State};
 use pendulum_core::{Accounted, Circle, Directions, Error, Harmonic, trajectory};
-use pendulum_tests::batches::{assert_bits, pools, random_chain, whirl, whirl_state};
+use pendulum_tests::batches::{assert_bits, assert_same_state, pools, random_chain, whirl, whirl_state};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -134,9 +134,7 @@ fn rk4_steps_of_a_batch_equal_each_chain_alone_bit_for_bit() {
             assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 20)).expect("batch").is_empty());
             for (k, ((a, b), c)) in states.iter().zip(&single).zip(&run).enumerate() {
                 for s in [a, c] {
-                    assert_eq!(s.t().to_bits(), b.t().to_bits());
-                    assert_bits(s.x().as_slice(), b.x().as_slice(), &format!("chain {k} of {chains}×{n}"));
-                    assert_bits(s.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+                    assert_same_state(s, b, &format!("chain {k} of {chains}×{n}"));
                 }
             }
         }
@@ -195,9 +193,7 @@ fn rk4_steps_from_states_that_carry_a_compensation_equal_each_chain_alone() {
                 assert!(pool.install(|| batch.integrate_rk4(&mut run, h, 3)).expect("batch").is_empty());
                 for (k, ((a, b), c)) in states.iter().zip(&expected).zip(&run).enumerate() {
                     for s in [a, c] {
-                        assert_eq!(s.t().to_bits(), b.t().to_bits());
-                        assert_bits(s.x().as_slice(), b.x().as_slice(), &format!("chain {k}"));
-                        assert_bits(s.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+                        assert_same_state(s, b, &format!("chain {k}"));
                     }
                 }
             }
@@ -541,10 +537,7 @@ macro_rules! midpoint_helpers {
                         .expect("back");
                     for (k, ((a, b), c)) in states.iter().zip(&single).zip(&parts).enumerate() {
                         for (state, whose) in [(a, "batch"), (c, "split")] {
-                            let what = format!("{what}: chain {k}, {whose}");
-                            assert_eq!(state.t().to_bits(), b.t().to_bits(), "{what}: t");
-                            assert_bits(state.x().as_slice(), b.x().as_slice(), &what);
-                            assert_bits(state.compensation().as_slice(), b.compensation().as_slice(), &what);
+                            assert_same_state(state, b, &format!("{what}: chain {k}, {whose}"));
                         }
                     }
                 }
@@ -671,9 +664,7 @@ fn rod_midpoint_runs_of_a_batch_are_each_chains_own_and_a_failure_stays_in_its_c
             let expected = errors[4].as_ref().map(ToString::to_string);
             assert_eq!((failures[0].chain, Some(failures[0].error.to_string())), (4, expected), "{what}");
             for (k, (a, b)) in states.iter().zip(&single).enumerate() {
-                assert_eq!(a.t().to_bits(), b.t().to_bits(), "{what}: chain {k}'s t");
-                assert_bits(a.x().as_slice(), b.x().as_slice(), &format!("{what}: chain {k}"));
-                assert_bits(a.compensation().as_slice(), b.compensation().as_slice(), "compensation");
+                assert_same_state(a, b, &format!("{what}: chain {k}"));
             }
         }
     }
