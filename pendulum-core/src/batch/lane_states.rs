@@ -82,8 +82,9 @@ fn fill_lanes<const W: usize>(
         gather_rows(rows.map(|row| &row[start..end]), end - start, Lanes::flatten_mut(lanes));
         nan += non_finite_sum(lanes);
     }
-    // Projected steps clear the compensation: a run of them arrives with none, most often
-    // (read to be sure, the compensations were a twentieth of a one-step call).
+    // Projected steps clear the compensation: a run of them arrives with none, most often.
+    // The states know it (reading the compensations to be sure was a twentieth of a
+    // one-step call).
     let uncompensated = states.iter().all(|state| state.is_cleared());
     if !uncompensated {
         gather_rows(parts.map(|p| p.3), m, Lanes::flatten_mut(carry));
