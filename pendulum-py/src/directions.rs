@@ -128,7 +128,7 @@ pub fn accelerations_in_place<'py>(
             let batch = batch(u.len())?;
             let failures = maybe_detached(py, u.len(), || batch.accelerations_split(0.0, u, w, out))
                 .map_err(core_error)?;
-            first_failure(failures, u, w, u.len() / width, first_error)
+            first_failure(&failures, u, w, u.len() / width)
         });
     }
     let run = |u: &[f32], w: &[f32], out: &mut [f32]| {
@@ -136,7 +136,7 @@ pub fn accelerations_in_place<'py>(
         let batch = batch(u.len())?;
         let failures = maybe_detached(py, u.len(), || batch.accelerations_split_f32(0.0, u, w, out))
             .map_err(core_error)?;
-        first_failure(failures, u, w, u.len() / width, first_error)
+        first_failure(&failures, u, w, u.len() / width)
     };
     match in_place(py, q, qd, width, run)? {
         Some(out) => Ok(Some(out)),

@@ -115,7 +115,7 @@ pub fn planar_table_f32<'py>(
         let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || batch.accelerations_f32(qs, qds, None, None, out))
             .map_err(core_error)?;
-        first_failure(failures, qs, qds, count, first_error)
+        first_failure(&failures, qs, qds, count)
     })
 }
 
@@ -161,26 +161,25 @@ pub fn planar_in_place<'py, T: numpy::Element + Copy + Into<f64> + Send + Sync +
         let count = qs.len() / chain.links();
         let batch = PlanarBatch::repeated(chain.clone(), count).map_err(core_error)?;
         let failures = maybe_detached(py, qs.len(), || run(&batch, qs, qds, os)).map_err(core_error)?;
-        first_failure(failures, qs, qds, count, first_error)
+        first_failure(&failures, qs, qds, count)
     })
 }
 
 /// The `failures` of a batch of `count` states (rows of `q`, `qd`) as the error, if any: a
 /// non-finite number of `q` or `qd` named as the general path names it
-/// ([`non_finite_input`]), else `otherwise(failures)`'s, naming its state.
+/// ([`non_finite_input`]), else the first failure ([`first_error`]), naming its state.
 pub fn first_failure<T: Copy + Into<f64>>(
-    failures: Vec<Failure>,
+    failures: &[Failure],
     q: &[T],
     qd: &[T],
     count: usize,
-    otherwise: impl FnOnce(&[Failure]) -> StatesResult<()>,
 ) -> PyResult<()> {
     if failures.is_empty() {
         return Ok(());
     }
     match non_finite_input(q, qd) {
         Some(error) => Err(error),
-        None => otherwise(&failures).map_err(|e| e.named(&[count])),
+        None => first_error(failures).map_err(|e| e.named(&[count])),
     }
 }
 

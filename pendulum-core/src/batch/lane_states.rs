@@ -23,10 +23,6 @@ pub(super) struct Arrival<const W: usize> {
     pub uncompensated: bool,
 }
 
-/// The rows of a strip of [`fill_lanes`]: a block's strip of the states (`W` chains of
-/// this many numbers) is still in L1 when it is checked.
-const STRIP: usize = 64;
-
 /// The states `states` (`m` numbers each) into lanes: the times and their compensations
 /// into `t`, the states into `x`, their compensations into `carry`, which is written only
 /// where a state brings one or `carry_zero` is false (it says every entry of `carry` is
@@ -61,9 +57,7 @@ fn into_lanes_avx2<const W: usize>(
     fill_lanes(states, m, t, x, carry)
 }
 
-/// The body of [`into_lanes`], in strips of [`STRIP`] rows: each strip transposed, then
-/// searched for entries that are not finite while in L1 (in a pass over the whole block,
-/// the search was a fortieth of a one-step call).
+/// The body of [`into_lanes`].
 #[inline(always)]
 fn fill_lanes<const W: usize>(
     states: [&State<Dyn>; W],
@@ -74,14 +68,7 @@ fn fill_lanes<const W: usize>(
 ) -> Arrival<W> {
     let parts = states.map(State::parts);
     *t = [Lanes::from_fn(|k| parts[k].0), Lanes::from_fn(|k| parts[k].1)];
-    let rows = parts.map(|p| &p.2[..m]);
-    let mut nan = Lanes([0.0; W]);
-    for start in (0..m).step_by(STRIP) {
-        let end = (start + STRIP).min(m);
-        let lanes = &mut x[start..end];
-        gather_rows(rows.map(|row| &row[start..end]), end - start, Lanes::flatten_mut(lanes));
-        nan += non_finite_sum(lanes);
-    }
+    gather_rows(parts.map(|p| p.2), m, Lanes::flatten_mut(x));
     // Projected steps clear the compensation: a run of them arrives with none, most often.
     // The states know it (reading the compensations to be sure was a twentieth of a
     // one-step call).
@@ -91,7 +78,7 @@ fn fill_lanes<const W: usize>(
     } else if !carry_zero {
         carry[..m].fill(Lanes([0.0; W]));
     }
-    Arrival { suspect: nan.not_finite(), uncompensated }
+    Arrival { suspect: non_finite_lanes(&x[..m]), uncompensated }
 }
 
 /// The block's states (up to `W`, lane `k` for the `k`-th) that `ran` (flag `1`) out
