@@ -43,6 +43,31 @@ pub(crate) fn outside_ends<T: PartialOrd>([lowest, highest]: [T; 2], [low, high]
     !(lowest >= low && highest <= high)
 }
 
+/// [`widened`] lane by lane.
+#[inline(always)]
+pub(crate) fn widened_lanes<T: PartialOrd + Copy, const W: usize>(
+    x: [T; W],
+    [mut lowest, mut highest]: [[T; W]; 2],
+) -> [[T; W]; 2] {
+    for ((lowest, highest), x) in lowest.iter_mut().zip(&mut highest).zip(x) {
+        [*lowest, *highest] = widened(x, [*lowest, *highest]);
+    }
+    [lowest, highest]
+}
+
+/// [`outside_ends`] lane by lane, as flags `1` and `0`.
+#[inline(always)]
+pub(crate) fn outside_lanes<T: PartialOrd + Copy, M: From<bool> + Copy + Default, const W: usize>(
+    [lowest, highest]: [[T; W]; 2],
+    ends: [T; 2],
+) -> [M; W] {
+    let mut out = [M::default(); W];
+    for ((o, lowest), highest) in out.iter_mut().zip(lowest).zip(highest) {
+        *o = M::from(outside_ends([lowest, highest], ends));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

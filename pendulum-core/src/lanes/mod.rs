@@ -19,9 +19,8 @@ mod subnormals;
 
 pub(crate) use aligned::Aligned;
 pub use continuants::CONTINUANT_RANGE;
-pub(crate) use continuants::{
-    CONTINUANT_ENDS, CONTINUANT_ENDS_32, CONTINUANT_RANGE_32, outside_ends, widened,
-};
+pub(crate) use continuants::{CONTINUANT_ENDS, CONTINUANT_ENDS_32, CONTINUANT_RANGE_32};
+use continuants::{outside_ends, outside_lanes, widened, widened_lanes};
 #[cfg(target_arch = "x86_64")]
 pub(crate) use registers::{Avx4, Avx8, AvxF32};
 pub(crate) use subnormals::FlushSubnormals;
@@ -513,19 +512,12 @@ impl<const W: usize> Lane for Lanes32<W> {
         out
     }
     #[inline(always)]
-    fn widen(self, [mut lowest, mut highest]: [Self; 2]) -> [Self; 2] {
-        for ((lowest, highest), x) in lowest.0.iter_mut().zip(&mut highest.0).zip(self.0) {
-            [*lowest, *highest] = widened(x, [*lowest, *highest]);
-        }
-        [lowest, highest]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        widened_lanes(self.0, [lowest.0, highest.0]).map(Self)
     }
     #[inline(always)]
     fn range_outside([lowest, highest]: [Self; 2]) -> [u32; W] {
-        let mut out = [0; W];
-        for ((o, lowest), highest) in out.iter_mut().zip(lowest.0).zip(highest.0) {
-            *o = outside_ends([lowest, highest], CONTINUANT_ENDS_32) as u32;
-        }
-        out
+        outside_lanes([lowest.0, highest.0], CONTINUANT_ENDS_32)
     }
 }
 
@@ -580,19 +572,12 @@ impl<const W: usize> Lane for Lanes<W> {
         self.map(f64::normalizer)
     }
     #[inline(always)]
-    fn widen(self, [mut lowest, mut highest]: [Self; 2]) -> [Self; 2] {
-        for ((lowest, highest), x) in lowest.0.iter_mut().zip(&mut highest.0).zip(self.0) {
-            [*lowest, *highest] = x.widen([*lowest, *highest]);
-        }
-        [lowest, highest]
+    fn widen(self, [lowest, highest]: [Self; 2]) -> [Self; 2] {
+        widened_lanes(self.0, [lowest.0, highest.0]).map(Self)
     }
     #[inline(always)]
     fn range_outside([lowest, highest]: [Self; 2]) -> [u64; W] {
-        let mut out = [0; W];
-        for ((o, lowest), highest) in out.iter_mut().zip(lowest.0).zip(highest.0) {
-            *o = f64::range_outside([lowest, highest]) as u64;
-        }
-        out
+        outside_lanes([lowest.0, highest.0], CONTINUANT_ENDS)
     }
 }
 
