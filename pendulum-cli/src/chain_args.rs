@@ -19,8 +19,7 @@ pub fn chain_of(options: &ChainOptions) -> CliResult<Chain<Dyn>> {
 pub fn per_link_values(options: &ChainOptions) -> CliResult<(Vec<f64>, Vec<f64>)> {
     let masses = per_link("--masses", &options.masses)?;
     let lengths = per_link("--lengths", &options.lengths)?;
-    let (_, masses, lengths) =
-        pendulum_experiment::options::links(options.n, ("--masses", masses), ("--lengths", lengths))?;
+    let (_, masses, lengths) = pendulum_experiment::options::links(options.n, masses, lengths)?;
     Ok((masses, lengths))
 }
 

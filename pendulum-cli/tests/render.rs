@@ -307,12 +307,12 @@ fn bad_inputs_get_one_line_and_exit_status_2() {
     usage(
         &dir,
         &["render", "empty"],
-        "error: empty holds no run: no run.json (`pendulum simulate --out DIR` writes one)",
+        "error: empty holds no run: no run.json (a run given --out DIR writes one)",
     );
     usage(
         &dir,
         &["render", "nowhere"],
-        "error: nowhere is not a run directory (what `pendulum simulate --out DIR` writes)",
+        "error: nowhere is not a run directory (what a run given --out DIR writes)",
     );
     copy("half", None);
     usage(&dir, &["render", "half"], "error: half holds no run: no trajectory.csv beside its run.json");

@@ -73,7 +73,7 @@ fn bad_inputs_are_one_line_errors() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(
         stderr(&out).trim(),
-        "error: nowhere is not a run directory (what `pendulum simulate --out DIR` writes)"
+        "error: nowhere is not a run directory (what a run given --out DIR writes)"
     );
     // A trajectory cut in the middle of a line.
     let (run_dir, _) = exported("view-truncated");

@@ -19,6 +19,7 @@ use pendulum_core::{
 use crate::description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, check_components,
 };
+use crate::description::{circle_in_2d, midpoint_in_2d};
 use crate::error::{Error, Result};
 
 /// One sample of a run, in plain numbers.
@@ -97,9 +98,7 @@ fn plain_integrator<'a, S: System<Dim = Dyn> + 'a>(
         (IntegratorKind::Rk4, _) => Box::new(Rk4::new(system)),
         (IntegratorKind::Dp54, _) => Box::new(DormandPrince::new(system, method.tolerance, Unprojected)?),
         (IntegratorKind::Midpoint, _) => {
-            return Err(Error::invalid(
-                "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
-            ));
+            return Err(midpoint_in_2d());
         }
     })
 }
@@ -309,7 +308,7 @@ where
 
 impl RunSpace for U2 {
     fn circle(_: &DriveConfig) -> Result<Box<dyn Drive<U2>>> {
-        Err(Error::invalid("--drive circle moves the pivot on a horizontal circle: 3D only"))
+        Err(circle_in_2d())
     }
 }
 

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::spelling::{opt, opt_is};
 
 /// Space dimension of the chain.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -251,7 +252,10 @@ impl RunConfig {
         };
         let directions = self.initial.directions.as_ref();
         if directions.is_some() && self.dim == Dimension::Two {
-            return Err(Error::invalid("initial state: a state in unit directions is for 3D runs (--dim 3)"));
+            return Err(Error::invalid(format!(
+                "initial state: a state in unit directions is for 3D runs ({})",
+                opt_is("dim", 3)
+            )));
         }
         let angles = if directions.is_some() { 0 } else { dof };
         let counts = [
@@ -281,45 +285,48 @@ impl RunConfig {
             return Err(Error::invalid(format!("initial state: {v} is not finite")));
         }
         if let Some(v) = self.torque.iter().find(|v| !v.is_finite()) {
-            return Err(Error::invalid(format!("--torque: {v} is not finite")));
+            return Err(Error::invalid(format!("{}: {v} is not finite", opt("torque"))));
         }
         check_step(self.step)?;
         if let Some(t) = self.tolerance
             && !(1e-14..=1e-1).contains(&t)
         {
-            return Err(Error::invalid(format!("--tolerance must be within 1e-14 … 0.1, got {t}")));
+            return Err(Error::invalid(format!("{} must be within 1e-14 … 0.1, got {t}", opt("tolerance"))));
         }
-        if !(self.end.is_finite() && self.end > 0.0) {
-            return Err(Error::invalid(format!("--end must be finite and positive, got {}", self.end)));
-        }
+        check_end(self.end)?;
         let steps = (self.end / self.step).ceil();
         if steps > 1e8 {
             let origin = if self.chosen.as_deref().is_some_and(|c| c.contains("step ")) {
-                " (chosen for the chain's fastest mode; name one with --step)"
+                format!(" (chosen for the chain's fastest mode; name one with {})", opt("step"))
             } else {
-                ""
+                String::new()
             };
             return Err(Error::invalid(format!(
-                "--end {} with --step {:e}{origin} needs {steps:e} steps; more than 1e8 is refused",
-                self.end, self.step
+                "{} with {}{origin} needs {steps:e} steps; more than 1e8 is refused",
+                opt_is("end", self.end),
+                opt_is("step", format_args!("{:e}", self.step))
             )));
         }
         if self.every == 0 {
-            return Err(Error::invalid("--every must be at least 1 step, got 0"));
+            return Err(Error::invalid(format!("{} must be at least 1 step, got 0", opt("every"))));
         }
         if self.view == View::CoRotating && !View::turns_with(self.dim, &self.drive) {
-            return Err(Error::invalid(
-                "--view co-rotating needs a 3D chain whose pivot circles (--dim 3 --drive circle)",
-            ));
+            return Err(Error::invalid(format!(
+                "{} needs a 3D chain whose pivot circles ({} {})",
+                opt_is("view", "co-rotating"),
+                opt_is("dim", 3),
+                opt_is("drive", "circle")
+            )));
         }
         if self.frames < 2 {
-            return Err(Error::invalid(format!("--frames must be at least 2, got {}", self.frames)));
+            return Err(Error::invalid(format!("{} must be at least 2, got {}", opt("frames"), self.frames)));
         }
         if let DriveConfig::Harmonic { direction, .. } = &self.drive {
             let space = if self.dim == Dimension::Two { 2 } else { 3 };
             if direction.len() != space {
                 return Err(Error::invalid(format!(
-                    "--direction: got {} components, the {space}D pivot moves in {space}",
+                    "{}: got {} components, the {space}D pivot moves in {space}",
+                    opt("direction"),
                     direction.len()
                 )));
             }
@@ -328,14 +335,10 @@ impl RunConfig {
             check_components(positions, self.dim.space())?;
         }
         if self.integrator == IntegratorKind::Midpoint && self.dim == Dimension::Two {
-            return Err(Error::invalid(
-                "--integrator midpoint steps chains in unit directions: 3D only (--dim 3)",
-            ));
+            return Err(midpoint_in_2d());
         }
         if matches!(self.drive, DriveConfig::Circle { .. }) && self.dim == Dimension::Two {
-            return Err(Error::invalid(
-                "--drive circle moves the pivot on a horizontal circle: 3D only (--dim 3)",
-            ));
+            return Err(circle_in_2d());
         }
         Ok(())
     }
@@ -355,11 +358,38 @@ pub(crate) fn check_components(positions: &[Vec<f64>], space: usize) -> Result<(
 /// The dp54 integrator's tolerance when none is given.
 pub const DEFAULT_TOLERANCE: f64 = 1e-8;
 
+/// The rod midpoint asked of a planar run.
+pub(crate) fn midpoint_in_2d() -> Error {
+    Error::invalid(format!(
+        "{} steps chains in unit directions: 3D only ({})",
+        opt_is("integrator", "midpoint"),
+        opt_is("dim", 3)
+    ))
+}
+
+/// The circle drive asked of a planar run.
+pub(crate) fn circle_in_2d() -> Error {
+    Error::invalid(format!(
+        "{} moves the pivot on a horizontal circle: 3D only ({})",
+        opt_is("drive", "circle"),
+        opt_is("dim", 3)
+    ))
+}
+
+/// Errors unless the run's end time (s) is finite and positive.
+pub(crate) fn check_end(end: f64) -> Result<()> {
+    if end.is_finite() && end > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!("{} must be finite and positive, got {end}", opt("end"))))
+    }
+}
+
 /// Errors unless the step is finite and positive.
 pub(crate) fn check_step(h: f64) -> Result<()> {
     if h.is_finite() && h > 0.0 {
         Ok(())
     } else {
-        Err(Error::invalid(format!("--step must be finite and positive, got {h}")))
+        Err(Error::invalid(format!("{} must be finite and positive, got {h}", opt("step"))))
     }
 }

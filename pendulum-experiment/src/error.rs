@@ -4,6 +4,8 @@
 
 use std::fmt;
 
+use crate::spelling::Front;
+
 /// A run's error: one line naming the bad value or the failure.
 ///
 /// `Invalid`: a bad parameter, value or input file; nothing was computed.
@@ -50,11 +52,19 @@ impl Error {
     }
 }
 
-impl fmt::Display for Error {
-    /// The message on one line (newlines in wrapped errors become "; ").
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Error {
+    /// The message on one line (newlines in wrapped errors become "; "), with the options
+    /// it names spelled for `front` (the `Display` of an error is the command line's).
+    pub fn message(&self, front: Front) -> String {
         let (Self::Invalid(m) | Self::Failed(m) | Self::Interrupted(m)) = self;
-        f.write_str(&m.trim().replace('\n', "; "))
+        front.spell(&m.trim().replace('\n', "; "))
+    }
+}
+
+impl fmt::Display for Error {
+    /// [`Error::message`] on the command line.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message(Front::CommandLine))
     }
 }
 

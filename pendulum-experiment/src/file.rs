@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::description::RunConfig;
 use crate::error::{Error, Result};
 use crate::json::write_json_atomic;
+use crate::spelling::opt;
 
 /// The version of the program that writes run.json and final.json (the workspace's crates
 /// share it).
@@ -97,18 +98,19 @@ impl RunFile {
     /// Reads and checks a run.json; errors name the file and the problem.
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
+            .map_err(|e| Error::invalid(format!("{}: cannot read {}: {e}", opt("from"), path.display())))?;
         let file: Self = serde_json::from_str(&text).map_err(|e| {
-            Error::invalid(format!("--from: {} is not a valid run.json: {e}", path.display()))
+            Error::invalid(format!("{}: {} is not a valid run.json: {e}", opt("from"), path.display()))
         })?;
         if file.program != "pendulum" {
             return Err(Error::invalid(format!(
-                "--from: {} was written by '{}', not pendulum",
+                "{}: {} was written by '{}', not pendulum",
+                opt("from"),
                 path.display(),
                 file.program
             )));
         }
-        file.config.check().map_err(|e| Error::invalid(format!("--from: {}: {e}", path.display())))?;
+        file.config.check().map_err(|e| e.context(format_args!("{}: {}", opt("from"), path.display())))?;
         Ok(file)
     }
 

@@ -11,6 +11,7 @@ use crate::description::Dimension;
 use crate::error::{Error, Result};
 use crate::file::VERSION;
 use crate::json::write_json_atomic;
+use crate::spelling::opt;
 
 /// The file name a run writes its final state to.
 pub const FILE_NAME: &str = "final.json";
@@ -83,7 +84,7 @@ impl FinalState {
     /// for a run of `links` links in `dim`; errors name the file and what does not fit.
     pub fn read_for(path: &Path, dim: Dimension, links: usize) -> Result<Self> {
         let file: PathBuf = if path.is_dir() { path.join(FILE_NAME) } else { path.to_path_buf() };
-        let fail = |m: String| Error::invalid(format!("--initial {}: {m}", file.display()));
+        let fail = |m: String| Error::invalid(format!("{} {}: {m}", opt("initial"), file.display()));
         let text = std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read it: {e}")))?;
         let state: Self =
             serde_json::from_str(&text).map_err(|e| fail(format!("not a pendulum final state: {e}")))?;

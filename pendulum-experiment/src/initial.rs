@@ -7,6 +7,7 @@ use std::path::Path;
 use crate::description::{Dimension, InitialConfig};
 use crate::error::{Error, Result};
 use crate::final_state::FinalState;
+use crate::spelling::opt;
 
 /// How the chain starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,7 +103,7 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
             });
         }
         InitialSpec::File(path) => {
-            let values = read_numbers("--initial", path)?;
+            let values = read_numbers(&opt("initial"), path)?;
             if values.len() != 2 * dof {
                 let layout = if dim == Dimension::Two {
                     "θ_1..θ_n then θ̇_1..θ̇_n"
@@ -110,7 +111,8 @@ pub fn initial_state(spec: &InitialSpec, dim: Dimension, n: usize, spin: f64) ->
                     "θ_1..θ_n, φ_1..φ_n, θ̇_1..θ̇_n, φ̇_1..φ̇_n"
                 };
                 return Err(Error::invalid(format!(
-                    "--initial: {} holds {} numbers, expected {} ({layout}) for n = {n}",
+                    "{}: {} holds {} numbers, expected {} ({layout}) for n = {n}",
+                    opt("initial"),
                     path.display(),
                     values.len(),
                     2 * dof

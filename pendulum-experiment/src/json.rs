@@ -8,6 +8,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use crate::error::{Error, Result, io_failed};
+use crate::spelling::opt;
 
 /// Writes `value` as pretty JSON atomically: to `NAME.json.tmp` beside `path`, flushed and
 /// synced, then renamed over `path`, so a reader sees the old or the new file, never half.
@@ -29,11 +30,12 @@ pub fn write_json_atomic<T: Serialize + ?Sized>(path: &Path, value: &T) -> Resul
 /// misses.
 pub fn read_command_file<T: DeserializeOwned>(path: &Path, command: &str) -> Result<T> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::invalid(format!("--from: cannot read {}: {e}", path.display())))?;
+        .map_err(|e| Error::invalid(format!("{}: cannot read {}: {e}", opt("from"), path.display())))?;
     let article = if command.starts_with(['a', 'e', 'i', 'o', 'u']) { "an" } else { "a" };
     let not_it = |why: String| {
         Error::invalid(format!(
-            "--from: {} is not {article} {command}.json of pendulum {command}: {why}",
+            "{}: {} is not {article} {command}.json of pendulum {command}: {why}",
+            opt("from"),
             path.display()
         ))
     };

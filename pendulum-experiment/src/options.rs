@@ -12,31 +12,18 @@ use crate::assemble::sampled_path;
 use crate::description::{Dimension, DriveConfig};
 use crate::error::{Error, Result};
 use crate::initial::read_numbers;
+use crate::spelling::{opt, opt_is};
 
 /// The links of a chain from its per-link lists: `n` if given, else the length of a list of
 /// more than one value, else 3 links; a single value is repeated for every link.
-/// Returns `(n, masses, lengths)`; errors name `what` of each (`"--masses"`, `"masses"`).
-pub fn links(
-    n: Option<usize>,
-    masses: (&str, Vec<f64>),
-    lengths: (&str, Vec<f64>),
-) -> Result<(usize, Vec<f64>, Vec<f64>)> {
+/// Returns `(n, masses, lengths)`; errors name the options `n`, `masses` and `lengths`.
+pub fn links(n: Option<usize>, masses: Vec<f64>, lengths: Vec<f64>) -> Result<(usize, Vec<f64>, Vec<f64>)> {
     let n = match n {
-        Some(0) => {
-            return Err(Error::invalid(format!(
-                "{}: a chain needs at least 1 link, got 0",
-                n_flag(masses.0)
-            )));
-        }
+        Some(0) => return Err(Error::invalid(format!("{}: a chain needs at least 1 link, got 0", opt("n")))),
         Some(n) => n,
-        None => [masses.1.len(), lengths.1.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
+        None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
     };
-    Ok((n, expand(masses.0, masses.1, n)?, expand(lengths.0, lengths.1, n)?))
-}
-
-/// `--n` beside `--masses`, `n` beside `masses`.
-fn n_flag(masses: &str) -> &'static str {
-    if masses.starts_with("--") { "--n" } else { "n" }
+    Ok((n, expand(&opt("masses"), masses, n)?, expand(&opt("lengths"), lengths, n)?))
 }
 
 /// A per-link list of `n` entries: one value is repeated, otherwise the list must have
@@ -136,16 +123,34 @@ impl DriveOptions {
             },
         };
         if (self.ramp_time.is_some() || self.ramp_from.is_some()) && self.kind != DriveKind::Circle {
-            return Err(Error::invalid("--ramp-time and --ramp-from apply to --drive circle only"));
+            return Err(Error::invalid(format!(
+                "{} and {} apply to {} only",
+                opt("ramp-time"),
+                opt("ramp-from"),
+                opt_is("drive", "circle")
+            )));
         }
         if self.ramp_from.is_some() && self.ramp_time.is_none() {
-            return Err(Error::invalid("--ramp-from needs --ramp-time (the ramp's duration, s)"));
+            return Err(Error::invalid(format!(
+                "{} needs {} (the ramp's duration, s)",
+                opt("ramp-from"),
+                opt("ramp-time")
+            )));
         }
         if self.direction.is_some() && self.kind != DriveKind::Harmonic {
-            return Err(Error::invalid("--direction applies to --drive harmonic only"));
+            return Err(Error::invalid(format!(
+                "{} applies to {} only",
+                opt("direction"),
+                opt_is("drive", "harmonic")
+            )));
         }
         if (self.path.is_some() || self.path_at_rest) && self.kind != DriveKind::Sampled {
-            return Err(Error::invalid("--path and --path-at-rest apply to --drive sampled only"));
+            return Err(Error::invalid(format!(
+                "{} and {} apply to {} only",
+                opt("path"),
+                opt("path-at-rest"),
+                opt_is("drive", "sampled")
+            )));
         }
         Ok(drive)
     }
@@ -154,14 +159,21 @@ impl DriveOptions {
     /// position's `dim` components each) and its spline checked.
     fn sampled(&self, dim: Dimension) -> Result<DriveConfig> {
         let (label, numbers) = match &self.path {
-            None => return Err(Error::invalid("--drive sampled needs --path FILE (rows of t, x, y[, z])")),
-            Some(PathSamples::File(path)) => (path.display().to_string(), read_numbers("--path", path)?),
+            None => {
+                return Err(Error::invalid(format!(
+                    "{} needs {} (rows of t, x, y[, z])",
+                    opt_is("drive", "sampled"),
+                    opt("path")
+                )));
+            }
+            Some(PathSamples::File(path)) => (path.display().to_string(), read_numbers(&opt("path"), path)?),
             Some(PathSamples::Rows { label, numbers }) => (label.clone(), numbers.clone()),
         };
         let width = 1 + dim.space();
         if numbers.len() % width != 0 || numbers.is_empty() {
             return Err(Error::invalid(format!(
-                "--path: {label} holds {} numbers, not rows of {width} (t and {} components of the position)",
+                "{}: {label} holds {} numbers, not rows of {width} (t and {} components of the position)",
+                opt("path"),
                 numbers.len(),
                 dim.space()
             )));
@@ -174,7 +186,7 @@ impl DriveOptions {
             Dimension::Two => sampled_path::<U2>(&times, &positions, at_rest).map(|_| ()),
             Dimension::Three => sampled_path::<U3>(&times, &positions, at_rest).map(|_| ()),
         };
-        checked.map_err(|e| Error::invalid(format!("--path {label}: {e}")))?;
+        checked.map_err(|e| Error::invalid(format!("{} {label}: {e}", opt("path"))))?;
         Ok(DriveConfig::Sampled { file: label, times, positions, at_rest })
     }
 }
@@ -255,7 +267,8 @@ pub fn check_radius(radius: f64) -> Result<()> {
         Ok(())
     } else {
         Err(Error::invalid(format!(
-            "--radius must be finite and positive (the pivot's circle drives the chain), got {radius}"
+            "{} must be finite and positive (the pivot's circle drives the chain), got {radius}",
+            opt("radius")
         )))
     }
 }
@@ -264,17 +277,17 @@ pub fn check_radius(radius: f64) -> Result<()> {
 mod tests {
     use super::*;
     use crate::description::IntegratorKind;
+    use crate::spelling::Front;
 
     #[test]
     fn lists_expand_to_the_links_and_errors_name_the_option() {
-        assert_eq!(links(None, ("m", vec![1.0]), ("l", vec![0.5])).unwrap(), (3, vec![1.0; 3], vec![0.5; 3]));
-        assert_eq!(links(None, ("m", vec![1.0, 2.0]), ("l", vec![0.5])).unwrap().2, vec![0.5; 2]);
-        let e = links(Some(3), ("--masses", vec![1.0, 2.0]), ("--lengths", vec![0.5])).unwrap_err();
+        assert_eq!(links(None, vec![1.0], vec![0.5]).unwrap(), (3, vec![1.0; 3], vec![0.5; 3]));
+        assert_eq!(links(None, vec![1.0, 2.0], vec![0.5]).unwrap().2, vec![0.5; 2]);
+        let e = links(Some(3), vec![1.0, 2.0], vec![0.5]).unwrap_err();
         assert_eq!(e.to_string(), "--masses: got 2 values for 3 links (give 1 or 3)");
-        assert_eq!(
-            links(Some(0), ("masses", vec![1.0]), ("lengths", vec![1.0])).unwrap_err().to_string(),
-            "n: a chain needs at least 1 link, got 0"
-        );
+        assert_eq!(e.message(Front::Python), "masses: got 2 values for 3 links (give 1 or 3)");
+        let e = links(Some(0), vec![1.0], vec![1.0]).unwrap_err();
+        assert_eq!(e.message(Front::Python), "n: a chain needs at least 1 link, got 0");
     }
 
     #[test]
@@ -354,7 +367,7 @@ mod tests {
             "{e}"
         );
         let e = message(DriveOptions { path: None, ..base.clone() }, Dimension::Two);
-        assert_eq!(e, "--drive sampled needs --path FILE (rows of t, x, y[, z])");
+        assert_eq!(e, "--drive sampled needs --path (rows of t, x, y[, z])");
         let e = message(DriveOptions { kind: DriveKind::Harmonic, ..base }, Dimension::Two);
         assert_eq!(e, "--path and --path-at-rest apply to --drive sampled only");
         // A run.json's path whose positions do not fit the chain's space.

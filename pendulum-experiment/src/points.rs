@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::balance::RunBalance;
 use crate::error::{Error, Result};
 use crate::json::{read_command_file, write_json_atomic};
+use crate::spelling::opt;
 
 /// Where a point stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -245,12 +246,13 @@ impl<
     /// Reads and checks the file given to `--from`; errors name the file and the problem.
     pub fn read(path: &Path) -> Result<Self> {
         let file: Self = read_command_file(path, C::COMMAND)?;
-        file.config.check().map_err(|e| e.context(format_args!("--from {}", path.display())))?;
+        file.config.check().map_err(|e| e.context(format_args!("{} {}", opt("from"), path.display())))?;
         if let Some(expected) = file.config.points()
             && expected != file.points.len()
         {
             return Err(Error::invalid(format!(
-                "--from: {}: {} points recorded, its configuration has {expected}",
+                "{}: {}: {} points recorded, its configuration has {expected}",
+                opt("from"),
                 path.display(),
                 file.points.len()
             )));

@@ -9,10 +9,12 @@ use pendulum_core::{Chain, Drive, fastest_frequency_bound};
 
 use crate::assemble::sampled_path;
 use crate::description::{
-    DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, View, check_step,
+    DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, View, check_end,
+    check_step,
 };
 use crate::error::{Error, Result};
 use crate::initial::{InitialSpec, initial_state};
+use crate::spelling::{opt, opt_is};
 
 /// Everything a run needs except what the library may choose: give `integrator`, `step`
 /// and `every` to fix them, leave them `None` to have them chosen from the chain and the
@@ -62,23 +64,29 @@ impl Request {
     pub fn resolve(mut self) -> Result<RunConfig> {
         let n = self.masses.len();
         if self.spin.is_some() && self.dim == Dimension::Two {
-            return Err(Error::invalid("--spin (initial azimuthal rate) applies to --dim 3 only"));
+            return Err(Error::invalid(format!(
+                "{} (initial azimuthal rate) applies to {} only",
+                opt("spin"),
+                opt_is("dim", 3)
+            )));
         }
         let torque = match (self.torque.take(), self.dim) {
             (None, Dimension::Two) => vec![0.0; n],
             (None, Dimension::Three) => Vec::new(),
             (Some(t), Dimension::Two) => t,
             (Some(_), Dimension::Three) => {
-                return Err(Error::invalid("--torque: constant torques are available in 2D only (--dim 2)"));
+                return Err(Error::invalid(format!(
+                    "{}: constant torques are available in 2D only ({})",
+                    opt("torque"),
+                    opt_is("dim", 2)
+                )));
             }
         };
         let initial = initial_state(&self.initial, self.dim, n, self.spin.unwrap_or(0.0))?;
         if let Some(h) = self.step {
             check_step(h)?;
         }
-        if !(self.end.is_finite() && self.end > 0.0) {
-            return Err(Error::invalid(format!("--end must be finite and positive, got {}", self.end)));
-        }
+        check_end(self.end)?;
         let choice = choose(&self)?;
         let config = RunConfig {
             dim: self.dim,
@@ -94,7 +102,13 @@ impl Request {
             tolerance: match (choice.integrator, self.tolerance) {
                 (IntegratorKind::Dp54, t) => Some(t.unwrap_or(DEFAULT_TOLERANCE)),
                 (_, None) => None,
-                (_, Some(_)) => return Err(Error::invalid("--tolerance applies to --integrator dp54 only")),
+                (_, Some(_)) => {
+                    return Err(Error::invalid(format!(
+                        "{} applies to {} only",
+                        opt("tolerance"),
+                        opt_is("integrator", "dp54")
+                    )));
+                }
             },
             end: self.end,
             every: choice.every,
@@ -104,6 +118,9 @@ impl Request {
             chosen: choice.reason,
         };
         config.check()?;
+        // The chain's own checks (masses and lengths positive, gravity finite and ≥ 0,
+        // damping ≥ 0), now rather than when the run starts: `choose` passes over them.
+        Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?;
         Ok(config)
     }
 }
@@ -252,10 +269,11 @@ fn default_every(config: &Request, step: f64) -> Result<(usize, String)> {
         return Err(Error::invalid(format!(
             "a chain of {} links: one sample of trajectory.csv takes about {:.0} MB, and the default \
              sampling keeps the file under {:.0} MB, too little for the first and the last state: give \
-             --every {steps} to write those two (about {:.0} MB)",
+             {} to write those two (about {:.0} MB)",
             config.masses.len(),
             mb(row),
             mb(TRAJECTORY_BUDGET),
+            opt_is("every", steps),
             mb(2.0 * row),
         )));
     }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::description::{Dimension, RunConfig};
 use crate::error::{Error, Result};
 use crate::file::RunFile;
+use crate::spelling::opt_is;
 
 /// A run directory as `pendulum simulate` leaves it.
 pub struct Run {
@@ -24,13 +25,15 @@ impl Run {
         let shown = dir.display();
         if !dir.is_dir() {
             return Err(Error::invalid(format!(
-                "{shown} is not a run directory (what `pendulum simulate --out DIR` writes)"
+                "{shown} is not a run directory (what a run given {} writes)",
+                opt_is("out", "DIR")
             )));
         }
         let json = dir.join("run.json");
         if !json.is_file() {
             return Err(Error::invalid(format!(
-                "{shown} holds no run: no run.json (`pendulum simulate --out DIR` writes one)"
+                "{shown} holds no run: no run.json (a run given {} writes one)",
+                opt_is("out", "DIR")
             )));
         }
         let text = std::fs::read_to_string(&json)

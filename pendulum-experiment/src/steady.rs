@@ -14,6 +14,7 @@ use pendulum_core::{
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::spelling::{opt, opt_is};
 
 /// Margin of the default `ω_max` over the third critical speed (below the fourth for
 /// uniform chains: ω_4/ω_3 = 1.37 at n = 12, 1.36 in the continuum).
@@ -39,28 +40,14 @@ pub fn default_omega_max(free: &SteadyRotation, listed: &[f64]) -> Result<f64> {
     Ok(listed.iter().fold(default, |a, &b| a.max(b)))
 }
 
-/// How a front end names the options of a steady request, for its one-line messages
-/// (`"--omega-max"` on the command line, `"omega_max"` in Python).
-#[derive(Debug, Clone, Copy)]
-pub struct Names {
-    /// The listed speeds.
-    pub omega: &'static str,
-    /// The largest speed of the branches.
-    pub omega_max: &'static str,
-    /// The number of branches from the vertical.
-    pub branches: &'static str,
-    /// A fixed pivot, as the front end writes it (`"--radius 0"`).
-    pub fixed_pivot: &'static str,
-}
-
 /// Checks a given `ω_max` (rad/s): finite and positive.
 ///
 /// Errors: [`Error::Invalid`] naming it.
-pub fn check_omega_max(omega_max: f64, names: &Names) -> Result<()> {
+pub fn check_omega_max(omega_max: f64) -> Result<()> {
     if omega_max.is_finite() && omega_max > 0.0 {
         Ok(())
     } else {
-        Err(Error::invalid(format!("{} must be finite and positive, got {omega_max}", names.omega_max)))
+        Err(Error::invalid(format!("{} must be finite and positive, got {omega_max}", opt("omega-max"))))
     }
 }
 
@@ -77,27 +64,31 @@ pub fn requested_omega_max(
     listed: Option<&[f64]>,
     omega_max: Option<f64>,
     branches: Option<usize>,
-    names: &Names,
 ) -> Result<f64> {
     let n = free.links();
     if radius != 0.0 && branches.is_some() {
         return Err(Error::invalid(format!(
             "{} applies to a fixed pivot ({}) only",
-            names.branches, names.fixed_pivot
+            opt("branches"),
+            opt_is("radius", 0)
         )));
     }
     if let Some(count) = branches
         && (count == 0 || count > n)
     {
-        return Err(Error::invalid(format!("{} must be between 1 and n = {n}, got {count}", names.branches)));
+        return Err(Error::invalid(format!(
+            "{} must be between 1 and n = {n}, got {count}",
+            opt("branches")
+        )));
     }
     match omega_max {
         Some(w) => {
-            check_omega_max(w, names)?;
+            check_omega_max(w)?;
             if let Some(&above) = listed.into_iter().flatten().find(|&&v| v > w) {
                 return Err(Error::invalid(format!(
                     "{}: {above} rad/s is above {} = {w} rad/s (the branches end there)",
-                    names.omega, names.omega_max
+                    opt("omega"),
+                    opt("omega-max")
                 )));
             }
             Ok(w)

@@ -317,7 +317,7 @@ impl Chain {
         // One number each: one link (a pendulum), unlike a run's default of 3.
         let (m, l) = (per_link("masses", masses)?, per_link("lengths", lengths)?);
         let n = m.len().max(l.len());
-        let (n, m, l) = links(Some(n), ("masses", m), ("lengths", l)).map_err(run_error)?;
+        let (n, m, l) = links(Some(n), m, l).map_err(run_error)?;
         let chain = pendulum_core::Chain::<Dyn>::new(&m, &l, gravity).map_err(core_error)?;
         let chain = match damping.filter(|d| !d.is_none()) {
             Some(d) => {

@@ -1,13 +1,13 @@
 //! The library's errors as Python exceptions: a bad value `ValueError`, a failed
 //! computation `RuntimeError`, a run stopped by Ctrl-C `KeyboardInterrupt`, each with the
-//! CLI's one-line message.
+//! CLI's one-line message, the options it names spelled as keyword arguments.
 
 use pyo3::PyErr;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 
 /// [`pendulum_experiment::Error`] as a Python exception.
 pub fn run_error(e: pendulum_experiment::Error) -> PyErr {
-    let message = e.to_string();
+    let message = e.message(pendulum_experiment::Front::Python);
     match e {
         pendulum_experiment::Error::Invalid(_) => PyValueError::new_err(message),
         pendulum_experiment::Error::Failed(_) => PyRuntimeError::new_err(message),

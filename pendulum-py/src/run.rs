@@ -132,12 +132,9 @@ impl Run {
                 None => Ok(vec![default]),
             }
         };
-        let (n, masses, lengths) = options::links(
-            n,
-            ("masses", listed("masses", masses, 1.0)?),
-            ("lengths", listed("lengths", lengths, 0.5)?),
-        )
-        .map_err(run_error)?;
+        let (n, masses, lengths) =
+            options::links(n, listed("masses", masses, 1.0)?, listed("lengths", lengths, 0.5)?)
+                .map_err(run_error)?;
         let damping = options::expand("damping", listed("damping", damping, 0.0)?, n).map_err(run_error)?;
         let torque = match torque.filter(|t| !t.is_none()) {
             Some(t) => Some(options::expand("torque", per_link("torque", t)?, n).map_err(run_error)?),

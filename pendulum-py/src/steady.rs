@@ -8,7 +8,7 @@ use std::sync::atomic::Ordering;
 use numpy::PyArray1;
 use pendulum_core::{SteadyRotation, SteadyShape};
 use pendulum_experiment::options::expand;
-use pendulum_experiment::steady::{Family, Judged, Names, follow, requested_omega_max, shapes_at};
+use pendulum_experiment::steady::{Family, Judged, follow, requested_omega_max, shapes_at};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -16,10 +16,6 @@ use crate::arrays::{array, per_link};
 use crate::chain::Chain;
 use crate::errors::{core_error, invalid, run_error};
 use crate::interrupt::interruptible;
-
-/// Python's names for the options of a steady request.
-const NAMES: Names =
-    Names { omega: "omega", omega_max: "omega_max", branches: "branches", fixed_pivot: "radius = 0" };
 
 /// The steady shapes of ``chain`` turning at ω about the vertical through its pivot, the
 /// pivot fixed (``radius = 0``) or driven round a horizontal circle of ``radius`` (m).
@@ -82,8 +78,8 @@ pub fn steady<'py>(
     let problem = SteadyRotation::new(&chain.inner, radius).map_err(core_error)?;
     let base = chain.inner.clone();
     let free = SteadyRotation::new(&chain.inner, 0.0).map_err(core_error)?;
-    let omega_max = requested_omega_max(&free, radius, listed.as_deref(), omega_max, branches, &NAMES)
-        .map_err(run_error)?;
+    let omega_max =
+        requested_omega_max(&free, radius, listed.as_deref(), omega_max, branches).map_err(run_error)?;
     let speeds = listed.unwrap_or_else(|| vec![omega_max]);
     // Ctrl-C returns at once: the worker stops judging at its next point and its result
     // is dropped.

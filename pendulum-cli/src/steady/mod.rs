@@ -43,7 +43,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     };
     let free = SteadyRotation::new(&chain, 0.0)?;
     let omega_max =
-        requested_omega_max(&free, args.radius, listed.as_deref(), args.omega_max, args.branches, &NAMES)?;
+        requested_omega_max(&free, args.radius, listed.as_deref(), args.omega_max, args.branches)?;
     let (family, cut) = branches::follow(&problem, &free, omega_max, args.branches)?;
     if let Some((judged, total)) = cut {
         create_out(args)?;
@@ -116,14 +116,6 @@ pub(crate) fn parse_speeds(list: &str) -> CliResult<Vec<f64>> {
         .collect()
 }
 
-/// The command's names for the options of a steady request.
-pub(crate) const NAMES: Names =
-    Names { omega: "--omega", omega_max: "--omega-max", branches: "--branches", fixed_pivot: "--radius 0" };
-
-pub(crate) fn check_omega_max(omega_max: f64) -> CliResult<()> {
-    pendulum_experiment::steady::check_omega_max(omega_max, &NAMES)
-}
-
 /// A rate (1/s) to three significant digits, in exponent form below 1e-3 and from 1e4 on.
 fn rate(g: f64) -> String {
     let magnitude = g.abs();
@@ -136,7 +128,7 @@ fn rate(g: f64) -> String {
 }
 
 pub use pendulum_experiment::steady::{
-    DEFAULT_MARGIN, Judged, Names, nodes_name, requested_omega_max, round_up,
+    DEFAULT_MARGIN, Judged, check_omega_max, nodes_name, requested_omega_max, round_up,
 };
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ use super::{AtlasKind, Axis, Parameter};
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
 use crate::options::{check_positive, check_radius};
+use crate::spelling::{opt, opt_is};
 use crate::whirls::{first_mode_decay, reference_speed};
 
 /// Most steps of one point.
@@ -192,13 +193,13 @@ impl AtlasConfig {
             }
         }
         if let Some(w) = self.omega.filter(|w| !(w.is_finite() && *w >= 0.0)) {
-            return Err(Error::invalid(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
+            return Err(Error::invalid(format!("{}: {w} rad/s is not a finite speed ≥ 0", opt("omega"))));
         }
         if let Some(d) = &self.damping {
             if d.len() != n {
                 return Err(Error::invalid(format!("damping: got {} values, expected {n}", d.len())));
             }
-            chain.clone().with_damping(d).map_err(|e| Error::from(e).context("--damping"))?;
+            chain.clone().with_damping(d).map_err(|e| Error::from(e).context(opt("damping")))?;
         }
         let radii = match self.radius {
             Some(r) => vec![r],
@@ -208,35 +209,53 @@ impl AtlasConfig {
             check_radius(r)?;
         }
         if self.kinds.is_empty() {
-            return Err(Error::invalid("--kind: no kind of start given"));
+            return Err(Error::invalid(format!("{}: no kind of start given", opt("kind"))));
         }
         let ramps = self.kinds.contains(&AtlasKind::RampUp);
         let ramp_axis = is_axis(Parameter::RampTime);
         if ramp_axis && self.kinds.contains(&AtlasKind::Sudden) {
-            return Err(Error::invalid("--ramp-time as an axis applies to the kind ramp-up only"));
+            return Err(Error::invalid(format!(
+                "{} as an axis applies to the kind ramp-up only",
+                opt("ramp-time")
+            )));
         }
-        check_positive("--duration", self.duration, "s")?;
+        check_positive(&opt("duration"), self.duration, "s")?;
         let ramp_times = match (self.ramp_time, ramp_axis) {
-            (Some(_), true) => return Err(Error::invalid("--ramp-time is an axis and also given one value")),
+            (Some(_), true) => {
+                return Err(Error::invalid(format!(
+                    "{} is an axis and also given one value",
+                    opt("ramp-time")
+                )));
+            }
             (Some(t), false) if ramps => vec![t],
-            (Some(_), false) => return Err(Error::invalid("--ramp-time applies to the kind ramp-up only")),
+            (Some(_), false) => {
+                return Err(Error::invalid(format!("{} applies to the kind ramp-up only", opt("ramp-time"))));
+            }
             (None, true) => self.axis(Parameter::RampTime).map_or(vec![], |a| a.values.clone()),
-            (None, false) if ramps => return Err(Error::invalid("--ramp-time: no value given for ramp-up")),
+            (None, false) if ramps => {
+                return Err(Error::invalid(format!("{}: no value given for ramp-up", opt("ramp-time"))));
+            }
             (None, false) => vec![],
         };
         if let Some(t) = ramp_times.iter().find(|t| !(t.is_finite() && **t > 0.0 && **t < self.duration)) {
             return Err(Error::invalid(format!(
-                "--ramp-time must be positive and shorter than --duration {} s, got {t} s",
-                self.duration
+                "{} must be positive and shorter than {} s, got {t} s",
+                opt("ramp-time"),
+                opt_is("duration", self.duration)
             )));
         }
         if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(Error::invalid(format!("--step must be finite and positive, got {} (s)", self.step)));
+            return Err(Error::invalid(format!(
+                "{} must be finite and positive, got {} (s)",
+                opt("step"),
+                self.step
+            )));
         }
         if self.duration / self.step > MAX_STEPS {
             return Err(Error::invalid(format!(
-                "--step {} s: {} s would take more than {MAX_STEPS:e} steps per point",
-                self.step, self.duration
+                "{} s: {} s would take more than {MAX_STEPS:e} steps per point",
+                opt_is("step", self.step),
+                self.duration
             )));
         }
         if self.feed_every == 0 {

@@ -23,6 +23,8 @@ mod tests;
 
 use serde::{Deserialize, Serialize};
 
+use crate::spelling::opt;
+
 pub use config::{AtlasConfig, Derived, MAX_POINTS, Setting};
 pub use file::AtlasFile;
 pub use folds::{Fold, folds};
@@ -67,14 +69,14 @@ impl Parameter {
         }
     }
 
-    /// The option that sets it on the command line.
-    pub fn option(self) -> &'static str {
-        match self {
-            Self::Omega => "--omega",
-            Self::Radius => "--radius",
-            Self::Damping => "--damping",
-            Self::RampTime => "--ramp-time",
-        }
+    /// The option that sets it, marked for each front end's spelling ([`opt`]).
+    pub fn option(self) -> String {
+        opt(match self {
+            Self::Omega => "omega",
+            Self::Radius => "radius",
+            Self::Damping => "damping",
+            Self::RampTime => "ramp-time",
+        })
     }
 
     /// Its symbol and unit, for axes' labels.

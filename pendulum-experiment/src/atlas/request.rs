@@ -8,6 +8,7 @@ use pendulum_core::Chain;
 use super::{AtlasConfig, AtlasKind, Axis, Parameter};
 use crate::error::{Error, Result};
 use crate::options::check_positive;
+use crate::spelling::opt;
 use crate::steady::round_up;
 use crate::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, reference_speed,
@@ -54,7 +55,8 @@ impl AtlasRequest {
         let chain = Chain::<Dyn>::new(&self.masses, &self.lengths, self.gravity)?;
         if !(self.gravity.is_finite() && self.gravity > 0.0) {
             return Err(Error::invalid(format!(
-                "--gravity must be finite and positive for an atlas (the chain starts hanging at rest), got {}",
+                "{} must be finite and positive for an atlas (the chain starts hanging at rest), got {}",
+                opt("gravity"),
                 self.gravity
             )));
         }
@@ -82,10 +84,11 @@ impl AtlasRequest {
             .map(|(parameter, values)| Axis { parameter: *parameter, values: values.to_vec() })
             .collect();
         if axes.len() != 2 {
-            let named: Vec<&str> = axes.iter().map(|a| a.parameter.option()).collect();
+            let named: Vec<String> = axes.iter().map(|a| a.parameter.option()).collect();
+            let all: Vec<String> = Parameter::ALL.iter().map(|p| p.option()).collect();
             return Err(Error::invalid(format!(
-                "an atlas needs exactly two axes (two of --omega, --radius, --damping, --ramp-time with \
-                 more than one value, e.g. --omega 1:5:32), got {}{}",
+                "an atlas needs exactly two axes (two of {} with more than one value), got {}{}",
+                all.join(", "),
                 axes.len(),
                 if named.is_empty() { String::new() } else { format!(" ({})", named.join(", ")) }
             )));
@@ -100,17 +103,19 @@ impl AtlasRequest {
         let ramps = kinds.contains(&AtlasKind::RampUp);
         let ramp_axis = axes.iter().any(|a| a.parameter == Parameter::RampTime);
         if ramp_axis && kinds.contains(&AtlasKind::Sudden) {
-            return Err(Error::invalid(
-                "--ramp-time as an axis applies to the kind ramp-up only (--kind sudden has no ramp)",
-            ));
+            return Err(Error::invalid(format!(
+                "{} as an axis applies to the kind ramp-up only (a sudden start has no ramp)",
+                opt("ramp-time")
+            )));
         }
         if !ramps && !self.ramp_time.is_empty() {
-            return Err(Error::invalid(
-                "--ramp-time applies to the kind ramp-up only (--kind sudden has no ramp)",
-            ));
+            return Err(Error::invalid(format!(
+                "{} applies to the kind ramp-up only (a sudden start has no ramp)",
+                opt("ramp-time")
+            )));
         }
         if let Some(d) = self.duration {
-            check_positive("--duration", d, "s")?;
+            check_positive(&opt("duration"), d, "s")?;
         }
         // The least damped chain decays slowest; the most damped has the fastest decay.
         let extreme = |pick: fn(f64, f64) -> f64| -> Result<Chain<Dyn>> {
@@ -118,7 +123,7 @@ impl AtlasRequest {
                 Some(d) => d.clone(),
                 None => vec![damping_axis.iter().copied().reduce(pick).unwrap_or(0.0); n],
             };
-            chain.clone().with_damping(&per_link).map_err(|e| Error::from(e).context("--damping"))
+            chain.clone().with_damping(&per_link).map_err(|e| Error::from(e).context(opt("damping")))
         };
         let duration = match self.duration {
             Some(d) => d,

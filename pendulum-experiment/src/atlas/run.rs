@@ -9,6 +9,7 @@ use super::{AtlasConfig, AtlasKind, Parameter};
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
 use crate::points::{Outcome, Status};
+use crate::spelling::opt;
 use crate::whirls::{WhirlResult, WhirlRuns, WhirlStop};
 
 /// An atlas ready to run: its configuration and the chains of its rows or columns.
@@ -26,13 +27,13 @@ impl Atlas {
         config.check()?;
         let chain = config.chain()?;
         let damped =
-            |d: &[f64]| chain.clone().with_damping(d).map_err(|e| Error::from(e).context("--damping"));
+            |d: &[f64]| chain.clone().with_damping(d).map_err(|e| Error::from(e).context(opt("damping")));
         let chains = match (&config.damping, config.axis(Parameter::Damping)) {
             (Some(d), _) => vec![damped(d)?],
             (None, Some(axis)) => {
                 axis.values.iter().map(|&v| damped(&vec![v; config.links()])).collect::<Result<_>>()?
             }
-            (None, None) => return Err(Error::invalid("--damping: no value given")),
+            (None, None) => return Err(Error::invalid(format!("{}: no value given", opt("damping")))),
         };
         let whirls = WhirlRuns::new(
             chains[0].clone(),

@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::description::DriveConfig;
+use crate::spelling::Front;
 
 fn request() -> AtlasRequest {
     AtlasRequest {
@@ -41,9 +42,15 @@ fn bad_requests_say_what_is_wrong() {
     let message = |r: AtlasRequest| r.resolve().unwrap_err().to_string();
     let one_axis = AtlasRequest { radius: vec![0.02], ..request() };
     assert_eq!(
-        message(one_axis),
+        message(one_axis.clone()),
         "an atlas needs exactly two axes (two of --omega, --radius, --damping, --ramp-time with more than \
-         one value, e.g. --omega 1:5:32), got 1 (--omega)"
+         one value), got 1 (--omega)"
+    );
+    // Python's keyword arguments in the same message.
+    assert_eq!(
+        one_axis.resolve().unwrap_err().message(Front::Python),
+        "an atlas needs exactly two axes (two of omega, radius, damping, ramp_time with more than \
+         one value), got 1 (omega)"
     );
     let ramp_axis = AtlasRequest { radius: vec![0.02], ramp_time: vec![1.0, 2.0], ..request() };
     assert!(message(ramp_axis).contains("applies to the kind ramp-up only"));
@@ -52,7 +59,9 @@ fn bad_requests_say_what_is_wrong() {
     let zero = message(AtlasRequest { radius: vec![0.0, 0.02], ..request() });
     assert!(zero.starts_with("--radius must be finite and positive"), "{zero}");
     let long_ramp = AtlasRequest { ramp_time: vec![40.0], ..request() };
-    assert!(message(long_ramp).contains("shorter than --duration 30 s"));
+    let long_ramp = long_ramp.resolve().unwrap_err();
+    assert!(long_ramp.to_string().contains("shorter than --duration 30 s"), "{long_ramp}");
+    assert!(long_ramp.message(Front::Python).contains("shorter than duration=30 s"), "{long_ramp}");
 }
 
 #[test]

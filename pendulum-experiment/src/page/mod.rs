@@ -11,6 +11,7 @@ pub use scene::{DEFAULT_FRAMES, Scene};
 
 use crate::error::{Error, Result};
 use crate::run_dir::Run;
+use crate::spelling::opt;
 
 /// The page's HTML and style, with `/*SCENE*/` where the data goes and `/*VIEWER*/`
 /// where the script goes.
@@ -25,7 +26,7 @@ const VIEWER: &str = include_str!("viewer.js");
 /// every k-th), and its scene.
 pub fn page(dir: &Path, frames: usize) -> Result<(String, Scene)> {
     if frames < 2 {
-        return Err(Error::invalid(format!("--frames must be at least 2, got {frames}")));
+        return Err(Error::invalid(format!("{} must be at least 2, got {frames}", opt("frames"))));
     }
     let run = Run::open(dir)?;
     let scene = Scene::read(dir, &run, frames)?;

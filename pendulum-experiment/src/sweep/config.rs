@@ -12,6 +12,7 @@ use super::point::Point;
 use crate::error::{Error, Result};
 use crate::options::{check_positive, check_radius, parse_values};
 use crate::points::{PointsFile, Recorded};
+use crate::spelling::{opt, opt_is};
 use crate::steady::round_up;
 use crate::whirls::{
     FEED_EVERY, SETTLE_PERIODS, SETTLE_TOLERANCE, default_duration, default_step, first_mode_decay,
@@ -80,7 +81,7 @@ impl SweepConfig {
 
     /// The damped chain of the runs.
     pub fn damped_chain(&self) -> Result<Chain<Dyn>> {
-        self.chain()?.with_damping(&self.damping).map_err(|e| Error::from(e).context("--damping"))
+        self.chain()?.with_damping(&self.damping).map_err(|e| Error::from(e).context(opt("damping")))
     }
 
     /// Checks what building the chain and the drives does not: counts, signs, times.
@@ -103,27 +104,29 @@ impl SweepConfig {
         self.damped_chain()?;
         check_radius(self.radius)?;
         if self.omegas.is_empty() {
-            return Err(Error::invalid("--omega: no speed to sweep"));
+            return Err(Error::invalid(format!("{}: no speed to sweep", opt("omega"))));
         }
         if let Some(w) = self.omegas.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
-            return Err(Error::invalid(format!("--omega: {w} rad/s is not a finite speed ≥ 0")));
+            return Err(Error::invalid(format!("{}: {w} rad/s is not a finite speed ≥ 0", opt("omega"))));
         }
         if self.kinds.is_empty() {
-            return Err(Error::invalid("--kind: no kind of experiment given"));
+            return Err(Error::invalid(format!("{}: no kind of experiment given", opt("kind"))));
         }
-        check_positive("--duration", self.duration, "s")?;
+        check_positive(&opt("duration"), self.duration, "s")?;
         let ramps = self.kinds.iter().any(|&k| k != SweepKind::Sudden);
         match (self.ramp_time, ramps) {
             (Some(t), true) => {
                 if !(t.is_finite() && t > 0.0) {
                     return Err(Error::invalid(format!(
-                        "--ramp-time must be finite and positive, got {t} (s)"
+                        "{} must be finite and positive, got {t} (s)",
+                        opt("ramp-time")
                     )));
                 }
                 if t >= self.duration {
                     return Err(Error::invalid(format!(
-                        "--ramp-time {t} s must be shorter than --duration {} s (the speed is held at ω after the ramp)",
-                        self.duration
+                        "{} s must be shorter than {} s (the speed is held at ω after the ramp)",
+                        opt_is("ramp-time", t),
+                        opt_is("duration", self.duration)
                     )));
                 }
             }
@@ -132,13 +135,18 @@ impl SweepConfig {
             (None, false) => {}
         }
         if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(Error::invalid(format!("--step must be finite and positive, got {}", self.step)));
+            return Err(Error::invalid(format!(
+                "{} must be finite and positive, got {}",
+                opt("step"),
+                self.step
+            )));
         }
         let steps = (self.duration / self.step).ceil();
         if steps > MAX_STEPS {
             return Err(Error::invalid(format!(
-                "--duration {} s with --step {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
-                self.duration, self.step
+                "{} s with {} s needs {steps:e} steps per point; more than {MAX_STEPS:e} is refused",
+                opt_is("duration", self.duration),
+                opt_is("step", self.step)
             )));
         }
         if self.feed_every == 0 {
@@ -210,20 +218,23 @@ impl SweepRequest {
         let (masses, lengths, damping) = (p.masses.clone(), p.lengths.clone(), p.damping.clone());
         if !(p.gravity.is_finite() && p.gravity > 0.0) {
             return Err(Error::invalid(format!(
-                "--gravity must be finite and positive for a sweep (the chain starts hanging at rest), got {}",
+                "{} must be finite and positive for a sweep (the chain starts hanging at rest), got {}",
+                opt("gravity"),
                 p.gravity
             )));
         }
         if damping.len() != masses.len() {
             return Err(Error::invalid(format!(
-                "--damping: got {} values, expected {}",
+                "{}: got {} values, expected {}",
+                opt("damping"),
                 damping.len(),
                 masses.len()
             )));
         }
         // The chain's own checks (positive masses and lengths, damping ≥ 0), named by link.
         let chain = Chain::<Dyn>::new(&masses, &lengths, p.gravity)?;
-        let damped = chain.clone().with_damping(&damping).map_err(|e| Error::from(e).context("--damping"))?;
+        let damped =
+            chain.clone().with_damping(&damping).map_err(|e| Error::from(e).context(opt("damping")))?;
         check_radius(p.radius)?;
         let spec = p.omega_spec.clone();
         let listed = parse_omegas(&spec, p.scaled)?;
@@ -236,7 +247,7 @@ impl SweepRequest {
             }
         }
         if let Some(d) = p.duration {
-            check_positive("--duration", d, "s")?;
+            check_positive(&opt("duration"), d, "s")?;
         }
         let duration = match p.duration {
             Some(d) => d,
@@ -247,9 +258,10 @@ impl SweepRequest {
             (Some(t), true) => Some(t),
             (None, true) => Some(round_up(duration / 3.0)),
             (Some(_), false) => {
-                return Err(Error::invalid(
-                    "--ramp-time applies to the kinds ramp-up and ramp-down only (--kind sudden has no ramp)",
-                ));
+                return Err(Error::invalid(format!(
+                    "{} applies to the kinds ramp-up and ramp-down only (a sudden start has no ramp)",
+                    opt("ramp-time")
+                )));
             }
             (None, false) => None,
         };
@@ -299,7 +311,7 @@ pub struct Derived {
 /// Parses `--omega`: a comma list of speeds or `A:B:N`, every speed finite and ≥ 0 (in
 /// rad/s, or in units of √(g/L) when `scaled`). Errors name the value.
 pub fn parse_omegas(spec: &str, scaled: bool) -> Result<Vec<f64>> {
-    parse_values("--omega", spec, ("speed", "speeds"), if scaled { "√(g/L)" } else { "rad/s" })
+    parse_values(&opt("omega"), spec, ("speed", "speeds"), if scaled { "√(g/L)" } else { "rad/s" })
 }
 
 /// What sweep.json holds.
