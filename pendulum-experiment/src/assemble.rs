@@ -18,8 +18,8 @@ use pendulum_core::{
 
 use crate::description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, check_components,
+    circle_in_2d, midpoint_in_2d,
 };
-use crate::description::{circle_in_2d, midpoint_in_2d};
 use crate::error::{Error, Result};
 
 /// One sample of a run, in plain numbers.
@@ -348,6 +348,15 @@ where
         Sampled::new(times.to_vec(), path)
     };
     Ok(path?)
+}
+
+/// Checks a run's drive in `dim` as the core builds it (finite parameters, a direction of
+/// positive length, a valid spline, the circle in 3D only); errors name the bad value.
+pub fn check_drive(dim: Dimension, config: &DriveConfig) -> Result<()> {
+    match dim {
+        Dimension::Two => drive::<U2>(config).map(|_| ()),
+        Dimension::Three => drive::<U3>(config).map(|_| ()),
+    }
 }
 
 /// The pivot drive of a configuration.

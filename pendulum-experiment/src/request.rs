@@ -7,7 +7,7 @@
 use nalgebra::{DefaultAllocator, DimName, Dyn, U2, U3, allocator::Allocator};
 use pendulum_core::{Chain, Drive, fastest_frequency_bound};
 
-use crate::assemble::sampled_path;
+use crate::assemble::{check_drive, sampled_path};
 use crate::description::{
     DEFAULT_TOLERANCE, Dimension, DriveConfig, IntegratorKind, RunConfig, StageSolver, View, check_end,
     check_step,
@@ -87,6 +87,11 @@ impl Request {
             check_step(h)?;
         }
         check_end(self.end)?;
+        // The chain's and the drive's own checks (masses and lengths positive, gravity and
+        // the drive's parameters finite, ...) now, not when the run starts: `choose`
+        // assumes them.
+        Chain::<Dyn>::new(&self.masses, &self.lengths, self.gravity)?.with_damping(&self.damping)?;
+        check_drive(self.dim, &self.drive)?;
         let choice = choose(&self)?;
         let config = RunConfig {
             dim: self.dim,
@@ -118,9 +123,6 @@ impl Request {
             chosen: choice.reason,
         };
         config.check()?;
-        // The chain's own checks (masses and lengths positive, gravity finite and ≥ 0,
-        // damping ≥ 0), now rather than when the run starts: `choose` passes over them.
-        Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?;
         Ok(config)
     }
 }
@@ -402,6 +404,30 @@ mod tests {
     }
 
     const WHIRL: DriveConfig = DriveConfig::Circle { radius: 0.02, omega: 6.0 };
+
+    #[test]
+    fn a_request_is_refused_for_its_chain_or_drive_before_anything_is_chosen() {
+        // An infinite drive speed once made the chosen step 0, and the error named the step.
+        let fast =
+            config(Dimension::Three, 3, DriveConfig::Circle { radius: 0.02, omega: f64::INFINITY }, 0.0);
+        assert_eq!(
+            fast.resolve().unwrap_err().to_string(),
+            "drive angular frequency must be finite, got inf"
+        );
+        let flat =
+            DriveConfig::Harmonic { direction: vec![0.0, 0.0], amplitude: 0.1, omega: 1.0, phase: 0.0 };
+        let e = config(Dimension::Two, 3, flat, 0.0).resolve().unwrap_err().to_string();
+        assert_eq!(e, "drive direction norm must be finite and positive, got 0");
+        let mut weightless = config(Dimension::Two, 3, DriveConfig::Fixed, 0.0);
+        weightless.gravity = f64::NAN;
+        let e = weightless.resolve().unwrap_err().to_string();
+        assert!(e.contains("gravity") && e.contains("NaN"), "{e}");
+        let circle_2d = config(Dimension::Two, 3, WHIRL, 0.0).resolve().unwrap_err();
+        assert_eq!(
+            circle_2d.message(crate::Front::Python),
+            "drive=\"circle\" moves the pivot on a horizontal circle: 3D only (dim=3)"
+        );
+    }
 
     #[test]
     fn a_driven_3d_chain_gets_the_midpoint_step_at_a_twentieth_of_the_drive_period() {

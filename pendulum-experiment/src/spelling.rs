@@ -6,7 +6,7 @@
 //! An [`Error`](crate::Error)'s `Display` is the command line's; the Python layer asks for
 //! its own with [`Error::message`](crate::Error::message).
 
-use std::fmt;
+use std::fmt::{self, Write};
 
 /// Opens a marked option (a character of Unicode's private use area: never typed by a user).
 const OPEN: char = '\u{E000}';
@@ -60,15 +60,17 @@ impl Front {
 
     /// One option, `name` (the command line's, without dashes) and perhaps its value.
     fn write(self, out: &mut String, name: &str, value: Option<&str>) {
-        match (self, value) {
-            (Self::CommandLine, None) => out.push_str(&format!("--{name}")),
-            (Self::CommandLine, Some(value)) => out.push_str(&format!("--{name} {value}")),
-            (Self::Python, None) => out.push_str(&python_name(name)),
+        // Writing to a `String` cannot fail.
+        let _ = match (self, value) {
+            (Self::CommandLine, None) => write!(out, "--{name}"),
+            (Self::CommandLine, Some(value)) => write!(out, "--{name} {value}"),
+            (Self::Python, None) => write!(out, "{}", python_name(name)),
+            // A number as it is, anything else as a string.
             (Self::Python, Some(value)) if value.parse::<f64>().is_ok() => {
-                out.push_str(&format!("{}={value}", python_name(name)));
+                write!(out, "{}={value}", python_name(name))
             }
-            (Self::Python, Some(value)) => out.push_str(&format!("{}=\"{value}\"", python_name(name))),
-        }
+            (Self::Python, Some(value)) => write!(out, "{}=\"{value}\"", python_name(name)),
+        };
     }
 }
 

@@ -111,6 +111,8 @@ def test_a_run_on_a_sampled_path_reads_its_file_and_keeps_the_samples(tmp_path):
         ({"direction": [0.0, 1.0]}, '^direction applies to drive="harmonic" only$'),
         ({"every": 0}, "^every must be at least 1 step, got 0$"),
         ({"gravity": float("nan")}, "gravity g must be finite and non-negative, got NaN"),
+        ({"dim": 3, "drive": "circle", "omega": float("inf")}, "^drive angular frequency must be finite, got inf$"),
+        ({"drive": "harmonic", "direction": [0.0, 0.0]}, "^drive direction norm must be finite and positive, got 0$"),
         ({"masses": [1.0, 2.0], "n": 3}, "masses: got 2 values for 3 links"),
         ({"integrator": "euler"}, "integrator: 'euler' is not one of"),
         ({"initial": "sideways"}, "initial: 'sideways' is not hanging"),
