@@ -1,6 +1,7 @@
 //! What went wrong with a run, and whose fault it was: every front end maps the three
 //! kinds to its own signal (the CLI to exit statuses 2, 1 and 130; Python to `ValueError`,
-//! `RuntimeError` and `KeyboardInterrupt`) and shows the same one-line message.
+//! `RuntimeError` and `KeyboardInterrupt`) and shows the same one-line message, the options
+//! it names spelled its own way ([`crate::spelling`]).
 
 use std::fmt;
 
@@ -50,9 +51,7 @@ impl Error {
             Self::Interrupted(m) => Self::Interrupted(format!("{prefix}: {m}")),
         }
     }
-}
 
-impl Error {
     /// The message on one line (newlines in wrapped errors become "; "), with the options
     /// it names spelled for `front` (the `Display` of an error is the command line's).
     pub fn message(&self, front: Front) -> String {
