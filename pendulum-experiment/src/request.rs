@@ -87,10 +87,8 @@ impl Request {
             check_step(h)?;
         }
         check_end(self.end)?;
-        // The chain's and the drive's own checks (masses and lengths positive, gravity and
-        // the drive's parameters finite, ...) now, not when the run starts: `choose`
-        // assumes them.
-        Chain::<Dyn>::new(&self.masses, &self.lengths, self.gravity)?.with_damping(&self.damping)?;
+        // The drive's own checks (finite parameters, ...) now, not when the run starts:
+        // `choose` takes its speed for the step (the chain it checks itself).
         check_drive(self.dim, &self.drive)?;
         let choice = choose(&self)?;
         let config = RunConfig {
@@ -161,13 +159,15 @@ const EXPLICIT_DEFAULT_STEP: f64 = 0.005;
 ///   ([`suggested_step`]);
 /// - every: about 500 samples over the run, fewer where trajectory.csv would pass
 ///   [`TRAJECTORY_BUDGET`] (an error where even two samples would).
+///
+/// Errors: the chain's own (masses, lengths, gravity, damping), which the choices assume.
 pub fn choose(config: &Request) -> Result<Choice> {
     let mut reasons = Vec::new();
     let driven = !matches!(config.drive, DriveConfig::Fixed);
     let damped = config.damping.iter().any(|l| *l != 0.0);
-    let fastest = Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)
-        .and_then(|c| c.with_damping(&config.damping))
-        .map_or(0.0, |c| fastest_mode(&c, &config.drive));
+    let chain =
+        Chain::<Dyn>::new(&config.masses, &config.lengths, config.gravity)?.with_damping(&config.damping)?;
+    let fastest = fastest_mode(&chain, &config.drive);
     let chosen_integrator = config.integrator.unwrap_or_else(|| {
         let kind = if config.dim == Dimension::Three && (driven || damped) {
             IntegratorKind::Midpoint
