@@ -5,7 +5,8 @@
 
 use std::path::PathBuf;
 
-use nalgebra::{U2, U3};
+use nalgebra::{Dyn, U2, U3};
+use pendulum_core::Chain;
 use serde::de::DeserializeOwned;
 
 use crate::assemble::sampled_path;
@@ -24,6 +25,12 @@ pub fn links(n: Option<usize>, masses: Vec<f64>, lengths: Vec<f64>) -> Result<(u
         None => [masses.len(), lengths.len()].into_iter().find(|&len| len > 1).unwrap_or(3),
     };
     Ok((n, expand(&opt("masses"), masses, n)?, expand(&opt("lengths"), lengths, n)?))
+}
+
+/// `chain` with `damping` (N·m·s per link), checked by the chain (finite, non-negative,
+/// named by link); errors name the option `damping`.
+pub fn damped(chain: &Chain<Dyn>, damping: &[f64]) -> Result<Chain<Dyn>> {
+    chain.clone().with_damping(damping).map_err(|e| Error::from(e).context(opt("damping")))
 }
 
 /// A per-link list of `n` entries: one value is repeated, otherwise the list must have

@@ -35,8 +35,7 @@ pub fn steady(args: &SteadyArgs) -> CliResult<()> {
     let damping = match &args.damping {
         Some(spec) => {
             let d = expand("--damping", per_link("--damping", spec)?, n)?;
-            // Validated by the chain (finite, non-negative, named by link).
-            chain.clone().with_damping(&d).map_err(|e| CliError::from(e).context("--damping"))?;
+            pendulum_experiment::options::damped(&chain, &d)?;
             d.iter().any(|&v| v > 0.0).then_some(d)
         }
         None => None,

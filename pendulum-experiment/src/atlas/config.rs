@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::{AtlasKind, Axis, Parameter};
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
-use crate::options::{check_positive, check_radius};
+use crate::options::{check_positive, check_radius, damped};
 use crate::spelling::{opt, opt_is};
 use crate::whirls::{first_mode_decay, reference_speed};
 
@@ -199,7 +199,7 @@ impl AtlasConfig {
             if d.len() != n {
                 return Err(Error::invalid(format!("damping: got {} values, expected {n}", d.len())));
             }
-            chain.clone().with_damping(d).map_err(|e| Error::from(e).context(opt("damping")))?;
+            damped(&chain, d)?;
         }
         let radii = match self.radius {
             Some(r) => vec![r],

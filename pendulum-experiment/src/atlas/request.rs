@@ -7,7 +7,7 @@ use pendulum_core::Chain;
 
 use super::{AtlasConfig, AtlasKind, Axis, Parameter};
 use crate::error::{Error, Result};
-use crate::options::check_positive;
+use crate::options::{check_positive, damped};
 use crate::spelling::opt;
 use crate::steady::round_up;
 use crate::whirls::{
@@ -123,7 +123,7 @@ impl AtlasRequest {
                 Some(d) => d.clone(),
                 None => vec![damping_axis.iter().copied().reduce(pick).unwrap_or(0.0); n],
             };
-            chain.clone().with_damping(&per_link).map_err(|e| Error::from(e).context(opt("damping")))
+            damped(&chain, &per_link)
         };
         let duration = match self.duration {
             Some(d) => d,

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::{AtlasConfig, AtlasKind, Parameter};
 use crate::description::DriveConfig;
 use crate::error::{Error, Result};
+use crate::options::damped;
 use crate::points::{Outcome, Status};
 use crate::spelling::opt;
 use crate::whirls::{WhirlResult, WhirlRuns, WhirlStop};
@@ -26,8 +27,7 @@ impl Atlas {
     pub fn new(config: AtlasConfig) -> Result<Self> {
         config.check()?;
         let chain = config.chain()?;
-        let damped =
-            |d: &[f64]| chain.clone().with_damping(d).map_err(|e| Error::from(e).context(opt("damping")));
+        let damped = |d: &[f64]| damped(&chain, d);
         let chains = match (&config.damping, config.axis(Parameter::Damping)) {
             (Some(d), _) => vec![damped(d)?],
             (None, Some(axis)) => {

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::SweepKind;
 use super::point::Point;
 use crate::error::{Error, Result};
-use crate::options::{check_positive, check_radius, parse_values};
+use crate::options::{check_positive, check_radius, damped, parse_values};
 use crate::points::{PointsFile, Recorded};
 use crate::spelling::{opt, opt_is};
 use crate::steady::round_up;
@@ -81,7 +81,7 @@ impl SweepConfig {
 
     /// The damped chain of the runs.
     pub fn damped_chain(&self) -> Result<Chain<Dyn>> {
-        self.chain()?.with_damping(&self.damping).map_err(|e| Error::from(e).context(opt("damping")))
+        damped(&self.chain()?, &self.damping)
     }
 
     /// Checks what building the chain and the drives does not: counts, signs, times.
@@ -233,8 +233,7 @@ impl SweepRequest {
         }
         // The chain's own checks (positive masses and lengths, damping ≥ 0), named by link.
         let chain = Chain::<Dyn>::new(&masses, &lengths, p.gravity)?;
-        let damped =
-            chain.clone().with_damping(&damping).map_err(|e| Error::from(e).context(opt("damping")))?;
+        let damped = damped(&chain, &damping)?;
         check_radius(p.radius)?;
         let spec = p.omega_spec.clone();
         let listed = parse_omegas(&spec, p.scaled)?;
