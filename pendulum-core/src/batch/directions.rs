@@ -3,7 +3,7 @@
 
 use nalgebra::{DefaultAllocator, DimName, Dyn, OVector, allocator::Allocator};
 
-use super::lane_states::{non_finite_lanes, non_finite_lanes_f32};
+use super::lane_states::{finite_unless_flagged, non_finite_lanes_f32};
 use super::transpose::Transpose;
 use super::{
     Blocks, F32x8, Failure, Rooms, WIDTH, WIDTH_AVX512, WIDTH_F32, block_chains, check_len, check_links,
@@ -168,6 +168,7 @@ impl<const C: usize, V: Lane> Solve<C, V> {
     /// The direction accelerations `ü` (1/s²) into `out` (its first `C·n`) of chains with rods `rods`
     /// at directions and rates `x = (u, w)` (`2·C·n`), under gravity `g⃗` and pivot
     /// accelerations `p̈` (m/s²): [`Directions`]' tension solve, in lanes of any precision.
+    /// Returns the lanes' sums of the `ü` written ([`finite_unless_flagged`]).
     #[inline(always)]
     pub(super) fn accelerations(
         &mut self,
@@ -176,8 +177,8 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         pivot: [V; C],
         x: &[V],
         out: &mut [V],
-    ) {
-        self.solve_loaded(rods, gravity, pivot, self.loads(rods, x), out);
+    ) -> V {
+        self.solve_loaded(rods, gravity, pivot, self.loads(rods, x), out)
     }
 
     /// The loads of the states `x = (u, w)` (`2·C·n`) on rods `rods`.
@@ -250,7 +251,9 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         rods.solve(gravity, pivot, &mut self.rows, loads, |i, _, _, t| out[i] = t);
     }
 
-    /// The tension solve of `loads`: `ü` into `out` (`C·n`).
+    /// The tension solve of `loads`: `ü` into `out` (`C·n`). Returns the lanes' sums of
+    /// the `ü` written, one sum per component (its own serial chain) added at the end (no
+    /// work where the caller drops it).
     #[inline(always)]
     fn solve_loaded(
         &mut self,
@@ -259,10 +262,15 @@ impl<const C: usize, V: Lane> Solve<C, V> {
         pivot: [V; C],
         loads: RateLoads<'_, C, V>,
         out: &mut [V],
-    ) {
+    ) -> V {
+        let mut sums = [V::splat(0.0); C];
         rods.solve(gravity, pivot, &mut self.rows, loads, |i, a, _, _| {
             out[i * C..(i + 1) * C].copy_from_slice(&a);
+            for (sum, a) in sums.iter_mut().zip(a) {
+                *sum += a;
+            }
         });
+        sums.into_iter().fold(V::splat(0.0), |total, sum| total + sum)
     }
 }
 
@@ -585,9 +593,9 @@ where
             let half = C * self.links;
             x.gather(chains, half, Lanes::flatten_mut(x_lanes));
             let pivot = self.pivot_lanes::<C, W, _>(chains, [t; W], Dr::acceleration, Lanes);
-            solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
+            let sum = solve.accelerations(&block.rods, gravity(block.down), pivot, x_lanes, a_lanes);
             scatter::<_, W>(Lanes::flatten(a_lanes), half, out);
-            non_finite_lanes(a_lanes).map(|flag| flag != 0)
+            finite_unless_flagged(sum, a_lanes).map(|flag| flag != 0)
         }
         dispatch fn evaluate_simd, evaluate_avx2, avx512 evaluate_avx512
     }
