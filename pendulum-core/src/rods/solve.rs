@@ -75,10 +75,8 @@ impl<V: Lane> Rods<V> {
     ///
     /// `load.load(i)` gives rod `i`'s [`Load`] (called for rods `i` and `i + 1` at row `i`,
     /// so twice per rod: reading a load where it is needed, rather than carrying it from row
-    /// to row, spares the registers spills, in lanes and for one chain alike; only rod
-    /// `i + 1`'s force pair is carried to the next row, so an inlined builder forms each
-    /// pair once: the multiplies bound the lanes' kernels; a closure serves, and the lanes'
-    /// kernels pass types with inlined methods, [`Loads`]);
+    /// to row, spares the registers spills, in lanes and for one chain alike; a closure
+    /// serves, and the lanes' kernels pass types with inlined methods, [`Loads`]);
     /// `emit(i, ü_i, u_i, T_i)` receives rod `i`'s direction acceleration (1/s²), its
     /// direction and its tension (N), once per rod in order `n−1, …, 0`. Gravity `g⃗` and
     /// the pivot acceleration `p̈` in m/s². Work O(n), one division per rod (off the serial
@@ -120,7 +118,6 @@ impl<V: Lane> Rods<V> {
         let mut continuants = Continuants::new();
         // 1/D_{i−1}, e_{i−1}.
         let (mut inverse_pivot_above, mut eliminated_above) = (zero, zero);
-        let mut pair = if n > 0 { load.load(0).pair } else { [zero; S] };
         for (i, row) in rows.iter_mut().enumerate() {
             let here = load.load(i);
             // Below the last rod, no load (no `Option`: copied through one, a load of lanes
@@ -131,7 +128,7 @@ impl<V: Lane> Rods<V> {
             let mut a = gravity;
             let mut rhs = self.length[i] * here.rate_squared;
             for k in 0..S {
-                a[k] += (pair[k] - pair_below[k]) * im;
+                a[k] += (here.pair[k] - pair_below[k]) * im;
                 rhs += u[k] * (a[k] - free_above[k]);
             }
             let (diagonal, off) = entries(im, inverse_mass_above, &u_above, &u);
@@ -142,7 +139,6 @@ impl<V: Lane> Rods<V> {
             free_above = a;
             inverse_mass_above = im;
             u_above = u;
-            pair = pair_below;
             (inverse_pivot_above, eliminated_above) = (inverse_pivot, eliminated);
         }
         continuants.outside()
@@ -188,19 +184,14 @@ impl<V: Lane> Rods<V> {
         let mut factor_below = zero;
         let mut u_below = [zero; S];
         let mut a_below = [zero; S];
-        // `T_{i+1} u_{i+1}`, the pull of the rod below, carried from its row (not formed
-        // again: the multiplies, not the additions, bound the lanes' kernels).
-        let mut pull_below = [zero; S];
         for i in (0..n).rev() {
             let row = &rows[i];
             // The serial chain: one multiply and one subtraction per rod.
             let t = row.scaled - factor_below * tension_below;
             let im = self.inverse_mass[i];
             let mut a = row.free;
-            let mut pull = [zero; S];
             for k in 0..S {
-                pull[k] = t * row.direction[k];
-                a[k] += (pull_below[k] - pull[k]) * im;
+                a[k] += (tension_below * u_below[k] - t * row.direction[k]) * im;
             }
             if i + 1 < n {
                 let il = self.inverse_length[i + 1];
@@ -214,7 +205,6 @@ impl<V: Lane> Rods<V> {
             factor_below = row.factor;
             u_below = row.direction;
             a_below = a;
-            pull_below = pull;
         }
         let il = self.inverse_length[0];
         let mut udd = [zero; S];
